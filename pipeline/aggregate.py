@@ -1,0 +1,311 @@
+"""Hysteresis aggregation: angles.csv rows -> mean/sd bending angle per pressure level.
+
+One output row per material x direction (``up`` = increasing, ``down`` = decreasing pressure)
+x pressure level, as in the paper's Fig. 6.  A pressure level is the nominal setpoint
+(``pressure_kpa``) by default, or, when measured pressures scatter around the setpoints, a bin of
+configurable width of the measured pressure (``measured_pressure_kpa`` when present).
+
+Rows whose ``status`` is not ``ok`` (``flagged`` or ``failed``) or whose psi is not finite are
+excluded by default and counted in ``n_excluded``; a level whose rows are all excluded is still
+written (with ``n = 0`` and a NaN mean) so nothing disappears silently.
+
+Identity conventions: an actuator is identified by its ``actuator`` value (as text) within a
+material; a trial by the pair (actuator, trial).  If two angles.csv files of the same material
+reuse an actuator name, they are the same actuator to this module.
+
+Examples
+--------
+>>> import pandas as pd
+>>> rows = pd.DataFrame({
+...     "image": ["a", "b", "c"], "psi_deg": [200.0, 190.0, 0.0], "status": ["ok", "ok", "failed"],
+...     "pressure_kpa": [0.0, 0.0, 0.0], "direction": ["up"] * 3, "material": ["DS20"] * 3,
+...     "actuator": [1, 2, 2], "trial": [1, 1, 2]})
+>>> h = aggregate_hysteresis(rows)
+>>> h[["psi_mean_deg", "n", "n_actuators", "n_excluded"]].to_numpy().tolist()
+[[195.0, 2.0, 2.0, 1.0]]
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline.errors import UserInputError
+
+#: columns angles.csv must have for aggregation
+REQUIRED_ANGLE_COLUMNS: tuple[str, ...] = (
+    "image", "psi_deg", "status", "pressure_kpa", "direction", "material", "actuator", "trial",
+)
+#: hysteresis.csv columns, in order (contract); ``pressure_mean_kpa`` is an extra trailing column
+HYSTERESIS_COLUMNS: tuple[str, ...] = (
+    "material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg",
+    "n", "n_actuators", "n_trials", "n_excluded", "pressure_mean_kpa",
+)
+#: per-actuator curve columns, in order
+PER_ACTUATOR_COLUMNS: tuple[str, ...] = (
+    "material", "actuator", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg",
+    "n", "n_trials", "n_excluded", "pressure_mean_kpa",
+)
+DIRECTION_ORDER: tuple[str, ...] = ("up", "down")
+STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
+
+
+def read_angles(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
+    """Read and concatenate angles.csv files, checking the columns aggregation needs.
+
+    Parameters
+    ----------
+    paths : sequence of path-like
+        angles.csv files written by ``python -m pipeline measure``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        All rows, in file order, with an added ``dataset`` column (the path as given) and
+        ``actuator``/``trial`` read as text.
+
+    Raises
+    ------
+    UserInputError
+        If a file is missing, unreadable, lacks a required column, or has a bad direction,
+        status or pressure value (the message names the file and the 1-based CSV line).
+    """
+    if not paths:
+        raise UserInputError("no angles.csv given; pass at least one file")
+    frames = []
+    for path in paths:
+        p = Path(path)
+        try:
+            df = pd.read_csv(p, dtype={"actuator": str, "trial": str, "image": str, "reason": str})
+        except FileNotFoundError:
+            raise UserInputError(f"{p}: file not found; pass an angles.csv written by 'measure'") from None
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            raise UserInputError(f"{p}: not a readable CSV ({exc}); regenerate it with 'measure'") from None
+        check_angles(df, str(p))
+        df.insert(0, "dataset", str(path))
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
+    """Validate an angles frame for aggregation.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Rows shaped like angles.csv.
+    where : str
+        File name used in error messages.
+
+    Raises
+    ------
+    UserInputError
+        Missing columns, unknown direction or status, non-numeric pressure or psi.
+    """
+    missing = [c for c in REQUIRED_ANGLE_COLUMNS if c not in angles.columns]
+    if missing:
+        raise UserInputError(
+            f"{where}: missing column(s) {missing}; an angles.csv needs {list(REQUIRED_ANGLE_COLUMNS)}"
+        )
+    for column in ("pressure_kpa", "psi_deg") + (
+        ("measured_pressure_kpa",) if "measured_pressure_kpa" in angles.columns else ()
+    ):
+        values = pd.to_numeric(angles[column], errors="coerce")
+        bad = values.isna() & angles[column].notna()
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy())[0])
+            raise UserInputError(
+                f"{where} line {i + 2}: column '{column}' must be a number, got {angles[column].iloc[i]!r}"
+            )
+    bad_p = pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna().to_numpy()
+    if bad_p.any():
+        i = int(np.flatnonzero(bad_p)[0])
+        raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every row needs its setpoint (kPa)")
+    for column, allowed in (("direction", DIRECTION_ORDER), ("status", STATUSES)):
+        bad = ~angles[column].isin(allowed).to_numpy()
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise UserInputError(
+                f"{where} line {i + 2}: '{column}' is {angles[column].iloc[i]!r}; use one of {list(allowed)}"
+            )
+
+
+def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Series:
+    """Pressure level (kPa) of each row.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Rows with ``pressure_kpa`` and optionally ``measured_pressure_kpa``.
+    bin_kpa : float, optional
+        Bin width (kPa).  ``None``: the nominal setpoint ``pressure_kpa``.  Otherwise the
+        measured pressure (``measured_pressure_kpa`` where present and finite, else the
+        setpoint) rounded to the nearest multiple of ``bin_kpa`` (bin centres 0, W, 2W, ...).
+
+    Returns
+    -------
+    pandas.Series of float
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> df = pd.DataFrame({"pressure_kpa": [10.0, 10.0], "measured_pressure_kpa": [8.1, 12.6]})
+    >>> pressure_levels(df, 5.0).tolist()
+    [10.0, 15.0]
+    """
+    nominal = pd.to_numeric(angles["pressure_kpa"], errors="coerce").astype(float)
+    if bin_kpa is None:
+        return nominal
+    if not (math.isfinite(bin_kpa) and bin_kpa > 0):
+        raise UserInputError(f"--bin-kpa must be a positive number of kPa, got {bin_kpa}")
+    measured = nominal
+    if "measured_pressure_kpa" in angles.columns:
+        m = pd.to_numeric(angles["measured_pressure_kpa"], errors="coerce").astype(float)
+        measured = m.where(np.isfinite(m), nominal)
+    # floor(x / w + 0.5) rounds half up, unlike numpy's round-half-to-even
+    return pd.Series(np.floor(measured.to_numpy() / bin_kpa + 0.5) * bin_kpa, index=angles.index)
+
+
+def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool) -> pd.DataFrame:
+    check_angles(angles)
+    df = angles.copy()
+    df["actuator"] = df["actuator"].astype(str)
+    df["trial"] = df["trial"].astype(str)
+    df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
+    df["_level"] = pressure_levels(df, bin_kpa)
+    pressure_used = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
+    if bin_kpa is not None and "measured_pressure_kpa" in df.columns:
+        m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
+        pressure_used = m.where(np.isfinite(m), pressure_used)
+    df["_pressure"] = pressure_used
+    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
+    df["_included"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
+    df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
+    return df
+
+
+def _summarise(df: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
+    """Group ``df`` by ``keys`` (+ level) and compute the statistics of included rows."""
+    rows = []
+    for key, group in df.groupby(keys + ["_level"], sort=False):
+        inc = group[group["_included"]]
+        psi = inc["psi_deg"].to_numpy(dtype=float)
+        n = psi.size
+        rows.append(
+            dict(
+                zip(keys + ["pressure_kpa"], key, strict=True),
+                psi_mean_deg=float(np.mean(psi)) if n else math.nan,
+                psi_sd_deg=float(np.std(psi, ddof=1)) if n > 1 else math.nan,
+                n=n,
+                n_actuators=int(inc["actuator"].nunique()),
+                n_trials=int(inc["_ramp"].nunique()),
+                n_excluded=int(len(group) - n),
+                pressure_mean_kpa=float(np.mean(inc["_pressure"])) if n else math.nan,
+            )
+        )
+    out = pd.DataFrame(rows)
+    if out.empty:
+        return out
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    sort_keys = [k if k != "direction" else "_dir" for k in keys] + ["pressure_kpa"]
+    out = out.sort_values(sort_keys, kind="stable").drop(columns="_dir").reset_index(drop=True)
+    for c in ("n", "n_actuators", "n_trials", "n_excluded"):
+        out[c] = out[c].astype(int)
+    return out
+
+
+def aggregate_hysteresis(
+    angles: pd.DataFrame, *, bin_kpa: float | None = None, include_flagged: bool = False
+) -> pd.DataFrame:
+    """Mean and sample standard deviation of psi per material x direction x pressure level.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Rows shaped like angles.csv (see :data:`REQUIRED_ANGLE_COLUMNS`).
+    bin_kpa : float, optional
+        Pressure bin width (kPa); ``None`` groups by the nominal setpoint (see
+        :func:`pressure_levels`).
+    include_flagged : bool
+        Also average rows with status ``flagged`` (``failed`` rows are always excluded).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`HYSTERESIS_COLUMNS`, sorted by material, direction (up, down) and
+        pressure.  ``psi_sd_deg`` uses ddof=1 (NaN when n < 2); ``n`` counts averaged rows,
+        ``n_actuators`` distinct actuators, ``n_trials`` distinct (actuator, trial) ramps,
+        ``n_excluded`` rows left out (status or non-finite psi), ``pressure_mean_kpa`` the mean
+        pressure of the averaged rows (measured when binning).
+    """
+    df = _prepare(angles, bin_kpa, include_flagged)
+    out = _summarise(df, ["material", "direction"])
+    if out.empty:
+        return pd.DataFrame(columns=list(HYSTERESIS_COLUMNS))
+    return out[list(HYSTERESIS_COLUMNS)]
+
+
+def aggregate_per_actuator(
+    angles: pd.DataFrame, *, bin_kpa: float | None = None, include_flagged: bool = False
+) -> pd.DataFrame:
+    """Per-actuator hysteresis curves: mean/sd of psi over that actuator's trials.
+
+    Parameters
+    ----------
+    angles, bin_kpa, include_flagged
+        As in :func:`aggregate_hysteresis`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`PER_ACTUATOR_COLUMNS`, sorted by material, actuator, direction, pressure.
+    """
+    df = _prepare(angles, bin_kpa, include_flagged)
+    out = _summarise(df, ["material", "actuator", "direction"])
+    if out.empty:
+        return pd.DataFrame(columns=list(PER_ACTUATOR_COLUMNS))
+    return out[list(PER_ACTUATOR_COLUMNS)]
+
+
+def status_counts(angles: pd.DataFrame) -> pd.DataFrame:
+    """Count rows per dataset (when present), material and status, with the reasons.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Rows shaped like angles.csv; ``dataset`` and ``reason`` columns are used when present.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (dataset, material): ``images``, ``ok``, ``flagged``, ``failed`` and
+        ``reasons`` (text ``"reason xN; ..."`` over non-ok rows, most frequent first).
+    """
+    df = angles.copy()
+    if "dataset" not in df.columns:
+        df["dataset"] = ""
+    if "reason" not in df.columns:
+        df["reason"] = ""
+    rows = []
+    for (dataset, material), g in df.groupby(["dataset", "material"], sort=False):
+        bad = g[g["status"] != "ok"]
+        reasons = bad["reason"].fillna("").astype(str).replace("", "(no reason given)")
+        counts = reasons.value_counts(sort=False)
+        ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+        rows.append(
+            {
+                "dataset": dataset,
+                "material": material,
+                "images": int(len(g)),
+                "ok": int((g["status"] == "ok").sum()),
+                "flagged": int((g["status"] == "flagged").sum()),
+                "failed": int((g["status"] == "failed").sum()),
+                "reasons": "; ".join(f"{r} x{c}" for r, c in ordered),
+            }
+        )
+    return pd.DataFrame(rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"])
