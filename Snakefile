@@ -1,0 +1,28 @@
+# Circular-actuator characterisation workflow.
+# `snakemake --cores 2` turns every dataset of config.yaml into angles, hysteresis curves, a
+# model-versus-data comparison and results/report.pdf.  All logic lives in the `pipeline` package;
+# the rules under rules/ only name files and call `python -m pipeline ...`.
+
+from snakemake.utils import min_version
+
+min_version("8.0")
+
+
+configfile: "config.yaml"
+
+
+include: "rules/common.smk"
+include: "rules/acquire.smk"
+include: "rules/measure.smk"
+include: "rules/aggregate.smk"
+include: "rules/model.smk"
+include: "rules/compare.smk"
+include: "rules/bench.smk"
+include: "rules/force.smk"
+include: "rules/report.smk"
+
+
+rule all:
+    default_target: True
+    input:
+        report=f"{RESULTS}/report.pdf",

@@ -1,0 +1,184 @@
+"""Workflow configuration: defaults, JSON-schema validation and checks that need the file system.
+
+The schema (``rules/config.schema.yaml``) is the single source of the keys, their defaults and
+their descriptions.  :func:`validate_config` fills defaults and refuses a bad config with one
+message per problem, naming the key path (``datasets[2].material``) and the fix, before any
+Snakemake job runs.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import yaml
+
+from pipeline.errors import UserInputError
+
+SCHEMA_PATH = Path(__file__).resolve().parent.parent / "rules" / "config.schema.yaml"
+BUILTIN_MATERIALS = ("DS20", "DS30", "SS40", "SS50")
+
+
+def load_schema(path: str | Path = SCHEMA_PATH) -> dict[str, Any]:
+    """Read the configuration JSON-schema (YAML)."""
+    return yaml.safe_load(Path(path).read_text())
+
+
+def fill_defaults(config: Any, schema: Mapping[str, Any]) -> Any:
+    """Return a copy of ``config`` with every missing key set to its schema ``default``.
+
+    Recurses into ``properties`` of objects and ``items`` of arrays.
+
+    Examples
+    --------
+    >>> fill_defaults({}, {"type": "object", "properties": {"a": {"default": 1}}})
+    {'a': 1}
+    """
+    config = copy.deepcopy(config)
+    if isinstance(config, dict) and "properties" in schema:
+        for key, sub in schema["properties"].items():
+            if key not in config and "default" in sub:
+                config[key] = copy.deepcopy(sub["default"])
+            if key in config:
+                config[key] = fill_defaults(config[key], sub)
+    elif isinstance(config, list) and isinstance(schema.get("items"), Mapping):
+        config = [fill_defaults(item, schema["items"]) for item in config]
+    return config
+
+
+def _key_path(path: Any) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "(top level)"
+
+
+def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list[str]:
+    validator = jsonschema.Draft7Validator(schema)
+    messages = []
+    for err in sorted(validator.iter_errors(config), key=lambda e: list(map(str, e.absolute_path))):
+        key = _key_path(err.absolute_path)
+        hint = err.schema.get("description", "") if isinstance(err.schema, Mapping) else ""
+        if err.validator == "additionalProperties":
+            allowed = sorted(err.schema.get("properties", {}))
+            messages.append(f"{key}: {err.message}; allowed keys here: {allowed}")
+        elif err.validator == "enum":
+            messages.append(f"{key}: {err.instance!r} is not one of {err.validator_value}")
+        else:
+            messages.append(f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else ""))
+    return messages
+
+
+def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[str]) -> list[str]:
+    messages = []
+    names: dict[str, int] = {}
+    for section in ("datasets",):
+        for i, ds in enumerate(config.get(section, [])):
+            key = f"{section}[{i}]"
+            name = ds.get("name")
+            if name in names:
+                messages.append(f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give each dataset a unique name")
+            names.setdefault(name, i)
+            source = ds.get("source")
+            if source in ("folder", "rig") and not ds.get("path"):
+                messages.append(f"{key}.path: required for source {source!r}; set it to the photo-set folder")
+            if source == "folder" and ds.get("path") and not (workdir / ds["path"]).is_dir():
+                messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
+            if source in ("synthetic", "rig"):
+                mat = ds.get("material")
+                if not mat:
+                    messages.append(f"{key}.material: required for source {source!r}; use one of {sorted(materials)}")
+                elif mat not in materials:
+                    messages.append(f"{key}.material: unknown material {mat!r}; use one of {sorted(materials)} or add it to a materials file (model.materials_file)")
+            if source == "rig":
+                for req in ("port", "l0_mm"):
+                    if ds.get(req) in (None, ""):
+                        messages.append(f"{key}.{req}: required for source 'rig'")
+    for i, ds in enumerate(config.get("force", {}).get("datasets", [])):
+        if not isinstance(ds, Mapping) or "name" not in ds or "source" not in ds:
+            messages.append(f"force.datasets[{i}]: needs at least 'name' and 'source' (folder or synthetic)")
+        elif ds.get("source") == "folder" and not (workdir / str(ds.get("path", ""))).is_dir():
+            messages.append(f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist")
+        elif ds.get("source") == "synthetic" and ds.get("material") not in materials:
+            messages.append(f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; use one of {sorted(materials)}")
+    grasp = config.get("force", {}).get("grasp_log")
+    if grasp and not (workdir / grasp).is_file():
+        messages.append(f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null")
+    mfile = config.get("model", {}).get("materials_file")
+    if mfile and not (workdir / mfile).is_file():
+        messages.append(f"model.materials_file: file {mfile!r} does not exist; fix the path or set it to null")
+    return messages
+
+
+def known_materials(materials_file: str | Path | None = None) -> set[str]:
+    """Names of the materials the model knows (built-in table, or ``materials_file``)."""
+    try:
+        from pipeline.model import load_materials
+    except ImportError:  # the model package is optional for config checks
+        return set(BUILTIN_MATERIALS)
+    return set(load_materials(materials_file) if materials_file else load_materials())
+
+
+def validate_config(
+    config: Mapping[str, Any],
+    *,
+    workdir: str | Path = ".",
+    source: str = "config.yaml",
+    schema_path: str | Path = SCHEMA_PATH,
+) -> dict[str, Any]:
+    """Fill defaults and validate a workflow configuration.
+
+    Parameters
+    ----------
+    config : mapping
+        The configuration as loaded from YAML.
+    workdir : path
+        Folder relative to which paths in the config are resolved.
+    source : str
+        Name of the config file, used in error messages.
+    schema_path : path
+        The JSON-schema (YAML); the workflow passes its own ``rules/config.schema.yaml``.
+
+    Returns
+    -------
+    dict
+        The configuration with every default filled in.
+
+    Raises
+    ------
+    UserInputError
+        Listing every problem, each naming the key path and the fix.
+    """
+    schema = load_schema(schema_path)
+    filled = fill_defaults(dict(config), schema)
+    problems = _schema_errors(filled, schema)
+    if not problems:
+        workdir = Path(workdir)
+        mfile = filled["model"]["materials_file"]
+        materials = known_materials(workdir / mfile if mfile and (workdir / mfile).is_file() else None)
+        problems = _semantic_errors(filled, workdir, materials)
+    if problems:
+        raise UserInputError(
+            f"{source} is not valid ({len(problems)} problem(s)); nothing was run:\n  - "
+            + "\n  - ".join(problems)
+            + f"\n  Every key, its default and its meaning: {schema_path}"
+        )
+    return filled
+
+
+def config_digest(config: Mapping[str, Any]) -> str:
+    """Short, stable SHA-256 digest of a configuration (key order does not matter)."""
+    text = json.dumps(config, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def write_resolved_config(config: Mapping[str, Any], path: str | Path) -> None:
+    """Write the validated configuration (defaults filled in) as YAML, with its digest."""
+    data = {"config_digest": config_digest(config), **dict(config)}
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Path(path).write_text(yaml.safe_dump(json.loads(json.dumps(data, default=str)), sort_keys=False))

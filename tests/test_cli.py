@@ -1,0 +1,46 @@
+"""The command line lists every stage and explains units."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from pipeline.cli import SUBCOMMANDS
+
+REQUIRED = {"synth", "measure", "aggregate", "model", "compare", "report", "acquire", "bench", "photoset"}
+
+
+def _run(*args):
+    return subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True)
+
+
+def test_help_lists_the_subcommands():
+    out = _run("--help")
+    assert out.returncode == 0
+    for name in REQUIRED:
+        assert name in out.stdout
+    assert REQUIRED <= set(SUBCOMMANDS)
+
+
+@pytest.mark.parametrize("name", sorted(SUBCOMMANDS))
+def test_every_subcommand_has_help(name):
+    out = _run(name, "--help")
+    assert out.returncode == 0, out.stderr
+    assert "usage" in out.stdout
+
+
+def test_photoset_init_then_check(photo_folder):
+    out = _run("photoset", "init", str(photo_folder), "--pattern", "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200")
+    assert out.returncode == 0, out.stderr
+    assert "8 photos (6 up, 2 down)" in out.stdout
+    out = _run("photoset", "check", str(photo_folder))
+    assert out.returncode == 0, out.stderr
+    assert "OK (8 photos)" in out.stdout
+
+
+def test_bad_input_is_one_line_without_traceback(tmp_path):
+    out = _run("photoset", "init", str(tmp_path / "nope"), "--pattern", "{pressure_kpa}.jpg")
+    assert out.returncode == 2
+    assert "Traceback" not in out.stderr and "not a folder" in out.stderr

@@ -1,0 +1,111 @@
+"""The photo-set format: init from file names, validation naming every bad row, atomic writes."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline import photoset as ps
+from pipeline.errors import UserInputError
+
+PATTERN = "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg"
+
+
+def test_init_reads_fields_and_infers_direction(photo_folder):
+    df = ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    df = df.sort_values(["trial", "step"]).reset_index(drop=True)
+    assert list(df["pressure_kpa"]) == [0, 10, 20, 10, 0, 0, 10, 20]
+    assert list(df["direction"]) == ["up", "up", "up", "down", "down", "up", "up", "up"]
+    assert set(df["material"]) == {"DS30"} and set(df["actuator"]) == {"A2"}
+    loaded = ps.load_photoset(photo_folder)
+    assert len(loaded.manifest) == 8
+    assert (loaded.manifest["l0_mm"] == 210.0).all()
+    assert ps.validate_photoset(photo_folder) == []
+
+
+def test_init_refuses_to_overwrite_and_unknown_field(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN)
+    with pytest.raises(UserInputError, match="already exists"):
+        ps.init_photoset(photo_folder, PATTERN)
+    with pytest.raises(UserInputError, match="unknown"):
+        ps.pattern_to_regex("{pressure}_{pressure_kpa}.jpg")
+    with pytest.raises(UserInputError, match="no image .* matches"):
+        ps.init_photoset(photo_folder, "{pressure_kpa}psi.png", overwrite=True)
+
+
+def test_pressure_with_p_as_decimal_point():
+    m = ps.pattern_to_regex("P{pressure_kpa}_{direction}.png").match("P12p5_dec.png")
+    assert m and m["pressure_kpa"] == "12p5" and m["direction"] == "dec"
+
+
+def test_check_names_every_bad_row_and_its_fix(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    m = pd.read_csv(photo_folder / "manifest.csv")
+    m.loc[1, "direction"] = "sideways"
+    m.loc[2, "pressure_kpa"] = np.nan
+    m.loc[3, "image"] = "missing.jpg"
+    m.loc[4, "step"] = m.loc[0, "step"]  # same trial: duplicate step
+    m.to_csv(photo_folder / "manifest.csv", index=False)
+    (photo_folder / m.loc[5, "image"]).write_bytes(b"not a jpeg")
+    problems = ps.validate_photoset(photo_folder)
+    text = "\n".join(map(str, problems))
+    assert "line 3: direction 'sideways' is unknown" in text
+    assert "line 4: pressure_kpa" in text and "not a number" in text
+    assert "line 5: image 'missing.jpg' does not exist" in text
+    assert "line 6: step" in text and "repeats" in text
+    assert "line 7: image" in text and "cannot be decoded" in text
+    assert all(p.fix for p in problems)
+    # the command line prints the same and exits 1
+    out = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(photo_folder)], capture_output=True, text=True)
+    assert out.returncode == 1 and "direction 'sideways'" in out.stderr
+
+
+def test_missing_l0_is_reported_unless_every_row_has_it(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN)
+    assert any("l0_mm is missing" in str(p) for p in ps.validate_photoset(photo_folder))
+    m = pd.read_csv(photo_folder / "manifest.csv")
+    m["l0_mm"] = 180.0
+    m.to_csv(photo_folder / "manifest.csv", index=False)
+    assert ps.validate_photoset(photo_folder) == []
+
+
+def test_row_overrides_win_over_folder_settings(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": "black", "fixed_end": [5, 6]})
+    m = pd.read_csv(photo_folder / "manifest.csv")
+    m["l0_mm"] = [np.nan] * (len(m) - 1) + [150.0]
+    m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
+    m.to_csv(photo_folder / "manifest.csv", index=False)
+    rows = ps.load_photoset(photo_folder).manifest
+    assert list(rows["l0_mm"])[-1] == 150.0 and (rows["l0_mm"].iloc[:-1] == 210.0).all()
+    assert rows["line_color"].iloc[0] == "blue" and (rows["line_color"].iloc[1:] == "black").all()
+    assert (rows["fixed_end_x"] == 5).all() and (rows["fixed_end_y"] == 6).all()
+
+
+def test_bad_settings_values_are_named(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN)
+    (photo_folder / "photoset.yaml").write_text("l0_mm: -3\npositive_turn: left\nline_color: purple\n")
+    text = "\n".join(map(str, ps.validate_photoset(photo_folder)))
+    assert "l0_mm = -3" in text and "positive_turn = 'left'" in text and "purple" in text
+
+
+@pytest.mark.parametrize("value, expected", [("red", 2), ("0,0,0-179,255,60", 1), ({"lower": [1, 2, 3], "upper": [4, 5, 6]}, 1)])
+def test_line_color_ranges(value, expected):
+    assert len(ps.line_color_ranges(value)) == expected
+
+
+def test_line_color_rejects_bad_range():
+    with pytest.raises(UserInputError):
+        ps.line_color_ranges("10,0,0-5,255,255")
+
+
+def test_append_rows_is_idempotent(tmp_path):
+    row = {"image": "a.jpg", "pressure_kpa": 10, "direction": "up", "material": "DS20", "actuator": "A1", "trial": 1, "step": 0}
+    ps.append_manifest_rows(tmp_path, [row])
+    ps.append_manifest_rows(tmp_path, [row, {**row, "image": "b.jpg", "step": 1}])
+    df = pd.read_csv(tmp_path / "manifest.csv")
+    assert list(df["image"]) == ["a.jpg", "b.jpg"]
+    assert not list(tmp_path.glob(".*.tmp"))
