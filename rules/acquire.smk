@@ -13,6 +13,8 @@ rule synth_photoset:
     benchmark:
         f"{BENCHMARKS}/synth/{{dataset}}.tsv"
     threads: 2
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=2000,
         runtime=30,
@@ -33,6 +35,8 @@ rule acquire_rig:
     benchmark:
         f"{BENCHMARKS}/acquire/{{dataset}}.tsv"
     threads: 1
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=1000,
         runtime=240,

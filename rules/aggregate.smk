@@ -15,6 +15,8 @@ rule aggregate:
     benchmark:
         f"{BENCHMARKS}/aggregate/{{dataset}}.tsv"
     threads: 1
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=1000,
         runtime=10,

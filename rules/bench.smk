@@ -10,6 +10,8 @@ rule bench_default:
     benchmark:
         f"{BENCHMARKS}/bench/default.tsv"
     threads: 2
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=2000,
         runtime=30,
@@ -25,6 +27,8 @@ rule bench_full:
     benchmark:
         f"{BENCHMARKS}/bench/full.tsv"
     threads: 2
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=4000,
         runtime=120,

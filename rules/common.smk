@@ -20,6 +20,7 @@ RESULTS = config["results_dir"]
 DATASETS = {ds["name"]: ds for ds in config["datasets"]}
 FORCE_DATASETS = {ds["name"]: ds for ds in config["force"]["datasets"]}
 LOGS = f"{RESULTS}/logs"
+CONDA_ENV = "envs/pipeline.yaml"
 BENCHMARKS = f"{RESULTS}/benchmarks"
 
 
@@ -86,21 +87,3 @@ def scene_overrides(ds):
     """`--set KEY=VALUE` options of a synthetic dataset's scene overrides."""
     return " ".join(f"--set {k}={v}" for k, v in sorted(ds.get("scene_set", {}).items()))
 
-
-rule resolved_config:
-    output:
-        f"{RESULTS}/config.resolved.yaml",
-    params:
-        config=config,
-    log:
-        f"{LOGS}/resolved_config.log",
-    benchmark:
-        f"{BENCHMARKS}/resolved_config.tsv"
-    threads: 1
-    resources:
-        mem_mb=200,
-        runtime=1,
-    run:
-        from pipeline.config import write_resolved_config
-
-        write_resolved_config(params.config, output[0])

@@ -17,6 +17,8 @@ rule compare:
     benchmark:
         f"{BENCHMARKS}/compare.tsv"
     threads: 1
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=1000,
         runtime=10,

@@ -16,6 +16,8 @@ rule measure:
     benchmark:
         f"{BENCHMARKS}/measure/{{dataset}}.tsv"
     threads: config["measure"]["jobs"]
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=2000,
         runtime=30,

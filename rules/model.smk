@@ -11,6 +11,8 @@ rule model_curve:
     benchmark:
         f"{BENCHMARKS}/model/{{material}}.tsv"
     threads: 1
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=500,
         runtime=5,

@@ -22,6 +22,8 @@ rule report:
     benchmark:
         f"{BENCHMARKS}/report.tsv"
     threads: 1
+    conda:
+        CONDA_ENV
     resources:
         mem_mb=2000,
         runtime=10,
@@ -30,3 +32,24 @@ rule report:
         " --hysteresis {input.hysteresis} --rms {input.rms} --model-curves {input.curves}"
         " --photosets {params.photosets} --overlays {params.overlays} {params.bench}"
         " --config {input.config} --title '{params.title}' --out {output} > {log} 2>&1"
+
+
+rule resolved_config:
+    output:
+        f"{RESULTS}/config.resolved.yaml",
+    params:
+        config=config,
+    log:
+        f"{LOGS}/resolved_config.log",
+    benchmark:
+        f"{BENCHMARKS}/resolved_config.tsv"
+    threads: 1
+    conda:
+        CONDA_ENV
+    resources:
+        mem_mb=200,
+        runtime=1,
+    run:
+        from pipeline.config import write_resolved_config
+
+        write_resolved_config(params.config, output[0])

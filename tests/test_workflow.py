@@ -1,0 +1,140 @@
+"""End to end: the real `snakemake` on a tiny config in a temporary folder."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+pytestmark = pytest.mark.slow
+
+SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+
+
+def _tiny_config(repo: Path) -> dict:
+    return {
+        "datasets": [
+            {"name": "sample", "source": "folder", "path": str(repo / "sample_images")},
+            {
+                "name": "tiny",
+                "source": "synthetic",
+                "material": "SS50",
+                "actuators": 1,
+                "trials": 1,
+                "step_kpa": 60,
+                "max_kpa": 240,
+                "scene": "clean",
+                "scene_set": {"width": 480, "height": 360},
+            },
+        ],
+        "compare": {"bootstrap": 20},
+        "bench": {"in_report": False},
+    }
+
+
+def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(workdir), *args],
+        capture_output=True,
+        text=True,
+    )
+
+
+def _planned_jobs(stdout: str) -> dict[str, int]:
+    table = stdout.split("Job stats:")[-1]
+    return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.M) if m[1] != "total"}
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory, request):
+    repo = Path(request.config.rootpath)
+    workdir = tmp_path_factory.mktemp("wf")
+    (workdir / "config.yaml").write_text(yaml.safe_dump(_tiny_config(repo)))
+    out = _snakemake(workdir, repo, "--cores", "2")
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-5000:]
+    return repo, workdir
+
+
+def test_outputs_exist_and_hold_real_numbers(finished_run):
+    repo, workdir = finished_run
+    res = workdir / "results"
+    for name in ("sample", "tiny"):
+        angles = pd.read_csv(res / "datasets" / name / "angles.csv")
+        assert {"image", "psi_deg", "status", "pressure_kpa", "direction"} <= set(angles.columns)
+        assert (angles["status"] != "failed").mean() > 0.9
+        hyst = pd.read_csv(res / "datasets" / name / "hysteresis.csv")
+        assert {"material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n"} <= set(hyst.columns)
+    # the synthetic set is measured against its ground truth
+    angles = pd.read_csv(res / "datasets" / "tiny" / "angles.csv")
+    truth = pd.read_csv(res / "photosets" / "tiny" / "truth.csv")
+    merged = angles.merge(truth[["image", "psi_deg"]], on="image", suffixes=("", "_true"))
+    ok = merged[merged["status"] == "ok"]
+    assert len(ok) >= len(merged) - 1
+    assert (ok["psi_deg"] - ok["psi_deg_true"]).abs().median() < 1.0
+    rms = pd.read_csv(res / "rms.csv")
+    assert {"DS20", "SS50"} <= set(rms["material"])
+    pdf = (res / "report.pdf").read_bytes()
+    assert pdf.startswith(b"%PDF") and len(pdf) > 20_000
+    for sub in ("logs", "benchmarks"):
+        assert any((res / sub).rglob("*")), f"no {sub} written"
+
+
+def test_rerun_does_nothing(finished_run):
+    repo, workdir = finished_run
+    out = _snakemake(workdir, repo, "-n", "--cores", "2")
+    assert out.returncode == 0
+    assert "Nothing to be done" in out.stdout + out.stderr
+
+
+def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
+    repo, workdir = finished_run
+    cfg = _tiny_config(repo)
+    cfg["datasets"].append({"name": "new", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1, "step_kpa": 120, "max_kpa": 240})
+    (workdir / "config2.yaml").write_text(yaml.safe_dump(cfg))
+    out = _snakemake(workdir, repo, "-n", "--cores", "2", "--configfile", str(workdir / "config2.yaml"))
+    assert out.returncode == 0, out.stderr[-3000:]
+    jobs = _planned_jobs(out.stdout)
+    assert jobs.get("synth_photoset") == 1 and jobs.get("measure") == 1 and jobs.get("aggregate") == 1
+    assert jobs.get("compare") == 1 and jobs.get("report") == 1
+    assert "model_curve" not in jobs  # SS50's curve is already there
+    assert "results/datasets/new/angles.csv" in out.stdout
+    assert "results/datasets/tiny/angles.csv" not in re.findall(r"output: (\S+)", out.stdout)
+
+
+def test_broken_config_is_refused_before_any_job(tmp_path, repo):
+    cfg = _tiny_config(repo)
+    cfg["datasets"][1]["material"] = "DS25"
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(cfg))
+    out = _snakemake(tmp_path, repo, "--cores", "1")
+    assert out.returncode != 0
+    text = out.stdout + out.stderr
+    assert "datasets[1].material: unknown material 'DS25'" in text
+    assert not (tmp_path / "results").exists()
+
+
+def test_lint_and_dry_run_on_the_default_config(repo, tmp_path):
+    work = tmp_path / "clone"
+    shutil.copytree(repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__"))
+    out = subprocess.run([*SNAKEMAKE, "--lint"], cwd=work, capture_output=True, text=True)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    out = subprocess.run([*SNAKEMAKE, "-n", "--cores", "2"], cwd=work, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-3000:]
+    jobs = _planned_jobs(out.stdout)
+    assert jobs["synth_photoset"] == 4 and jobs["measure"] == 5 and jobs["report"] == 1
+
+
+def test_slurm_profile_plans_the_workflow(repo, tmp_path):
+    work = tmp_path / "clone"
+    shutil.copytree(repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__"))
+    out = subprocess.run(
+        [*SNAKEMAKE, "--executor", "slurm", "--profile", "rules/profiles/slurm", "-n"],
+        cwd=work, capture_output=True, text=True,
+    )
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert _planned_jobs(out.stdout)["measure"] == 5
