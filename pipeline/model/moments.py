@@ -1,0 +1,85 @@
+"""Bending moments of axial stress (Eq. 12) and of pressure on the end cap (Eq. 13)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pipeline.model.geometry import (
+    BAD_STRETCH,
+    OK,
+    Section,
+    axial_stretch_base,
+    gauss_nodes,
+    rest_heights,
+)
+from pipeline.model.materials import Material
+from pipeline.model.ogden import axial_stress_mpa
+from pipeline.model.options import ModelOptions
+
+FloatArray = NDArray[np.float64]
+
+
+def stress_moment_nmm(
+    mat: Material, psi: FloatArray, sec: Section, l0: float, opts: ModelOptions
+) -> tuple[FloatArray, FloatArray]:
+    """Eq. 12: moment M_sigma of the axial stress about the inextensible layer, in N mm.
+
+    The base (width 2 (a0 + t0), stretch of Eq. 1, lambda_2 = 1) plus the deformed wall (stretches
+    of Eqs. 2-3 on the deformed section, integrated over the undeformed tau in [0, t0] and phi in
+    [-pi/2, pi/2] by Gauss-Legendre, using the evenness in phi).  ``opts.jacobian="deformed"``
+    multiplies the wall area element by (2 phi_m/pi)(t/t0); ``opts.l0_factor="metres"``
+    multiplies both terms by l0 in metres as printed.
+
+    Returns
+    -------
+    moment_nmm : ndarray, shape (n,)
+    reason : ndarray of int, shape (n,)
+    """
+    mu, alpha = mat.ogden_terms()
+    beta, w_beta = gauss_nodes(opts.n_beta, 0.0, mat.b_mm)
+    lam_b = axial_stretch_base(mat, beta[None, :], psi[:, None], l0)
+    with np.errstate(all="ignore"):
+        sig_b = axial_stress_mpa(lam_b, np.ones_like(lam_b), mu, alpha)
+    m_base = 2.0 * (mat.a0_mm + mat.t0_mm) * (sig_b * beta[None, :]) @ w_beta
+
+    tau, w_tau = gauss_nodes(opts.n_tau, 0.0, mat.t0_mm)
+    phi, w_phi = gauss_nodes(opts.n_phi, 0.0, 0.5 * math.pi)
+    t = sec.t[:, None, None]
+    phi_m = sec.phi_m[:, None, None]
+    a = sec.a[:, None, None]
+    q = sec.q[:, None, None]
+    r_def = a + tau[None, :, None] * (t / mat.t0_mm)  # a + tau'
+    phi_def = phi[None, None, :] * (2.0 * phi_m / math.pi)  # phi'
+    height = mat.b_mm + q + r_def * np.cos(phi_def)
+    h0 = rest_heights(mat, tau[:, None], phi[None, :])[None]
+    lam1 = (l0 - height * psi[:, None, None]) / (l0 - h0 * mat.psi0_rad)
+    lam2 = 2.0 * r_def * phi_m / ((mat.a0_mm + tau[None, :, None]) * math.pi)
+    bad = ~((lam1 > 0) & (lam2 > 0)).all(axis=(1, 2)) | ~(lam_b > 0).all(axis=1)
+    with np.errstate(all="ignore"):
+        sig = axial_stress_mpa(lam1, lam2, mu, alpha)
+    integrand = sig * height * r_def
+    m_wall = 2.0 * np.einsum("nij,i,j->n", integrand, w_tau, w_phi)
+    if opts.jacobian == "deformed":
+        m_wall = m_wall * (2.0 * sec.phi_m / math.pi) * (sec.t / mat.t0_mm)
+    moment = m_base + m_wall
+    if opts.l0_factor == "metres":
+        moment = moment * (l0 / 1000.0)
+    reason = np.where((sec.reason == OK) & bad, BAD_STRETCH, sec.reason)
+    return np.where(reason == OK, moment, np.nan), reason
+
+
+def pressure_area_mm3(mat: Material, sec: Section, opts: ModelOptions) -> FloatArray:
+    """Eq. 13 divided by P: first moment of the pressurised end-cap area about the layer (mm^3).
+
+    ``"half_disc"`` (as printed): (4 a^3 + 3 pi a^2 (b + q))/6.  ``"segment"``: the chamber
+    actually bounded by the arc and the base plane, (b + q) a^2 (phi_m - sin cos) + 2/3 a^3 sin^3.
+    Both equal the undeformed half disc at rest.
+    """
+    a, q = sec.a, sec.q
+    if opts.pressure_area == "segment":
+        s, c = np.sin(sec.phi_m), np.cos(sec.phi_m)
+        return (mat.b_mm + q) * a**2 * (sec.phi_m - s * c) + (2.0 / 3.0) * a**3 * s**3
+    return (4.0 * a**3 + 3.0 * math.pi * a**2 * (mat.b_mm + q)) / 6.0
