@@ -1,0 +1,367 @@
+"""pyserial driver for the Pico pressure controller (protocol in :mod:`pipeline.rig.firmware.rigcore`).
+
+The driver refuses a setpoint above its ``max_kpa`` *before* sending anything, converts
+pressures through a :class:`~pipeline.rig.calibration.Calibration` when one is given, skips
+garbage lines, notices ``EVT ESTOP`` at any time, and turns a vanished or silent port into
+:class:`PortLostError`.
+
+Examples
+--------
+Against the emulator (a real pseudo-terminal)::
+
+    from pipeline.rig.emulator import Emulator
+    with Emulator() as emu, PicoDriver.open(emu.port, max_kpa=260) as rig:
+        rig.set_kpa(40.0)
+        print(rig.get().measured_kpa)
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+from types import TracebackType
+
+import numpy as np
+import serial
+
+from pipeline.rig.calibration import Calibration
+from pipeline.rig.protocol import BAUDRATE, Reply, encode, parse_reply
+
+log = logging.getLogger(__name__)
+
+#: garbage lines tolerated while waiting for one reply
+MAX_GARBAGE_PER_REPLY = 20
+
+
+class RigError(Exception):
+    """Base class of every rig failure; the message says what happened and what to do."""
+
+
+class PortLostError(RigError):
+    """The serial port vanished, failed, or the device stopped answering."""
+
+
+class EStopError(RigError):
+    """The emergency stop is (or was) pressed; the device has vented."""
+
+
+class LimitError(RigError):
+    """A setpoint outside the limits.  ``sent`` tells whether the device refused it (``ERR LIMIT``)
+    or the host refused it before sending (``sent=False``)."""
+
+    def __init__(self, message: str, *, sent: bool) -> None:
+        super().__init__(message)
+        self.sent = sent
+
+
+class DeviceError(RigError):
+    """The device answered ``ERR PARSE`` / ``ERR HW`` or something inconsistent."""
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """What the device says about itself (``ID`` and ``CFG``)."""
+
+    name: str
+    version: str
+    kpa_per_code: float
+    max_kpa: float
+    dac_bits: int
+
+
+@dataclass(frozen=True)
+class PressureReading:
+    """One ``GET``: setpoint and monitor reading (kPa), and the stop button state."""
+
+    setpoint_kpa: float
+    measured_kpa: float
+    estop: bool
+
+
+@dataclass(frozen=True)
+class SetResult:
+    """One ``SET``: the pressure asked for (kPa), the nominal value sent and the DAC code applied."""
+
+    pressure_kpa: float
+    sent_kpa: float
+    dac_code: int
+
+
+class PicoDriver:
+    """Talk to the rig over a serial port.
+
+    Parameters
+    ----------
+    link : serial.Serial
+        An open port (see :meth:`open`).
+    max_kpa : float
+        Host-side limit (kPa): a higher setpoint raises :class:`LimitError` and is never sent.
+        A calibration's own ``max_kpa``, when lower, applies instead.
+    calibration : Calibration, optional
+        Maps the pressure wanted to the DAC code; without it the firmware's nominal scaling is used.
+    timeout_s : float
+        Longest wait for one reply before the port counts as lost (s).
+    """
+
+    def __init__(self, link: serial.Serial, *, max_kpa: float, calibration: Calibration | None = None,
+                 timeout_s: float = 2.0) -> None:
+        self.link = link
+        self.calibration = calibration
+        limits = [max_kpa] + ([calibration.max_kpa] if calibration and calibration.max_kpa else [])
+        self.max_kpa = float(min(limits))
+        self.timeout_s = timeout_s
+        self.info: DeviceInfo | None = None
+        self.garbage_lines = 0
+        self.commands_sent = 0
+        self._estop_seen = False
+        self._buf = b""
+
+    # -- opening / closing ------------------------------------------------------------------
+
+    @classmethod
+    def open(cls, port: str, *, max_kpa: float, calibration: Calibration | None = None,
+             timeout_s: float = 2.0) -> "PicoDriver":
+        """Open ``port`` (a device path such as ``/dev/ttyACM0`` or a pyserial URL), identify the device.
+
+        Raises
+        ------
+        PortLostError
+            If the port cannot be opened or the device does not answer ``ID``.
+        """
+        try:
+            link = serial.serial_for_url(port, baudrate=BAUDRATE, timeout=0.05, write_timeout=timeout_s)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise PortLostError(f"cannot open serial port {port!r}: {exc}; check the cable and the --port name") from exc
+        driver = cls(link, max_kpa=max_kpa, calibration=calibration, timeout_s=timeout_s)
+        try:
+            driver.connect()
+        except BaseException:
+            driver.close()
+            raise
+        return driver
+
+    def connect(self) -> DeviceInfo:
+        """Discard stale input, read ``ID`` and ``CFG``, send the calibration's load-cell scale."""
+        self._drain()
+        r = self._command("ID")
+        name, version = r.fields
+        c = self._command("CFG")
+        self.info = DeviceInfo(name, version, float(c.fields[0]), float(c.fields[1]), int(c.fields[2]))
+        if self.calibration and self.calibration.load_counts_per_newton:
+            self.set_scale(self.calibration.load_counts_per_newton)
+        return self.info
+
+    def close(self) -> None:
+        """Close the port (never raises)."""
+        try:
+            self.link.close()
+        except Exception:  # noqa: BLE001 - closing a dead port must not mask the real error
+            pass
+
+    def __enter__(self) -> "PicoDriver":
+        return self
+
+    def __exit__(self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None) -> None:
+        self.safe_vent()
+        self.close()
+
+    # -- pressure -----------------------------------------------------------------------------
+
+    def set_kpa(self, pressure_kpa: float) -> SetResult:
+        """Set the regulator to ``pressure_kpa``.
+
+        Raises
+        ------
+        LimitError
+            Above ``max_kpa`` or negative (not sent), or refused by the device (``ERR LIMIT``).
+        EStopError
+            The stop is pressed.
+        """
+        p = float(pressure_kpa)
+        if not math.isfinite(p) or p < 0:
+            raise LimitError(f"refused setpoint {pressure_kpa!r} kPa: must be a number >= 0 (nothing sent)", sent=False)
+        if p > self.max_kpa + 1e-9:
+            raise LimitError(
+                f"refused setpoint {p:g} kPa: above the host limit max_kpa = {self.max_kpa:g} kPa (nothing sent)",
+                sent=False,
+            )
+        want_code = None
+        sent = p
+        if self.calibration is not None and self.info is not None:
+            want_code = self.calibration.kpa_to_code(p)
+            sent = want_code * self.info.kpa_per_code
+        r = self._command("SET", sent)
+        code = int(r.fields[1])
+        if want_code is not None and code != want_code:
+            log.warning("device applied DAC code %d, calibration asked for %d", code, want_code)
+        return SetResult(p, sent, code)
+
+    def get(self) -> PressureReading:
+        """Setpoint, monitor reading (kPa) and stop state; raises :class:`EStopError` if pressed."""
+        r = self._command("GET")
+        reading = PressureReading(float(r.fields[0]), float(r.fields[1]), r.fields[2] == "1")
+        if reading.estop:
+            self._estop_seen = True
+            self._raise_estop()
+        return reading
+
+    def vent(self) -> None:
+        """Set 0 kPa (allowed while the stop is pressed)."""
+        self._command("VENT", raise_estop=False)
+
+    def safe_vent(self, timeout_s: float = 1.0) -> bool:
+        """Try to vent; ``True`` if the device acknowledged.  Never raises (used on the way out)."""
+        saved = self.timeout_s
+        self.timeout_s = timeout_s
+        try:
+            self.vent()
+            return True
+        except Exception:  # noqa: BLE001 - best effort on a port that may be gone
+            return False
+        finally:
+            self.timeout_s = saved
+
+    def sleep(self, seconds: float) -> None:
+        """Wait ``seconds`` while watching the port for ``EVT ESTOP`` (raised at once)."""
+        deadline = time.monotonic() + seconds
+        while True:
+            self._raise_estop()
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return
+            line = self._read_line(time.monotonic() + min(left, 0.05))
+            if line is not None:
+                self._dispatch_unsolicited(line)
+
+    def check_events(self) -> None:
+        """Read whatever is waiting without blocking; raise :class:`EStopError` on ``EVT ESTOP``."""
+        while True:
+            line = self._read_line(time.monotonic())
+            if line is None:
+                break
+            self._dispatch_unsolicited(line)
+        self._raise_estop()
+
+    # -- load cell ------------------------------------------------------------------------------
+
+    def load_n(self) -> float:
+        """One load-cell reading (N, after tare and scale)."""
+        return float(self._command("LOAD").fields[0])
+
+    def load_samples(self, count: int, interval_s: float = 0.0) -> np.ndarray:
+        """``count`` load-cell readings (N), ``interval_s`` apart, watching for the stop."""
+        out = np.empty(count)
+        for i in range(count):
+            if i and interval_s > 0:
+                self.sleep(interval_s)
+            out[i] = self.load_n()
+        return out
+
+    def load_raw(self) -> int:
+        """One raw HX711 reading (counts)."""
+        return int(self._command("LOADRAW").fields[0])
+
+    def tare(self, reads: int = 10) -> int:
+        """Zero the load cell on the mean of ``reads`` readings; returns the offset (counts)."""
+        return int(self._command("TARE", int(reads)).fields[0])
+
+    def set_scale(self, counts_per_newton: float) -> float:
+        """Set the load-cell scale (counts per newton)."""
+        return float(self._command("SCALE", float(counts_per_newton)).fields[0])
+
+    # -- line handling ----------------------------------------------------------------------------
+
+    def _raise_estop(self) -> None:
+        if self._estop_seen:
+            self._estop_seen = False
+            raise EStopError("emergency stop pressed: the device vented; release the button and re-run to resume")
+
+    def _drain(self) -> None:
+        try:
+            self.link.reset_input_buffer()
+        except (serial.SerialException, OSError) as exc:
+            raise PortLostError(f"serial port {self.link.port!r} failed: {exc}") from exc
+        self._buf = b""
+
+    def _read_line(self, deadline: float) -> bytes | None:
+        """One line (without ``\\n``) or ``None`` at the deadline."""
+        while b"\n" not in self._buf:
+            try:
+                waiting = self.link.in_waiting
+                chunk = self.link.read(max(1, waiting)) if waiting or time.monotonic() < deadline else b""
+            except (serial.SerialException, OSError) as exc:
+                raise PortLostError(
+                    f"serial port {self.link.port!r} lost ({exc}); reconnect the rig and re-run the same command to resume"
+                ) from exc
+            if chunk:
+                self._buf += chunk
+            elif time.monotonic() >= deadline:
+                return None
+        line, self._buf = self._buf.split(b"\n", 1)
+        return line
+
+    def _dispatch_unsolicited(self, line: bytes) -> None:
+        reply = parse_reply(line)
+        if reply is not None and reply.kind == "EVT":
+            self._estop_seen = True
+        elif line.strip():
+            self.garbage_lines += 1
+            log.debug("ignored line from device: %r", line[:80])
+
+    def _command(self, command: str, *args: float | int, raise_estop: bool = True, retries: int = 1) -> Reply:
+        for attempt in range(retries + 1):
+            try:
+                self.link.write(encode(command, *args))
+                self.link.flush()
+            except (serial.SerialException, OSError) as exc:
+                raise PortLostError(
+                    f"serial port {self.link.port!r} lost while sending {command} ({exc}); "
+                    "reconnect the rig and re-run the same command to resume"
+                ) from exc
+            self.commands_sent += 1
+            reply = self._await_reply(command)
+            if reply.kind == "ERR" and reply.command == "PARSE" and attempt < retries:
+                log.warning("device answered ERR PARSE to %s; sending it again", command)
+                continue
+            break
+        if reply.kind == "ERR":
+            if reply.command == "ESTOP":
+                self._estop_seen = False
+                raise EStopError("emergency stop pressed: the device refused the setpoint and vented; "
+                                 "release the button and re-run to resume")
+            if reply.command == "LIMIT":
+                limit = f" ({self.info.max_kpa:g} kPa)" if self.info else ""
+                raise LimitError(f"device refused {command} {args[0] if args else ''}: above its limit{limit}", sent=True)
+            raise DeviceError(f"device answered {reply.line!r} to {command}")
+        if raise_estop:
+            self._raise_estop()
+        return reply
+
+    def _await_reply(self, command: str) -> Reply:
+        deadline = time.monotonic() + self.timeout_s
+        garbage = 0
+        while True:
+            line = self._read_line(deadline)
+            if line is None:
+                raise PortLostError(
+                    f"no reply to {command} within {self.timeout_s:g} s from {self.link.port!r}: the device is not "
+                    "answering; check power and cable, then re-run the same command to resume"
+                )
+            reply = parse_reply(line)
+            if reply is None:
+                if line.strip():
+                    garbage += 1
+                    self.garbage_lines += 1
+                    log.debug("ignored garbage line from device: %r", line[:80])
+                    if garbage > MAX_GARBAGE_PER_REPLY:
+                        raise DeviceError(f"more than {MAX_GARBAGE_PER_REPLY} garbage lines while waiting for {command}; check the baud rate ({BAUDRATE}) and the port")
+                continue
+            if reply.kind == "EVT":
+                self._estop_seen = True
+                continue
+            if reply.kind == "OK" and reply.command != command:
+                log.warning("ignored stale reply %r while waiting for %s", reply.line, command)
+                continue
+            return reply
