@@ -10,8 +10,9 @@ excluded by default and counted in ``n_excluded``; a level whose rows are all ex
 written (with ``n = 0`` and a NaN mean) so nothing disappears silently.
 
 Identity conventions: an actuator is identified by its ``actuator`` value (as text) within a
-material; a trial by the pair (actuator, trial).  If two angles.csv files of the same material
-reuse an actuator name, they are the same actuator to this module.
+material; a trial by the pair (actuator, trial).  When rows come from several datasets (a
+``dataset`` column with more than one value, as :func:`read_angles` writes), actuators are
+``"<dataset>/<actuator>"``: different photo sets hold different actuators.
 
 Examples
 --------
@@ -174,7 +175,7 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
 def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool) -> pd.DataFrame:
     check_angles(angles)
     df = angles.copy()
-    df["actuator"] = df["actuator"].astype(str)
+    df["actuator"] = actuator_keys(df)
     df["trial"] = df["trial"].astype(str)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["_level"] = pressure_levels(df, bin_kpa)
@@ -309,3 +310,70 @@ def status_counts(angles: pd.DataFrame) -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"])
+
+
+def actuator_keys(angles: pd.DataFrame) -> pd.Series:
+    """Actuator identity of each row (text): the ``actuator`` value, qualified by ``dataset``
+    (``"<dataset>/<actuator>"``) when the rows come from more than one dataset."""
+    actuator = angles["actuator"].astype(str)
+    if "dataset" in angles.columns and angles["dataset"].nunique() > 1:
+        return angles["dataset"].astype(str) + "/" + actuator
+    return actuator
+
+
+def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
+    """Merge hysteresis rows of the same material x direction x level (e.g. two datasets of DS20).
+
+    The pooled mean and sample sd are exactly those of the union of the underlying rows:
+    mean = sum(n_i m_i) / N and sd^2 = (sum((n_i - 1) s_i^2) + sum(n_i (m_i - mean)^2)) / (N - 1).
+    Counts are summed (actuators and trials of different datasets are distinct).
+
+    Parameters
+    ----------
+    hyst : pandas.DataFrame
+        Rows with at least :data:`HYSTERESIS_COLUMNS` minus ``pressure_mean_kpa``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Same columns, one row per material x direction x pressure level, sorted as
+        :func:`aggregate_hysteresis` sorts.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> a = dict(material="DS20", direction="up", pressure_kpa=0.0, n_actuators=1, n_trials=2, n_excluded=0)
+    >>> h = pd.DataFrame([dict(a, psi_mean_deg=1.0, psi_sd_deg=2 ** 0.5, n=2),
+    ...                   dict(a, psi_mean_deg=4.0, psi_sd_deg=float("nan"), n=1)])
+    >>> pool_hysteresis(h)[["psi_mean_deg", "psi_sd_deg", "n"]].to_numpy().tolist()  # of 0, 2, 4
+    [[2.0, 2.0, 3.0]]
+    """
+    keys = ["material", "direction", "pressure_kpa"]
+    if not hyst.duplicated(keys).any():
+        return hyst.reset_index(drop=True)
+    rows = []
+    for key, g in hyst.groupby(keys, sort=False):
+        n = g["n"].to_numpy(float)
+        m = g["psi_mean_deg"].to_numpy(float)
+        sd = np.nan_to_num(g["psi_sd_deg"].to_numpy(float))
+        used = n > 0
+        total = float(n[used].sum())
+        mean = float(np.sum(n[used] * m[used]) / total) if total else math.nan
+        ss = float(np.sum((n[used] - 1) * sd[used] ** 2) + np.sum(n[used] * (m[used] - mean) ** 2)) if total else 0.0
+        row = dict(zip(keys, key, strict=True))
+        row.update(
+            psi_mean_deg=mean,
+            psi_sd_deg=math.sqrt(ss / (total - 1)) if total > 1 else math.nan,
+            n=int(total),
+            n_actuators=int(g["n_actuators"].sum()) if "n_actuators" in g else 0,
+            n_trials=int(g["n_trials"].sum()) if "n_trials" in g else 0,
+            n_excluded=int(g["n_excluded"].sum()) if "n_excluded" in g else 0,
+        )
+        if "pressure_mean_kpa" in g:
+            pm = g["pressure_mean_kpa"].to_numpy(float)
+            row["pressure_mean_kpa"] = float(np.sum(n[used] * pm[used]) / total) if total else math.nan
+        rows.append(row)
+    out = pd.DataFrame(rows)
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    out = out.sort_values(["material", "_dir", "pressure_kpa"], kind="stable").drop(columns="_dir")
+    return out.reset_index(drop=True)

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from pipeline.aggregate import actuator_keys, pool_hysteresis
 from pipeline.errors import UserInputError
 
 ModelPsi = Callable[[str, np.ndarray], np.ndarray]
@@ -94,19 +95,17 @@ RMS_COLUMNS: tuple[str, ...] = (
 
 
 def check_hysteresis(hyst: pd.DataFrame, where: str = "hysteresis.csv") -> None:
-    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has duplicates."""
+    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has a bad direction."""
     missing = [c for c in HYSTERESIS_REQUIRED if c not in hyst.columns]
     if missing:
         raise UserInputError(
             f"{where}: missing column(s) {missing}; pass a hysteresis.csv written by 'aggregate'"
         )
-    dup = hyst.duplicated(["material", "direction", "pressure_kpa"])
-    if dup.any():
-        i = int(np.flatnonzero(dup.to_numpy())[0])
-        r = hyst.iloc[i]
+    bad = ~hyst["direction"].isin(("up", "down")).to_numpy()
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
         raise UserInputError(
-            f"{where} line {i + 2}: duplicate level (material {r['material']}, {r['direction']}, "
-            f"{r['pressure_kpa']} kPa); pass each material's hysteresis only once"
+            f"{where} line {i + 2}: direction {hyst['direction'].iloc[i]!r}; use 'up' or 'down'"
         )
 
 
@@ -355,7 +354,7 @@ def included_rows(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Dat
         p = m.where(np.isfinite(m), p)
     df["pressure_kpa"] = p
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
-    df["actuator"] = df["actuator"].astype(str)
+    df["actuator"] = actuator_keys(df)
     ok = np.isfinite(df["pressure_kpa"]) & np.isfinite(df["psi_deg"])
     return df[ok].reset_index(drop=True)
 
@@ -376,7 +375,8 @@ def compare(
     Parameters
     ----------
     hyst : pandas.DataFrame
-        hysteresis.csv rows (any number of materials).
+        hysteresis.csv rows (any number of materials); rows of the same material x direction x
+        level (several datasets of one material) are pooled first (:func:`pool_hysteresis`).
     angles : pandas.DataFrame, optional
         angles.csv rows for the k_P fit and its bootstrap; ``None`` skips the fit.
     model_psi, fit_k_p : callable or None
@@ -393,6 +393,7 @@ def compare(
         Columns :data:`RMS_COLUMNS`, materials in sorted order.
     """
     check_hysteresis(hyst)
+    hyst = pool_hysteresis(hyst)
     rows_all = None if angles is None else included_rows(angles, include_flagged)
     psi0 = dict(psi0_deg or {})
     records = []

@@ -37,8 +37,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the k_P bootstrap (integer; default 0)")
     parser.add_argument(
-        "--n-boot", type=int, default=200, metavar="N",
+        "--bootstrap", "--n-boot", dest="n_boot", type=int, default=200, metavar="N",
         help="bootstrap resamples of actuators for the k_P 95%% interval (default 200; 0 = no interval)",
+    )
+    parser.add_argument(
+        "--datasets", nargs="+", default=None, metavar="NAME",
+        help="dataset names, one per HYSTERESIS.csv in the same order (used in messages only)",
     )
     parser.add_argument(
         "--include-flagged", action="store_true",
@@ -58,13 +62,18 @@ def read_hysteresis(paths: list[Path]) -> pd.DataFrame:
             raise UserInputError(f"{p}: not a readable CSV ({exc}); regenerate it with 'aggregate'") from None
         check_hysteresis(df, str(p))
         frames.append(df)
-    out = pd.concat(frames, ignore_index=True)
-    check_hysteresis(out, " + ".join(map(str, paths)))
-    return out
+    return pd.concat(frames, ignore_index=True)
 
 
 def run(args: argparse.Namespace) -> int:
     """Compare and write rms.csv; print a one-line summary."""
+    if args.datasets is not None and len(args.datasets) != len(args.hysteresis):
+        raise UserInputError(
+            f"--datasets names {len(args.datasets)} dataset(s) but {len(args.hysteresis)} HYSTERESIS.csv "
+            "file(s) were given; pass one name per file, in the same order"
+        )
+    if args.n_boot < 0:
+        raise UserInputError(f"--bootstrap must be >= 0 resamples, got {args.n_boot}")
     hyst = read_hysteresis(args.hysteresis)
     angles = read_angles(args.angles) if args.angles else None
     model_psi, fit_k_p, psi0 = model_callables(args.materials)

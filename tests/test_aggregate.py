@@ -12,6 +12,7 @@ from pipeline.aggregate import (
     HYSTERESIS_COLUMNS,
     aggregate_hysteresis,
     aggregate_per_actuator,
+    pool_hysteresis,
     pressure_levels,
     read_angles,
     status_counts,
@@ -137,3 +138,15 @@ def test_cli_roundtrip_and_bad_input(crafted, tmp_path, capsys):
         read_angles([a])
     with pytest.raises(UserInputError, match="not found"):
         read_angles([tmp_path / "nope.csv"])
+
+
+def test_pooling_two_datasets_equals_aggregating_their_union(crafted):
+    a = crafted.assign(dataset="first")
+    b = crafted.assign(dataset="second", psi_deg=crafted["psi_deg"] * 0.5 + 3.0)
+    pooled = pool_hysteresis(pd.concat([aggregate_hysteresis(a), aggregate_hysteresis(b)]))
+    union = aggregate_hysteresis(pd.concat([a, b], ignore_index=True))
+    pd.testing.assert_frame_equal(pooled, union, check_dtype=False)
+    r = _level(union, "DS20", "up", 0)
+    assert r["n_actuators"] == 4  # "first/1", "first/2", "second/1", "second/2"
+    values = np.r_[200.0, 210.0, 220.0, 103.0, 108.0, 113.0]
+    assert r["psi_sd_deg"] == pytest.approx(values.std(ddof=1))

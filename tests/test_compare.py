@@ -140,8 +140,15 @@ def test_unknown_material_keeps_data_metrics():
 def test_bad_hysteresis_table():
     with pytest.raises(UserInputError, match="missing column"):
         compare(_hyst().drop(columns="psi_mean_deg"), model_psi=None, fit_k_p=None)
-    with pytest.raises(UserInputError, match="duplicate level"):
-        compare(pd.concat([_hyst(), _hyst()]), model_psi=None, fit_k_p=None)
+    with pytest.raises(UserInputError, match="direction"):
+        compare(_hyst().replace({"direction": {"up": "rising"}}), model_psi=None, fit_k_p=None)
+
+
+def test_two_datasets_of_one_material_are_pooled():
+    one = compare(_hyst(), model_psi=linear_model, fit_k_p=None).iloc[0]
+    two = compare(pd.concat([_hyst(), _hyst()]), model_psi=linear_model, fit_k_p=None).iloc[0]
+    for column in ("rms_deg", "rms_up_deg", "p_zero_down_kpa", "range_deg", "hysteresis_width_deg"):
+        assert two[column] == pytest.approx(one[column])
 
 
 def test_cli_with_the_real_model(tmp_path, capsys):
