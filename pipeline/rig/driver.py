@@ -271,6 +271,10 @@ class PicoDriver:
         """Set the load-cell scale (counts per newton)."""
         return float(self._command("SCALE", float(counts_per_newton)).fields[0])
 
+    def get_scale(self) -> float:
+        """Current load-cell scale (counts per newton)."""
+        return float(self._command("SCALE").fields[0])
+
     # -- line handling ----------------------------------------------------------------------------
 
     def _raise_estop(self) -> None:
