@@ -23,7 +23,9 @@ How the fit works
    envelope theorem (d distance / d parameter = -normal . d X / d parameter at the foot
    point), so the problem stays 5-dimensional.  This is the maximum-likelihood fit under
    isotropic pixel noise and removes the direct fit's short-arc bias.
-4. **Trust.**  From the Jacobian at the solution, ``eccentricity_sd`` = the standard error of
+4. **Outliers.**  Points far off the fitted ellipse (a dark clamp or a stray mark joined to
+   the line) are trimmed by a robust threshold and the fit repeated (``trim_rounds``).
+5. **Trust.**  From the Jacobian at the solution, ``eccentricity_sd`` = the standard error of
    e (residual variance x (J^T J)^-1, propagated to e).  The result is ``flagged`` when the arc
    covers less than ``min_arc_fraction`` of the perimeter, when ``eccentricity_sd`` exceeds
    ``max_eccentricity_sd`` (the shape does not pin e down: short or flat arc, noisy line),
@@ -80,7 +82,9 @@ class EllipseFit:
     residual_px : float
         RMS orthogonal distance of the points to the ellipse (px).
     n_points : int
-        Number of points used in the fit.
+        Number of line points considered (after thinning).
+    n_outliers : int
+        Points left out of the fit as off the ellipse (see ``trim_rounds``).
     method : str
         ``"direct"`` (Fitzgibbon) or ``"geometric"`` (direct, then orthogonal-distance refinement).
     status : str
@@ -99,6 +103,7 @@ class EllipseFit:
     arc_fraction: float
     residual_px: float
     n_points: int
+    n_outliers: int
     method: str
     status: str
     reason: str
@@ -117,7 +122,7 @@ class EllipseFit:
 def failed_fit(reason: str, n_points: int = 0, method: str = "direct") -> EllipseFit:
     """A falsy :class:`EllipseFit` with NaN numbers and the given reason."""
     nan = float("nan")
-    return EllipseFit(nan, nan, nan, nan, nan, nan, nan, nan, nan, n_points, method, "failed", reason)
+    return EllipseFit(nan, nan, nan, nan, nan, nan, nan, nan, nan, n_points, 0, method, "failed", reason)
 
 
 def eccentricity(semi_major: float, semi_minor: float) -> float:
@@ -161,6 +166,10 @@ def fit_ellipse(
     min_arc_fraction: float = 0.4,
     max_eccentricity_sd: float = 0.02,
     max_residual_px: float = 3.0,
+    trim_rounds: int = 3,
+    outlier_sigma: float = 4.0,
+    min_outlier_px: float = 2.0,
+    max_outlier_fraction: float = 0.1,
 ) -> EllipseFit:
     """Fit an ellipse to line points; report its eccentricity, arc coverage and trust.
 
@@ -181,6 +190,14 @@ def fit_ellipse(
         Standard error of e above this: ``flagged``.
     max_residual_px : float
         RMS orthogonal residual above this (px): ``flagged`` (the line is not an ellipse).
+    trim_rounds : int
+        Rounds of outlier trimming (0: none).  After each fit, points farther from the ellipse
+        than ``max(outlier_sigma * 1.4826 * MAD, min_outlier_px)`` are left out and the fit is
+        repeated, so a clamp or a stray mark joined to the line does not pull the ellipse.
+    outlier_sigma, min_outlier_px : float
+        Trimming threshold (robust sigmas, and a floor in px).
+    max_outlier_fraction : float
+        More of the points trimmed than this: ``flagged``.
 
     Returns
     -------
@@ -205,17 +222,32 @@ def fit_ellipse(
         return failed_fit(f"only {n} line points (need {max(min_points, 6)})", n)
     if np.linalg.matrix_rank(pts - pts.mean(axis=0), tol=1e-6 * max(1.0, float(np.ptp(pts)))) < 2:
         return failed_fit("line points are collinear", n)
-    params = _direct_fit(pts)
-    if params is None:
-        return failed_fit("direct ellipse fit is degenerate", n)
-    method = "direct"
-    fraction = _arc_fraction(pts, params)
-    if refine == "always" or (refine == "auto" and fraction < refine_below):
-        refined = _geometric_fit(pts, params)
-        if refined is not None:
-            params, method = refined, "geometric"
-            fraction = _arc_fraction(pts, params)
+    inlier = np.ones(n, dtype=bool)
+    params: NDArray[np.float64] | None = None
+    method, fraction = "direct", float("nan")
+    for _ in range(1 + max(0, trim_rounds)):
+        params = _direct_fit(pts[inlier])
+        if params is None:
+            return failed_fit("direct ellipse fit is degenerate", n)
+        method = "direct"
+        fraction = _arc_fraction(pts[inlier], params)
+        if refine == "always" or (refine == "auto" and fraction < refine_below):
+            refined = _geometric_fit(pts[inlier], params)
+            if refined is not None:
+                params, method = refined, "geometric"
+                fraction = _arc_fraction(pts[inlier], params)
+        if trim_rounds <= 0:
+            break
+        d_all = np.abs(_signed_distances(pts, _canonical(params))[0])
+        sigma = 1.4826 * float(np.median(d_all[inlier]))
+        keep = d_all <= max(outlier_sigma * sigma, min_outlier_px)
+        if np.array_equal(keep, inlier) or keep.sum() < max(min_points, 6):
+            break
+        inlier = keep
+    assert params is not None
     params = _canonical(params)
+    n_outliers = int(n - inlier.sum())
+    pts = pts[inlier]
     dist = _signed_distances(pts, params)[0]
     residual = float(np.sqrt(np.mean(dist**2)))
     e_sd = _eccentricity_sd(pts, params, dist)
@@ -228,6 +260,8 @@ def fit_ellipse(
         reasons.append(f"eccentricity uncertain (sd {e_sd:.3f} > {max_eccentricity_sd})")
     if residual > max_residual_px:
         reasons.append(f"line is not an ellipse (RMS residual {residual:.1f} px > {max_residual_px})")
+    if n_outliers > max_outlier_fraction * n:
+        reasons.append(f"{n_outliers / n:.0%} of the line points are off the ellipse (ignored in the fit)")
     return EllipseFit(
         centre_x_px=float(xc),
         centre_y_px=float(yc),
@@ -239,6 +273,7 @@ def fit_ellipse(
         arc_fraction=fraction,
         residual_px=residual,
         n_points=n,
+        n_outliers=n_outliers,
         method=method,
         status="flagged" if reasons else "ok",
         reason="; ".join(reasons),

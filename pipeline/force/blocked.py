@@ -1,0 +1,288 @@
+"""Measure the eccentricity of the blocked marker line in every photo of a blocked-force set.
+
+Per photo: the marker line's ordered sub-pixel centre line is extracted exactly as for the
+bending angle (:func:`pipeline.measure.extract.extract_centreline`), an ellipse is fitted to it
+(:func:`pipeline.force.ellipse.fit_ellipse`: direct fit, geometric refinement on partial arcs)
+and ``e = sqrt(1 - b**2/a**2)`` is reported with the same status semantics as the angle:
+
+``ok``
+    A trustworthy number.
+``flagged``
+    A number with every reason it may be wrong: from the line (touches the image border, partly
+    hidden or too long for ``l0``, several candidate lines, low contrast, closes on itself or
+    branches -- the thresholds of :mod:`pipeline.measure.quality`) and from the fit (arc too
+    short, e uncertain, the line is not an ellipse).
+``failed``
+    No number (NaN): unreadable image, no line found, no ellipse could be fitted.
+
+One bad photo never stops the set.  The output table (``eccentricity.csv``) has one row per
+manifest row, same order: :data:`RESULT_COLUMNS`, then the manifest's pressure/force columns
+carried over, then ``image_path`` (absolute path of the photo, for report overlays).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from pipeline.force.ellipse import EllipseFit, Refine, fit_ellipse
+
+RESULT_COLUMNS: tuple[str, ...] = (
+    "image", "eccentricity", "eccentricity_sd", "semi_major_px", "semi_minor_px", "semi_major_mm", "semi_minor_mm",
+    "centre_x_px", "centre_y_px", "angle_deg", "arc_fraction", "residual_px", "length_px", "method", "status",
+    "reason", "seconds",
+)
+CARRIED_COLUMNS: tuple[str, ...] = (
+    "pressure_kpa", "direction", "material", "actuator", "trial", "step", "measured_pressure_kpa", "force_n",
+    "force_sd_n", "force_samples", "timestamp",
+)
+
+
+@dataclass(frozen=True)
+class EccentricityResult:
+    """Eccentricity of the marker line in one photo.
+
+    Attributes
+    ----------
+    fit : EllipseFit
+        The ellipse (px) with eccentricity, its sd, arc fraction, residual and method.
+    length_px : float
+        Length of the extracted centre line (px), NaN when no line.
+    mm_per_px : float
+        Scale used for the mm columns (NaN when unknown).
+    status : str
+        ``ok``, ``flagged`` or ``failed`` (line and fit combined).
+    reason : str
+        Every reason, ``; ``-separated ("" when ok).
+    centreline_px : ndarray
+        The extracted centre line (N, 2), empty when none.
+    """
+
+    fit: EllipseFit
+    length_px: float
+    mm_per_px: float
+    status: str
+    reason: str
+    centreline_px: np.ndarray = field(repr=False)
+
+    @property
+    def eccentricity(self) -> float:
+        """The eccentricity (NaN when failed)."""
+        return self.fit.eccentricity
+
+    def row(self) -> dict[str, Any]:
+        """The result as an ``eccentricity.csv`` row (without image/seconds)."""
+        f = self.fit
+        return {
+            "eccentricity": f.eccentricity,
+            "eccentricity_sd": f.eccentricity_sd,
+            "semi_major_px": f.semi_major_px,
+            "semi_minor_px": f.semi_minor_px,
+            "semi_major_mm": f.semi_major_px * self.mm_per_px,
+            "semi_minor_mm": f.semi_minor_px * self.mm_per_px,
+            "centre_x_px": f.centre_x_px,
+            "centre_y_px": f.centre_y_px,
+            "angle_deg": f.angle_deg,
+            "arc_fraction": f.arc_fraction,
+            "residual_px": f.residual_px,
+            "length_px": self.length_px,
+            "method": f.method,
+            "status": self.status,
+            "reason": self.reason,
+        }
+
+
+def _failed(reason: str) -> EccentricityResult:
+    from pipeline.force.ellipse import failed_fit
+
+    return EccentricityResult(failed_fit(reason), float("nan"), float("nan"), "failed", reason, np.empty((0, 2)))
+
+
+def line_flags(line: Any, length_px: float, expected_length_px: float | None) -> list[str]:
+    """Reasons to distrust an extracted line (same thresholds as the angle measurement).
+
+    Parameters
+    ----------
+    line : pipeline.measure.extract.LineExtraction
+    length_px : float
+        Measured centre-line length (px).
+    expected_length_px : float or None
+        ``l0_mm / mm_per_px`` when the scale is known.
+
+    Returns
+    -------
+    list of str
+    """
+    from pipeline.measure.quality import LENGTH_HIGH, LENGTH_LOW, LOW_CONTRAST
+
+    flags = []
+    if line.touches_border:
+        flags.append("line touches the image border")
+    if expected_length_px:
+        ratio = length_px / expected_length_px
+        if ratio < LENGTH_LOW:
+            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
+        elif ratio > LENGTH_HIGH:
+            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
+    if line.n_candidates > 1:
+        flags.append(f"{line.n_candidates} candidate lines")
+    if line.contrast < LOW_CONTRAST:
+        flags.append(f"low contrast ({line.contrast:.0f})")
+    if line.branched_fraction > 0.05:
+        flags.append("line closes on itself or branches")
+    return flags
+
+
+def measure_blocked_image(
+    image_bgr: np.ndarray | None,
+    *,
+    l0_mm: float | None = None,
+    mm_per_px: float | None = None,
+    line_color: Any = "black",
+    fixed_end_px: tuple[float, float] | None = None,
+    refine: Refine = "auto",
+    **fit_options: Any,
+) -> EccentricityResult:
+    """Eccentricity of the marker line in one blocked-force photo.
+
+    Parameters
+    ----------
+    image_bgr : ndarray (H, W, 3) uint8 or None
+        The photo (None: unreadable, gives ``failed``).
+    l0_mm : float, optional
+        Length of the marked line (mm); with ``mm_per_px`` it lets a partly hidden line be flagged.
+    mm_per_px : float, optional
+        Scale (mm per px) for the mm columns and the length check.
+    line_color : str or mapping
+        Marker colour (see :func:`pipeline.photoset.line_color_ranges`).
+    fixed_end_px : (x, y), optional
+        Near the clamped end; only helps the extraction pick the line's ends.
+    refine : {"auto", "always", "never"}
+        Geometric refinement of the ellipse (see :func:`pipeline.force.ellipse.fit_ellipse`).
+    **fit_options
+        Further thresholds of :func:`~pipeline.force.ellipse.fit_ellipse`.
+
+    Returns
+    -------
+    EccentricityResult
+    """
+    from pipeline.measure.extract import NoLineFound, extract_centreline
+
+    if image_bgr is None:
+        return _failed("unreadable image (cannot be decoded)")
+    try:
+        line = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px)
+    except NoLineFound as exc:
+        return _failed(str(exc))
+    pts = line.centreline_px
+    length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) if len(pts) > 1 else 0.0
+    scale_ok = mm_per_px is not None and np.isfinite(mm_per_px) and mm_per_px > 0
+    expected = l0_mm / mm_per_px if scale_ok and l0_mm else None
+    fit = fit_ellipse(pts, refine=refine, **fit_options)
+    if not fit:
+        return EccentricityResult(fit, length, float(mm_per_px) if scale_ok else float("nan"), "failed", fit.reason, pts)
+    reasons = line_flags(line, length, expected) + ([fit.reason] if fit.reason else [])
+    return EccentricityResult(
+        fit=fit,
+        length_px=length,
+        mm_per_px=float(mm_per_px) if scale_ok else float("nan"),
+        status="flagged" if reasons else "ok",
+        reason="; ".join(reasons),
+        centreline_px=pts,
+    )
+
+
+def _read_image(path: Path) -> np.ndarray | None:
+    import cv2
+
+    try:
+        data = np.fromfile(str(path), dtype=np.uint8)
+    except OSError:
+        return None
+    if data.size == 0:
+        return None
+    return cv2.imdecode(data, cv2.IMREAD_COLOR)
+
+
+def _measure_row(args: tuple[str, dict[str, Any], str, dict[str, Any]]) -> dict[str, Any]:
+    path, settings, refine, fit_options = args
+    t0 = time.perf_counter()
+    fe = (settings["fixed_end_x"], settings["fixed_end_y"])
+    fe_px = None if not np.all(np.isfinite(np.asarray(fe, dtype=float))) else (float(fe[0]), float(fe[1]))
+    p = Path(path)
+    if not p.is_file():
+        result = _failed(f"image file {p.name} not found")
+    else:
+        result = measure_blocked_image(
+            _read_image(p),
+            l0_mm=settings["l0_mm"],
+            mm_per_px=settings["mm_per_px"],
+            line_color=settings["line_color"],
+            fixed_end_px=fe_px,
+            refine=refine,  # type: ignore[arg-type]
+            **fit_options,
+        )
+    row = result.row()
+    row["seconds"] = round(time.perf_counter() - t0, 4)
+    return row
+
+
+def measure_blocked_photoset(
+    folder: str | os.PathLike[str],
+    *,
+    jobs: int = 1,
+    refine: Refine = "auto",
+    **fit_options: Any,
+) -> pd.DataFrame:
+    """Measure the eccentricity of every photo of a blocked-force photo set.
+
+    Parameters
+    ----------
+    folder : path
+        Photo-set folder (manifest.csv + photoset.yaml + images).
+    jobs : int
+        Worker processes.
+    refine : {"auto", "always", "never"}
+        Geometric refinement of the ellipse fit.
+    **fit_options
+        Thresholds of :func:`pipeline.force.ellipse.fit_ellipse`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``eccentricity.csv``: one row per manifest row (see module docstring).
+
+    Raises
+    ------
+    UserInputError
+        When the photo set itself is not valid.
+    """
+    from pipeline.photoset import load_photoset
+
+    ps = load_photoset(folder)
+    m = ps.manifest
+    tasks = []
+    for _, r in m.iterrows():
+        settings = {k: r[k] for k in ("l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y")}
+        settings = {k: (None if k in ("l0_mm", "mm_per_px") and pd.isna(v) else v) for k, v in settings.items()}
+        tasks.append((str(ps.image_path(str(r["image"]))), settings, refine, dict(fit_options)))
+    if jobs > 1 and len(tasks) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            rows = list(pool.map(_measure_row, tasks, chunksize=max(1, len(tasks) // (4 * jobs))))
+    else:
+        rows = [_measure_row(t) for t in tasks]
+    out = pd.DataFrame(rows)
+    out.insert(0, "image", m["image"].astype(str).to_numpy())
+    out = out[list(RESULT_COLUMNS)]
+    for c in CARRIED_COLUMNS:
+        if c in m.columns:
+            out[c] = m[c].to_numpy()
+    out["image_path"] = [str(Path(t[0]).resolve()) for t in tasks]
+    return out
