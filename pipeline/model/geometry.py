@@ -143,9 +143,13 @@ def solve_phi_m(mat: Material, t: FloatArray, opts: ModelOptions, max_iter: int 
     tt = np.where(ok, tt, mat.t0_mm)
     half = np.full_like(tt, 0.5 * math.pi)
     f_half, df_half = _eq5_area_residual(mat, half, tt)
-    # start right of the root: pi/2 if F(pi/2) >= 0, else the smaller of two right-side points
-    theta_up = np.arccos(np.clip(math.pi * tt * mat.a0_mm / mat.area0_mm2, 0.0, 1.0))
-    x = np.where(f_half >= 0, half, np.minimum(half + theta_up, half - f_half / df_half))
+    # start at the root of the second-order Taylor expansion about pi/2 (F'' = pi t a0 there),
+    # capped by a point known to be right of the root (F > 0 where pi t a0 / cos(theta) > A0)
+    curv = math.pi * tt * mat.a0_mm
+    disc = df_half**2 - 2.0 * curv * f_half
+    theta = np.where(disc >= 0, (np.sqrt(np.maximum(disc, 0.0)) - df_half) / curv, 0.0)
+    theta_up = np.arccos(np.clip(curv / mat.area0_mm2, 0.0, 1.0))
+    x = half + np.where(f_half >= 0, theta, np.minimum(theta, theta_up))
     x = np.clip(x, 1e-12, math.pi - 1e-12)
     for _ in range(max_iter):
         f, df = _eq5_area_residual(mat, x, tt)

@@ -35,7 +35,7 @@ def _reachable_grid(mat: Material, opts: ModelOptions) -> tuple[FloatArray, Floa
     return grid[:n], p[:n]
 
 
-def _illinois(
+def _bracketed_root(
     mat: Material,
     opts: ModelOptions,
     target: FloatArray,
@@ -43,33 +43,69 @@ def _illinois(
     fa: FloatArray,
     b: FloatArray,
     fb: FloatArray,
-    tol_kpa: float = 1e-9,
+    c: FloatArray,
+    fc: FloatArray,
+    x0: FloatArray | None = None,
+    tol_kpa: float = 1e-7,
     max_iter: int = 60,
 ) -> FloatArray:
-    """Vectorised Illinois (modified regula falsi) for P(psi) = target on brackets [a, b].
+    """Vectorised bracketed root of P(psi) = target (inverse quadratic interpolation + Illinois).
 
-    ``fa`` and ``fb`` are P - target at the ends, of opposite sign (or zero).
+    ``[a, b]`` brackets the root (``fa = P(a) - target`` and ``fb`` of opposite sign or zero);
+    ``(c, fc)`` is a third grid point; ``x0`` an optional first guess inside the bracket.  Each iteration
+    tries inverse quadratic interpolation through (a, b, c) and falls back to an Illinois
+    (modified regula falsi) step when that leaves the bracket, so the root never leaves [a, b].
     """
-    a, fa, b, fb = a.copy(), fa.copy(), b.copy(), fb.copy()
+    a, fa, b, fb, c, fc = (v.astype(float, copy=True) for v in (a, fa, b, fb, c, fc))
+    wa = np.ones_like(a)  # Illinois weight of fa in the fallback secant
     x = np.where(np.abs(fa) <= np.abs(fb), a, b)
     active = (np.abs(fa) > tol_kpa) & (np.abs(fb) > tol_kpa)
-    for _ in range(max_iter):
-        idx = np.flatnonzero(active)
-        if idx.size == 0:
-            break
-        ai, bi, fai, fbi = a[idx], b[idx], fa[idx], fb[idx]
-        xi = (ai * fbi - bi * fai) / (fbi - fai)
-        fx, _ = pressure_core(mat, xi, opts)
-        fx = fx - target[idx]
-        same = np.sign(fx) == np.sign(fbi)
-        # Illinois: keep the old end and halve its residual when the new point lands on b's side
-        new_a = np.where(same, ai, bi)
-        new_fa = np.where(same, 0.5 * fai, fbi)
-        a[idx], fa[idx], b[idx], fb[idx] = new_a, new_fa, xi, fx
-        x[idx] = xi
-        done = (np.abs(fx) <= tol_kpa) | (np.abs(bi - ai) <= 1e-15) | ~np.isfinite(fx)
-        active[idx[done]] = False
+    with np.errstate(all="ignore"):
+        for it in range(max_iter):
+            idx = np.flatnonzero(active)
+            if idx.size == 0:
+                break
+            ai, bi, ci, fai, fbi, fci = a[idx], b[idx], c[idx], fa[idx], fb[idx], fc[idx]
+            iqi = (ai * fbi * fci / ((fai - fbi) * (fai - fci))
+                   + bi * fai * fci / ((fbi - fai) * (fbi - fci))
+                   + ci * fai * fbi / ((fci - fai) * (fci - fbi)))
+            lo, hi = np.minimum(ai, bi), np.maximum(ai, bi)
+            fw = wa[idx] * fai
+            secant = (ai * fbi - bi * fw) / (fbi - fw)
+            use_iqi = np.isfinite(iqi) & (iqi > lo) & (iqi < hi)
+            xi = np.where(use_iqi, iqi, secant)
+            if it == 0 and x0 is not None:
+                x0i = x0[idx]
+                xi = np.where((x0i > lo) & (x0i < hi), x0i, xi)
+            fx, _ = pressure_core(mat, xi, opts)
+            fx = fx - target[idx]
+            same = np.sign(fx) == np.sign(fbi)
+            # the new point replaces b; a stays if x fell on b's side (then Illinois halves its weight)
+            a[idx] = np.where(same, ai, bi)
+            fa[idx] = np.where(same, fai, fbi)
+            wa[idx] = np.where(same, 0.5 * wa[idx], 1.0)
+            c[idx], fc[idx] = np.where(same, bi, ai), np.where(same, fbi, fai)
+            b[idx], fb[idx] = xi, fx
+            x[idx] = xi
+            done = (np.abs(fx) <= tol_kpa) | (np.abs(bi - ai) <= 1e-15) | ~np.isfinite(fx)
+            active[idx[done]] = False
     return x
+
+
+def _hermite_guess(x: FloatArray, f: FloatArray, j: NDArray[np.intp], target: FloatArray) -> FloatArray:
+    """Root of the cubic Hermite interpolant of the grid P(psi) on [x[j-1], x[j]] (first guess)."""
+    slope = np.gradient(f, x)
+    h = x[j] - x[j - 1]
+    f0, f1 = f[j - 1], f[j]
+    m0, m1 = slope[j - 1] * h, slope[j] * h
+    with np.errstate(all="ignore"):
+        s = np.clip((target - f0) / (f1 - f0), 0.0, 1.0)
+        for _ in range(4):  # Newton on the cubic in s (no model evaluations)
+            s2, s3 = s * s, s * s * s
+            p = (2 * s3 - 3 * s2 + 1) * f0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * f1 + (s3 - s2) * m1
+            dp = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * f1 + (3 * s2 - 2 * s) * m1
+            s = np.clip(s - (p - target) / dp, 0.0, 1.0)
+    return x[j - 1] + np.where(np.isfinite(s), s, 0.5) * h
 
 
 def psi_rad_core(mat: Material, p_kpa: FloatArray, opts: ModelOptions, branch: str) -> FloatArray:
@@ -97,7 +133,11 @@ def psi_rad_core(mat: Material, p_kpa: FloatArray, opts: ModelOptions, branch: s
     if sel.size:
         j = i[sel]
         tgt = target[sel]
-        out[sel] = _illinois(mat, opts, tgt, x[j - 1], f[j - 1] - tgt, x[j], f[j] - tgt)
+        k = np.where(j + 1 < len(x), j + 1, j - 2)  # third point for the first quadratic step
+        k = np.clip(k, 0, len(x) - 1)
+        guess = _hermite_guess(x, f, j, tgt)
+        out[sel] = _bracketed_root(mat, opts, tgt, x[j - 1], f[j - 1] - tgt, x[j], f[j] - tgt,
+                                   x[k], f[k] - tgt, guess)
     return out
 
 

@@ -63,9 +63,9 @@ class ModelOptions:
     thickness_phi: str = "mean"
     l0_mm: float | None = None
     k_p: float | None = None
-    n_tau: int = 6
+    n_tau: int = 4
     n_phi: int = 8
-    n_beta: int = 4
+    n_beta: int = 3
     n_grid: int = 400
     psi_min_deg: float = -360.0
 

@@ -1,0 +1,138 @@
+"""Speed and accuracy of the model against the quadrature size (prints figures; not a timed test).
+
+``python -m pipeline model bench`` or ``python -m pipeline.model.bench``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from pipeline.model.forward import pressure_core
+from pipeline.model.inverse import psi_deg
+from pipeline.model.materials import Material, load_materials
+from pipeline.model.options import make_options
+
+MATERIALS: tuple[str, ...] = ("DS20", "DS30", "SS40", "SS50")
+
+
+def grid_options(grid_n: int) -> dict[str, int]:
+    """Node counts of grid size ``grid_n``: n_tau = n, n_phi = 2n, n_beta = max(2, 3n // 4).
+
+    ``grid_n = 4`` is the default (4, 8, 3).
+    """
+    return {"n_tau": int(grid_n), "n_phi": 2 * int(grid_n), "n_beta": max(2, (3 * int(grid_n)) // 4)}
+
+
+def _best_time(fn: Any, repeats: int) -> float:
+    best = np.inf
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return float(best)
+
+
+def benchmark_model(
+    grid_sizes: Sequence[int] = (2, 3, 4, 6, 8, 12),
+    n_angles: int = 400,
+    n_pressures: int = 400,
+    reference_n: int = 32,
+    repeats: int = 7,
+    materials: Sequence[str] = MATERIALS,
+    **options: Any,
+) -> pd.DataFrame:
+    """Time full P(psi) curves and the loading inverse for every material at several grid sizes.
+
+    Parameters
+    ----------
+    grid_sizes : sequence of int
+        Quadrature sizes, see :func:`grid_options`.
+    n_angles : int
+        Angles per forward curve (psi0 down to -360 deg).
+    n_pressures : int
+        Pressures per inverse (0 up to the pressure at -360 deg on the reference grid).
+    reference_n : int
+        Grid size of the reference solution the errors are measured against.
+    repeats : int
+        Timings are the best of this many runs.
+    materials : sequence of str
+    **options
+        Model readings (see :class:`pipeline.model.options.ModelOptions`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per grid size: ``grid_n``, ``n_tau``, ``n_phi``, ``n_beta``, ``nodes`` (wall nodes
+        per angle), ``forward_seconds`` (all materials, ``n_angles`` each), ``inverse_seconds``
+        (all materials, ``n_pressures`` each), ``seconds`` (sum), ``max_rel_error`` (forward P vs
+        the reference grid, over all materials and angles), ``inverse_max_abs_error_deg``.
+    """
+    table = load_materials()
+    mats: list[Material] = [table[m] for m in materials]
+    psi = np.linspace(210.0, -360.0, n_angles)
+    ref_kw = {**options, **grid_options(reference_n)}
+    ref_p = {}
+    pressures = {}
+    ref_psi = {}
+    for m in mats:
+        ref_p[m.name], _ = pressure_core(m, np.radians(psi), make_options(**ref_kw))
+        top = float(np.nanmax(ref_p[m.name])) if np.isfinite(ref_p[m.name]).any() else 0.0
+        pressures[m.name] = np.linspace(0.0, top, n_pressures)
+        ref_psi[m.name] = psi_deg(m, pressures[m.name], **ref_kw)
+    rows = []
+    for n in grid_sizes:
+        kw = {**options, **grid_options(n)}
+
+        def forward(kw: dict[str, Any] = kw) -> None:
+            for m in mats:
+                pressure_core(m, np.radians(psi), make_options(**kw))
+
+        def inverse(kw: dict[str, Any] = kw) -> None:
+            for m in mats:
+                psi_deg(m, pressures[m.name], **kw)
+
+        t_fwd = _best_time(forward, repeats)
+        t_inv = _best_time(inverse, repeats)
+        rel, dpsi = 0.0, 0.0
+        for m in mats:
+            p, _ = pressure_core(m, np.radians(psi), make_options(**kw))
+            ok = np.isfinite(p) & np.isfinite(ref_p[m.name]) & (np.abs(ref_p[m.name]) > 1e-9)
+            if ok.any():
+                rel = max(rel, float(np.max(np.abs(p[ok] / ref_p[m.name][ok] - 1.0))))
+            q = psi_deg(m, pressures[m.name], **kw)
+            ok = np.isfinite(q) & np.isfinite(ref_psi[m.name])
+            if ok.any():
+                dpsi = max(dpsi, float(np.max(np.abs(q[ok] - ref_psi[m.name][ok]))))
+        g = grid_options(n)
+        rows.append({"grid_n": int(n), **g, "nodes": g["n_tau"] * g["n_phi"],
+                     "forward_seconds": t_fwd, "inverse_seconds": t_inv, "seconds": t_fwd + t_inv,
+                     "max_rel_error": rel, "inverse_max_abs_error_deg": dpsi})
+    return pd.DataFrame(rows)
+
+
+def format_benchmark(df: pd.DataFrame) -> str:
+    """Human-readable table of :func:`benchmark_model` (times in ms)."""
+    out = df.copy()
+    for col in ("forward_seconds", "inverse_seconds", "seconds"):
+        out[col.replace("seconds", "ms")] = (out.pop(col) * 1e3).round(3)
+    return out.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+
+
+def main() -> int:
+    """Print the benchmark (4 materials x 400 angles forward + 400 pressures inverse)."""
+    df = benchmark_model()
+    print("model benchmark: 4 materials x 400 angles (forward) + 400 pressures (loading inverse), one process")
+    print(format_benchmark(df))
+    default = df[df.grid_n == 4]
+    if len(default):
+        print(f"default grid (grid_n=4): {1e3 * float(default.seconds.iloc[0]):.2f} ms total (target < 10 ms)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
