@@ -1,0 +1,101 @@
+"""Assemble the report PDF with byte-identical output for identical inputs."""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg", force=False)
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from pipeline import __version__  # noqa: E402
+from pipeline.photoset import atomic_write_bytes  # noqa: E402
+from pipeline.report.data import ReportData, ReportInputs, load_report_data  # noqa: E402
+from pipeline.report.extra import extra_pages  # noqa: E402
+from pipeline.report.pages import comparison_page, material_page, overview_page, summary_lines, text_pages  # noqa: E402
+from pipeline.report.style import report_style  # noqa: E402
+
+
+@dataclass(frozen=True)
+class ReportResult:
+    """What was written."""
+
+    path: Path
+    pages: int
+    materials: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def render_pdf(figures: list[Figure], title: str) -> bytes:
+    """Save figures as pages of one PDF; no timestamps, so the bytes depend on the figures only."""
+    buf = io.BytesIO()
+    metadata = {"Title": title, "Creator": f"pipeline {__version__}", "CreationDate": None}
+    saved_epoch = os.environ.pop("SOURCE_DATE_EPOCH", None)  # would re-introduce a date
+    try:
+        with PdfPages(buf, metadata=metadata) as pdf:
+            for i, fig in enumerate(figures, start=1):
+                fig.text(0.99, 0.004, f"{title} | page {i} of {len(figures)}", ha="right", va="bottom",
+                         fontsize=6.5, color="0.4")
+                pdf.savefig(fig)
+    finally:
+        if saved_epoch is not None:
+            os.environ["SOURCE_DATE_EPOCH"] = saved_epoch
+    return buf.getvalue()
+
+
+def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
+    """Every page in order, and the warnings printed on the summary page."""
+    bench = extra_pages("pipeline.bench.pages", data.inputs.bench_dir)
+    force = extra_pages("pipeline.force.pages", data.inputs.force_dir)
+    warnings = bench.warnings + force.warnings
+    if data.inputs.model_curves:
+        for m in data.materials:
+            if not (data.model_curves["material"].astype(str) == m).any():
+                warnings.append(f"{m}: no model curve in --model-curves; its plot has no dashed model line")
+    for m in data.materials:
+        if not (data.rms["material"].astype(str) == m).any():
+            warnings.append(f"{m}: no row in --rms; its comparison values show n/a")
+    for d in data.inputs.datasets:
+        for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
+            if folder is not None and not folder.is_dir():
+                warnings.append(f"{d.name}: {label} folder {folder} does not exist")
+    config_digest = data.digests.get(str(data.inputs.config)) if data.inputs.config is not None else None
+    lines = summary_lines(data, __version__, config_digest, warnings, bench.infos + force.infos)
+    figures = text_pages(data.inputs.title, lines)
+    figures.append(overview_page(data))
+    figures += [material_page(data, m) for m in data.materials]
+    figures.append(comparison_page(data))
+    return figures + bench.figures + force.figures, warnings
+
+
+def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportResult:
+    """Load the inputs, draw every page and write the PDF atomically.
+
+    Parameters
+    ----------
+    inputs : ReportInputs
+    out : path-like
+        The PDF to write (parent folders are created).
+
+    Returns
+    -------
+    ReportResult
+    """
+    data = load_report_data(inputs)
+    with report_style():
+        figures, warnings = report_figures(data)
+        try:
+            pdf = render_pdf(figures, inputs.title)
+        finally:
+            for fig in figures:
+                plt.close(fig)
+    path = Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(path, pdf)
+    return ReportResult(path=path, pages=len(figures), materials=tuple(data.materials), warnings=tuple(warnings))

@@ -1,0 +1,205 @@
+"""Everything the report shows, loaded and checked once: a :class:`ReportData`.
+
+The pages are pure functions of this object, so the PDF depends on the inputs' content only.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from pipeline.aggregate import aggregate_hysteresis, aggregate_per_actuator, pool_hysteresis, read_angles
+from pipeline.compare import check_hysteresis
+from pipeline.errors import UserInputError
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """One measured photo set.
+
+    Attributes
+    ----------
+    name : str
+        Label shown in the report.
+    angles_csv : Path
+        Its angles.csv (from ``measure``).
+    photoset_dir : Path or None
+        The photo-set folder (raw photos), if available.
+    overlays_dir : Path or None
+        The ``measure --overlays`` folder (``<image stem>.jpg`` with the extracted line), if any.
+    """
+
+    name: str
+    angles_csv: Path
+    photoset_dir: Path | None = None
+    overlays_dir: Path | None = None
+
+
+@dataclass(frozen=True)
+class ReportInputs:
+    """Files the report is built from (see ``python -m pipeline report --help``)."""
+
+    datasets: tuple[Dataset, ...]
+    hysteresis: tuple[Path, ...] = ()
+    rms: tuple[Path, ...] = ()
+    model_curves: tuple[Path, ...] = ()
+    bench_dir: Path | None = None
+    force_dir: Path | None = None
+    config: Path | None = None
+    title: str = "Circular actuator characterisation"
+
+
+@dataclass(frozen=True)
+class ReportData:
+    """Loaded tables.
+
+    Attributes
+    ----------
+    inputs : ReportInputs
+    angles : pandas.DataFrame
+        All angles rows with a ``dataset`` column holding the dataset *name*.
+    hysteresis : pandas.DataFrame
+        Pooled hysteresis per material x direction x level.
+    per_actuator : pandas.DataFrame
+        Per-actuator curves (from the angles, default exclusions).
+    rms : pandas.DataFrame
+        rms.csv rows (may be empty).
+    model_curves : pandas.DataFrame
+        ``material``, ``psi_deg``, ``pressure_kpa`` (may be empty).
+    digests : dict of str to str
+        sha256 of every input file (path as given -> hex digest).
+    notes : list of str
+        Things the reader should know (e.g. hysteresis recomputed from angles).
+    """
+
+    inputs: ReportInputs
+    angles: pd.DataFrame
+    hysteresis: pd.DataFrame
+    per_actuator: pd.DataFrame
+    rms: pd.DataFrame
+    model_curves: pd.DataFrame
+    digests: dict[str, str]
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def materials(self) -> list[str]:
+        """Materials in the data, sorted by name."""
+        return sorted(self.hysteresis["material"].astype(str).unique())
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """Hex sha256 of a file's bytes.
+
+    Raises
+    ------
+    UserInputError
+        If the file cannot be read.
+    """
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError as exc:
+        raise UserInputError(f"{path}: cannot read ({exc.strerror}); check the path") from None
+    return h.hexdigest()
+
+
+def _read_csv(path: Path, what: str, required: Sequence[str]) -> pd.DataFrame:
+    try:
+        df = pd.read_csv(path)
+    except FileNotFoundError:
+        raise UserInputError(f"{path}: file not found; pass an existing {what}") from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise UserInputError(f"{path}: not a readable CSV ({exc}); regenerate the {what}") from None
+    missing = [c for c in required if c not in df.columns]
+    if missing:
+        raise UserInputError(f"{path}: missing column(s) {missing}; pass a {what}")
+    return df
+
+
+def load_report_data(inputs: ReportInputs) -> ReportData:
+    """Read and check every input of the report.
+
+    Parameters
+    ----------
+    inputs : ReportInputs
+
+    Returns
+    -------
+    ReportData
+
+    Raises
+    ------
+    UserInputError
+        Missing/unreadable files, missing columns, duplicate dataset names.
+    """
+    if not inputs.datasets:
+        raise UserInputError("no dataset given; pass at least one --angles ANGLES.csv")
+    names = [d.name for d in inputs.datasets]
+    if len(set(names)) != len(names):
+        raise UserInputError(f"--datasets: names must be unique, got {names}")
+    frames = []
+    for d in inputs.datasets:
+        a = read_angles([d.angles_csv])
+        a["dataset"] = d.name
+        frames.append(a)
+    angles = pd.concat(frames, ignore_index=True)
+    notes: list[str] = []
+    if inputs.hysteresis:
+        parts = []
+        for p in inputs.hysteresis:
+            h = _read_csv(p, "hysteresis.csv written by 'aggregate'", ())
+            check_hysteresis(h, str(p))
+            parts.append(h)
+        hysteresis = pool_hysteresis(pd.concat(parts, ignore_index=True))
+    else:
+        hysteresis = aggregate_hysteresis(angles)
+        notes.append("hysteresis recomputed from the angles (setpoint levels, ok rows only): no --hysteresis given")
+    per_actuator = aggregate_per_actuator(angles)
+    rms = pd.concat(
+        [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms], ignore_index=True
+    ) if inputs.rms else pd.DataFrame(columns=["material"])
+    if rms["material"].duplicated().any():
+        dup = rms.loc[rms["material"].duplicated(), "material"].iloc[0]
+        raise UserInputError(f"--rms: material {dup!r} appears twice; pass one rms.csv row per material")
+    curves = pd.concat(
+        [_read_csv(p, "model curve CSV from 'model curve'", ("material", "psi_deg", "pressure_kpa"))
+         for p in inputs.model_curves], ignore_index=True
+    ) if inputs.model_curves else pd.DataFrame(columns=["material", "psi_deg", "pressure_kpa"])
+    if not inputs.model_curves:
+        notes.append("no --model-curves given: plots show the measurements only")
+    files: list[Path] = [d.angles_csv for d in inputs.datasets]
+    files += list(inputs.hysteresis) + list(inputs.rms) + list(inputs.model_curves)
+    if inputs.config is not None:
+        files.append(inputs.config)
+    digests = {str(p): sha256_file(p) for p in files}
+    return ReportData(
+        inputs=inputs, angles=angles, hysteresis=hysteresis, per_actuator=per_actuator, rms=rms,
+        model_curves=curves, digests=digests, notes=notes,
+    )
+
+
+def rms_row(data: ReportData, material: str) -> dict[str, float]:
+    """rms.csv row of a material as a dict (empty when absent)."""
+    sel = data.rms[data.rms["material"].astype(str) == material]
+    if sel.empty:
+        return {}
+    return {k: v for k, v in sel.iloc[0].to_dict().items()}
+
+
+def fmt(value: object, digits: int = 0, unit: str = "") -> str:
+    """Number as text for a table: ``"n/a"`` for missing/NaN values."""
+    try:
+        x = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return "n/a"
+    if not math.isfinite(x):
+        return "n/a"
+    return f"{x:.{digits}f}{unit}"

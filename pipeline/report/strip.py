@@ -1,0 +1,135 @@
+"""Fig. 5-style strip: one actuator's photos across the pressure ramp, with the extracted line.
+
+Photos come from the ``measure --overlays`` folder (``<image stem>.jpg``, line and psi drawn) when
+present, else the raw photo from the photo-set folder (and the strip says so).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+
+from pipeline.report.data import Dataset, ReportData
+
+#: photos per strip
+STRIP_PHOTOS = 6
+#: widest thumbnail kept (px); larger photos are reduced with area averaging
+THUMB_MAX_WIDTH_PX = 480
+
+
+@dataclass(frozen=True)
+class StripPhoto:
+    """One photo of the strip.
+
+    Attributes
+    ----------
+    image : numpy.ndarray or None
+        RGB uint8 thumbnail; ``None`` when the file is missing or unreadable.
+    pressure_kpa : float
+    psi_deg : float
+        Measured psi (NaN when the measurement failed).
+    status : str
+    source : str
+        ``"overlay"``, ``"raw"`` or ``"missing"``.
+    """
+
+    image: np.ndarray | None
+    pressure_kpa: float
+    psi_deg: float
+    status: str
+    source: str
+
+
+@dataclass(frozen=True)
+class Strip:
+    """The strip of one material: which ramp and its photos."""
+
+    material: str
+    dataset: str
+    actuator: str
+    trial: str
+    direction: str
+    photos: tuple[StripPhoto, ...]
+
+    @property
+    def note(self) -> str:
+        """What the photos are, for the caption."""
+        sources = {p.source for p in self.photos}
+        if sources == {"overlay"}:
+            return "extracted line and psi drawn by 'measure --overlays'"
+        if "overlay" in sources:
+            return "overlays where available, raw photos elsewhere (no overlay file for some images)"
+        if "raw" in sources:
+            return "raw photos: no overlays found (run 'measure --overlays DIR' to draw the extracted line)"
+        return "no photos found (pass --photosets / --overlays)"
+
+
+def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX) -> np.ndarray | None:
+    """RGB thumbnail of an image file, at most ``max_width_px`` wide; ``None`` if unreadable."""
+    if not path.is_file():
+        return None
+    data = np.fromfile(str(path), dtype=np.uint8)
+    bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    if bgr is None:
+        return None
+    h, w = bgr.shape[:2]
+    if w > max_width_px:
+        bgr = cv2.resize(bgr, (max_width_px, max(1, round(h * max_width_px / w))), interpolation=cv2.INTER_AREA)
+    return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+
+
+def pick_ramp(angles: pd.DataFrame, material: str) -> pd.DataFrame:
+    """Rows of the first ramp (dataset, actuator, trial, direction) of ``material`` in sorted order.
+
+    Increasing pressure is preferred (as Fig. 5); the rows are in ramp order.
+    """
+    m = angles[angles["material"].astype(str) == material].copy()
+    if m.empty:
+        return m
+    m["actuator"] = m["actuator"].astype(str)
+    m["trial"] = m["trial"].astype(str)
+    direction = "up" if (m["direction"] == "up").any() else "down"
+    m = m[m["direction"] == direction]
+    first = m.sort_values(["dataset", "actuator", "trial"], kind="stable").iloc[0]
+    ramp = m[(m["dataset"] == first["dataset"]) & (m["actuator"] == first["actuator"]) & (m["trial"] == first["trial"])]
+    return ramp.sort_values("pressure_kpa", ascending=(direction == "up"), kind="stable")
+
+
+def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -> Strip | None:
+    """Choose up to ``n_photos`` photos evenly spread over one ramp of ``material``.
+
+    Returns
+    -------
+    Strip or None
+        ``None`` when the material has no angles rows.
+    """
+    ramp = pick_ramp(data.angles, material)
+    if ramp.empty:
+        return None
+    first = ramp.iloc[0]
+    dataset: Dataset = next(d for d in data.inputs.datasets if d.name == first["dataset"])
+    idx = np.unique(np.round(np.linspace(0, len(ramp) - 1, min(n_photos, len(ramp)))).astype(int))
+    photos = []
+    for i in idx:
+        row = ramp.iloc[int(i)]
+        image, source = None, "missing"
+        if dataset.overlays_dir is not None:
+            image = load_thumbnail(dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"))
+            source = "overlay" if image is not None else source
+        if image is None and dataset.photoset_dir is not None:
+            image = load_thumbnail(dataset.photoset_dir / str(row["image"]))
+            source = "raw" if image is not None else source
+        photos.append(
+            StripPhoto(
+                image=image, pressure_kpa=float(row["pressure_kpa"]), psi_deg=float(row["psi_deg"]),
+                status=str(row["status"]), source=source,
+            )
+        )
+    return Strip(
+        material=material, dataset=str(first["dataset"]), actuator=str(first["actuator"]),
+        trial=str(first["trial"]), direction=str(first["direction"]), photos=tuple(photos),
+    )
