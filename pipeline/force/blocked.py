@@ -140,6 +140,60 @@ def line_flags(line: Any, length_px: float, expected_length_px: float | None) ->
     return flags
 
 
+def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndarray, int]:
+    """Paint over blobs of the line colour much thicker than the line (a dark clamp).
+
+    The marker line is thin; a clamp of the same dark colour is a thick blob whose lighter
+    details (frame, screw heads) can leave thin dark bits attached to the line end, which the
+    centre-line extraction would follow.  Each thick core (distance to the background above
+    ``r = max(2.5 w, w + 3)`` px, ``w`` the line's half width, after a morphological closing of
+    size ``4 r`` that fills the blob's light details), its convex hull grown by ``r`` plus a line
+    width, is filled with the image's median colour.
+
+    Parameters
+    ----------
+    image_bgr : ndarray (H, W, 3) uint8
+    line_color : str or mapping
+        Marker colour (see :func:`pipeline.photoset.line_color_ranges`).
+
+    Returns
+    -------
+    image : ndarray
+        A copy with the blobs painted over (the input itself when there is none).
+    n_blobs : int
+        How many blobs were painted over.
+    """
+    import cv2
+
+    from pipeline.measure.extract import line_mask
+
+    mask = (line_mask(image_bgr, line_color) > 0).astype(np.uint8)
+    if not mask.any():
+        return image_bgr, 0
+    dt = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
+    ridge = (dt > 0) & (dt >= cv2.dilate(dt, np.ones((3, 3), np.uint8)))
+    half_width = float(np.median(dt[ridge])) if ridge.any() else 0.5
+    radius = max(2.5 * half_width, half_width + 3.0)
+    # close the blob's lighter details (frame, screw heads) so it reads as one solid thick blob
+    k = 2 * int(np.ceil(2.0 * radius)) + 1
+    solid = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    dt = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
+    n, labels = cv2.connectedComponents((dt > radius).astype(np.uint8), connectivity=8)
+    if n <= 1:
+        return image_bgr, 0
+    out = image_bgr.copy()
+    fill = np.median(image_bgr.reshape(-1, 3), axis=0).astype(np.uint8)
+    grow = int(np.ceil(radius + 2.0 * half_width + 4.0))
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * grow + 1, 2 * grow + 1))
+    for k in range(1, n):
+        ys, xs = np.nonzero(labels == k)
+        hull = cv2.convexHull(np.c_[xs, ys].astype(np.int32))
+        blob = np.zeros(mask.shape, np.uint8)
+        cv2.fillConvexPoly(blob, hull, 1)
+        out[cv2.dilate(blob, disc) > 0] = fill
+    return out, n - 1
+
+
 def measure_blocked_image(
     image_bgr: np.ndarray | None,
     *,
@@ -148,6 +202,7 @@ def measure_blocked_image(
     line_color: Any = "black",
     fixed_end_px: tuple[float, float] | None = None,
     refine: Refine = "auto",
+    blank_clamp: bool = True,
     **fit_options: Any,
 ) -> EccentricityResult:
     """Eccentricity of the marker line in one blocked-force photo.
@@ -166,6 +221,9 @@ def measure_blocked_image(
         Near the clamped end; only helps the extraction pick the line's ends.
     refine : {"auto", "always", "never"}
         Geometric refinement of the ellipse (see :func:`pipeline.force.ellipse.fit_ellipse`).
+    blank_clamp : bool
+        Paint over thick blobs of the line colour (a dark clamp) first, see
+        :func:`blank_thick_blobs`.
     **fit_options
         Further thresholds of :func:`~pipeline.force.ellipse.fit_ellipse`.
 
@@ -177,6 +235,8 @@ def measure_blocked_image(
 
     if image_bgr is None:
         return _failed("unreadable image (cannot be decoded)")
+    if blank_clamp:
+        image_bgr = blank_thick_blobs(image_bgr, line_color)[0]
     try:
         line = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px)
     except NoLineFound as exc:
