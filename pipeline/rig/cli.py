@@ -150,6 +150,11 @@ def run_calibration(rig: Any, points_kpa: list[float], *, settle_s: float, sampl
         kpa.append(float(np.mean(readings)))
     rig.vent()
     keep = [0] + [i for i in range(1, len(kpa)) if kpa[i] > max(kpa[:i]) + 0.5]
+    if (method or ("linear" if len(keep) == 2 else "piecewise")) == "linear":
+        # code 0 vents (a dead zone, not on the regulator's line): fit the line through pressurised points
+        pressurised = [i for i in keep if codes[i] > 0]
+        if len(pressurised) >= 2:
+            keep, method = pressurised, "linear"
     name = f"{rig.info.name} {rig.info.version}" if rig.info else ""
     return fit_calibration([codes[i] for i in keep], [kpa[i] for i in keep], method, max_kpa=max_kpa, device=name)
 

@@ -31,6 +31,13 @@ from pipeline.rig.protocol import BAUDRATE, Reply, encode, parse_reply
 
 log = logging.getLogger(__name__)
 
+try:  # POSIX: a hung-up tty raises termios.error (not an OSError) from tcdrain/tcsetattr
+    import termios
+
+    _PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, termios.error)
+except ImportError:  # pragma: no cover - Windows
+    _PORT_ERRORS = (serial.SerialException, OSError)
+
 #: garbage lines tolerated while waiting for one reply
 MAX_GARBAGE_PER_REPLY = 20
 
@@ -132,7 +139,7 @@ class PicoDriver:
         """
         try:
             link = serial.serial_for_url(port, baudrate=BAUDRATE, timeout=0.05, write_timeout=timeout_s)
-        except (serial.SerialException, OSError, ValueError) as exc:
+        except (*_PORT_ERRORS, ValueError) as exc:
             raise PortLostError(f"cannot open serial port {port!r}: {exc}; check the cable and the --port name") from exc
         driver = cls(link, max_kpa=max_kpa, calibration=calibration, timeout_s=timeout_s)
         try:
@@ -285,7 +292,7 @@ class PicoDriver:
     def _drain(self) -> None:
         try:
             self.link.reset_input_buffer()
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise PortLostError(f"serial port {self.link.port!r} failed: {exc}") from exc
         self._buf = b""
 
@@ -295,7 +302,7 @@ class PicoDriver:
             try:
                 waiting = self.link.in_waiting
                 chunk = self.link.read(max(1, waiting)) if waiting or time.monotonic() < deadline else b""
-            except (serial.SerialException, OSError) as exc:
+            except _PORT_ERRORS as exc:
                 raise PortLostError(
                     f"serial port {self.link.port!r} lost ({exc}); reconnect the rig and re-run the same command to resume"
                 ) from exc
@@ -319,7 +326,7 @@ class PicoDriver:
             try:
                 self.link.write(encode(command, *args))
                 self.link.flush()
-            except (serial.SerialException, OSError) as exc:
+            except _PORT_ERRORS as exc:
                 raise PortLostError(
                     f"serial port {self.link.port!r} lost while sending {command} ({exc}); "
                     "reconnect the rig and re-run the same command to resume"
