@@ -30,9 +30,19 @@ PSI = np.linspace(210.0, -360.0, 97)
 #: every combination of the readings that define a rest state (Eq. 5 and the k_t scaling as
 #: printed do not: see test_as_printed_readings_are_nan_not_garbage)
 ALL_READINGS = [
-    dict(zip(("jacobian", "l0_factor", "pressure_area", "thickness_phi", "kt_scaling"), combo, strict=True))
+    dict(
+        zip(
+            ("jacobian", "l0_factor", "pressure_area", "thickness_phi", "kt_scaling"),
+            combo,
+            strict=True,
+        )
+    )
     for combo in itertools.product(
-        ("none", "deformed"), ("metres", "none"), ("half_disc", "segment"), ("mean", "crown"), ("one_minus", "none")
+        ("none", "deformed"),
+        ("metres", "none"),
+        ("half_disc", "segment"),
+        ("mean", "crown"),
+        ("one_minus", "none"),
     )
 ]
 #: a smaller set for the costlier inverse tests: the default, then each option flipped once
@@ -73,8 +83,12 @@ def test_ds30_three_terms_equal_one_summed_term(reading: dict) -> None:
     ds30 = load_materials()["DS30"]
     assert len(ds30.mu_mpa) == 3  # kept as printed in the data file
     single = dataclasses.replace(ds30, mu_mpa=(sum(ds30.mu_mpa),), alpha=(ds30.alpha[0],))
-    np.testing.assert_allclose(pressure_kpa(single, PSI, **reading), pressure_kpa("DS30", PSI, **reading),
-                               rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        pressure_kpa(single, PSI, **reading),
+        pressure_kpa("DS30", PSI, **reading),
+        rtol=1e-12,
+        atol=1e-12,
+    )
 
 
 def test_ds20_terms_are_never_merged() -> None:
@@ -83,7 +97,9 @@ def test_ds20_terms_are_never_merged() -> None:
     assert len(mu) == 3 and sorted(alpha) == sorted(ds20.alpha)
     lam = np.linspace(0.8, 2.5, 50)
     exact = sum(m * (lam**a - lam ** (-a)) for m, a in zip(ds20.mu_mpa, ds20.alpha, strict=True))
-    np.testing.assert_allclose(axial_stress_mpa(lam, np.ones_like(lam), mu, alpha), exact, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        axial_stress_mpa(lam, np.ones_like(lam), mu, alpha), exact, rtol=1e-12, atol=1e-15
+    )
     merged = sum(ds20.mu_mpa) * (lam ** np.mean(ds20.alpha) - lam ** (-np.mean(ds20.alpha)))
     assert np.max(np.abs(merged - exact)) > 0.1 * np.max(np.abs(exact))
 
@@ -96,22 +112,33 @@ def test_ogden_stress_is_lambda_dW_dlambda_minus_pressure() -> None:
     h = 1e-6
 
     def w(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:  # unconstrained W(l1, l2, l3)
-        return sum(m / al * (a**al + b**al + c**al - 3) for m, al in zip(ds20.mu_mpa, ds20.alpha, strict=True))
+        return sum(
+            m / al * (a**al + b**al + c**al - 3)
+            for m, al in zip(ds20.mu_mpa, ds20.alpha, strict=True)
+        )
 
     l3 = 1 / (l1 * l2)
     d1 = (w(l1 + h, l2, l3) - w(l1 - h, l2, l3)) / (2 * h)
     d3 = (w(l1, l2, l3 + h) - w(l1, l2, l3 - h)) / (2 * h)
-    np.testing.assert_allclose(axial_stress_mpa(l1, l2, ds20.mu_mpa, ds20.alpha), l1 * d1 - l3 * d3, rtol=1e-6)
-    assert float(strain_energy_mpa(np.array(1.0), np.array(1.0), ds20.mu_mpa, ds20.alpha)) == pytest.approx(0.0)
+    np.testing.assert_allclose(
+        axial_stress_mpa(l1, l2, ds20.mu_mpa, ds20.alpha), l1 * d1 - l3 * d3, rtol=1e-6
+    )
+    assert float(
+        strain_energy_mpa(np.array(1.0), np.array(1.0), ds20.mu_mpa, ds20.alpha)
+    ) == pytest.approx(0.0)
 
 
 @pytest.mark.parametrize("reading", FEW_READINGS, ids=_rid)
 def test_pressure_proportional_to_k_p(reading: dict) -> None:
     for name in MATERIAL_NAMES:
         base = pressure_kpa(name, PSI, k_p=1.0, **reading)
-        np.testing.assert_allclose(pressure_kpa(name, PSI, k_p=3.7, **reading), 3.7 * base, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(
+            pressure_kpa(name, PSI, k_p=3.7, **reading), 3.7 * base, rtol=1e-12, atol=1e-12
+        )
         mat = load_materials()[name]
-        np.testing.assert_allclose(pressure_kpa(name, PSI, **reading), mat.k_p * base, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(
+            pressure_kpa(name, PSI, **reading), mat.k_p * base, rtol=1e-12, atol=1e-12
+        )
 
 
 @pytest.mark.parametrize("branch", ["loading", "unloading"])
@@ -139,7 +166,9 @@ def test_loading_branch_is_non_increasing(reading: dict) -> None:
         assert np.all(np.isfinite(psi[: finite.size]))
 
 
-@pytest.mark.parametrize("reading", [{}, {"jacobian": "deformed", "pressure_area": "segment"}], ids=_rid)
+@pytest.mark.parametrize(
+    "reading", [{}, {"jacobian": "deformed", "pressure_area": "segment"}], ids=_rid
+)
 def test_quadrature_converged(reading: dict) -> None:
     """Halving the node spacing (doubling every node count) changes P by < 1e-6 relative."""
     d = ModelOptions()
@@ -224,8 +253,12 @@ def test_snap_regions_match_the_inverse() -> None:
     assert after == pytest.approx(load.psi_to_deg, abs=2.0)
     assert before - after > 30
     unload = snaps[snaps.branch == "unloading"].iloc[0]
-    hi, lo = psi_deg("DS20", [unload.pressure_kpa * (1 + 1e-6), unload.pressure_kpa * (1 - 1e-6)],
-                     branch="unloading", **reading)
+    hi, lo = psi_deg(
+        "DS20",
+        [unload.pressure_kpa * (1 + 1e-6), unload.pressure_kpa * (1 - 1e-6)],
+        branch="unloading",
+        **reading,
+    )
     assert lo - hi > 30
     # monotonic under the default reading: nothing to report
     for name in MATERIAL_NAMES:
@@ -274,14 +307,22 @@ def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
     assert cli_main(["model", "pressure", "--material", "SS50", "--psi-deg", "0"]) == 0
     printed = float(capsys.readouterr().out.strip())
     assert printed == pytest.approx(float(pressure_kpa("SS50", 0.0)), rel=1e-5)
-    assert cli_main(["model", "psi", "--material", "DS20", "--pressure-kpa", "50", "--kt-scaling", "none"]) == 0
-    assert float(capsys.readouterr().out.strip()) == pytest.approx(float(psi_deg("DS20", 50.0, kt_scaling="none")),
-                                                                   rel=1e-5)
+    assert (
+        cli_main(
+            ["model", "psi", "--material", "DS20", "--pressure-kpa", "50", "--kt-scaling", "none"]
+        )
+        == 0
+    )
+    assert float(capsys.readouterr().out.strip()) == pytest.approx(
+        float(psi_deg("DS20", 50.0, kt_scaling="none")), rel=1e-5
+    )
     out = tmp_path / "curve.csv"
     assert cli_main(["model", "curve", "--material", "DS20", "--out", str(out), "--n", "50"]) == 0
     df = pd.read_csv(out)
     assert len(df) == 50 and df.psi_deg.iloc[0] == 210.0
-    np.testing.assert_allclose(df.pressure_kpa, pressure_kpa("DS20", df.psi_deg), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        df.pressure_kpa, pressure_kpa("DS20", df.psi_deg), rtol=1e-12, atol=1e-12
+    )
     capsys.readouterr()
     assert cli_main(["model", "calibrate"]) == 0
     text = capsys.readouterr().out
@@ -291,9 +332,16 @@ def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
 
 def test_cli_materials_option(tmp_path, capsys) -> None:
     path = tmp_path / "m.yaml"
-    path.write_text("geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 250}\n"
-                    "materials:\n  NEW: {mu_mpa: 0.3, alpha: 2.0, k_p: 1.0}\n")
-    assert cli_main(["model", "pressure", "--materials", str(path), "--material", "NEW", "--psi-deg", "0"]) == 0
+    path.write_text(
+        "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 250}\n"
+        "materials:\n  NEW: {mu_mpa: 0.3, alpha: 2.0, k_p: 1.0}\n"
+    )
+    assert (
+        cli_main(
+            ["model", "pressure", "--materials", str(path), "--material", "NEW", "--psi-deg", "0"]
+        )
+        == 0
+    )
     value = float(capsys.readouterr().out.strip())
     assert value == pytest.approx(float(pressure_kpa(load_materials(path)["NEW"], 0.0)), rel=1e-5)
     assert math.isfinite(value) and value > 0

@@ -1,4 +1,4 @@
-"""``python -m pipeline model ...``: P(psi) curves, single values, k_P calibration table, benchmark."""
+"""``python -m pipeline model ...``: P(psi) curves, single values, anchor table, benchmark."""
 
 from __future__ import annotations
 
@@ -16,8 +16,10 @@ from pipeline.model.options import CHOICES, ModelOptions
 _DEFAULTS = ModelOptions()
 
 _OPTION_HELP = {
-    "eq5": "reading of Eq. 5 (arc_length: A0/(2 phi_m t) - t/2 = a0/sin phi_m; as_printed has no root)",
-    "kt_scaling": "Dragon Skin thickness scaling (one_minus: t (1 - k_t|psi-psi0|/psi0); as_printed: t k_t (1 - ...))",
+    "eq5": "reading of Eq. 5 (arc_length: A0/(2 phi_m t) - t/2 = a0/sin phi_m; "
+    "as_printed has no root)",
+    "kt_scaling": "Dragon Skin thickness scaling (one_minus: t (1 - k_t|psi-psi0|/psi0); "
+    "as_printed: t k_t (1 - |psi-psi0|/psi0))",
     "jacobian": "Eq. 12 wall area element (none: as printed; deformed: times (2 phi_m/pi)(t/t0))",
     "l0_factor": "Eq. 12 l0 prefactor (metres: as printed, l0 in m; none: dropped)",
     "pressure_area": "Eq. 13 area (half_disc: as printed; segment: real chamber cut by the base)",
@@ -27,14 +29,30 @@ _OPTION_HELP = {
 
 def _reading_parent() -> argparse.ArgumentParser:
     parent = argparse.ArgumentParser(add_help=False)
-    parent.add_argument("--materials", metavar="PATH", type=Path, default=None,
-                        help="materials YAML (default: the packaged pipeline/model/materials.yaml)")
+    parent.add_argument(
+        "--materials",
+        metavar="PATH",
+        type=Path,
+        default=None,
+        help="materials YAML (default: the packaged pipeline/model/materials.yaml)",
+    )
     for key, choices in CHOICES.items():
-        parent.add_argument(f"--{key.replace('_', '-')}", dest=key, choices=choices, default=None,
-                            help=f"{_OPTION_HELP[key]}; default {getattr(_DEFAULTS, key)}")
-    parent.add_argument("--l0-mm", type=float, default=None,
-                        help="override the inextensible-layer length l0 (mm); default from the materials file")
-    parent.add_argument("--k-p", type=float, default=None, help="override the pressure scale k_P (dimensionless)")
+        parent.add_argument(
+            f"--{key.replace('_', '-')}",
+            dest=key,
+            choices=choices,
+            default=None,
+            help=f"{_OPTION_HELP[key]}; default {getattr(_DEFAULTS, key)}",
+        )
+    parent.add_argument(
+        "--l0-mm",
+        type=float,
+        default=None,
+        help="override the inextensible-layer length l0 (mm); default from the materials file",
+    )
+    parent.add_argument(
+        "--k-p", type=float, default=None, help="override the pressure scale k_P (dimensionless)"
+    )
     return parent
 
 
@@ -42,27 +60,56 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``model`` sub-subcommands to ``parser``."""
     parent = _reading_parent()
     sub = parser.add_subparsers(dest="model_command", metavar="ACTION", required=True)
-    p = sub.add_parser("curve", parents=[parent], help="write P(psi) (kPa) over an angle range to CSV")
+    p = sub.add_parser(
+        "curve", parents=[parent], help="write P(psi) (kPa) over an angle range to CSV"
+    )
     p.add_argument("--material", required=True, help="material name, e.g. DS20, DS30, SS40, SS50")
-    p.add_argument("--out", type=Path, required=True, help="output CSV: material, psi_deg, pressure_kpa, reason")
-    p.add_argument("--psi-max", type=float, default=None, help="first angle (deg); default psi0 = 210")
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="output CSV: material, psi_deg, pressure_kpa, reason",
+    )
+    p.add_argument(
+        "--psi-max", type=float, default=None, help="first angle (deg); default psi0 = 210"
+    )
     p.add_argument("--psi-min", type=float, default=-360.0, help="last angle (deg); default -360")
     p.add_argument("--n", type=int, default=400, help="number of angles (default 400)")
-    p = sub.add_parser("pressure", parents=[parent], help="print the pressure (kPa) needed for an angle")
+    p = sub.add_parser(
+        "pressure", parents=[parent], help="print the pressure (kPa) needed for an angle"
+    )
     p.add_argument("--material", required=True, help="material name")
-    p.add_argument("--psi-deg", type=float, required=True, nargs="+", help="bending angle(s) psi in degrees")
+    p.add_argument(
+        "--psi-deg", type=float, required=True, nargs="+", help="bending angle(s) psi in degrees"
+    )
     p = sub.add_parser("psi", parents=[parent], help="print the angle (deg) reached at a pressure")
     p.add_argument("--material", required=True, help="material name")
-    p.add_argument("--pressure-kpa", type=float, required=True, nargs="+", help="input pressure(s) in kPa")
-    p.add_argument("--branch", choices=("loading", "unloading"), default="loading",
-                   help="rising (loading) or falling (unloading) pressure; default loading")
-    sub.add_parser("calibrate", parents=[parent],
-                   help="print the paper's anchors: paper value, ours, %% off")
-    p = sub.add_parser("snaps", parents=[parent], help="print snap-through regions of P(psi) per material")
+    p.add_argument(
+        "--pressure-kpa", type=float, required=True, nargs="+", help="input pressure(s) in kPa"
+    )
+    p.add_argument(
+        "--branch",
+        choices=("loading", "unloading"),
+        default="loading",
+        help="rising (loading) or falling (unloading) pressure; default loading",
+    )
+    sub.add_parser(
+        "calibrate", parents=[parent], help="print the paper's anchors: paper value, ours, %% off"
+    )
+    p = sub.add_parser(
+        "snaps", parents=[parent], help="print snap-through regions of P(psi) per material"
+    )
     p.add_argument("--material", default=None, help="one material (default: all)")
-    p = sub.add_parser("bench", help="print time (ms) per quadrature grid size and convergence error")
-    p.add_argument("--grid-sizes", type=int, nargs="+", default=[2, 3, 4, 6, 8, 12],
-                   help="grid sizes n (n_tau = n, n_phi = 2n nodes); default 2 3 4 6 8 12")
+    p = sub.add_parser(
+        "bench", help="print time (ms) per quadrature grid size and convergence error"
+    )
+    p.add_argument(
+        "--grid-sizes",
+        type=int,
+        nargs="+",
+        default=[2, 3, 4, 6, 8, 12],
+        help="grid sizes n (n_tau = n, n_phi = 2n nodes); default 2 3 4 6 8 12",
+    )
 
 
 def _options(args: argparse.Namespace) -> dict[str, object]:
@@ -73,8 +120,10 @@ def _options(args: argparse.Namespace) -> dict[str, object]:
 def _material(args: argparse.Namespace, name: str) -> Material:
     table = load_materials(args.materials)
     if name not in table:
-        raise UserInputError(f"--material {name!r} is not in {args.materials or 'the packaged materials'}; "
-                             f"choose one of {sorted(table)}")
+        raise UserInputError(
+            f"--material {name!r} is not in {args.materials or 'the packaged materials'}; "
+            f"choose one of {sorted(table)}"
+        )
     return table[name]
 
 
@@ -98,7 +147,9 @@ def run(args: argparse.Namespace) -> int:
         df = model_curve(mat, np.linspace(top, args.psi_min, args.n), **opts)
         args.out.parent.mkdir(parents=True, exist_ok=True)
         df.to_csv(args.out, index=False)
-        print(f"wrote {len(df)} angles to {args.out} ({int(df.pressure_kpa.isna().sum())} undefined)")
+        print(
+            f"wrote {len(df)} angles to {args.out} ({int(df.pressure_kpa.isna().sum())} undefined)"
+        )
     elif cmd == "pressure":
         mat = _material(args, args.material)
         for psi, p in zip(args.psi_deg, pressure_kpa(mat, args.psi_deg, **opts), strict=True):
@@ -107,11 +158,17 @@ def run(args: argparse.Namespace) -> int:
         mat = _material(args, args.material)
         out = psi_deg(mat, args.pressure_kpa, branch=args.branch, **opts)
         for p, psi in zip(args.pressure_kpa, out, strict=True):
-            print(f"{psi:.6g}" if len(args.pressure_kpa) == 1 else f"pressure_kpa={p:g} psi_deg={psi:.6g}")
+            print(
+                f"{psi:.6g}"
+                if len(args.pressure_kpa) == 1
+                else f"pressure_kpa={p:g} psi_deg={psi:.6g}"
+            )
     elif cmd == "calibrate":
         df = anchor_table(load_materials(args.materials), **opts)
         with pd.option_context("display.width", 200, "display.max_colwidth", 60):
-            print(df.drop(columns=["group"]).to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+            print(
+                df.drop(columns=["group"]).to_string(index=False, float_format=lambda v: f"{v:.1f}")
+            )
     elif cmd == "snaps":
         table = load_materials(args.materials)
         names = [args.material] if args.material else list(table)

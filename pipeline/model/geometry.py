@@ -61,7 +61,9 @@ def rest_heights(mat: Material, tau: FloatArray, phi: FloatArray) -> FloatArray:
     return mat.b_mm + (mat.a0_mm + tau) * np.cos(phi)
 
 
-def wall_thickness(mat: Material, psi: FloatArray, l0: float, opts: ModelOptions) -> tuple[FloatArray, FloatArray]:
+def wall_thickness(
+    mat: Material, psi: FloatArray, l0: float, opts: ModelOptions
+) -> tuple[FloatArray, FloatArray]:
     """Eq. 4 plus the k_t scaling: deformed wall thickness t for each angle.
 
     The axial stretch inside Eq. 4 is taken on the undeformed section (first pass; the paper then
@@ -105,7 +107,9 @@ def wall_thickness(mat: Material, psi: FloatArray, l0: float, opts: ModelOptions
     return np.where(reason == OK, t, np.nan), reason
 
 
-def _eq5_area_residual(mat: Material, phi_m: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _eq5_area_residual(
+    mat: Material, phi_m: FloatArray, t: FloatArray
+) -> tuple[FloatArray, FloatArray]:
     """F(phi_m) = 2 phi_m t (a0/sin(phi_m) + t/2) - A0 and dF/dphi_m (arc-length reading of Eq. 5).
 
     F = 0 is Eq. 5 multiplied by 2 phi_m t; F is increasing and convex on (0, pi), so Newton's
@@ -118,7 +122,9 @@ def _eq5_area_residual(mat: Material, phi_m: FloatArray, t: FloatArray) -> tuple
     return f, df
 
 
-def solve_phi_m(mat: Material, t: FloatArray, opts: ModelOptions, max_iter: int = 60) -> tuple[FloatArray, FloatArray]:
+def solve_phi_m(
+    mat: Material, t: FloatArray, opts: ModelOptions, max_iter: int = 60
+) -> tuple[FloatArray, FloatArray]:
     """Eq. 5: half angle phi_m of the deformed wall arc for each wall thickness ``t``.
 
     ``eq5="as_printed"`` solves sin(phi_m) = (A0/t - 2 a0)/t on the branch phi_m >= pi/2 (no root
@@ -143,23 +149,52 @@ def solve_phi_m(mat: Material, t: FloatArray, opts: ModelOptions, max_iter: int 
     tt = np.where(ok, tt, mat.t0_mm)
     half = np.full_like(tt, 0.5 * math.pi)
     f_half, df_half = _eq5_area_residual(mat, half, tt)
-    # start at the root of the second-order Taylor expansion about pi/2 (F'' = pi t a0 there),
-    # capped by a point known to be right of the root (F > 0 where pi t a0 / cos(theta) > A0)
+    # start: the root of the second-order Taylor expansion of F about pi/2 (F'' = pi t a0), or
+    # for thin walls the asymptote sin(phi_m) = a0 / (A0/(2 pi t) - t/2), whichever is smaller
     curv = math.pi * tt * mat.a0_mm
     disc = df_half**2 - 2.0 * curv * f_half
     theta = np.where(disc >= 0, (np.sqrt(np.maximum(disc, 0.0)) - df_half) / curv, 0.0)
-    theta_up = np.arccos(np.clip(curv / mat.area0_mm2, 0.0, 1.0))
-    x = half + np.where(f_half >= 0, theta, np.minimum(theta, theta_up))
+    with np.errstate(all="ignore"):
+        r_pi = mat.area0_mm2 / (2.0 * math.pi * tt) - 0.5 * tt
+        thin = math.pi - np.arcsin(np.clip(mat.a0_mm / r_pi, 0.0, 1.0))
+    x = np.clip(np.minimum(half + theta, np.where(r_pi > 0, thin, math.pi)), 1e-9, math.pi - 1e-12)
+    # Newton on G = sin(phi_m) (A0/(2 phi_m t) - t/2) - a0 (Eq. 5 times sin phi_m): nearly linear
+    # near pi, smooth at pi/2; converges in 3-4 steps from this start
+    with np.errstate(all="ignore"):
+        for _ in range(8):
+            s_, c_ = np.sin(x), np.cos(x)
+            r = mat.area0_mm2 / (2.0 * x * tt) - 0.5 * tt
+            g = s_ * r - mat.a0_mm
+            dg = c_ * r - s_ * mat.area0_mm2 / (2.0 * x * x * tt)
+            x_new = np.clip(x - g / dg, 1e-9, math.pi - 1e-12)
+            done = np.max(np.abs(x_new - x), initial=0.0, where=ok) < 1e-12
+            x = x_new
+            if done:
+                break
+    f, _ = _eq5_area_residual(mat, x, tt)
+    slow = ok & ~(np.abs(f) <= 1e-9 * mat.area0_mm2)
+    if slow.any():  # safeguard: monotone Newton on F from a point right of the root
+        x[slow] = _solve_monotone(mat, tt[slow], f_half[slow], df_half[slow])
+    phi_m = np.where(ok, x, np.nan)
+    return phi_m, np.where(ok | ~valid, OK, NO_EQ5_ROOT)
+
+
+def _solve_monotone(
+    mat: Material, tt: FloatArray, f_half: FloatArray, df_half: FloatArray, max_iter: int = 100
+) -> FloatArray:
+    """Newton on the increasing convex F from a start right of the root (always converges)."""
+    half = np.full_like(tt, 0.5 * math.pi)
+    theta_up = np.arccos(np.clip(math.pi * tt * mat.a0_mm / mat.area0_mm2, 0.0, 1.0))
+    x = np.where(f_half >= 0, half, np.minimum(half + theta_up, half - f_half / df_half))
     x = np.clip(x, 1e-12, math.pi - 1e-12)
     for _ in range(max_iter):
         f, df = _eq5_area_residual(mat, x, tt)
         x_new = np.clip(x - f / df, 1e-12, math.pi - 1e-12)
-        done = np.max(np.abs(x_new - x), initial=0.0) < 1e-12
+        done = np.max(np.abs(x_new - x), initial=0.0) < 1e-13
         x = x_new
-        if done:  # quadratic convergence: the next step is at round-off
+        if done:
             break
-    phi_m = np.where(ok, x, np.nan)
-    return phi_m, np.where(ok | ~valid, OK, NO_EQ5_ROOT)
+    return x
 
 
 @dataclass(frozen=True)

@@ -52,9 +52,9 @@ def _bracketed_root(
     """Vectorised bracketed root of P(psi) = target (inverse quadratic interpolation + Illinois).
 
     ``[a, b]`` brackets the root (``fa = P(a) - target`` and ``fb`` of opposite sign or zero);
-    ``(c, fc)`` is a third grid point; ``x0`` an optional first guess inside the bracket.  Each iteration
-    tries inverse quadratic interpolation through (a, b, c) and falls back to an Illinois
-    (modified regula falsi) step when that leaves the bracket, so the root never leaves [a, b].
+    ``(c, fc)`` is a third grid point; ``x0`` an optional first guess inside the bracket.
+    Each iteration tries inverse quadratic interpolation through (a, b, c) and falls back to an
+    Illinois (modified regula falsi) step when that leaves the bracket, so the root stays in [a, b].
     """
     a, fa, b, fb, c, fc = (v.astype(float, copy=True) for v in (a, fa, b, fb, c, fc))
     wa = np.ones_like(a)  # Illinois weight of fa in the fallback secant
@@ -66,9 +66,11 @@ def _bracketed_root(
             if idx.size == 0:
                 break
             ai, bi, ci, fai, fbi, fci = a[idx], b[idx], c[idx], fa[idx], fb[idx], fc[idx]
-            iqi = (ai * fbi * fci / ((fai - fbi) * (fai - fci))
-                   + bi * fai * fci / ((fbi - fai) * (fbi - fci))
-                   + ci * fai * fbi / ((fci - fai) * (fci - fbi)))
+            iqi = (
+                ai * fbi * fci / ((fai - fbi) * (fai - fci))
+                + bi * fai * fci / ((fbi - fai) * (fbi - fci))
+                + ci * fai * fbi / ((fci - fai) * (fci - fbi))
+            )
             lo, hi = np.minimum(ai, bi), np.maximum(ai, bi)
             fw = wa[idx] * fai
             secant = (ai * fbi - bi * fw) / (fbi - fw)
@@ -80,7 +82,7 @@ def _bracketed_root(
             fx, _ = pressure_core(mat, xi, opts)
             fx = fx - target[idx]
             same = np.sign(fx) == np.sign(fbi)
-            # the new point replaces b; a stays if x fell on b's side (then Illinois halves its weight)
+            # the new point replaces b; a stays if x fell on b's side (Illinois: halve its weight)
             a[idx] = np.where(same, ai, bi)
             fa[idx] = np.where(same, fai, fbi)
             wa[idx] = np.where(same, 0.5 * wa[idx], 1.0)
@@ -92,7 +94,9 @@ def _bracketed_root(
     return x
 
 
-def _hermite_guess(x: FloatArray, f: FloatArray, j: NDArray[np.intp], target: FloatArray) -> FloatArray:
+def _hermite_guess(
+    x: FloatArray, f: FloatArray, j: NDArray[np.intp], target: FloatArray
+) -> FloatArray:
     """Root of the cubic Hermite interpolant of the grid P(psi) on [x[j-1], x[j]] (first guess)."""
     slope = np.gradient(f, x)
     h = x[j] - x[j - 1]
@@ -102,14 +106,24 @@ def _hermite_guess(x: FloatArray, f: FloatArray, j: NDArray[np.intp], target: Fl
         s = np.clip((target - f0) / (f1 - f0), 0.0, 1.0)
         for _ in range(4):  # Newton on the cubic in s (no model evaluations)
             s2, s3 = s * s, s * s * s
-            p = (2 * s3 - 3 * s2 + 1) * f0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * f1 + (s3 - s2) * m1
-            dp = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * f1 + (3 * s2 - 2 * s) * m1
+            p = (
+                (2 * s3 - 3 * s2 + 1) * f0
+                + (s3 - 2 * s2 + s) * m0
+                + (-2 * s3 + 3 * s2) * f1
+                + (s3 - s2) * m1
+            )
+            dp = (
+                (6 * s2 - 6 * s) * f0
+                + (3 * s2 - 4 * s + 1) * m0
+                + (-6 * s2 + 6 * s) * f1
+                + (3 * s2 - 2 * s) * m1
+            )
             s = np.clip(s - (p - target) / dp, 0.0, 1.0)
     return x[j - 1] + np.where(np.isfinite(s), s, 0.5) * h
 
 
 def psi_rad_core(mat: Material, p_kpa: FloatArray, opts: ModelOptions, branch: str) -> FloatArray:
-    """Bending angle (rad) reached at each pressure on ``branch``; NaN outside the modelled range."""
+    """Angle (rad) reached at each pressure on ``branch``; NaN outside the modelled range."""
     grid, p = _reachable_grid(mat, opts)
     out = np.full(p_kpa.shape, np.nan)
     if grid.size < 2:
@@ -136,8 +150,9 @@ def psi_rad_core(mat: Material, p_kpa: FloatArray, opts: ModelOptions, branch: s
         k = np.where(j + 1 < len(x), j + 1, j - 2)  # third point for the first quadratic step
         k = np.clip(k, 0, len(x) - 1)
         guess = _hermite_guess(x, f, j, tgt)
-        out[sel] = _bracketed_root(mat, opts, tgt, x[j - 1], f[j - 1] - tgt, x[j], f[j] - tgt,
-                                   x[k], f[k] - tgt, guess)
+        out[sel] = _bracketed_root(
+            mat, opts, tgt, x[j - 1], f[j - 1] - tgt, x[j], f[j] - tgt, x[k], f[k] - tgt, guess
+        )
     return out
 
 
@@ -168,7 +183,7 @@ def psi_deg(
     Examples
     --------
     >>> from pipeline.model import psi_deg
-    >>> float(psi_deg("SS50", 0.0))
+    >>> round(float(psi_deg("SS50", 0.0)), 9)
     210.0
     """
     if branch not in BRANCHES:
@@ -226,4 +241,6 @@ def snap_regions(material: str | Material, **options: Any) -> pd.DataFrame:
                 k = j + 1
             else:
                 k += 1
-    return pd.DataFrame(rows, columns=["material", "branch", "pressure_kpa", "psi_from_deg", "psi_to_deg"])
+    return pd.DataFrame(
+        rows, columns=["material", "branch", "pressure_kpa", "psi_from_deg", "psi_to_deg"]
+    )

@@ -98,16 +98,22 @@ def _number(value: Any, where: str, key: str) -> float:
 def _parse_material(name: str, raw: Any, geometry: dict[str, Any], where: str) -> Material:
     here = f"{where}: materials.{name}"
     if not isinstance(raw, dict):
-        raise UserInputError(f"{here} must be a mapping with keys mu_mpa, alpha, k_p (and optional k_t)")
+        raise UserInputError(
+            f"{here} must be a mapping with keys mu_mpa, alpha, k_p (and optional k_t)"
+        )
     for key in ("mu_mpa", "alpha", "k_p"):
         if key not in raw:
-            raise UserInputError(f"{here}: missing key '{key}'; add it (see pipeline/model/materials.yaml)")
+            raise UserInputError(
+                f"{here}: missing key '{key}'; add it (see pipeline/model/materials.yaml)"
+            )
     mu = raw["mu_mpa"] if isinstance(raw["mu_mpa"], list) else [raw["mu_mpa"]]
     alpha = raw["alpha"] if isinstance(raw["alpha"], list) else [raw["alpha"]]
     if len(alpha) == 1 and len(mu) > 1:  # one shared exponent, as Table I writes it for DS30
         alpha = alpha * len(mu)
     if len(mu) != len(alpha) or not mu:
-        raise UserInputError(f"{here}: 'mu_mpa' and 'alpha' must be lists of the same non-zero length")
+        raise UserInputError(
+            f"{here}: 'mu_mpa' and 'alpha' must be lists of the same non-zero length"
+        )
     mu_t = tuple(_number(m, here, "mu_mpa") for m in mu)
     alpha_t = tuple(_number(a, here, "alpha") for a in alpha)
     if any(a == 0.0 for a in alpha_t):
@@ -143,15 +149,24 @@ def _load_cached(path: str, mtime_ns: int) -> dict[str, Material]:
         with open(path, encoding="utf-8") as fh:
             data = yaml.safe_load(fh)
     except OSError as exc:
-        raise UserInputError(f"{where}: cannot read materials file ({exc.strerror}); check the path") from None
+        raise UserInputError(
+            f"{where}: cannot read materials file ({exc.strerror}); check the path"
+        ) from None
     except yaml.YAMLError as exc:
         raise UserInputError(f"{where}: not valid YAML ({exc}); fix the syntax") from None
     if not isinstance(data, dict) or not isinstance(data.get("materials"), dict):
-        raise UserInputError(f"{where}: needs a top-level 'materials:' mapping (see pipeline/model/materials.yaml)")
+        raise UserInputError(
+            f"{where}: needs a top-level 'materials:' mapping (see pipeline/model/materials.yaml)"
+        )
     geometry = data.get("geometry") or {}
     if not isinstance(geometry, dict):
-        raise UserInputError(f"{where}: 'geometry:' must be a mapping of {', '.join(_GEOMETRY_KEYS)}")
-    return {str(n): _parse_material(str(n), raw, geometry, where) for n, raw in data["materials"].items()}
+        raise UserInputError(
+            f"{where}: 'geometry:' must be a mapping of {', '.join(_GEOMETRY_KEYS)}"
+        )
+    return {
+        str(n): _parse_material(str(n), raw, geometry, where)
+        for n, raw in data["materials"].items()
+    }
 
 
 def load_materials(path: str | os.PathLike[str] | None = None) -> dict[str, Material]:

@@ -48,7 +48,11 @@ def axial_stress_mpa(
     return out
 
 
-def strain_energy_mpa(lam1: FloatArray, lam2: FloatArray, mu_mpa: Sequence[float], alpha: Sequence[float]) -> FloatArray:
+def strain_energy_mpa(
+    lam1: FloatArray, lam2: FloatArray, mu_mpa: Sequence[float], alpha: Sequence[float]
+) -> FloatArray:
     """Ogden strain-energy density W of Eq. 8 (MPa), lambda_3 = 1/(lambda_1 lambda_2)."""
     lam3 = 1.0 / (lam1 * lam2)
-    return sum(mu / a * (lam1**a + lam2**a + lam3**a - 3.0) for mu, a in zip(mu_mpa, alpha, strict=True))
+    return sum(
+        mu / a * (lam1**a + lam2**a + lam3**a - 3.0) for mu, a in zip(mu_mpa, alpha, strict=True)
+    )

@@ -93,7 +93,9 @@ def make_options(base: ModelOptions | None = None, **options: Any) -> ModelOptio
         return opts
     unknown = set(options) - _NAMES
     if unknown:
-        raise UserInputError(f"model options: unknown option(s) {sorted(unknown)}; valid: {sorted(_NAMES)}")
+        raise UserInputError(
+            f"model options: unknown option(s) {sorted(unknown)}; valid: {sorted(_NAMES)}"
+        )
     for key, value in options.items():
         if key in CHOICES and value not in CHOICES[key]:
             raise UserInputError(f"model options: {key}={value!r} is not one of {CHOICES[key]}")
