@@ -127,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
     stop_up = psi0_stop_criterion(psi0) if stop_at_psi0 else None
     try:
         camera = open_camera(args.camera, material=args.material, l0_mm=settings["l0_mm"], seed=args.seed,
-                             timeout_s=args.camera_timeout_s)
+                             timeout_s=args.camera_timeout_s, mode=args.mode)
     except CameraError as exc:
         print(f"acquire: camera failed: {exc}", file=sys.stderr)
         return EXIT_CODES["camera"]

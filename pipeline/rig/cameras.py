@@ -212,11 +212,18 @@ class SyntheticCamera:
 
     psi comes from :func:`pipeline.model.psi_deg` at the *measured* pressure (``loading`` branch
     going up, ``unloading`` going down); the image from :func:`pipeline.synth.render_actuator`.
-    Each photo's noise seed is derived from (seed, trial, step), so a re-run renders the same image.
+    In ``blocked`` mode the line is the ellipse arc of
+    :func:`pipeline.force.synth_blocked.blocked_arc_mm` at the eccentricity
+    :func:`~pipeline.force.synth_blocked.blocked_eccentricity` gives for the measured pressure.
+    The static scene (camera placement, table, clamp, light) is built once per session from
+    ``seed``, so the fixed end stays at one pixel position (written to ``photoset.yaml``); each
+    photo's noise seed is derived from (seed, material, trial, step), so a re-run renders the
+    same image.
     """
 
     def __init__(self, material: str, l0_mm: float, *, preset: str = "lab", seed: int = 0,
-                 psi_fn: Any = None, scene_overrides: dict[str, Any] | None = None) -> None:
+                 psi_fn: Any = None, scene_overrides: dict[str, Any] | None = None,
+                 psi_frame_deg: float = 240.0, mode: str = "bending") -> None:
         from pipeline import synth
 
         if psi_fn is None:
@@ -228,7 +235,21 @@ class SyntheticCamera:
             self.scene = synth.scene_from(preset, **(scene_overrides or {}))
         except KeyError as exc:
             raise UserInputError(f"--camera synthetic:{preset}: unknown scene preset; use one of {sorted(synth.SCENE_PRESETS)}") from exc
-        self._fixed_end: tuple[float, float] | None = None
+        # one static scene (camera placement, table, clamp, lighting) for the whole session, framed
+        # to hold every shape from -psi_frame to +psi_frame, so the fixed end stays put on screen
+        self.mode = mode
+        self._blocked: Any = None
+        if mode == "blocked":
+            from pipeline.force import synth_blocked
+
+            self._blocked = synth_blocked
+            curves = [synth_blocked.blocked_arc_mm(float(e), self.l0_mm).points_mm for e in (0.0, 0.45, 0.9)]
+        else:
+            curves = [synth.centreline_mm(float(p), self.l0_mm, n=400) for p in np.linspace(-psi_frame_deg, psi_frame_deg, 17)]
+        camera = synth.make_camera(self.scene, rotation_deg=0.0, extent_mm=np.vstack(curves))
+        self.backdrop = synth.make_backdrop(self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=curves)
+        probe = synth.render_actuator(0.0, self.l0_mm, self.scene, seed=0, backdrop=self.backdrop, n=400)
+        self._fixed_end = (float(probe.fixed_end_px[0]), float(probe.fixed_end_px[1]))
 
     def psi_deg(self, pressure_kpa: float, direction: str) -> float:
         """Model bending angle (deg) at ``pressure_kpa`` on the branch of ``direction``."""
@@ -240,14 +261,17 @@ class SyntheticCamera:
         return int.from_bytes(digest[:4], "little")
 
     def capture(self, shot: Shot) -> tuple[bytes, str]:
+        if self._blocked is not None:
+            e = float(self._blocked.blocked_eccentricity(self.material, max(shot.measured_kpa, 0.0)))
+            shape = self._blocked.blocked_arc_mm(min(e, 0.95), self.l0_mm)
+            rendered = self._synth.render_curve(shape.points_mm, self.scene, seed=self._seed(shot.trial, shot.step),
+                                                backdrop=self.backdrop)
+            return bytes(rendered.jpeg_bytes), ".jpg"
         rendered = self._synth.render_actuator(self.psi_deg(shot.measured_kpa, shot.direction), self.l0_mm,
-                                               self.scene, seed=self._seed(shot.trial, shot.step))
-        self._fixed_end = tuple(float(v) for v in rendered.fixed_end_px)  # type: ignore[assignment]
+                                               self.scene, seed=self._seed(shot.trial, shot.step), backdrop=self.backdrop)
         return bytes(rendered.jpeg_bytes), ".jpg"
 
     def photoset_settings(self) -> dict[str, Any]:
-        if self._fixed_end is None:
-            self._fixed_end = tuple(float(v) for v in self._synth.render_actuator(0.0, self.l0_mm, self.scene, seed=0).fixed_end_px)  # type: ignore[assignment]
         out: dict[str, Any] = {"positive_turn": "ccw", "fixed_end": [round(v, 1) for v in self._fixed_end]}
         for key, attr in (("mm_per_px", "mm_per_px"), ("line_color", "line_color")):
             value = getattr(self.scene, attr, None)
@@ -259,7 +283,8 @@ class SyntheticCamera:
         pass
 
 
-def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeout_s: float = 30.0) -> Camera:
+def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeout_s: float = 30.0,
+                mode: str = "bending") -> Camera:
     """Open the camera named by ``spec`` (table in the module docstring).
 
     Raises
@@ -275,9 +300,9 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
     if spec == "synthetic" or spec.startswith("synthetic:"):
         preset = spec.partition(":")[2] or "lab"
         try:
-            return SyntheticCamera(material, l0_mm, preset=preset, seed=seed)
+            return SyntheticCamera(material, l0_mm, preset=preset, seed=seed, mode=mode)
         except ImportError as exc:
-            raise UserInputError(f"--camera synthetic needs pipeline.synth and pipeline.model ({exc})") from exc
+            raise UserInputError(f"--camera synthetic needs pipeline.synth, pipeline.model (and pipeline.force in blocked mode): {exc}") from exc
     if spec.isdigit():
         return OpenCVCamera(int(spec))
     if "://" in spec:
