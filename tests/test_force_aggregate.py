@@ -10,7 +10,11 @@ import pandas as pd
 import pytest
 
 from pipeline.errors import UserInputError
-from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure, read_tables
+from pipeline.force.aggregate_force import (
+    eccentricity_at_max_pressure,
+    force_vs_pressure,
+    read_tables,
+)
 from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
 
 

@@ -104,7 +104,7 @@ def force_vs_pressure(table: pd.DataFrame) -> pd.DataFrame:
             "pressure_kpa": float(pressure),
             "force_mean_n": float(np.mean(force)),
             "force_sd_n": float(np.std(force, ddof=1)) if len(force) > 1 else float("nan"),
-            "n": int(len(force)),
+            "n": len(force),
             "n_actuators": int(g["actuator"].nunique()),
             "n_trials": int(g[["actuator", "trial"]].drop_duplicates().shape[0]),
             "sample_sd_n": _pooled_sd(g),
@@ -113,7 +113,7 @@ def force_vs_pressure(table: pd.DataFrame) -> pd.DataFrame:
         e = _ok_eccentricities(g) if has_e else np.array([])
         row["eccentricity_mean"] = float(np.mean(e)) if len(e) else float("nan")
         row["eccentricity_sd"] = float(np.std(e, ddof=1)) if len(e) > 1 else float("nan")
-        row["n_eccentricity"] = int(len(e))
+        row["n_eccentricity"] = len(e)
         rows.append(row)
     return pd.DataFrame(rows, columns=list(FORCE_SUMMARY_COLUMNS))
 
@@ -151,7 +151,7 @@ def eccentricity_at_max_pressure(table: pd.DataFrame) -> pd.DataFrame:
             "pressure_kpa": p_max,
             "eccentricity_mean": float(np.mean(e)) if len(e) else float("nan"),
             "eccentricity_sd": float(np.std(e, ddof=1)) if len(e) > 1 else float("nan"),
-            "n": int(len(e)),
+            "n": len(e),
             "n_excluded": int(len(g) - len(e)),
             "force_mean_n": float(pd.to_numeric(g["force_n"], errors="coerce").mean()) if "force_n" in g else float("nan"),
         }

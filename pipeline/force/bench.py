@@ -52,9 +52,9 @@ def point_sweep(*, seeds: int = 3, noise_px: float = 0.5, a_px: float = 280.0) -
                     for mode in ("never", "auto", "always"):
                         t0 = time.perf_counter()
                         fit = fit_ellipse(pts, refine=mode)  # type: ignore[arg-type]
-                        rows.append(dict(e_true=e, arc_fraction=fraction, gap_deg=gap, seed=seed, refine=mode,
-                                         error=fit.eccentricity - e, e_sd=fit.eccentricity_sd, status=fit.status,
-                                         ms=1000 * (time.perf_counter() - t0)))
+                        rows.append({"e_true": e, "arc_fraction": fraction, "gap_deg": gap, "seed": seed,
+                                     "refine": mode, "error": fit.eccentricity - e, "e_sd": fit.eccentricity_sd,
+                                     "status": fit.status, "ms": 1000 * (time.perf_counter() - t0)})
     return pd.DataFrame(rows)
 
 
@@ -81,9 +81,10 @@ def image_sweep(*, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int 
                         t0 = time.perf_counter()
                         r = measure_blocked_image(photo, l0_mm=270.0, mm_per_px=scene.mm_per_px,
                                                   line_color=scene.line_color, fixed_end_px=img.fixed_end_px)
-                        rows.append(dict(scene=scene_name, e_true=e, arc_fraction=fraction, gap_deg=gap, seed=seed,
-                                         error=r.eccentricity - e, status=r.status, reason=r.reason,
-                                         in_frame=img.line_in_frame, ms=1000 * (time.perf_counter() - t0)))
+                        rows.append({"scene": scene_name, "e_true": e, "arc_fraction": fraction, "gap_deg": gap,
+                                     "seed": seed, "error": r.eccentricity - e, "status": r.status,
+                                     "reason": r.reason, "in_frame": img.line_in_frame,
+                                     "ms": 1000 * (time.perf_counter() - t0)})
     return pd.DataFrame(rows)
 
 

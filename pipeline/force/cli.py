@@ -23,8 +23,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pipeline.errors import UserInputError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -94,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     }[args.force_command](args)
 
 
-def _write_csv(df, path: Path) -> None:  # noqa: ANN001
+def _write_csv(df: pd.DataFrame, path: Path) -> None:
     from pipeline.photoset import atomic_write_bytes
 
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -154,7 +158,11 @@ def _measure(args: argparse.Namespace) -> int:
 
 
 def _aggregate(args: argparse.Namespace) -> int:
-    from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure, read_tables
+    from pipeline.force.aggregate_force import (
+        eccentricity_at_max_pressure,
+        force_vs_pressure,
+        read_tables,
+    )
 
     table = read_tables(args.tables)
     force = force_vs_pressure(table)

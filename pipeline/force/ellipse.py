@@ -391,7 +391,7 @@ def _geometric_fit(pts: NDArray[np.float64], start: NDArray[np.float64]) -> NDAr
 
 def _arc_fraction(pts: NDArray[np.float64], params: NDArray[np.float64]) -> float:
     """Fraction of the perimeter (by arc length) covered by the points' foot angles."""
-    xc, yc, a, b, th = params
+    a, b = params[2], params[3]
     t = np.sort(np.mod(_foot_angles(pts, params), 2.0 * np.pi))
     gaps = np.diff(np.r_[t, t[0] + 2.0 * np.pi])
     i = int(np.argmax(gaps))

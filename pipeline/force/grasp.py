@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from pipeline.errors import UserInputError
 
@@ -174,14 +175,14 @@ def heaviest_held(log: pd.DataFrame) -> pd.DataFrame:
             dict(
                 zip(keys, key),
                 max_mass_held_g=float(held.max()) if len(held) else float("nan"),
-                n_attempts=int(len(g)),
-                n_held=int(len(held)),
+                n_attempts=len(g),
+                n_held=len(held),
             )
         )
     return pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
 
 
-def grasp_figure(summary: pd.DataFrame):  # -> matplotlib.figure.Figure
+def grasp_figure(summary: pd.DataFrame) -> Figure:
     """Fig. 8B-style plot: heaviest mass held (g) against pressure (kPa), one line per material.
 
     One panel per (side, object diameter); pressures where nothing was held are drawn as
@@ -196,8 +197,6 @@ def grasp_figure(summary: pd.DataFrame):  # -> matplotlib.figure.Figure
     -------
     matplotlib.figure.Figure
     """
-    from matplotlib.figure import Figure
-
     groups = list(summary.groupby(["side", "diameter_mm"], sort=True))
     n = max(1, len(groups))
     fig = Figure(figsize=(8.27, 2.2 + 2.6 * n))

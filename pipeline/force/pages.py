@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from pipeline.force.grasp import grasp_figure
@@ -133,7 +134,7 @@ def eccentricity_figure(summary: pd.DataFrame, *, base: Path | None = None) -> F
     return fig
 
 
-def _draw_photo(ax, r: pd.Series, base: Path | None) -> None:  # noqa: ANN001
+def _draw_photo(ax: Axes, r: pd.Series, base: Path | None) -> None:
     import cv2
 
     title = f"{r['material']} at {r['pressure_kpa']:g} kPa"
