@@ -158,3 +158,14 @@ def test_grasp_log_missing_column(tmp_path: Path) -> None:
     log.write_text("material,object,diameter_mm,mass_g,pressure_kpa,held\nDS20,x,90,1,1,yes\n")
     with pytest.raises(UserInputError, match=r"missing column\(s\) \['side'\]"):
         read_grasp_log(log)
+
+
+def test_manifest_without_eccentricity_gives_force_only(tmp_path: Path) -> None:
+    manifest = crafted().drop(columns=["eccentricity", "status"])
+    path = tmp_path / "manifest.csv"
+    manifest.to_csv(path, index=False)
+    table = read_tables([path])
+    force = force_vs_pressure(table)
+    assert force["n_eccentricity"].eq(0).all() and force["eccentricity_mean"].isna().all()
+    assert force.set_index(["material", "pressure_kpa"]).loc[("DS20", 100.0), "force_mean_n"] == pytest.approx(2.75)
+    assert eccentricity_at_max_pressure(table).empty
