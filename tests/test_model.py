@@ -345,3 +345,18 @@ def test_cli_materials_option(tmp_path, capsys) -> None:
     value = float(capsys.readouterr().out.strip())
     assert value == pytest.approx(float(pressure_kpa(load_materials(path)["NEW"], 0.0)), rel=1e-5)
     assert math.isfinite(value) and value > 0
+
+
+def test_unloading_from_a_peak_pressure() -> None:
+    """Unloading from below the snap retraces loading; from above it keeps the curled branch."""
+    reading = {"jacobian": "deformed", "pressure_area": "segment"}
+    snap = snap_regions("DS20", **reading)
+    p_snap = float(snap[snap.branch == "loading"].pressure_kpa.iloc[0])
+    p = np.linspace(0.0, 0.95 * p_snap, 20)
+    below = psi_deg("DS20", p, branch="unloading", unload_from_kpa=0.95 * p_snap, **reading)
+    np.testing.assert_allclose(below, psi_deg("DS20", p, **reading), atol=1e-6)
+    peak = 1.2 * p_snap
+    above = psi_deg("DS20", p, branch="unloading", unload_from_kpa=peak, **reading)
+    np.testing.assert_allclose(pressure_kpa("DS20", above, **reading), p, atol=1e-6)
+    assert np.nanmax(below - above) > 30  # hysteresis: stays curled (lower psi) on the way down
+    assert np.isnan(psi_deg("DS20", [peak * 1.01], branch="unloading", unload_from_kpa=peak)).all()

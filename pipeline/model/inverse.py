@@ -136,6 +136,15 @@ def psi_rad_core(mat: Material, p_kpa: FloatArray, opts: ModelOptions, branch: s
         i = np.searchsorted(env, np.where(finite, target, np.inf), side="left")
     else:
         x, f = grid[::-1], p[::-1]
+        if opts.unload_from_kpa is not None:  # start from the loading state at the peak pressure
+            peak = float(opts.unload_from_kpa)
+            start = psi_rad_core(mat, np.array([peak]), opts, "loading")[0]
+            if not np.isfinite(start):
+                return out
+            keep = grid > start
+            x = np.concatenate([[start], grid[keep][::-1]])
+            f = np.concatenate([[peak], p[keep][::-1]])
+            finite &= target <= peak
         env = np.minimum.accumulate(f)
         i = np.searchsorted(-env, np.where(finite, -target, np.inf), side="left")
     inside = finite & (i < len(x))
@@ -170,7 +179,8 @@ def psi_deg(
     branch : {"loading", "unloading"}
         ``"loading"``: rising pressure from psi0 (first crossing going down from psi0, so the
         angle jumps across snap-through regions).  ``"unloading"``: falling pressure from the most
-        negative modelled angle ``psi_min_deg``.
+        negative modelled angle ``psi_min_deg``, or from the loading state at the peak pressure
+        ``unload_from_kpa=`` when given.
     **options
         See :class:`pipeline.model.options.ModelOptions`.
 

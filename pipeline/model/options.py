@@ -53,6 +53,9 @@ class ModelOptions:
         Angles of the grid the inverse brackets its roots on (psi_min_deg .. psi0).
     psi_min_deg : float
         Most negative angle the inverse searches (deg).
+    unload_from_kpa : float or None
+        Unloading branch only: start from the loading state reached at this peak pressure (kPa)
+        instead of from ``psi_min_deg``; matters only where P(psi) has snap-through.
     """
 
     eq5: str = "arc_length"
@@ -68,6 +71,7 @@ class ModelOptions:
     n_beta: int = 3
     n_grid: int = 400
     psi_min_deg: float = -360.0
+    unload_from_kpa: float | None = None
 
 
 _NAMES = {f.name for f in fields(ModelOptions)}
@@ -101,6 +105,8 @@ def make_options(base: ModelOptions | None = None, **options: Any) -> ModelOptio
             raise UserInputError(f"model options: {key}={value!r} is not one of {CHOICES[key]}")
         if key in ("n_tau", "n_phi", "n_beta", "n_grid") and (int(value) != value or value < 2):
             raise UserInputError(f"model options: {key} must be an integer >= 2, got {value!r}")
+        if key == "unload_from_kpa" and value is not None and not float(value) >= 0:
+            raise UserInputError(f"model options: unload_from_kpa must be >= 0 kPa, got {value!r}")
         if key in ("l0_mm", "k_p") and value is not None and not float(value) > 0:
             raise UserInputError(f"model options: {key} must be > 0, got {value!r}")
     return replace(opts, **options)
