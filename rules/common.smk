@@ -87,3 +87,22 @@ def scene_overrides(ds):
     """`--set KEY=VALUE` options of a synthetic dataset's scene overrides."""
     return " ".join(f"--set {k}={v}" for k, v in sorted(ds.get("scene_set", {}).items()))
 
+
+def force_photoset_dir(name):
+    """Folder of a blocked-force photo set (synthetic sets are rendered under results/)."""
+    ds = FORCE_DATASETS[name]
+    return f"{RESULTS}/force_photosets/{name}" if ds["source"] == "synthetic" else ds["path"]
+
+
+def force_photoset_input(wildcards):
+    """What a force measure job waits for."""
+    ds = FORCE_DATASETS[wildcards.force_dataset]
+    if ds["source"] == "synthetic":
+        return f"{RESULTS}/force_photosets/{wildcards.force_dataset}"
+    return [f"{ds['path']}/manifest.csv", f"{ds['path']}/photoset.yaml"]
+
+
+FORCE_OUTPUTS = (
+    [f"{RESULTS}/force/force_summary.csv"] if FORCE_DATASETS else []
+) + ([f"{RESULTS}/force/grasp_summary.csv"] if config["force"]["grasp_log"] else [])
+
