@@ -14,7 +14,7 @@ from scipy import optimize, stats
 
 from pipeline.errors import UserInputError
 from pipeline.model.forward import pressure_core
-from pipeline.model.inverse import psi_rad_core
+from pipeline.model.inverse import grid_inverse, psi_rad_core
 from pipeline.model.materials import Material, resolve_material
 from pipeline.model.options import CHOICES, make_options
 
@@ -31,8 +31,9 @@ def fit_k_p(
     """Least-squares pressure scale k_P of the model to measured bending angles, as in the paper.
 
     Minimises sum (psi_model(P_i; k_P) - psi_i)^2 over k_P, where psi_model(P; k_P) is the inverse
-    of k_P * P_raw(psi) on ``branch``.  Model angles that are undefined (pressure beyond the
-    modelled range) count as ``psi_min_deg``.
+    of k_P * P_raw(psi) on ``branch`` (cubic Hermite interpolation of one model grid, exact to
+    well under 0.01 deg).  Model angles that are undefined (pressure beyond the modelled range)
+    count as ``psi_min_deg``.
 
     Parameters
     ----------
@@ -71,8 +72,10 @@ def fit_k_p(
     opts = make_options(k_p=1.0, **options)
     floor = math.radians(opts.psi_min_deg)
 
+    inverse = grid_inverse(mat, opts, branch)  # P = k P_1(psi): one grid serves every k
+
     def model_rad(k: float) -> np.ndarray:
-        out = psi_rad_core(mat, p / k, opts, branch)
+        out = inverse(p / k)
         return np.where(np.isfinite(out), out, floor)
 
     target = np.radians(psi)

@@ -93,6 +93,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="loading",
         help="rising (loading) or falling (unloading) pressure; default loading",
     )
+    p.add_argument(
+        "--unload-from-kpa",
+        type=float,
+        default=None,
+        help="unloading only: start from the loading state at this peak pressure (kPa); "
+        "default: from psi_min_deg = -360",
+    )
     sub.add_parser(
         "calibrate", parents=[parent], help="print the paper's anchors: paper value, ours, %% off"
     )
@@ -113,7 +120,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _options(args: argparse.Namespace) -> dict[str, object]:
-    keys = [*CHOICES, "l0_mm", "k_p"]
+    keys = [*CHOICES, "l0_mm", "k_p", "unload_from_kpa"]
     return {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
 
 
