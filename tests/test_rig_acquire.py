@@ -196,25 +196,36 @@ def test_blocked_mode_records_force_statistics(tmp_path, photo):
     assert load_photoset(out).manifest["force_n"].notna().all()
 
 
-def test_dry_run_prints_plan_and_resume_point(tmp_path, photo):
+def main_inprocess(cmd: list[str], capsys) -> tuple[int, str, str]:
+    """Run the same command line through ``pipeline.cli.main`` in this process (cheap checks)."""
+    from pipeline.cli import main
+
+    code = main(cmd[3:])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_dry_run_prints_plan_and_resume_point(tmp_path, photo, capsys):
     out = tmp_path / "set"
-    plan = run(acquire_cmd("", out, photo, "--dry-run")[:5] + acquire_cmd("", out, photo, "--dry-run")[5:])
-    assert plan.returncode == 0, plan.stderr
-    assert "up 0 50 100 120" in plan.stdout and "trial 2: 7 steps, 0 recorded, start at step 0" in plan.stdout
+    code, text, _ = main_inprocess(acquire_cmd("", out, photo, "--dry-run"), capsys)
+    assert code == 0
+    assert "up 0 50 100 120" in text and "trial 2: 7 steps, 0 recorded, start at step 0" in text
     assert not out.exists()
     with Emulator(faults=Faults(drop_after=14)) as emu:
-        run(acquire_cmd(emu.port, out, photo))
+        assert run(acquire_cmd(emu.port, out, photo)).returncode == 4
     n = len(manifest(out))
-    plan = run(acquire_cmd("", out, photo, "--dry-run"))
-    assert f"trial 1: 7 steps, {n}" in plan.stdout or "trial 1: complete" in plan.stdout
-    assert "resume at step" in plan.stdout and "without photos" in plan.stdout
+    code, text, _ = main_inprocess(acquire_cmd("", out, photo, "--dry-run"), capsys)
+    assert code == 0
+    assert f"trial 1: 7 steps, {n} recorded, resume at step {n} ({FULL_RAMP[n]} kPa" in text
+    assert f"after passing {' '.join(str(p) for p in FULL_RAMP[1:n])} kPa without photos" in text
+    assert "trial 2: 7 steps, 0 recorded" in text
 
 
-def test_bad_options_exit_2(tmp_path, photo):
-    done = run(acquire_cmd("/dev/null", tmp_path / "x", photo, "--trials", "0"))
-    assert done.returncode == 2 and "--trials" in done.stderr
-    done = run(acquire_cmd("/nonexistent/tty", tmp_path / "x", photo))
-    assert done.returncode == 4 and "cannot open serial port" in done.stderr
+def test_bad_options_exit_2(tmp_path, photo, capsys):
+    code, _, err = main_inprocess(acquire_cmd("/dev/null", tmp_path / "x", photo, "--trials", "0"), capsys)
+    assert code == 2 and "--trials" in err
+    code, _, err = main_inprocess(acquire_cmd("/nonexistent/tty", tmp_path / "x", photo), capsys)
+    assert code == 4 and "cannot open serial port" in err
 
 
 def test_watched_folder_camera(tmp_path, photo):

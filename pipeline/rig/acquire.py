@@ -15,6 +15,7 @@ what happened and how to resume, and returns a non-zero :data:`EXIT_CODES` value
 from __future__ import annotations
 
 import contextlib
+import logging
 import signal
 import sys
 import time
@@ -32,6 +33,8 @@ from pipeline.photoset import MANIFEST, append_manifest_rows, atomic_write_bytes
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
 from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
+
+log = logging.getLogger(__name__)
 
 #: exit status per way a run ends
 EXIT_CODES: dict[str, int] = {
@@ -394,12 +397,16 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
         if image is None:
             return False
         fe = settings.get("fixed_end", "auto")
-        r = measure_image(
-            image, l0_mm=float(settings["l0_mm"]), mm_per_px=settings.get("mm_per_px"),
-            line_color=settings.get("line_color", "black"),
-            fixed_end_px=None if fe in (None, "auto") else (float(fe[0]), float(fe[1])),
+        try:
+            r = measure_image(
+                image, l0_mm=float(settings["l0_mm"]), mm_per_px=settings.get("mm_per_px"),
+                line_color=settings.get("line_color", "black"),
+                fixed_end_px=None if fe in (None, "auto") else (float(fe[0]), float(fe[1])),
             positive_turn=settings.get("positive_turn", "ccw"),
-        )
+            )
+        except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
+            log.warning("live psi measurement failed (%s: %s); the ramp continues to --max-kpa", type(exc).__name__, exc)
+            return False
         return getattr(r, "status", "failed") != "failed" and float(r.psi_deg) <= -abs(psi0_deg)
 
     return stop

@@ -67,8 +67,10 @@ def _material_defaults(material: str) -> Any:
 
 
 def _settings(args: argparse.Namespace) -> dict[str, Any]:
-    mat = _material_defaults(args.material)
-    l0 = args.l0_mm if args.l0_mm is not None else (mat.l0_mm if mat is not None else None)
+    l0 = args.l0_mm
+    if l0 is None:  # importing the model costs ~0.5 s: only when needed
+        mat = _material_defaults(args.material)
+        l0 = mat.l0_mm if mat is not None else None
     if l0 is None or l0 <= 0:
         raise UserInputError(f"--l0-mm is needed (material {args.material!r} has no default l0): give the marked layer's length in mm")
     fixed_end: Any = args.fixed_end
@@ -105,8 +107,9 @@ def run(args: argparse.Namespace) -> int:
                         mode=args.mode, force_samples=args.force_samples, force_interval_s=args.force_interval_s,
                         tare=not args.no_tare)
     synthetic = args.camera.strip().startswith("synthetic")
-    measure_ok = importlib.util.find_spec("pipeline.measure") is not None and _has_measure_image()
-    stop_at_psi0 = args.stop_at_psi0 if args.stop_at_psi0 is not None else (synthetic and measure_ok and args.mode == "bending")
+    wants_stop = args.stop_at_psi0 if args.stop_at_psi0 is not None else (synthetic and args.mode == "bending")
+    measure_ok = wants_stop and importlib.util.find_spec("pipeline.measure") is not None and _has_measure_image()
+    stop_at_psi0 = bool(measure_ok) if args.stop_at_psi0 is None else args.stop_at_psi0
     if stop_at_psi0 and not measure_ok:
         raise UserInputError("--stop-at-psi0 needs pipeline.measure.measure_image, which is not available; drop the option")
     if args.dry_run:

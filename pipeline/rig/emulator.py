@@ -339,8 +339,15 @@ class Emulator:
         self._master = self._slave = -1
 
     def _drop(self) -> None:
-        self._close_pty()
+        old = (self._master, self._slave)
         if self.link is not None:
-            self._open_pty()
+            self._open_pty()  # the link points at the new pty before the old one vanishes
         else:
             self._stop.set()
+        for fd in old:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        if self.link is None:
+            self._master = self._slave = -1
