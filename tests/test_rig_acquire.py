@@ -46,7 +46,7 @@ def acquire_cmd(port: str, out: Path, photo: Path, *extra: str, trials: int = 2)
 
 
 def run(cmd: list[str], timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=timeout, check=False)
 
 
 def manifest(out: Path) -> pd.DataFrame:
@@ -239,7 +239,7 @@ def test_watched_folder_camera(tmp_path, photo):
         i = 0
         while not stop.is_set():
             img = np.full((40, 40, 3), i % 256, np.uint8)
-            ok, buf = cv2.imencode(".png", img)
+            _, buf = cv2.imencode(".png", img)
             tmp = watch / f".tmp{i}"
             tmp.write_bytes(buf.tobytes())
             os.replace(tmp, watch / f"img{i:05d}.png")

@@ -88,7 +88,7 @@ def test_dropped_connection_raises_port_lost():
 
 def test_dropped_connection_with_link_reconnects(tmp_path):
     link = tmp_path / "ttyPICO"
-    with Emulator(faults=Faults(drop_after=3), link=link) as emu:
+    with Emulator(faults=Faults(drop_after=3), link=link):
         rig = PicoDriver.open(str(link), max_kpa=260)
         rig.set_kpa(50)
         with pytest.raises(PortLostError):

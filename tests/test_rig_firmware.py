@@ -23,7 +23,7 @@ def test_dac_scaling_and_clipping():
     assert rigcore.kpa_to_code(0.0, CFG) == 0
     assert rigcore.kpa_to_code(-5.0, CFG) == 0
     assert rigcore.kpa_to_code(10_000.0, CFG) == 4095
-    codes = [rigcore.kpa_to_code(p / 10, CFG) for p in range(0, 5000)]
+    codes = [rigcore.kpa_to_code(p / 10, CFG) for p in range(5000)]
     assert codes == sorted(codes)
     assert abs(rigcore.code_to_kpa(1, CFG) - 500.0 / 4096) < 1e-9
 

@@ -18,7 +18,6 @@ import contextlib
 import logging
 import signal
 import sys
-import time
 import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -29,7 +28,13 @@ from typing import Any, TextIO
 import numpy as np
 from tqdm import tqdm
 
-from pipeline.photoset import MANIFEST, append_manifest_rows, atomic_write_bytes, write_manifest, write_settings
+from pipeline.photoset import (
+    MANIFEST,
+    append_manifest_rows,
+    atomic_write_bytes,
+    write_manifest,
+    write_settings,
+)
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
 from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
@@ -117,7 +122,7 @@ class _Interrupts:
             return
         raise KeyboardInterrupt(signal.Signals(signum).name)
 
-    def __enter__(self) -> "_Interrupts":
+    def __enter__(self) -> _Interrupts:
         for sig in (signal.SIGINT, signal.SIGTERM):
             try:
                 self._old[sig] = signal.signal(sig, self._handler)
@@ -125,7 +130,7 @@ class _Interrupts:
                 pass
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         for sig, old in self._old.items():
             signal.signal(sig, old)
 
@@ -157,14 +162,14 @@ def describe_plan(cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = 
     """The ``--dry-run`` text: ramp, what is recorded, where each trial resumes, time estimate."""
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     lines = [
-        f"acquire plan: {cfg.material} actuator {cfg.actuator}, {cfg.trials} trial(s), mode {cfg.mode}, "
-        f"port {port or '-'}, camera {camera_spec or '-'}",
+        (f"acquire plan: {cfg.material} actuator {cfg.actuator}, {cfg.trials} trial(s), mode {cfg.mode}, "
+         f"port {port or '-'}, camera {camera_spec or '-'}"),
         f"  out: {cfg.out_dir}",
         f"  ramp (kPa): up {' '.join(f'{p:g}' for p in up)}; then down the same steps to 0",
         f"  settle {cfg.settle_s:g} s per step"
         + (f"; {cfg.force_samples} load-cell samples per step" if cfg.mode == "blocked" else "")
         + ("; up leg stops early when measured psi <= -psi0" if stop_at_psi0 else ""),
-        f"  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items()),
+        "  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items()),
     ]
     todo = 0
     for trial, seq, recorded in trial_plans(cfg):
@@ -402,7 +407,7 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
                 image, l0_mm=float(settings["l0_mm"]), mm_per_px=settings.get("mm_per_px"),
                 line_color=settings.get("line_color", "black"),
                 fixed_end_px=None if fe in (None, "auto") else (float(fe[0]), float(fe[1])),
-            positive_turn=settings.get("positive_turn", "ccw"),
+                positive_turn=settings.get("positive_turn", "ccw"),
             )
         except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
             log.warning("live psi measurement failed (%s: %s); the ramp continues to --max-kpa", type(exc).__name__, exc)

@@ -18,7 +18,13 @@ from pathlib import Path
 from typing import Any
 
 from pipeline.errors import UserInputError
-from pipeline.rig.acquire import EXIT_CODES, SessionConfig, describe_plan, psi0_stop_criterion, run_session
+from pipeline.rig.acquire import (
+    EXIT_CODES,
+    SessionConfig,
+    describe_plan,
+    psi0_stop_criterion,
+    run_session,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

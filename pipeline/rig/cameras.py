@@ -145,7 +145,7 @@ class CommandCamera:
         path.unlink(missing_ok=True)
         command = self.template.replace("{path}", shlex.quote(str(path)))
         try:
-            done = subprocess.run(command, shell=True, capture_output=True, timeout=self.timeout_s)
+            done = subprocess.run(command, shell=True, capture_output=True, timeout=self.timeout_s, check=False)
         except subprocess.TimeoutExpired as exc:
             raise CameraError(f"camera command timed out after {self.timeout_s:g} s: {command}") from exc
         if done.returncode != 0:

@@ -129,7 +129,7 @@ class PicoDriver:
 
     @classmethod
     def open(cls, port: str, *, max_kpa: float, calibration: Calibration | None = None,
-             timeout_s: float = 2.0) -> "PicoDriver":
+             timeout_s: float = 2.0) -> PicoDriver:
         """Open ``port`` (a device path such as ``/dev/ttyACM0`` or a pyserial URL), identify the device.
 
         Raises
@@ -167,7 +167,7 @@ class PicoDriver:
         except Exception:  # noqa: BLE001 - closing a dead port must not mask the real error
             pass
 
-    def __enter__(self) -> "PicoDriver":
+    def __enter__(self) -> PicoDriver:
         return self
 
     def __exit__(self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None) -> None:
@@ -321,7 +321,7 @@ class PicoDriver:
             self.garbage_lines += 1
             log.debug("ignored line from device: %r", line[:80])
 
-    def _command(self, command: str, *args: float | int, raise_estop: bool = True, retries: int = 1) -> Reply:
+    def _command(self, command: str, *args: float, raise_estop: bool = True, retries: int = 1) -> Reply:
         for attempt in range(retries + 1):
             try:
                 self.link.write(encode(command, *args))

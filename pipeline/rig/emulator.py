@@ -236,7 +236,7 @@ class Emulator:
         """Release the emergency-stop button."""
         self.hw.estop = False
 
-    def start(self) -> "Emulator":
+    def start(self) -> Emulator:
         """Start serving in a daemon thread."""
         self._thread = threading.Thread(target=self.serve_forever, name="pico-emulator", daemon=True)
         self._thread.start()
@@ -251,7 +251,7 @@ class Emulator:
         if self.link is not None:
             self.link.unlink(missing_ok=True)
 
-    def __enter__(self) -> "Emulator":
+    def __enter__(self) -> Emulator:
         return self.start()
 
     def __exit__(self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None) -> None:

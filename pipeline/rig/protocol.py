@@ -50,7 +50,7 @@ class Reply:
     line: str
 
 
-def encode(command: str, *args: float | int | str) -> bytes:
+def encode(command: str, *args: float | str) -> bytes:
     """One command line as bytes; floats are written with 4 decimals (0.0001 kPa resolution)."""
     words = [command] + [f"{a:.4f}" if isinstance(a, float) else str(a) for a in args]
     return (" ".join(words)).encode("ascii") + EOL

@@ -13,13 +13,12 @@ host tests and emulates; this file only binds it to the pins and the USB serial 
 Install: ``mpremote cp rigcore.py : && mpremote cp main.py : && mpremote reset``.
 """
 
+import select
 import sys
 import time
 
 import machine
 import micropython
-import select
-
 import rigcore
 
 PIN_SCK, PIN_MOSI, PIN_CS = 18, 19, 17

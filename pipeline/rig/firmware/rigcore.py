@@ -1,3 +1,4 @@
+# ruff: noqa: UP031, RUF046, PLR0124  (MicroPython: %-formatting, explicit int(), NaN test)
 """Pure logic of the Pico firmware: line protocol, DAC and ADC arithmetic, limits, e-stop, load cell.
 
 This file runs unchanged on the Pico (MicroPython) and on the host (CPython: tests and the
