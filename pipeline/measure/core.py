@@ -1,0 +1,299 @@
+"""psi from one photo: extraction + estimator + quality (see the package docstring).
+
+Sign convention (DESIGN.md): walking along the line from the fixed end to the free end, a turn
+in the ``positive_turn`` direction *as seen on screen* counts positive.  Image y points down, so
+the centre line is mirrored to a y-up frame (``y -> -y``) before the estimators, whose ccw is
+then the on-screen ccw; ``positive_turn="cw"`` flips the sign.
+
+psi = mean curvature x l0 when ``mm_per_px`` is known, else the total turning angle over the
+measured line (mean curvature x measured length).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from pipeline.measure.estimators import METHODS, CurveEstimate, hyper, turning
+from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline
+from pipeline.measure.quality import assess
+
+#: default estimator (see the package docstring for the measurements behind the choice)
+DEFAULT_METHOD = "hyper"
+#: work on images at most about this wide (px); larger ones are decoded / reduced by 2, 4 or 8
+WORK_WIDTH_PX = 640
+#: seed of the random places of the ``paper`` estimators (deterministic output)
+SEED = 20240
+
+
+@dataclass(frozen=True)
+class AngleResult:
+    """The bending angle measured on one photo.
+
+    Attributes
+    ----------
+    psi_deg : float
+        Signed bending angle (deg); NaN when failed.
+    kappa_per_mm : float
+        Signed mean curvature (1/mm) = psi / l0; NaN when failed.
+    length_mm : float
+        Measured line length (mm); NaN without ``mm_per_px`` or when failed.
+    method : str
+        Estimator name.
+    residual_px : float
+        RMS misfit of the estimator's model (px, original image); NaN when it has none.
+    status : str
+        ``ok``, ``flagged`` or ``failed``.
+    reason : str
+        Why flagged / failed ('' when ok), '; '-separated.
+    centreline_px : ndarray, shape (N, 2)
+        Centre line (x right, y down, original px), fixed end first; empty when failed.
+    """
+
+    psi_deg: float
+    kappa_per_mm: float
+    length_mm: float
+    method: str
+    residual_px: float
+    status: str
+    reason: str
+    centreline_px: np.ndarray
+
+
+def failed(method: str, reason: str) -> AngleResult:
+    """An :class:`AngleResult` for a photo that could not be measured."""
+    nan = float("nan")
+    return AngleResult(nan, nan, nan, method, nan, "failed", reason, np.empty((0, 2)))
+
+
+def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
+    """Largest factor in (1, 2, 4, 8) keeping the work image at least ``work_width_px`` wide.
+
+    Examples
+    --------
+    >>> reduction_for(4000), reduction_for(1280), reduction_for(640)
+    (4, 2, 1)
+    """
+    f = 1
+    while f < 8 and width_px / (2 * f) >= work_width_px:
+        f *= 2
+    return f
+
+
+def _psi_from(est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | None, length_px: float) -> float:
+    if mm_per_px:
+        return float(np.rad2deg(sign * est.kappa_per_px / mm_per_px * l0_mm))
+    return float(np.rad2deg(sign * est.kappa_per_px * length_px))
+
+
+def measure_work_image(
+    image_bgr: np.ndarray,
+    *,
+    scale: float,
+    l0_mm: float,
+    mm_per_px: float | None = None,
+    line_color: Any = "black",
+    fixed_end_px: tuple[float, float] | None = None,
+    positive_turn: str = "ccw",
+    method: str = DEFAULT_METHOD,
+) -> AngleResult:
+    """Measure an image already reduced by ``scale`` (original px per work px).
+
+    Same parameters and result as :func:`measure_image`; used by :func:`measure_file`, which
+    decodes JPEGs directly at reduced size.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
+    if positive_turn not in ("ccw", "cw"):
+        raise ValueError(f"positive_turn {positive_turn!r}: use 'ccw' or 'cw'")
+    if mm_per_px is not None and not np.isfinite(mm_per_px):
+        mm_per_px = None
+    try:
+        line: LineExtraction = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px, scale=scale)
+    except NoLineFound as exc:
+        return failed(method, str(exc))
+    pts = line.centreline_px * np.array([1.0, -1.0])  # y-up: on-screen ccw is positive
+    rng = np.random.default_rng(SEED)
+    sign = 1.0 if positive_turn == "ccw" else -1.0
+    try:
+        ends = line.trimmed_px
+        est = METHODS[method](pts, rng, ends_px=ends)
+        arc = est if method == "hyper" else hyper(pts, rng, ends_px=ends)
+        trn = est if method == "turning" else turning(pts, rng, ends_px=ends)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        return failed(method, f"curvature fit failed: {exc}")
+    length_px = est.length_px
+    psi = _psi_from(est, sign, l0_mm, mm_per_px, length_px)
+    quality = assess(
+        line,
+        method=method,
+        length_px=length_px,
+        expected_length_px=(l0_mm / mm_per_px) if mm_per_px else None,
+        psi_turning_deg=_psi_from(trn, sign, l0_mm, mm_per_px, length_px),
+        psi_arc_deg=_psi_from(arc, sign, l0_mm, mm_per_px, length_px),
+        turning_degree=trn.degree,
+    )
+    return AngleResult(
+        psi_deg=psi,
+        kappa_per_mm=float(np.deg2rad(psi) / l0_mm),
+        length_mm=float(length_px * mm_per_px) if mm_per_px else float("nan"),
+        method=method,
+        residual_px=est.residual_px,
+        status=quality.status,
+        reason=quality.reason,
+        centreline_px=line.centreline_px,
+    )
+
+
+def measure_image(
+    image_bgr: np.ndarray,
+    *,
+    l0_mm: float,
+    mm_per_px: float | None = None,
+    line_color: Any = "black",
+    fixed_end_px: tuple[float, float] | None = None,
+    positive_turn: str = "ccw",
+    method: str = DEFAULT_METHOD,
+    work_width_px: int = WORK_WIDTH_PX,
+) -> AngleResult:
+    """Measure the signed bending angle psi of the marker line in one photo.
+
+    Parameters
+    ----------
+    image_bgr : ndarray, shape (H, W, 3), uint8
+        The photo (OpenCV BGR).
+    l0_mm : float
+        Length of the marked inextensible layer (mm).
+    mm_per_px : float, optional
+        Image scale (mm per px); without it psi is the total turning angle of the measured line.
+    line_color : str or mapping
+        Marker colour name or HSV range (see :func:`pipeline.photoset.line_color_ranges`).
+    fixed_end_px : (x, y), optional
+        Pixel near the clamped end; None or NaN: guessed.
+    positive_turn : {"ccw", "cw"}
+        Turning direction (fixed end -> free end, as seen on screen) that counts positive.
+    method : str
+        Estimator, a key of :data:`pipeline.measure.METHODS`.
+    work_width_px : int
+        Images at least twice this wide are reduced (INTER_AREA) by 2, 4 or 8 before the work.
+
+    Returns
+    -------
+    AngleResult
+        Never raises on a bad photo: ``status="failed"`` with the reason instead.
+
+    Examples
+    --------
+    >>> import cv2, numpy as np
+    >>> img = np.full((480, 640, 3), 200, np.uint8)
+    >>> t = np.linspace(0, np.pi, 200)                      # half circle, radius 150 px
+    >>> pts = np.c_[320 + 150 * np.cos(t), 300 - 150 * np.sin(t)]
+    >>> _ = cv2.polylines(img, [np.round(pts * 16).astype(np.int32)], False, (20, 20, 20), 5, cv2.LINE_AA, 4)
+    >>> r = measure_image(img, l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end_px=(470, 300))
+    >>> print(round(r.psi_deg), r.status)
+    180 ok
+    """
+    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
+        fixed_end_px = None
+    f = reduction_for(image_bgr.shape[1], work_width_px) if image_bgr is not None and image_bgr.ndim == 3 else 1
+    work = image_bgr
+    if f > 1:
+        work = cv2.resize(image_bgr, (image_bgr.shape[1] // f, image_bgr.shape[0] // f), interpolation=cv2.INTER_AREA)
+    return measure_work_image(
+        work, scale=float(f), l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
+        fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
+    )
+
+
+_REDUCED = {1: cv2.IMREAD_COLOR, 2: cv2.IMREAD_REDUCED_COLOR_2, 4: cv2.IMREAD_REDUCED_COLOR_4, 8: cv2.IMREAD_REDUCED_COLOR_8}
+
+
+def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
+    """(width, height) from a JPEG's frame header without decoding; None if not a JPEG.
+
+    Examples
+    --------
+    >>> import cv2, numpy as np
+    >>> ok, buf = cv2.imencode(".jpg", np.zeros((30, 40, 3), np.uint8))
+    >>> jpeg_size(buf.tobytes())
+    (40, 30)
+    """
+    b = bytes(data[:65536]) if isinstance(data, np.ndarray) else data[:65536]
+    if b[:2] != b"\xff\xd8":
+        return None
+    i = 2
+    while i + 9 < len(b):
+        if b[i] != 0xFF:
+            return None
+        marker = b[i + 1]
+        if marker == 0xFF:
+            i += 1
+            continue
+        seg = int.from_bytes(b[i + 2 : i + 4], "big")
+        if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):
+            h = int.from_bytes(b[i + 5 : i + 7], "big")
+            w = int.from_bytes(b[i + 7 : i + 9], "big")
+            return w, h
+        i += 2 + seg
+    return None
+
+
+def decode_for_work(data: np.ndarray, work_width_px: int = WORK_WIDTH_PX) -> tuple[np.ndarray | None, int]:
+    """Decode image bytes, directly at reduced size for large JPEGs (DCT scaling: much faster).
+
+    Returns
+    -------
+    image : ndarray or None
+        BGR image, None if it cannot be decoded.
+    factor : int
+        Original px per decoded px.
+    """
+    size = jpeg_size(data)
+    f = reduction_for(size[0], work_width_px) if size else 1
+    img = cv2.imdecode(data, _REDUCED[f])
+    if img is not None and f == 1 and size is None:
+        f = reduction_for(img.shape[1], work_width_px)
+        if f > 1:
+            img = cv2.resize(img, (img.shape[1] // f, img.shape[0] // f), interpolation=cv2.INTER_AREA)
+    return img, f
+
+
+def measure_file(
+    path: str | Path,
+    *,
+    l0_mm: float,
+    mm_per_px: float | None = None,
+    line_color: Any = "black",
+    fixed_end_px: tuple[float, float] | None = None,
+    positive_turn: str = "ccw",
+    method: str = DEFAULT_METHOD,
+    work_width_px: int = WORK_WIDTH_PX,
+) -> tuple[AngleResult, float]:
+    """Read and measure one image file; never raises on a bad image.
+
+    Returns
+    -------
+    result : AngleResult
+    seconds : float
+        Wall time of reading + measuring.
+    """
+    t0 = time.perf_counter()
+    try:
+        data = np.fromfile(str(path), dtype=np.uint8)
+    except OSError as exc:
+        return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
+    img, f = decode_for_work(data, work_width_px) if data.size else (None, 1)
+    if img is None:
+        return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
+    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
+        fixed_end_px = None
+    res = measure_work_image(
+        img, scale=float(f), l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
+        fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
+    )
+    return res, time.perf_counter() - t0

@@ -1,0 +1,358 @@
+"""Curvature estimators: one interface, several methods (``--method`` selects one).
+
+Every estimator takes the ordered centre-line points of the marker line (``(N, 2)`` array, fixed
+end first, in pixels, in a **y-up** frame so that a counter-clockwise turn *as seen on screen* is
+positive) and returns a :class:`CurveEstimate` whose ``kappa_per_px`` is the signed *mean*
+curvature over the measured line.  The caller turns it into psi (``kappa * l0``).
+
+Methods
+-------
+``paper``
+    Faithful to the paper (Section II.C): curvature at 100 random places along the curve,
+    each from three *nearby* centre-line points (2 % of the line apart), unsigned, averaged (the overall sign is
+    taken from the turning direction, otherwise negative angles could not be reported).
+    Pixel noise makes each nearby-triple curvature large and of random sign, so the unsigned
+    average is biased upwards: a straight line never reads 0 deg.  Kept to show the trap.
+``paper_corrected``
+    Same sampling idea, but signed three-point (Menger) curvature over *widely spaced* triples
+    (spacing a quarter to a half of the line): unbiased, and exact for any three points of an
+    arc, including arcs past 180 deg.
+``pratt``, ``taubin``, ``hyper``
+    Algebraic circle fits (Chernov's formulation: minimise ``A^T M A`` subject to a quadratic
+    constraint ``A^T N A = 1`` on the circle ``A (x^2 + y^2) + B x + C y + D = 0``).  They stay
+    regular at zero curvature (``A -> 0`` is a straight line), unlike Kasa, which over-reads
+    curvature on short arcs.  Hyper is unbiased to second order in the noise.
+``turning``
+    Tangent angle theta(s) against arc length s, fitted by Legendre polynomials of degree
+    1..6, the degree chosen by BIC (constant curvature unless the photo demands more);
+    psi = theta(L) - theta(0).  Right when curvature is not constant.
+
+Examples
+--------
+>>> import numpy as np
+>>> t = np.linspace(0.0, np.deg2rad(250.0), 400)
+>>> pts = np.c_[100 * np.sin(t), 100 * (1 - np.cos(t))]   # ccw arc, radius 100 px
+>>> print(round(METHODS["hyper"](pts, np.random.default_rng(0)).kappa_per_px * 100, 6))
+1.0
+>>> print(round(np.rad2deg(METHODS["turning"](pts, np.random.default_rng(0)).turning_rad), 1))
+250.0
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from scipy import linalg
+
+#: paper: number of random places along the curve
+N_SAMPLES = 100
+#: paper: spacing of the "nearby" triples, as a fraction of the line
+NEARBY_FRACTION = 0.02
+#: turning: highest polynomial degree of theta(s) tried
+MAX_DEGREE = 10
+
+
+@dataclass(frozen=True)
+class CurveEstimate:
+    """Result of one curvature estimator.
+
+    Attributes
+    ----------
+    kappa_per_px : float
+        Signed mean curvature (1/px), counter-clockwise in a y-up frame positive.
+    turning_rad : float
+        Signed total turning angle over the measured line (rad) = kappa * length.
+    length_px : float
+        Arc length of the measured line (px).
+    residual_px : float
+        RMS distance of the points from the fitted model (px); NaN when the method has none.
+    degree : int
+        Model complexity used (1 for a circle / constant curvature).
+    """
+
+    kappa_per_px: float
+    turning_rad: float
+    length_px: float
+    residual_px: float
+    degree: int = 1
+
+
+class Estimator(Protocol):
+    """``estimator(points, rng, *, ends_px=(0.0, 0.0)) -> CurveEstimate``.
+
+    ``ends_px`` is the length of the line beyond the first and the last point (px), e.g. where
+    the extraction trimmed the ends: it counts in ``length_px`` and the turning method
+    extrapolates the tangent angle over it.
+    """
+
+    def __call__(
+        self, points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+    ) -> CurveEstimate: ...
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+
+
+def arc_length(points: np.ndarray) -> np.ndarray:
+    """Cumulative arc length of a polyline, starting at 0.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2)
+
+    Returns
+    -------
+    ndarray, shape (N,)
+    """
+    seg = np.hypot(*np.diff(points, axis=0).T)
+    return np.concatenate(([0.0], np.cumsum(seg)))
+
+
+def chunk_means(points: np.ndarray, n_chunks: int | None = None) -> tuple[np.ndarray, float]:
+    """Average a polyline over ``n_chunks`` equal arc-length pieces.
+
+    The polyline is resampled at about 0.5 px, cut into equal pieces, and each piece replaced by
+    its mean.  On an arc the means lie on a concentric circle at equal angular steps, so chord
+    directions between consecutive means are exact tangent angles while pixel noise is averaged.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2)
+    n_chunks : int, optional
+        Default: about one piece per 3 px, between 8 and 64.
+
+    Returns
+    -------
+    means : ndarray, shape (n_chunks, 2)
+    piece_px : float
+        Arc length of one piece (px).
+    """
+    s = arc_length(points)
+    total = float(s[-1])
+    if n_chunks is None:
+        n_chunks = int(np.clip(total / 3.0, 8, 64))
+    per = max(int(np.ceil(total / n_chunks / 0.5)), 1)
+    u = (np.arange(n_chunks * per) + 0.5) * (total / (n_chunks * per))
+    fine = np.c_[np.interp(u, s, points[:, 0]), np.interp(u, s, points[:, 1])]
+    return fine.reshape(n_chunks, per, 2).mean(axis=1), total / n_chunks
+
+
+def smooth_length(points: np.ndarray) -> float:
+    """Arc length of a noisy polyline, free of the zig-zag inflation of the raw polyline (px)."""
+    means, piece = chunk_means(points)
+    return float(arc_length(means)[-1] + piece)
+
+
+def _turn_sign(points: np.ndarray) -> float:
+    """+1 when the line as a whole turns counter-clockwise (y-up), -1 otherwise."""
+    d = np.diff(points, axis=0)
+    ang = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    k = max(len(ang) // 10, 1)
+    return 1.0 if ang[-k:].mean() - ang[:k].mean() >= 0 else -1.0
+
+
+def menger_curvature(p1: np.ndarray, p2: np.ndarray, p3: np.ndarray) -> np.ndarray:
+    """Signed curvature of the circle through three points (ccw positive), vectorised.
+
+    ``kappa = 2 * cross(p2 - p1, p3 - p2) / (|p2 - p1| |p3 - p2| |p3 - p1|)``.
+    """
+    a, b = p2 - p1, p3 - p2
+    cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    den = np.hypot(*a.T) * np.hypot(*b.T) * np.hypot(*(p3 - p1).T)
+    return np.divide(2.0 * cross, den, out=np.zeros_like(cross, dtype=float), where=den > 0)
+
+
+def _estimate(
+    kappa: float, points: np.ndarray, residual: float, ends_px: tuple[float, float], degree: int = 1
+) -> CurveEstimate:
+    length = smooth_length(points) + ends_px[0] + ends_px[1]
+    return CurveEstimate(float(kappa), float(kappa * length), length, float(residual), degree)
+
+
+# ---------------------------------------------------------------------------------------------
+# paper (faithful) and corrected
+
+
+def paper(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """The paper's estimator: unsigned curvature of neighbouring triples at 100 random places.
+
+    Biased upwards by pixel noise (a straight line never reads 0); see the module docstring.
+    """
+    n = len(points)
+    if n < 5:
+        raise ValueError("need at least 5 centre-line points")
+    m = max(int(round(NEARBY_FRACTION * n)), 1)
+    i = rng.integers(m, n - m, size=N_SAMPLES)
+    k = np.abs(menger_curvature(points[i - m], points[i], points[i + m]))
+    return _estimate(_turn_sign(points) * float(k.mean()), points, np.nan, ends_px)
+
+
+def paper_corrected(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Signed three-point curvature over widely spaced triples at 100 random places.
+
+    Each triple is ``(i, i + m, i + 2 m)`` with ``m`` between a quarter and a half of the line.
+    """
+    n = len(points)
+    if n < 5:
+        raise ValueError("need at least 5 centre-line points")
+    m = rng.integers(max(n // 4, 1), max((n - 1) // 2, 1) + 1, size=N_SAMPLES)
+    i = (rng.random(N_SAMPLES) * (n - 2 * m)).astype(int)
+    k = menger_curvature(points[i], points[i + m], points[i + 2 * m])
+    return _estimate(float(k.mean()), points, np.nan, ends_px)
+
+
+# ---------------------------------------------------------------------------------------------
+# algebraic circle fits (Chernov & Lesort)
+
+
+def _constraint(kind: str, zbar: float, xbar: float, ybar: float) -> np.ndarray:
+    pratt = np.array([[0, 0, 0, -2], [0, 1, 0, 0], [0, 0, 1, 0], [-2, 0, 0, 0]], float)
+    taubin = np.array(
+        [[4 * zbar, 2 * xbar, 2 * ybar, 0], [2 * xbar, 1, 0, 0], [2 * ybar, 0, 1, 0], [0, 0, 0, 0]], float
+    )
+    return {"pratt": pratt, "taubin": taubin, "hyper": 2 * taubin - pratt}[kind]
+
+
+def algebraic_circle(points: np.ndarray, kind: str = "hyper") -> tuple[np.ndarray, float]:
+    """Fit ``A (x^2 + y^2) + B x + C y + D = 0`` with the Pratt, Taubin or Hyper constraint.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2)
+    kind : {"pratt", "taubin", "hyper"}
+
+    Returns
+    -------
+    coef : ndarray, shape (4,)
+        ``(A, B, C, D)`` in the coordinates ``(points - origin) / scale``.
+    scale : float
+        Normalising scale (px); the origin is the centroid of ``points``.
+    """
+    origin = points.mean(axis=0)
+    q = points - origin
+    scale = float(np.sqrt((q**2).sum(axis=1).mean())) or 1.0
+    q = q / scale
+    z = (q**2).sum(axis=1)
+    design = np.c_[z, q, np.ones(len(q))]
+    m = design.T @ design / len(q)
+    m += np.eye(4) * 1e-12 * np.trace(m)  # exact data: keep M positive definite
+    cons = _constraint(kind, z.mean(), q[:, 0].mean(), q[:, 1].mean())
+    # N a = lambda M a  (lambda = 1 / eta): the wanted eta is the smallest positive one
+    lam, vec = linalg.eigh(cons, m)
+    coef = vec[:, int(np.argmax(lam))]
+    return coef, scale
+
+
+def _circle_estimate(points: np.ndarray, kind: str, ends_px: tuple[float, float]) -> CurveEstimate:
+    coef, scale = algebraic_circle(points, kind)
+    a, b, c, d = coef
+    q = (points - points.mean(axis=0)) / scale
+    grad = 2 * a * q + np.array([b, c])
+    disc = b * b + c * c - 4 * a * d
+    if disc <= 0:
+        raise ValueError("degenerate circle fit")
+    t = np.gradient(q, axis=0)
+    side = np.sign(np.sum(t[:, 0] * grad[:, 1] - t[:, 1] * grad[:, 0])) or 1.0
+    kappa = -2.0 * a * side / np.sqrt(disc) / scale
+    f = a * (q**2).sum(axis=1) + q @ np.array([b, c]) + d
+    resid = f / np.maximum(np.hypot(*grad.T), 1e-12) * scale
+    return _estimate(kappa, points, float(np.sqrt(np.mean(resid**2))), ends_px)
+
+
+def pratt(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Pratt algebraic circle fit (constraint ``B^2 + C^2 - 4 A D = 1``)."""
+    return _circle_estimate(points, "pratt", ends_px)
+
+
+def taubin(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Taubin algebraic circle fit (gradient-weighted)."""
+    return _circle_estimate(points, "taubin", ends_px)
+
+
+def hyper(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Hyper algebraic circle fit (Al-Sharadqah & Chernov 2009: no essential bias)."""
+    return _circle_estimate(points, "hyper", ends_px)
+
+
+# ---------------------------------------------------------------------------------------------
+# turning angle
+
+
+def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """Fit tangent angle against arc length with a polynomial degree chosen by BIC.
+
+    The tangent angle is taken from chords between consecutive points (pass the output of
+    :func:`chunk_means` so that chord angles are nearly independent and noise is averaged).
+
+    Returns
+    -------
+    s_mid : ndarray
+        Arc length at the chord midpoints (px).
+    coef : ndarray
+        Legendre coefficients of theta(u), ``u = 2 s / L - 1``.
+    degree : int
+        Chosen degree.
+    rss : float
+        Residual sum of squares of the chosen fit (rad^2).
+    """
+    d = np.diff(points, axis=0)
+    seg = np.hypot(d[:, 0], d[:, 1])
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    s = np.concatenate(([0.0], np.cumsum(seg)))
+    s_mid = 0.5 * (s[1:] + s[:-1])
+    u = 2.0 * s_mid / s[-1] - 1.0
+    n = len(theta)
+    best: tuple[float, np.ndarray, int, float] | None = None
+    for deg in range(1, min(max_degree, n - 2) + 1):
+        coef, diag = np.polynomial.legendre.legfit(u, theta, deg, w=np.sqrt(seg), full=True)
+        rss = float(np.sum(seg * (np.polynomial.legendre.legval(u, coef) - theta) ** 2) / seg.mean())
+        bic = n * np.log(max(rss, 1e-300) / n) + (deg + 1) * np.log(n)
+        if best is None or bic < best[0]:
+            best = (bic, coef, deg, rss)
+    assert best is not None
+    return s_mid, best[1], best[2], best[3]
+
+
+def turning(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Total turning angle theta(L) - theta(0) from a BIC-chosen smooth fit of theta(s)."""
+    if len(points) < 4:
+        raise ValueError("need at least 4 centre-line points")
+    means, piece = chunk_means(points)
+    s_mid, coef, deg, rss = turning_fit(means)
+    span = float(arc_length(means)[-1])
+    length = span + piece + ends_px[0] + ends_px[1]
+    # u = 2 s / span - 1 runs from the first mean to the last; the line ends lie beyond them
+    u0 = -1.0 - 2.0 * (piece / 2 + ends_px[0]) / span
+    u1 = 1.0 + 2.0 * (piece / 2 + ends_px[1]) / span
+    psi = float(np.polynomial.legendre.legval(u1, coef) - np.polynomial.legendre.legval(u0, coef))
+    n = len(means) - 1
+    spacing = piece
+    # chord-angle RMS residual -> positional scale (angle noise ~ sqrt(2) sigma / spacing)
+    resid_px = float(np.sqrt(rss / n) * spacing / np.sqrt(2.0))
+    return CurveEstimate(psi / length, psi, length, resid_px, deg)
+
+
+#: name -> estimator; every entry has the same signature
+METHODS: dict[str, Estimator] = {
+    "paper": paper,
+    "paper_corrected": paper_corrected,
+    "pratt": pratt,
+    "taubin": taubin,
+    "hyper": hyper,
+    "turning": turning,
+}

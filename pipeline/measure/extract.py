@@ -1,0 +1,471 @@
+"""From a photo to the ordered sub-pixel centre line of the marker line (paper, Section II.C).
+
+Steps (all vectorised OpenCV / numpy / scipy, no per-pixel Python loops):
+
+1. colour mask: the HSV range(s) of ``line_color`` (:func:`pipeline.photoset.line_color_ranges`);
+   for ranges that only bound the value (black) the HSV conversion is skipped;
+2. connected components; each large one is scored by its length (area / width, the width from
+   the distance transform), so the clamp (thick), glare (not in the colour range), short
+   distractor marks and specks lose to the long thin marker line;
+3. thick parts touching the line (a dark clamp) are cut off by a morphological opening whose disc
+   is wider than the line;
+4. the pixels of the line are ordered by their geodesic (Dijkstra, 8-neighbour) distance from one
+   end, found by a double sweep; the centroids of equal-distance bands are the sub-pixel centre
+   line, ordered along the line itself (never by angle around a centre), so arcs past 180 deg
+   whose ends approach each other are ordered correctly;
+5. the fixed end is the end nearer ``fixed_end_px``, or with ``auto`` the end nearer a removed
+   clamp blob, else the end nearer the image border.
+
+Coordinates are image pixels (x right, y down) of the *original* image, even when the work is done
+on a reduced image (``scale`` > 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from pipeline.photoset import line_color_ranges
+
+#: components shorter than this (work px) are never the marker line
+MIN_LENGTH_PX = 25.0
+#: another component at least this fraction of the chosen line's length is a rival candidate
+RIVAL_FRACTION = 0.4
+
+
+class NoLineFound(Exception):
+    """No marker line could be extracted; the message is the reason reported in angles.csv."""
+
+
+@dataclass(frozen=True)
+class LineExtraction:
+    """The extracted marker line and what is known about its quality.
+
+    Attributes
+    ----------
+    centreline_px : ndarray, shape (N, 2)
+        Sub-pixel centre-line points, fixed end first, original-image pixels (x right, y down).
+    width_px : float
+        Line width (original px).
+    touches_border : bool
+        The line reaches the image border (it may continue outside the photo).
+    n_candidates : int
+        Line-like components found (1 = unambiguous).
+    contrast : float
+        Colour distance between the line and its surroundings (0-441, BGR units).
+    ends_gap_px : float
+        Straight distance between the two ends of the line (original px).
+    branched_fraction : float
+        Fraction of equal-distance bands split in separate pieces (a line closing on itself or
+        crossing something).
+    fixed_end_auto : bool
+        The fixed end was guessed (``fixed_end: auto``).
+    clamp_removed : bool
+        A thick blob touching the line (clamp) was cut off.
+    trimmed_px : (float, float)
+        Length cut from the fixed and the free end of ``centreline_px`` (original px): the
+        measured line extends this far beyond the first and the last point.
+    gap_bridged : bool
+        A fragment beyond a gap (glare, occlusion) was joined to the line.
+    fixed_end_found : bool
+        A candidate line reaches the given fixed end (else the longest line was used).
+    """
+
+    centreline_px: np.ndarray
+    width_px: float
+    touches_border: bool
+    n_candidates: int
+    contrast: float
+    ends_gap_px: float
+    branched_fraction: float
+    fixed_end_auto: bool
+    clamp_removed: bool
+    trimmed_px: tuple[float, float] = (0.0, 0.0)
+    gap_bridged: bool = False
+    fixed_end_found: bool = True
+
+
+# ---------------------------------------------------------------------------------------------
+# colour mask
+
+
+def _kernel_px(shape: tuple[int, ...]) -> int:
+    """Side of the black-hat square: wider than any marker line, narrower than the clamp."""
+    return int(max(11, shape[1] // 40) | 1)
+
+
+def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndarray, np.ndarray]:
+    """Binary mask of the marker line's pixels and per-pixel weights for sub-pixel centroids.
+
+    For a value-only range (``black``) the mask is a black-hat (closing minus image) of the
+    value channel ``V = max(B, G, R)`` with a square wider than the line, thresholded at 35 % of
+    its strong response: thin dark strokes stand out whatever the lighting gradient, vignetting or
+    faded ink, while large dark things (clamp block, shadows) do not.  For coloured ranges the
+    HSV range itself is the mask.
+
+    Parameters
+    ----------
+    image_bgr : ndarray, shape (H, W, 3), uint8
+    line_color : str or mapping
+        See :func:`pipeline.photoset.line_color_ranges`.
+
+    Returns
+    -------
+    mask : ndarray, shape (H, W), uint8 (0 / 1)
+    weight : ndarray, shape (H, W), uint8
+        Line strength (black-hat response, or the mask for colour ranges).
+    """
+    ranges = line_color_ranges(line_color)
+    if all(lo[0] == 0 and hi[0] == 179 and lo[1] == 0 and hi[1] == 255 for lo, hi in ranges):
+        v = cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
+        k = _kernel_px(image_bgr.shape)
+        bh = cv2.morphologyEx(v, cv2.MORPH_BLACKHAT, cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)))
+        hist = cv2.calcHist([bh], [0], None, [256], [0, 256]).ravel()
+        cum = np.cumsum(hist[::-1])  # pixels at or above each level, from 255 down
+        peak = 255 - int(np.searchsorted(cum, 0.001 * bh.size))
+        thr = max(20, int(0.35 * peak))
+        mask = (bh >= thr).astype(np.uint8)
+        return mask, bh
+    hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
+    out = None
+    for lo, hi in ranges:
+        m = cv2.inRange(hsv, lo, hi)
+        out = m if out is None else cv2.bitwise_or(out, m)
+    assert out is not None
+    mask = (out > 0).astype(np.uint8)
+    return mask, mask
+
+
+# ---------------------------------------------------------------------------------------------
+# components
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    x0: int
+    y0: int
+    sub: np.ndarray  # uint8 0/1 mask of the component in its bounding box (1 px margin)
+    half_width: float
+    length: float  # half the outer perimeter: the length of a thin line, small for blobs
+    dist_fixed: float  # nearest pixel to the fixed end (work px), inf when unknown
+
+
+def _ridge_half_width(sub: np.ndarray) -> float:
+    dt = cv2.distanceTransform(sub, cv2.DIST_L2, 3)
+    ridge = (dt > 0) & (dt >= cv2.dilate(dt, np.ones((3, 3), np.uint8)))
+    vals = dt[ridge]
+    return float(np.median(vals)) if vals.size else 0.5
+
+
+def _candidates(mask: np.ndarray, fixed_xy: tuple[float, float] | None, max_candidates: int = 10) -> list[_Candidate]:
+    # external contours are ~50x cheaper than connectedComponentsWithStats on a full frame
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    h, w = mask.shape
+    boxes = []
+    for c in contours:
+        x, y, bw, bh = cv2.boundingRect(c)
+        if max(bw, bh) >= MIN_LENGTH_PX:
+            boxes.append((0.5 * cv2.arcLength(c, True), c, x, y, bw, bh))
+    boxes.sort(key=lambda b: -b[0])
+    out = []
+    for length, c, x, y, bw, bh in boxes[:max_candidates]:
+        x0, y0 = max(x - 1, 0), max(y - 1, 0)
+        x1, y1 = min(x + bw + 1, w), min(y + bh + 1, h)
+        sub = np.zeros((y1 - y0, x1 - x0), np.uint8)
+        cv2.drawContours(sub, [c], -1, 1, cv2.FILLED, offset=(-x0, -y0))
+        sub &= mask[y0:y1, x0:x1]
+        dist = np.inf
+        if fixed_xy is not None:
+            pts = c.reshape(-1, 2).astype(float)
+            dist = float(np.sqrt(np.min((pts[:, 0] - fixed_xy[0]) ** 2 + (pts[:, 1] - fixed_xy[1]) ** 2)))
+        out.append(_Candidate(x0, y0, sub, _ridge_half_width(sub), float(length), dist))
+    return out
+
+
+def _choose(cands: list[_Candidate], near_px: float) -> tuple[_Candidate, bool]:
+    """The marker line: the longest candidate reaching the fixed end (else the longest)."""
+    near = [c for c in cands if c.dist_fixed <= near_px]
+    if near:
+        return max(near, key=lambda c: c.length), True
+    return max(cands, key=lambda c: c.length), False
+
+
+def _fill_small_holes(sub: np.ndarray, max_fraction: float = 0.1) -> np.ndarray:
+    """Fill holes smaller than ``max_fraction`` of the box (a clamp's frame becomes a block).
+
+    Large holes (the inside of an actuator curled into a closed loop) are kept open.
+    """
+    contours, hier = cv2.findContours(sub, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
+    if hier is None:
+        return sub
+    holes = [c for c, h in zip(contours, hier[0]) if h[3] != -1 and cv2.contourArea(c) < max_fraction * sub.size]
+    if not holes:
+        return sub
+    filled = sub.copy()
+    cv2.drawContours(filled, holes, -1, 1, cv2.FILLED)
+    return filled
+
+
+def _cut_thick_parts(sub: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray | None]:
+    """Remove blobs much thicker than the line (a clamp); return (line, removed blob or None)."""
+    filled = _fill_small_holes(sub)
+    dt = cv2.distanceTransform(filled, cv2.DIST_L2, 3)
+    radius = int(np.ceil(max(2.5 * half_width, half_width + 3.0)))
+    if dt.max() <= radius:
+        return sub, None
+    k = 2 * radius + 1
+    thick = cv2.morphologyEx(filled, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    # everything within a disc radius of the thick part belongs to it (clamp frames, edges)
+    thick = cv2.dilate(thick, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 5,) * 2))
+    line = sub & (1 - thick)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(line, connectivity=8)
+    if n <= 1:
+        return sub, None
+    keep = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return (labels == keep).astype(np.uint8), thick
+
+
+# ---------------------------------------------------------------------------------------------
+# ordering
+
+
+_STEPS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0)))
+
+
+def _pixel_graph(ys: np.ndarray, xs: np.ndarray, shape: tuple[int, int]) -> csr_matrix:
+    idx = np.full((shape[0] + 2, shape[1] + 2), -1, np.int64)
+    idx[ys + 1, xs + 1] = np.arange(len(ys))
+    rows, cols, wts = [], [], []
+    for dy, dx, wt in _STEPS:
+        nb = idx[ys + 1 + dy, xs + 1 + dx]
+        ok = nb >= 0
+        rows.append(np.nonzero(ok)[0])
+        cols.append(nb[ok])
+        wts.append(np.full(int(ok.sum()), wt))
+    r, c, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(wts)
+    return csr_matrix((v, (r, c)), shape=(len(ys), len(ys)))
+
+
+def order_pixels(
+    sub: np.ndarray, weight: np.ndarray, start_xy: tuple[float, float] | None, band_px: float
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """Centre line of one thin component as band centroids of the geodesic distance from an end.
+
+    Parameters
+    ----------
+    sub : ndarray of 0/1
+        The component.
+    weight : ndarray
+        Per-pixel weights (line strength) for the centroids, same shape as ``sub``.
+    start_xy : (x, y) or None
+        The fixed end (in ``sub`` coordinates); pixels geodesically beyond it are dropped.
+    band_px : float
+        Band width along the line (px).
+
+    Returns
+    -------
+    points : ndarray, shape (N, 2)
+        Ordered weighted centroids (x, y) in ``sub`` coordinates, from the end nearer
+        ``start_xy`` (else from an arbitrary end).
+    branched_fraction : float
+        Fraction of bands whose pixels are spread wider than the line (loops, branches).
+    ends : ndarray, shape (2, 2)
+        The two end pixels (x, y), in the order of ``points``.
+    """
+    ys, xs = np.nonzero(sub)
+    graph = _pixel_graph(ys, xs, sub.shape)
+    seed = 0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
+    d0 = dijkstra(graph, directed=False, indices=seed)
+    d0[~np.isfinite(d0)] = -1.0
+    a = int(np.argmax(d0))  # the far (free) end
+    da = dijkstra(graph, directed=False, indices=a)
+    reach = np.isfinite(da)
+    if start_xy is not None:
+        # the line ends at the fixed end: drop what lies beyond it (clamp outline, tube edge)
+        reach &= da <= da[seed] + 0.5
+    b = int(np.argmax(np.where(reach, da, -1.0)))
+    ea, eb = np.array([xs[a], ys[a]], float), np.array([xs[b], ys[b]], float)
+    s = da[reach]
+    x, y = xs[reach].astype(float), ys[reach].astype(float)
+    wt = weight[ys[reach], xs[reach]].astype(float) + 1e-3
+    band = (s / band_px).astype(np.int64)
+    nb = int(band.max()) + 1
+    cnt = np.bincount(band, wt, nb)
+    good = cnt > 0
+    sx, sy = np.bincount(band, wt * x, nb), np.bincount(band, wt * y, nb)
+    sxx, syy = np.bincount(band, wt * x * x, nb), np.bincount(band, wt * y * y, nb)
+    cnt_g = cnt[good]
+    cx, cy = sx[good] / cnt_g, sy[good] / cnt_g
+    spread = np.sqrt(np.maximum(sxx[good] / cnt_g - cx**2 + syy[good] / cnt_g - cy**2, 0.0))
+    points = np.c_[cx, cy][::-1]  # from b (fixed end side when start_xy is given) to a
+    ends = np.array([eb, ea])
+    return points, float(np.mean(spread > 2.0 * band_px + 1.0)), ends
+
+
+# ---------------------------------------------------------------------------------------------
+# whole extraction
+
+
+def _contrast(image: np.ndarray, points: np.ndarray, half_width: float) -> float:
+    """Colour distance between the line and the background beside it, sampled across the line."""
+    d = np.gradient(points, axis=0)
+    n = np.c_[-d[:, 1], d[:, 0]] / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)[:, None]
+    off = 2.0 * half_width + 3.0
+    h, w = image.shape[:2]
+
+    def sample(p: np.ndarray) -> np.ndarray:
+        xi = np.clip(np.round(p[:, 0]).astype(int), 0, w - 1)
+        yi = np.clip(np.round(p[:, 1]).astype(int), 0, h - 1)
+        return image[yi, xi].astype(float)
+
+    inside = np.median(sample(points), axis=0)
+    outside = np.median(np.r_[sample(points + off * n), sample(points - off * n)], axis=0)
+    return float(np.linalg.norm(inside - outside))
+
+
+def _bridge(
+    line: np.ndarray, points: np.ndarray, others: list[_Candidate], best: _Candidate, max_gap_px: float
+) -> tuple[np.ndarray, int, int, int] | None:
+    """Join a fragment continuing the line past a gap (glare, occlusion) with a straight bridge.
+
+    Returns the union mask and its box offset / or None when no fragment continues the line.
+    """
+    end = points[-1] + np.array([best.x0, best.y0])
+    k = max(len(points) // 15, 3)
+    tangent = points[-1] - points[-k]
+    tangent = tangent / max(np.hypot(*tangent), 1e-9)
+    for c in others:
+        ys, xs = np.nonzero(c.sub)
+        gx, gy = xs + c.x0, ys + c.y0
+        d2 = (gx - end[0]) ** 2 + (gy - end[1]) ** 2
+        i = int(np.argmin(d2))
+        gap = float(np.sqrt(d2[i]))
+        if gap > max_gap_px or gap < 1.0:
+            continue
+        direction = np.array([gx[i] - end[0], gy[i] - end[1]]) / gap
+        if float(direction @ tangent) < np.cos(np.deg2rad(35.0)):
+            continue
+        x0, y0 = min(best.x0, c.x0), min(best.y0, c.y0)
+        x1 = max(best.x0 + line.shape[1], c.x0 + c.sub.shape[1])
+        y1 = max(best.y0 + line.shape[0], c.y0 + c.sub.shape[0])
+        union = np.zeros((y1 - y0, x1 - x0), np.uint8)
+        union[best.y0 - y0 : best.y0 - y0 + line.shape[0], best.x0 - x0 : best.x0 - x0 + line.shape[1]] |= line
+        union[c.y0 - y0 : c.y0 - y0 + c.sub.shape[0], c.x0 - x0 : c.x0 - x0 + c.sub.shape[1]] |= c.sub
+        thick = max(int(round(2 * best.half_width)), 1)
+        p0 = (int(round(end[0] - x0)), int(round(end[1] - y0)))
+        cv2.line(union, p0, (int(gx[i] - x0), int(gy[i] - y0)), 1, thick)
+        others.remove(c)
+        return union, x0, y0, int(np.count_nonzero(c.sub))
+    return None
+
+
+def extract_centreline(
+    image_bgr: np.ndarray,
+    *,
+    line_color: Any = "black",
+    fixed_end_px: tuple[float, float] | None = None,
+    scale: float = 1.0,
+) -> LineExtraction:
+    """Extract the ordered sub-pixel centre line of the marker line.
+
+    Parameters
+    ----------
+    image_bgr : ndarray, shape (H, W, 3), uint8
+        The photo, possibly reduced by ``scale`` from the original.
+    line_color : str or mapping
+        Marker colour (name or HSV range).
+    fixed_end_px : (x, y) or None
+        The clamped end of the line in *original* pixels; None: guess it.
+    scale : float
+        Original pixels per pixel of ``image_bgr``.
+
+    Returns
+    -------
+    LineExtraction
+
+    Raises
+    ------
+    NoLineFound
+        If no line-like component of the colour exists.
+    """
+    if image_bgr is None or image_bgr.ndim != 3 or image_bgr.shape[2] != 3:
+        raise NoLineFound("unreadable image (not a 3-channel colour image)")
+    h, w = image_bgr.shape[:2]
+    fe = None
+    if fixed_end_px is not None and np.all(np.isfinite(fixed_end_px)):
+        fe = ((fixed_end_px[0] - (scale - 1) / 2) / scale, (fixed_end_px[1] - (scale - 1) / 2) / scale)
+    mask, weight = line_mask(image_bgr, line_color)
+    cands = _candidates(mask, fe)
+    if not cands:
+        raise NoLineFound(
+            f"no line found: no long thin component of line_color={line_color!r}; check line_color and lighting"
+        )
+    diag = float(np.hypot(h, w))
+    best, at_fixed = _choose(cands, near_px=0.03 * diag)
+    others = [c for c in cands if c is not best]
+    rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
+    line, thick = _cut_thick_parts(best.sub, best.half_width)
+    band = max(1.0, min(2.0, best.half_width))
+    fe_sub = None if fe is None else (fe[0] - best.x0, fe[1] - best.y0)
+    x0, y0 = best.x0, best.y0
+    points, branched, ends = order_pixels(line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band)
+    bridged = 0
+    for _ in range(3):
+        if len(points) < 4:
+            break
+        joined = _bridge(line, points, others, _Candidate(x0, y0, line, best.half_width, best.length, 0.0), 0.08 * diag)
+        if joined is None:
+            break
+        line, x0, y0, n_px = joined
+        bridged += n_px
+        fe_sub = None if fe is None else (fe[0] - x0, fe[1] - y0)
+        points, branched, ends = order_pixels(line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band)
+    if bridged:
+        rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
+    if len(points) < 8:
+        raise NoLineFound(f"no line found: the longest candidate is only {len(points)} bands long")
+    fixed_auto = fe is None
+    if fixed_auto:
+        # clamp blob nearest, else image border nearest
+        if thick is not None:
+            ty, tx = np.nonzero(thick)
+            dist = [float(np.min((tx + best.x0 - x0 - e[0]) ** 2 + (ty + best.y0 - y0 - e[1]) ** 2)) for e in ends]
+        else:
+            dist = [float(min(e[0] + x0, e[1] + y0, w - 1 - e[0] - x0, h - 1 - e[1] - y0)) for e in ends]
+        if dist[1] < dist[0]:
+            points, ends = points[::-1], ends[::-1]
+    ys, xs = np.nonzero(line)
+    touches = bool(xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1)
+    gpts = points + np.array([x0, y0], float)
+    # drop about one line width at each end: the band centroids bend towards the corner pixel
+    # where the geodesic sweep starts, which would tilt the end tangents
+    seg = np.hypot(*np.diff(gpts, axis=0).T)
+    s_along = np.concatenate(([0.0], np.cumsum(seg)))
+    trim = max(2.0 * best.half_width, 2.0 * band)
+    keep = (s_along >= trim) & (s_along <= s_along[-1] - trim)
+    if keep.sum() >= 8:
+        i0, i1 = int(np.argmax(keep)), len(keep) - 1 - int(np.argmax(keep[::-1]))
+        trimmed = (s_along[i0] * scale, (s_along[-1] - s_along[i1]) * scale)
+        gpts = gpts[i0 : i1 + 1]
+    else:
+        trimmed = (0.0, 0.0)
+    centre = gpts * scale + (scale - 1) / 2
+    return LineExtraction(
+        centreline_px=centre,
+        width_px=float(2.0 * best.half_width * scale),
+        touches_border=touches,
+        n_candidates=1 + rivals,
+        contrast=_contrast(image_bgr, gpts, best.half_width),
+        ends_gap_px=float(np.hypot(*(ends[0] - ends[1])) * scale),
+        branched_fraction=branched,
+        fixed_end_auto=fixed_auto,
+        clamp_removed=thick is not None,
+        trimmed_px=(float(trimmed[0]), float(trimmed[1])),
+        gap_bridged=bridged > 0,
+        fixed_end_found=at_fixed or fe is None,
+    )

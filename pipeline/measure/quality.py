@@ -1,0 +1,104 @@
+"""Quality status of one measurement: ``ok``, ``flagged`` (with reasons) or ``failed``.
+
+Never a silent wrong number: whatever the estimator returns, a row is ``flagged`` when
+
+- the line touches the image border (it may continue outside the photo);
+- the line is partly hidden (measured length < 93 % of ``l0`` when ``mm_per_px`` is known) or
+  longer than ``l0`` by more than 7 % (wrong scale or extra marks joined to the line);
+- several candidate lines were found;
+- the contrast between line and surroundings is low;
+- the curvature is not constant beyond what the arc model explains (the BIC-chosen tangent-angle
+  fit needs degree >= 2 *and* its psi differs from the Hyper circle fit's by more than
+  ``NONCONSTANT_DEG``); the ``turning`` method measures such lines correctly, so for it this is
+  only noted in ``reason`` and the row stays ``ok``;
+- the two ends almost touch, or the line closes on itself / branches;
+- the fixed end had to be guessed (``fixed_end: auto``) and the line is almost symmetric
+  (no clamp blob was found to tell the ends apart) -- the sign may be wrong.
+
+``failed`` rows (no psi) come from :class:`pipeline.measure.extract.NoLineFound` or an image
+that cannot be decoded; their reason is set by the caller.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pipeline.measure.extract import LineExtraction
+
+#: below this colour distance (BGR units) the contrast is low
+LOW_CONTRAST = 45.0
+#: turning-vs-arc difference (deg) beyond which the curvature is called non-constant
+NONCONSTANT_DEG = 1.5
+#: measured / expected length outside [LENGTH_LOW, LENGTH_HIGH] -> flagged
+LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
+
+
+@dataclass(frozen=True)
+class Quality:
+    """Status and reasons of one measurement."""
+
+    status: str
+    reason: str
+
+
+def assess(
+    line: LineExtraction,
+    *,
+    method: str,
+    length_px: float,
+    expected_length_px: float | None,
+    psi_turning_deg: float,
+    psi_arc_deg: float,
+    turning_degree: int,
+) -> Quality:
+    """Decide ``ok`` / ``flagged`` and list every reason.
+
+    Parameters
+    ----------
+    line : LineExtraction
+        The extracted line.
+    method : str
+        Estimator used for psi.
+    length_px : float
+        Measured line length (original px).
+    expected_length_px : float or None
+        ``l0_mm / mm_per_px`` when the scale is known.
+    psi_turning_deg, psi_arc_deg : float
+        psi from the turning-angle fit and from the Hyper circle fit.
+    turning_degree : int
+        Polynomial degree the BIC chose for theta(s).
+
+    Returns
+    -------
+    Quality
+    """
+    flags: list[str] = []
+    notes: list[str] = []
+    if line.touches_border:
+        flags.append("line touches the image border")
+    if expected_length_px:
+        ratio = length_px / expected_length_px
+        if ratio < LENGTH_LOW:
+            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
+        elif ratio > LENGTH_HIGH:
+            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
+    if line.gap_bridged:
+        flags.append("line partly hidden: gap bridged")
+    if not line.fixed_end_found:
+        flags.append("no line reaches fixed_end; used the longest")
+    if line.n_candidates > 1:
+        flags.append(f"{line.n_candidates} candidate lines")
+    if line.contrast < LOW_CONTRAST:
+        flags.append(f"low contrast ({line.contrast:.0f})")
+    diff = psi_turning_deg - psi_arc_deg
+    if turning_degree >= 2 and abs(diff) > NONCONSTANT_DEG:
+        text = f"non-constant curvature (turning - arc = {diff:+.1f} deg)"
+        (notes if method == "turning" else flags).append(text)
+    if line.branched_fraction > 0.05:
+        flags.append("line closes on itself or branches")
+    elif line.ends_gap_px < 3.0 * line.width_px + 4.0:
+        flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
+    if line.fixed_end_auto and not line.clamp_removed:
+        flags.append("fixed end guessed (nearest the border); set fixed_end")
+    status = "flagged" if flags else "ok"
+    return Quality(status, "; ".join(flags + notes))
