@@ -3,6 +3,7 @@ identical bytes for identical inputs, bench/force pages fetched defensively."""
 
 from __future__ import annotations
 
+import subprocess
 import sys
 import types
 from pathlib import Path
@@ -96,6 +97,12 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
     return hyst, rms
 
 
+def cli_in_fresh_process(args: list[str]) -> str:
+    """Run ``python -m pipeline ARGS`` in a new interpreter; return stderr ('' on success)."""
+    proc = subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True, check=False)
+    return "" if proc.returncode == 0 else proc.stderr or f"exit {proc.returncode}"
+
+
 def page_images(pdf: Path, scale: float = 0.6) -> list[np.ndarray]:
     doc = pdfium.PdfDocument(str(pdf))
     try:
@@ -129,8 +136,8 @@ def test_four_materials_deterministic_and_not_blank(four, tmp_path):
             "--hysteresis", *map(str, hyst), "--rms", str(rms), "--model-curves", str(curves),
             "--config", str(config)]
     a, b = tmp_path / "a.pdf", tmp_path / "b.pdf"
-    assert main(args + ["--out", str(a)]) == 0
-    assert main(args + ["--out", str(b)]) == 0
+    assert cli_in_fresh_process(args + ["--out", str(a)]) == ""
+    assert cli_in_fresh_process(args + ["--out", str(b)]) == ""
     assert a.read_bytes() == b.read_bytes()
     raw = a.read_bytes()
     assert b"CreationDate" not in raw
@@ -140,7 +147,7 @@ def test_four_materials_deterministic_and_not_blank(four, tmp_path):
     # the config digest changes the bytes (it is printed on the summary page)
     config.write_text("datasets: [changed]\n")
     c = tmp_path / "c.pdf"
-    assert main(args + ["--out", str(c)]) == 0
+    assert cli_in_fresh_process(args + ["--out", str(c)]) == ""
     assert c.read_bytes() != raw
 
 
@@ -152,6 +159,14 @@ def test_one_material_without_optional_tables(tmp_path):
     images = page_images(out)
     assert len(images) == res.pages == 4
     assert_not_blank(images)
+    again = tmp_path / "again.pdf"
+    build_report(ReportInputs(datasets=(d,)), again)
+    assert again.read_bytes() == out.read_bytes()
+    # the command line (a fresh process, as Snakemake runs it) writes the same bytes as the API
+    other = tmp_path / "other.pdf"
+    assert cli_in_fresh_process(["report", "--angles", str(d.angles_csv), "--datasets", d.name,
+                                 "--out", str(other)]) == ""
+    assert other.read_bytes() == out.read_bytes()
 
 
 def test_increasing_only_photoset(tmp_path):
@@ -197,7 +212,7 @@ def test_extra_pages_added_and_errors_reported(tmp_path, monkeypatch, capsys):
     assert res.pages == 5  # summary, overview, SS50, table, bench
     assert any("force table is corrupt" in w for w in res.warnings)
     doc = pdfium.PdfDocument(str(out))
-    summary_text = doc[0].get_textpage().get_text_range()
+    summary_text = " ".join(doc[0].get_textpage().get_text_range().split())
     doc.close()
     assert "WARNING: pipeline.force.pages.figures" in summary_text
     assert "RuntimeError: force table is corrupt" in summary_text
