@@ -49,6 +49,15 @@ def run(cmd: list[str], timeout: float = 60) -> subprocess.CompletedProcess[str]
     return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=timeout, check=False)
 
 
+def main_inprocess(cmd: list[str], capsys) -> tuple[int, str, str]:
+    """Run the same command line through ``pipeline.cli.main`` in this process (cheap checks)."""
+    from pipeline.cli import main
+
+    code = main(cmd[3:])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
 def manifest(out: Path) -> pd.DataFrame:
     return pd.read_csv(out / "manifest.csv")
 
@@ -113,9 +122,14 @@ def test_dropped_connection_then_rerun_resumes_without_duplicates(tmp_path, phot
     out = tmp_path / "set"
     link = tmp_path / "ttyPICO"
     with Emulator(faults=Faults(drop_after=14), link=link) as emu:
-        first = run(acquire_cmd(str(link), out, photo))
+        first = run(acquire_cmd(str(link), out, photo, "--watchdog-s", "1"))
         assert first.returncode == 4, first.stderr
         assert "lost" in first.stderr and "COULD NOT VENT" in first.stderr
+        assert emu.setpoint_kpa > 0  # the host could not vent ...
+        deadline = time.monotonic() + 5
+        while emu.setpoint_kpa > 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert emu.setpoint_kpa == 0.0  # ... so the device's watchdog did
         kept = assert_consistent(out)
         n_kept = len(kept)
         assert 0 < n_kept < 14
@@ -154,33 +168,33 @@ def test_sigint_vents_and_keeps_manifest_intact(tmp_path, photo):
     assert 3 <= len(df) < 42
 
 
-def test_limit_refused_before_anything_is_sent(tmp_path, photo):
+def test_limit_refused_before_anything_is_sent(tmp_path, photo, capsys):
     out = tmp_path / "set"
     cal = tmp_path / "cal.yaml"
     cal.write_text("method: linear\npoints:\n- {dac_code: 0, pressure_kpa: 0}\n- {dac_code: 4095, pressure_kpa: 500}\nmax_kpa: 100\n")
     with Emulator() as emu:
-        done = run(acquire_cmd(emu.port, out, photo, "--calibration", str(cal)))
+        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--calibration", str(cal)), capsys)
         assert not [c for c in emu.stats.received if c.startswith("SET")]
-    assert done.returncode == 6
-    assert "above the driver limit 100 kPa" in done.stderr
+    assert code == 6
+    assert "above the driver limit 100 kPa" in err
 
 
-def test_garbage_from_device_is_ignored(tmp_path, photo):
+def test_garbage_from_device_is_ignored(tmp_path, photo, capsys):
     out = tmp_path / "set"
     with Emulator(faults=Faults(garbage_every=2), seed=3) as emu:
-        done = run(acquire_cmd(emu.port, out, photo))
-    assert done.returncode == 0, done.stderr
-    n = int(done.stderr.split("ignored ")[1].split()[0])
+        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo), capsys)
+    assert code == 0, err
+    n = int(err.split("ignored ")[1].split()[0])
     assert n >= 10
     assert len(assert_consistent(out)) == 14
 
 
-def test_blocked_mode_records_force_statistics(tmp_path, photo):
+def test_blocked_mode_records_force_statistics(tmp_path, photo, capsys):
     out = tmp_path / "set"
     plant = PlantParams(monitor_noise_kpa=0.0, force_noise_n=0.02)
     with Emulator(plant=plant, seed=7) as emu:
-        done = run(acquire_cmd(emu.port, out, photo, "--mode", "blocked", "--force-samples", "8", trials=1))
-        assert done.returncode == 0, done.stderr
+        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--mode", "blocked", "--force-samples", "8", trials=1), capsys)
+        assert code == 0, err
         assert [c for c in emu.stats.received if c.startswith("TARE")]
     df = assert_consistent(out)
     assert {"force_n", "force_sd_n", "force_samples"} <= set(df.columns)
@@ -194,15 +208,6 @@ def test_blocked_mode_records_force_statistics(tmp_path, photo):
     slopes = np.diff(up) / np.diff(df[df["direction"] == "up"]["measured_pressure_kpa"].to_numpy())
     assert slopes[-1] > 1.2 * slopes[0]
     assert load_photoset(out).manifest["force_n"].notna().all()
-
-
-def main_inprocess(cmd: list[str], capsys) -> tuple[int, str, str]:
-    """Run the same command line through ``pipeline.cli.main`` in this process (cheap checks)."""
-    from pipeline.cli import main
-
-    code = main(cmd[3:])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_dry_run_prints_plan_and_resume_point(tmp_path, photo, capsys):
@@ -228,7 +233,7 @@ def test_bad_options_exit_2(tmp_path, photo, capsys):
     assert code == 4 and "cannot open serial port" in err
 
 
-def test_watched_folder_camera(tmp_path, photo):
+def test_watched_folder_camera(tmp_path, photo, capsys):
     """``dir:`` takes the first image that arrives after each request (a feeder writes one every 30 ms)."""
     watch = tmp_path / "watch"
     watch.mkdir()
@@ -253,11 +258,11 @@ def test_watched_folder_camera(tmp_path, photo):
         with Emulator() as emu:
             cmd = acquire_cmd(emu.port, out, photo, trials=1)
             cmd[cmd.index("--camera") + 1] = f"dir:{watch}"
-            done = run(cmd)
+            code, _, err = main_inprocess(cmd, capsys)
     finally:
         stop.set()
         thread.join()
-    assert done.returncode == 0, done.stderr
+    assert code == 0, err
     df = assert_consistent(out)
     images = [(out / name).read_bytes() for name in df["image"]]
     assert len(set(images)) == len(images)  # a different file each step
@@ -300,9 +305,9 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
 
     psi0 = load_materials()["DS20"].psi0_deg
     out = tmp_path / "set"
-    # ID, CFG, VENT, VENT, then SET+GET per step: the port drops right after the 6th photo (100 kPa),
-    # the one that reaches -psi0, before any down step: the re-run must find the peak from that photo
-    with Emulator(seed=2, faults=Faults(drop_after=16)) as emu:
+    # ID, CFG, VENT, WDOG, VENT, then SET+GET per step: the port drops right after the 6th photo
+    # (100 kPa), the one that reaches -psi0, before any down step: the re-run must find the peak from it
+    with Emulator(seed=2, faults=Faults(drop_after=17)) as emu:
         first = run(synthetic_cmd(emu.port, out, "--stop-at-psi0", step=20, top=260), timeout=120)
     assert first.returncode == 4
     kept = manifest(out)
@@ -326,12 +331,12 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     assert float(psi_deg("DS20", np.array([peak]))[0]) < -psi0 + 30
 
 
-def test_synthetic_blocked_rig(tmp_path):
+def test_synthetic_blocked_rig(tmp_path, capsys):
     _need("pipeline.synth", "render_curve")
     _need("pipeline.force.synth_blocked", "blocked_arc_mm")
     out = tmp_path / "set"
     with Emulator(seed=3) as emu:
-        done = run(synthetic_cmd(emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100), timeout=120)
-    assert done.returncode == 0, done.stderr
+        code, _, err = main_inprocess(synthetic_cmd(emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100), capsys)
+    assert code == 0, err
     df = load_photoset(out).manifest
     assert len(df) == 5 and df["force_n"].notna().all() and (df["force_samples"] == 3).all()

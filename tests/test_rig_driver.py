@@ -13,7 +13,7 @@ import pytest
 from pipeline.errors import UserInputError
 from pipeline.rig.calibration import fit_calibration, read_calibration, write_calibration
 from pipeline.rig.cli import run_calibration
-from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError
+from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, WatchdogError
 from pipeline.rig.emulator import Emulator, Faults, PlantParams, parse_faults
 from pipeline.rig.firmware import rigcore
 
@@ -115,6 +115,19 @@ def test_estop_event_during_sleep_and_refused_set():
         assert rig.get().setpoint_kpa == 50
 
 
+def test_device_watchdog_vents_a_silent_host():
+    with Emulator() as emu, PicoDriver.open(emu.port, max_kpa=260) as rig:
+        assert rig.set_watchdog(0.2) == pytest.approx(0.2)
+        rig.set_kpa(100)
+        with pytest.raises(WatchdogError):
+            rig.sleep(1.0)
+        assert emu.setpoint_kpa == 0.0
+        rig.set_watchdog(0)
+        rig.set_kpa(100)
+        rig.sleep(0.4)
+        assert emu.setpoint_kpa == 100.0
+
+
 def test_estop_fault_at_kth_set():
     with Emulator(faults=Faults(estop_at_set=2)) as emu, PicoDriver.open(emu.port, max_kpa=260) as rig:
         rig.set_kpa(10)
@@ -202,3 +215,41 @@ def test_emulate_cli_prints_port_and_serves_until_killed():
     finally:
         proc.terminate()
         assert proc.wait(timeout=5) == 0
+
+
+def test_calibrate_cli_from_monitor_and_from_readings(tmp_path, capsys):
+    from pipeline.cli import main
+
+    with Emulator(plant=PlantParams(gain=0.9, offset_kpa=-2.0)) as emu:
+        path = tmp_path / "cal.yaml"
+        code = main(["rig", "calibrate", "--port", emu.port, "--out", str(path), "--points-kpa", "0,100,200",
+                     "--settle-s", "0", "--samples", "3", "--max-kpa", "250"])
+        assert code == 0 and "3 points" in capsys.readouterr().out
+        cal = read_calibration(path)
+        assert cal.method == "piecewise" and cal.max_kpa == 250
+        assert cal.code_to_kpa(cal.dac_code[-1]) == pytest.approx(0.9 * rigcore.code_to_kpa(cal.dac_code[-1], rigcore.Config()) - 2, abs=0.5)
+        assert emu.setpoint_kpa == 0.0
+    readings = tmp_path / "gauge.csv"
+    readings.write_text("dac_code,pressure_kpa\n400,47.5\n2000,242.0\n")
+    assert main(["rig", "calibrate", "--readings", str(readings), "--out", str(path)]) == 0
+    assert read_calibration(path).method == "linear"
+    readings.write_text("code,kpa\n1,2\n")
+    assert main(["rig", "calibrate", "--readings", str(readings), "--out", str(path)]) == 2
+
+
+def test_load_cli_sets_scale_from_a_known_force(tmp_path, capsys):
+    from pipeline.cli import main
+
+    plant = PlantParams(force_noise_n=0.005)
+    with Emulator(plant=plant, seed=9) as emu:
+        rig = PicoDriver.open(emu.port, max_kpa=260)
+        rig.tare(20)
+        rig.set_scale(21000.0)  # wrong by a factor 2
+        rig.set_kpa(120)
+        known = plant.force_n(emu.pressure_kpa)  # the "weight" hanging on the cell
+        rig.close()  # no vent: keep the force on
+        assert main(["rig", "load", "--port", emu.port, "--known-n", f"{known:.5f}", "--samples", "20"]) == 0
+        out = capsys.readouterr().out
+        new_scale = float(out.split("scale ")[1].split()[0])
+        assert new_scale == pytest.approx(plant.load_counts_per_newton, rel=0.01)
+        assert emu.controller.counts_per_newton == pytest.approx(new_scale, rel=1e-6)

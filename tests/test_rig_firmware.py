@@ -111,6 +111,21 @@ def test_estop_vents_reports_once_and_blocks_set():
     assert c.handle("GET")[0] == "EVT ESTOP"  # a press between commands is reported before the reply
 
 
+def test_watchdog_vents_when_the_host_goes_silent():
+    hw = rigcore.SimpleHardware()
+    c = rigcore.Controller(hw)
+    assert c.poll(idle_ms=10**9) == []  # off by default
+    assert c.handle("WDOG 1.5") == ["OK WDOG 1.500"]
+    c.handle("SET 80")
+    assert c.poll(idle_ms=1500) == []
+    assert c.poll(idle_ms=1501) == ["EVT WDOG"]
+    assert c.setpoint_kpa == 0.0 and hw.code == 0
+    assert c.poll(idle_ms=5000) == []  # already vented: no repeat
+    for bad in ("WDOG", "WDOG -1", "WDOG 4000", "WDOG x"):
+        assert c.handle(bad) == ["ERR PARSE"]
+    assert parse_reply("EVT WDOG").command == "WDOG"
+
+
 def test_load_cell_tare_scale():
     hw = rigcore.SimpleHardware()
     c = rigcore.Controller(hw)

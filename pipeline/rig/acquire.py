@@ -75,6 +75,9 @@ class SessionConfig:
         Time between load-cell readings (s).
     tare : bool
         Tare the load cell (vented) at the start of each trial in blocked mode.
+    watchdog_s : float
+        Device watchdog (s): the Pico vents by itself if the host sends nothing for this long
+        (lost cable, crashed host); 0 leaves it off.
     """
 
     out_dir: Path
@@ -89,6 +92,7 @@ class SessionConfig:
     force_samples: int = 10
     force_interval_s: float = 0.0
     tare: bool = True
+    watchdog_s: float = 0.0
 
 
 @dataclass
@@ -241,10 +245,14 @@ def run_session(
     try:
         with interrupts:
             driver.vent()
+            if cfg.watchdog_s > 0:
+                driver.set_watchdog(cfg.watchdog_s)
             driver.sleep(cfg.settle_s)
             for trial, seq, recorded in plans:
                 _run_trial(driver, camera, cfg, trial, seq, recorded, up, stop_up, settings, bar, interrupts, result)
             driver.vent()
+            if cfg.watchdog_s > 0:
+                driver.set_watchdog(0.0)
     except KeyboardInterrupt:
         result.status, result.message = "interrupted", "interrupted (Ctrl-C / SIGTERM)"
     except EStopError as exc:

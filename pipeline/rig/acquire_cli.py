@@ -56,6 +56,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--stop-at-psi0", action=argparse.BooleanOptionalAction, default=None,
                         help="end the up leg when the live-measured psi reaches -psi0 (default: on with the synthetic camera when pipeline.measure is available)")
     parser.add_argument("--psi0-deg", type=float, help="rest bending angle psi0 for --stop-at-psi0 (deg; default: the material's, else 210)")
+    parser.add_argument("--watchdog-s", type=float,
+                        help="the Pico vents by itself when the host sends nothing for this long, e.g. a pulled cable "
+                             "(s; default 3 x settle + camera timeout + 10; 0 = off)")
     parser.add_argument("--timeout-s", type=float, default=2.0, help="longest wait for one reply from the Pico before the port counts as lost (s, default 2)")
     parser.add_argument("--camera-timeout-s", type=float, default=30.0, help="longest wait for a photo (s, default 30)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the synthetic camera's noise (default 0)")
@@ -100,8 +103,8 @@ def _check_numbers(args: argparse.Namespace) -> None:
     for name in ("step_kpa", "max_kpa"):
         if not getattr(args, name) > 0:
             raise UserInputError(f"--{name.replace('_', '-')} must be positive (kPa)")
-    if args.settle_s < 0 or args.force_interval_s < 0:
-        raise UserInputError("--settle-s and --force-interval-s must be >= 0 (s)")
+    if args.settle_s < 0 or args.force_interval_s < 0 or (args.watchdog_s is not None and args.watchdog_s < 0):
+        raise UserInputError("--settle-s, --force-interval-s and --watchdog-s must be >= 0 (s)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -111,7 +114,8 @@ def run(args: argparse.Namespace) -> int:
     cfg = SessionConfig(out_dir=args.out, material=args.material, actuator=args.actuator, trials=args.trials,
                         step_kpa=args.step_kpa, max_kpa=args.max_kpa, settle_s=args.settle_s, settings=settings,
                         mode=args.mode, force_samples=args.force_samples, force_interval_s=args.force_interval_s,
-                        tare=not args.no_tare)
+                        tare=not args.no_tare,
+                        watchdog_s=args.watchdog_s if args.watchdog_s is not None else 3 * args.settle_s + args.camera_timeout_s + 10)
     synthetic = args.camera.strip().startswith("synthetic")
     wants_stop = args.stop_at_psi0 if args.stop_at_psi0 is not None else (synthetic and args.mode == "bending")
     measure_ok = wants_stop and importlib.util.find_spec("pipeline.measure") is not None and _has_measure_image()

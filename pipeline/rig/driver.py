@@ -67,6 +67,10 @@ class DeviceError(RigError):
     """The device answered ``ERR PARSE`` / ``ERR HW`` or something inconsistent."""
 
 
+class WatchdogError(RigError):
+    """The device vented by itself because the host sent nothing for longer than its watchdog."""
+
+
 @dataclass(frozen=True)
 class DeviceInfo:
     """What the device says about itself (``ID`` and ``CFG``)."""
@@ -123,6 +127,7 @@ class PicoDriver:
         self.garbage_lines = 0
         self.commands_sent = 0
         self._estop_seen = False
+        self._watchdog_seen = False
         self._buf = b""
 
     # -- opening / closing ------------------------------------------------------------------
@@ -278,13 +283,29 @@ class PicoDriver:
         """Set the load-cell scale (counts per newton)."""
         return float(self._command("SCALE", float(counts_per_newton)).fields[0])
 
+    def set_watchdog(self, seconds: float) -> float:
+        """Make the device vent by itself after ``seconds`` without a command (0 turns it off)."""
+        return float(self._command("WDOG", float(seconds)).fields[0])
+
     def get_scale(self) -> float:
         """Current load-cell scale (counts per newton)."""
         return float(self._command("SCALE").fields[0])
 
     # -- line handling ----------------------------------------------------------------------------
 
+    def _note_event(self, reply: Reply) -> None:
+        if reply.command == "WDOG":
+            self._watchdog_seen = True
+        else:
+            self._estop_seen = True
+
     def _raise_estop(self) -> None:
+        if self._watchdog_seen:
+            self._watchdog_seen = False
+            raise WatchdogError(
+                "the device vented by itself: no command reached it within its watchdog time "
+                "(host too slow, e.g. a camera longer than --watchdog-s); re-run to resume"
+            )
         if self._estop_seen:
             self._estop_seen = False
             raise EStopError("emergency stop pressed: the device vented; release the button and re-run to resume")
@@ -316,7 +337,7 @@ class PicoDriver:
     def _dispatch_unsolicited(self, line: bytes) -> None:
         reply = parse_reply(line)
         if reply is not None and reply.kind == "EVT":
-            self._estop_seen = True
+            self._note_event(reply)
         elif line.strip():
             self.garbage_lines += 1
             log.debug("ignored line from device: %r", line[:80])
@@ -370,7 +391,7 @@ class PicoDriver:
                         raise DeviceError(f"more than {MAX_GARBAGE_PER_REPLY} garbage lines while waiting for {command}; check the baud rate ({BAUDRATE}) and the port")
                 continue
             if reply.kind == "EVT":
-                self._estop_seen = True
+                self._note_event(reply)
                 continue
             if reply.kind == "OK" and reply.command != command:
                 log.warning("ignored stale reply %r while waiting for %s", reply.line, command)

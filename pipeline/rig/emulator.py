@@ -205,6 +205,7 @@ class Emulator:
         self.stats = EmulatorStats()
         self._garbage_rng = np.random.default_rng(seed + 1)
         self._replies = 0
+        self._last_command = time.monotonic()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._master = self._slave = -1
@@ -261,7 +262,7 @@ class Emulator:
         """Answer commands until :meth:`stop` (runs in the caller's thread)."""
         buf = b""
         while not self._stop.is_set():
-            for event in self.controller.poll():
+            for event in self.controller.poll(int((time.monotonic() - self._last_command) * 1000)):
                 self._write(event)
             try:
                 ready, _, _ = select.select([self._master], [], [], 0.01)
@@ -286,6 +287,7 @@ class Emulator:
             self._drop()
             return False
         self.stats.received.append(text)
+        self._last_command = time.monotonic()
         replies = self.controller.handle(line)
         if self.faults.slow_s > 0:
             time.sleep(self.faults.slow_s)

@@ -22,9 +22,11 @@ EOL = b"\n"
 KINDS = ("OK", "ERR", "EVT")
 #: number of fields after ``OK <COMMAND>`` for each command
 OK_FIELDS: dict[str, int] = {
-    "ID": 2, "SET": 2, "GET": 3, "VENT": 0, "CFG": 3, "LOAD": 1, "LOADRAW": 1, "TARE": 1, "SCALE": 1,
+    "ID": 2, "SET": 2, "GET": 3, "VENT": 0, "CFG": 3, "LOAD": 1, "LOADRAW": 1, "TARE": 1, "SCALE": 1, "WDOG": 1,
 }
 ERRORS = ("LIMIT", "ESTOP", "PARSE", "HW")
+#: unsolicited events
+EVENTS = ("ESTOP", "WDOG")
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,7 @@ class Reply:
         ``OK``, ``ERR`` or ``EVT``.
     command : str
         For ``OK``: the command answered; for ``ERR``: the error (``LIMIT``, ``ESTOP``,
-        ``PARSE``, ``HW``); for ``EVT``: the event (``ESTOP``).
+        ``PARSE``, ``HW``); for ``EVT``: the event (``ESTOP`` or ``WDOG``).
     fields : tuple of str
         The remaining words.
     line : str
@@ -83,6 +85,6 @@ def parse_reply(raw: bytes | str) -> Reply | None:
     elif kind == "ERR":
         if command not in ERRORS or fields:
             return None
-    elif command != "ESTOP" or fields:
+    elif command not in EVENTS or fields:
         return None
     return Reply(kind, command, fields, line)

@@ -87,12 +87,14 @@ def main():
     poller = select.poll()
     poller.register(sys.stdin, select.POLLIN)
     buf = ""
+    last_command = time.ticks_ms()
     while True:
-        for line in controller.poll():
+        for line in controller.poll(time.ticks_diff(time.ticks_ms(), last_command)):
             sys.stdout.write(line + "\n")
         if poller.poll(5):
             ch = sys.stdin.read(1)
             if ch == "\n":
+                last_command = time.ticks_ms()
                 for line in controller.handle(buf):
                     sys.stdout.write(line + "\n")
                 buf = ""

@@ -21,12 +21,16 @@ command             reply                                           notes
 ``LOADRAW``         ``OK LOADRAW <counts>``                         added: raw HX711 counts
 ``TARE [n]``        ``OK TARE <offset_counts>``                     added: zero = mean of n reads
 ``SCALE [c]``       ``OK SCALE <counts_per_newton>``                added: set (or read) the scale
+``WDOG <s>``        ``OK WDOG <s>``                                 added: host watchdog, 0 = off
 ==================  ==============================================  ==============================
 
 Anything malformed (unknown command, wrong number of arguments, a number that is not finite,
 a line longer than :data:`MAX_LINE` or with non-printable characters) gets ``ERR PARSE``; a
 load-cell read that times out gets ``ERR HW``.  When the emergency-stop button is pressed the
-firmware vents by itself and sends the unsolicited line ``EVT ESTOP`` (once per press).
+firmware vents by itself and sends the unsolicited line ``EVT ESTOP`` (once per press).  With
+``WDOG <s>`` set, the firmware also vents by itself when no command has arrived for ``s``
+seconds while pressure is applied (the host crashed or the cable was pulled) and sends
+``EVT WDOG``.
 
 Examples
 --------
@@ -249,6 +253,7 @@ class Controller:
         self.estop = False
         self.tare_counts = 0.0
         self.counts_per_newton = self.cfg.counts_per_newton
+        self.watchdog_ms = 0
         self._apply(0.0)
 
     def _apply(self, kpa: float) -> int:
@@ -262,8 +267,20 @@ class Controller:
         """Set the regulator to 0 kPa."""
         self._apply(0.0)
 
-    def poll(self) -> list:
-        """Check the stop button; on a new press vent and return ``['EVT ESTOP']``."""
+    def poll(self, idle_ms: int = 0) -> list:
+        """Check the stop button and the host watchdog.
+
+        Parameters
+        ----------
+        idle_ms : int
+            Milliseconds since the last command line arrived (the caller keeps the clock).
+
+        Returns
+        -------
+        list of str
+            ``['EVT ESTOP']`` on a new press, ``['EVT WDOG']`` when the watchdog (``WDOG``) ran
+            out with pressure applied; both vent.
+        """
         pressed = bool(self.hw.estop_pressed())
         if pressed and not self.estop:
             self.estop = True
@@ -271,6 +288,9 @@ class Controller:
             return ["EVT ESTOP"]
         if not pressed:
             self.estop = False
+        if self.watchdog_ms > 0 and idle_ms > self.watchdog_ms and self.code != 0:
+            self.vent()
+            return ["EVT WDOG"]
         return []
 
     def measured_kpa(self) -> float:
@@ -331,6 +351,12 @@ class Controller:
                 total += counts
             self.tare_counts = total / reads
             return "OK TARE %d" % int(round(self.tare_counts))
+        if cmd == "WDOG" and n == 1:
+            value = parse_number(args[0])
+            if value is None or not 0.0 <= value <= 3600.0:
+                return "ERR PARSE"
+            self.watchdog_ms = int(value * 1000)
+            return "OK WDOG %.3f" % value
         if cmd == "SCALE" and n <= 1:
             if n == 1:
                 value = parse_number(args[0])
