@@ -129,8 +129,6 @@ def run(args: argparse.Namespace) -> int:
         raise UserInputError("--port is required (the Pico's serial port, or the pty printed by 'python -m pipeline rig emulate')")
 
     from pipeline.rig.calibration import read_calibration
-    from pipeline.rig.cameras import CameraError, open_camera
-    from pipeline.rig.driver import PicoDriver, RigError
 
     calibration = read_calibration(args.calibration) if args.calibration else None
     psi0 = args.psi0_deg
@@ -138,6 +136,17 @@ def run(args: argparse.Namespace) -> int:
         mat = _material_defaults(args.material)
         psi0 = mat.psi0_deg if mat is not None else 210.0
     stop_up = psi0_stop_criterion(psi0) if stop_at_psi0 else None
+    try:
+        return _acquire(args, cfg, calibration, stop_up, settings)
+    except KeyboardInterrupt:
+        print("acquire: interrupted before the ramp started (nothing was pressurised by this run)", file=sys.stderr)
+        return EXIT_CODES["interrupted"]
+
+
+def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, stop_up: Any, settings: dict[str, Any]) -> int:
+    from pipeline.rig.cameras import CameraError, open_camera
+    from pipeline.rig.driver import PicoDriver, RigError
+
     try:
         camera = open_camera(args.camera, material=args.material, l0_mm=settings["l0_mm"], seed=args.seed,
                              timeout_s=args.camera_timeout_s, mode=args.mode)
