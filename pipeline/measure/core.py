@@ -19,7 +19,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipeline.measure.estimators import METHODS, CurveEstimate, hyper, turning
+from pipeline.measure.estimators import METHODS, CurveEstimate, hyper, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline
 from pipeline.measure.quality import assess
 
@@ -124,7 +124,7 @@ def measure_work_image(
         ends = line.trimmed_px
         est = METHODS[method](pts, rng, ends_px=ends)
         arc = est if method == "hyper" else hyper(pts, rng, ends_px=ends)
-        trn = est if method == "turning" else turning(pts, rng, ends_px=ends)
+        trn = est if method == "turning" else turning_quick(pts, rng, ends_px=ends)
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     length_px = est.length_px

@@ -23,9 +23,12 @@ Methods
     regular at zero curvature (``A -> 0`` is a straight line), unlike Kasa, which over-reads
     curvature on short arcs.  Hyper is unbiased to second order in the noise.
 ``turning``
-    Tangent angle theta(s) against arc length s, fitted by Legendre polynomials of degree
-    1..6, the degree chosen by BIC (constant curvature unless the photo demands more);
-    psi = theta(L) - theta(0).  Right when curvature is not constant.
+    Tangent angle theta(s) against arc length s, a Legendre polynomial of degree 1..9 whose
+    integrated curve is fitted to the centre line, the degree chosen by BIC (constant
+    curvature unless the photo demands more); psi = theta(L) - theta(0).  Right when curvature
+    is not constant.
+``auto``
+    ``hyper``, switching to ``turning`` only when the curvature is visibly not constant.
 
 Examples
 --------
@@ -50,8 +53,10 @@ from scipy import linalg
 N_SAMPLES = 100
 #: paper: spacing of the "nearby" triples, as a fraction of the line
 NEARBY_FRACTION = 0.02
+#: turning: information criterion choosing the degree ("bic" or "aic")
+CRITERION = "bic"
 #: turning: highest polynomial degree of theta(s) tried
-MAX_DEGREE = 10
+MAX_DEGREE = 9
 
 
 @dataclass(frozen=True)
@@ -326,10 +331,86 @@ def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.nd
     return s_mid, best[1], best[2], best[3]
 
 
+def _shape_model(params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]) -> np.ndarray:
+    """Chunk means of the curve p(s) = p0 + int (cos theta, sin theta) ds, theta Legendre in v.
+
+    ``v`` runs over the whole line, [-1, 1] from the fixed end to the free end; the data (the
+    ``n`` chunk means, ``q`` fine points each) cover its part ``[ends[0], ends[0] + span]``.
+    """
+    p0, stretch, coef = params[:2], np.exp(params[2]), params[3:]
+    total = span + ends[0] + ends[1]
+    ds = span / (n * q)
+    s_f = (np.arange(n * q) + 0.5) * ds
+    theta = np.polynomial.legendre.legval(2.0 * (s_f + ends[0]) / total - 1.0, coef)
+    step = np.c_[np.cos(theta), np.sin(theta)] * (ds * stretch)
+    pos = p0 + np.cumsum(step, axis=0) - 0.5 * step
+    return pos.reshape(n, q, 2).mean(axis=1)
+
+
 def turning(
+    points: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    ends_px: tuple[float, float] = (0.0, 0.0),
+    max_degree: int = MAX_DEGREE,
+) -> CurveEstimate:
+    """Total turning angle theta(L) - theta(0) from a BIC-chosen smooth model of theta(s).
+
+    theta(s) is a Legendre polynomial over the whole line; for each degree 1..``max_degree``
+    the curve it defines (integrated tangent, free start point and length scale) is fitted to
+    the centre line's chunk means by Levenberg-Marquardt (:func:`scipy.optimize.least_squares`),
+    started from a linear fit to the chord angles.  The degree with the lowest BIC on the
+    positional residuals wins: degree 1 is a circular arc, higher degrees only when the photo
+    demands them.  Fitting positions (an integral of theta) rather than noisy chord angles keeps
+    the end tangents, and so psi, stable.
+    """
+    from scipy.optimize import least_squares  # lazy: only this method needs it
+
+    if len(points) < 4:
+        raise ValueError("need at least 4 centre-line points")
+    means, piece = chunk_means(points)
+    n, q = len(means), 6
+    span = n * piece
+    total = span + ends_px[0] + ends_px[1]
+    d = np.diff(means, axis=0)
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    s_mid = (np.arange(1, n) * piece) + ends_px[0]
+    v_mid = 2.0 * s_mid / total - 1.0
+    best: tuple[float, np.ndarray, int, float] | None = None
+    worse = 0
+    for deg in range(1, min(max_degree, n - 3) + 1):
+        coef0 = np.polynomial.legendre.legfit(v_mid, theta, deg)
+        th0 = np.polynomial.legendre.legval(2.0 * (ends_px[0] + piece / 2) / total - 1.0, coef0)
+        start = means[0] - 0.5 * piece * np.array([np.cos(th0), np.sin(th0)])
+        x0 = np.r_[start, 0.0, coef0]
+        fit = least_squares(
+            lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(), x0, method="lm", xtol=1e-10, ftol=1e-10
+        )
+        rss = float(np.sum(fit.fun**2))
+        m = 2 * n
+        bic = m * np.log(max(rss, 1e-300) / m) + (deg + 4) * (np.log(m) if CRITERION == "bic" else 2.0)
+        if best is None or bic < best[0]:
+            best, worse = (bic, fit.x, deg, rss), 0
+        else:
+            worse += 1
+            if worse >= 2:
+                break
+    assert best is not None
+    _, params, deg, rss = best
+    coef = params[3:]
+    psi = float(np.polynomial.legendre.legval(1.0, coef) - np.polynomial.legendre.legval(-1.0, coef))
+    length = total * float(np.exp(params[2]))
+    resid_px = float(np.sqrt(rss / n))
+    return CurveEstimate(psi / length, psi, length, resid_px, deg)
+
+
+def turning_quick(
     points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
 ) -> CurveEstimate:
-    """Total turning angle theta(L) - theta(0) from a BIC-chosen smooth fit of theta(s)."""
+    """Linear variant of :func:`turning`: the BIC-chosen polynomial fitted to chord angles.
+
+    Cheaper (no iterations) and used by the quality check for non-constant curvature.
+    """
     if len(points) < 4:
         raise ValueError("need at least 4 centre-line points")
     means, piece = chunk_means(points)
@@ -341,10 +422,28 @@ def turning(
     u1 = 1.0 + 2.0 * (piece / 2 + ends_px[1]) / span
     psi = float(np.polynomial.legendre.legval(u1, coef) - np.polynomial.legendre.legval(u0, coef))
     n = len(means) - 1
-    spacing = piece
     # chord-angle RMS residual -> positional scale (angle noise ~ sqrt(2) sigma / spacing)
-    resid_px = float(np.sqrt(rss / n) * spacing / np.sqrt(2.0))
+    resid_px = float(np.sqrt(rss / n) * piece / np.sqrt(2.0))
     return CurveEstimate(psi / length, psi, length, resid_px, deg)
+
+
+#: auto: switch from the arc to the turning model beyond this turning-vs-arc difference (deg)
+AUTO_SWITCH_DEG = 1.5
+
+
+def auto(
+    points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+) -> CurveEstimate:
+    """Hyper circle fit, unless the curvature is visibly not constant: then :func:`turning`.
+
+    "Visibly": the linear tangent-angle fit (:func:`turning_quick`) needs degree >= 2 by BIC
+    *and* its psi differs from the arc's by more than ``AUTO_SWITCH_DEG``.
+    """
+    arc = hyper(points, rng, ends_px=ends_px)
+    quick = turning_quick(points, rng, ends_px=ends_px)
+    if quick.degree >= 2 and abs(np.rad2deg(quick.kappa_per_px - arc.kappa_per_px) * arc.length_px) > AUTO_SWITCH_DEG:
+        return turning(points, rng, ends_px=ends_px)
+    return arc
 
 
 #: name -> estimator; every entry has the same signature
@@ -355,4 +454,5 @@ METHODS: dict[str, Estimator] = {
     "taubin": taubin,
     "hyper": hyper,
     "turning": turning,
+    "auto": auto,
 }

@@ -13,8 +13,8 @@ Steps (all vectorised OpenCV / numpy / scipy, no per-pixel Python loops):
    end, found by a double sweep; the centroids of equal-distance bands are the sub-pixel centre
    line, ordered along the line itself (never by angle around a centre), so arcs past 180 deg
    whose ends approach each other are ordered correctly;
-5. the fixed end is the end nearer ``fixed_end_px``, or with ``auto`` the end nearer a removed
-   clamp blob, else the end nearer the image border.
+5. the line starts at ``fixed_end_px`` (what lies geodesically beyond it is dropped), or with
+   ``auto`` at the end with the darker surroundings (the clamp block).
 
 Coordinates are image pixels (x right, y down) of the *original* image, even when the work is done
 on a reduced image (``scale`` > 1).
@@ -30,7 +30,6 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from pipeline.photoset import line_color_ranges
 
 #: components shorter than this (work px) are never the marker line
 MIN_LENGTH_PX = 25.0
@@ -66,7 +65,8 @@ class LineExtraction:
     fixed_end_auto : bool
         The fixed end was guessed (``fixed_end: auto``).
     clamp_removed : bool
-        A thick blob touching the line (clamp) was cut off.
+        A clamp was seen: a thick blob touching the line was cut off, or (``auto``) one end
+        has clearly darker surroundings.
     trimmed_px : (float, float)
         Length cut from the fixed and the free end of ``centreline_px`` (original px): the
         measured line extends this far beyond the first and the last point.
@@ -94,6 +94,21 @@ class LineExtraction:
 # colour mask
 
 
+def resolve_ranges(line_color: Any) -> tuple[tuple[tuple[int, int, int], tuple[int, int, int]], ...]:
+    """HSV ranges of a colour name or range spec; already-resolved ranges pass through.
+
+    Parallel workers receive resolved ranges, so they never import :mod:`pipeline.photoset`
+    (and pandas).
+    """
+    if isinstance(line_color, tuple) and line_color and all(
+        isinstance(r, tuple) and len(r) == 2 and all(isinstance(v, tuple) and len(v) == 3 for v in r) for r in line_color
+    ):
+        return line_color
+    from pipeline.photoset import line_color_ranges
+
+    return line_color_ranges(line_color)
+
+
 def _kernel_px(shape: tuple[int, ...]) -> int:
     """Side of the black-hat square: wider than any marker line, narrower than the clamp."""
     return int(max(11, shape[1] // 40) | 1)
@@ -111,7 +126,7 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
     Parameters
     ----------
     image_bgr : ndarray, shape (H, W, 3), uint8
-    line_color : str or mapping
+    line_color : str or mapping or resolved ranges
         See :func:`pipeline.photoset.line_color_ranges`.
 
     Returns
@@ -120,7 +135,7 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
     weight : ndarray, shape (H, W), uint8
         Line strength (black-hat response, or the mask for colour ranges).
     """
-    ranges = line_color_ranges(line_color)
+    ranges = resolve_ranges(line_color)
     if all(lo[0] == 0 and hi[0] == 179 and lo[1] == 0 and hi[1] == 255 for lo, hi in ranges):
         v = cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
         k = _kernel_px(image_bgr.shape)
@@ -328,6 +343,44 @@ def _contrast(image: np.ndarray, points: np.ndarray, half_width: float) -> float
     return float(np.linalg.norm(inside - outside))
 
 
+def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """Cut the line where it runs into a dark block (a clamp the black-hat mask left out).
+
+    Only used with ``fixed_end: auto``, where no given fixed end truncates the line.
+    """
+    h, w = line.shape
+    pad = int(6 * cand.half_width + 8)
+    y0, x0 = max(cand.y0 - pad, 0), max(cand.x0 - pad, 0)
+    y1, x1 = min(cand.y0 + h + pad, image.shape[0]), min(cand.x0 + w + pad, image.shape[1])
+    roi = image[y0:y1, x0:x1]
+    v = cv2.blur(roi.max(axis=2), (5, 5))
+    dark = (v <= 110).astype(np.uint8)
+    radius = int(np.ceil(max(2.5 * cand.half_width, cand.half_width + 3.0)))
+    k = 2 * radius + 1
+    block = cv2.morphologyEx(dark, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    if not block.any():
+        return line, None
+    block = cv2.dilate(block, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 5,) * 2))
+    block = block[cand.y0 - y0 : cand.y0 - y0 + h, cand.x0 - x0 : cand.x0 - x0 + w]
+    cut = line & (1 - block)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(cut, connectivity=8)
+    if n <= 1 or not block[line > 0].any():
+        return line, None
+    keep = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return (labels == keep).astype(np.uint8), block
+
+
+def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> float:
+    """Mean darkness (255 - V) in a square around a line end: high next to a dark clamp."""
+    r = int(6 * half_width + 8)
+    h, w = image.shape[:2]
+    x, y = int(round(xy[0])), int(round(xy[1]))
+    roi = image[max(y - r, 0) : min(y + r + 1, h), max(x - r, 0) : min(x + r + 1, w)]
+    if roi.size == 0:
+        return 0.0
+    return float(255.0 - roi.max(axis=2).mean())
+
+
 def _bridge(
     line: np.ndarray, points: np.ndarray, others: list[_Candidate], best: _Candidate, max_gap_px: float
 ) -> tuple[np.ndarray, int, int, int] | None:
@@ -350,6 +403,13 @@ def _bridge(
         direction = np.array([gx[i] - end[0], gy[i] - end[1]]) / gap
         if float(direction @ tangent) < np.cos(np.deg2rad(35.0)):
             continue
+        # the fragment itself must run on in the same direction near its end
+        near = (gx - gx[i]) ** 2 + (gy - gy[i]) ** 2 <= (4.0 * best.half_width + 6.0) ** 2
+        if near.sum() >= 3:
+            cov = np.cov(np.c_[gx[near], gy[near]].T.astype(float))
+            axis = np.linalg.eigh(cov)[1][:, -1]
+            if abs(float(axis @ tangent)) < np.cos(np.deg2rad(35.0)):
+                continue
         x0, y0 = min(best.x0, c.x0), min(best.y0, c.y0)
         x1 = max(best.x0 + line.shape[1], c.x0 + c.sub.shape[1])
         y1 = max(best.y0 + line.shape[0], c.y0 + c.sub.shape[0])
@@ -410,6 +470,8 @@ def extract_centreline(
     others = [c for c in cands if c is not best]
     rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
     line, thick = _cut_thick_parts(best.sub, best.half_width)
+    if fe is None and thick is None:
+        line, thick = _cut_dark_blocks(image_bgr, best, line)
     band = max(1.0, min(2.0, best.half_width))
     fe_sub = None if fe is None else (fe[0] - best.x0, fe[1] - best.y0)
     x0, y0 = best.x0, best.y0
@@ -418,7 +480,8 @@ def extract_centreline(
     for _ in range(3):
         if len(points) < 4:
             break
-        joined = _bridge(line, points, others, _Candidate(x0, y0, line, best.half_width, best.length, 0.0), 0.08 * diag)
+        max_gap = 0.25 * float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
+        joined = _bridge(line, points, others, _Candidate(x0, y0, line, best.half_width, best.length, 0.0), max_gap)
         if joined is None:
             break
         line, x0, y0, n_px = joined
@@ -430,14 +493,12 @@ def extract_centreline(
     if len(points) < 8:
         raise NoLineFound(f"no line found: the longest candidate is only {len(points)} bands long")
     fixed_auto = fe is None
+    clamp_seen = thick is not None
     if fixed_auto:
-        # clamp blob nearest, else image border nearest
-        if thick is not None:
-            ty, tx = np.nonzero(thick)
-            dist = [float(np.min((tx + best.x0 - x0 - e[0]) ** 2 + (ty + best.y0 - y0 - e[1]) ** 2)) for e in ends]
-        else:
-            dist = [float(min(e[0] + x0, e[1] + y0, w - 1 - e[0] - x0, h - 1 - e[1] - y0)) for e in ends]
-        if dist[1] < dist[0]:
+        ends_g = ends + np.array([x0, y0], float)
+        darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
+        clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
+        if darkness[1] > darkness[0]:  # the clamp (dark block) sits at the fixed end
             points, ends = points[::-1], ends[::-1]
     ys, xs = np.nonzero(line)
     touches = bool(xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1)
@@ -450,10 +511,17 @@ def extract_centreline(
     keep = (s_along >= trim) & (s_along <= s_along[-1] - trim)
     if keep.sum() >= 8:
         i0, i1 = int(np.argmax(keep)), len(keep) - 1 - int(np.argmax(keep[::-1]))
-        trimmed = (s_along[i0] * scale, (s_along[-1] - s_along[i1]) * scale)
         gpts = gpts[i0 : i1 + 1]
     else:
-        trimmed = (0.0, 0.0)
+        i0, i1 = 0, len(s_along) - 1
+    # the end bands' centroids lie about a quarter band inside the line's ends (measured on
+    # synthetic lines of known length)
+    trimmed = ((s_along[i0] + band / 4) * scale, (s_along[-1] - s_along[i1] + band / 4) * scale)
+    if fe is not None:
+        # the line starts at the given fixed end, also where the clamp cut removed a piece of it
+        gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+        if gap_fixed < 0.15 * s_along[-1] * scale:
+            trimmed = (max(trimmed[0], gap_fixed), trimmed[1])
     centre = gpts * scale + (scale - 1) / 2
     return LineExtraction(
         centreline_px=centre,
@@ -464,7 +532,7 @@ def extract_centreline(
         ends_gap_px=float(np.hypot(*(ends[0] - ends[1])) * scale),
         branched_fraction=branched,
         fixed_end_auto=fixed_auto,
-        clamp_removed=thick is not None,
+        clamp_removed=clamp_seen,
         trimmed_px=(float(trimmed[0]), float(trimmed[1])),
         gap_bridged=bridged > 0,
         fixed_end_found=at_fixed or fe is None,

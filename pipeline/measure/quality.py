@@ -9,11 +9,11 @@ Never a silent wrong number: whatever the estimator returns, a row is ``flagged`
 - the contrast between line and surroundings is low;
 - the curvature is not constant beyond what the arc model explains (the BIC-chosen tangent-angle
   fit needs degree >= 2 *and* its psi differs from the Hyper circle fit's by more than
-  ``NONCONSTANT_DEG``); the ``turning`` method measures such lines correctly, so for it this is
+  ``NONCONSTANT_DEG``); the ``turning`` and ``auto`` methods measure such lines correctly, so for it this is
   only noted in ``reason`` and the row stays ``ok``;
 - the two ends almost touch, or the line closes on itself / branches;
-- the fixed end had to be guessed (``fixed_end: auto``) and the line is almost symmetric
-  (no clamp blob was found to tell the ends apart) -- the sign may be wrong.
+- the fixed end had to be guessed (``fixed_end: auto``) and no clamp was seen at either end
+  -- the sign may be wrong.
 
 ``failed`` rows (no psi) come from :class:`pipeline.measure.extract.NoLineFound` or an image
 that cannot be decoded; their reason is set by the caller.
@@ -93,12 +93,12 @@ def assess(
     diff = psi_turning_deg - psi_arc_deg
     if turning_degree >= 2 and abs(diff) > NONCONSTANT_DEG:
         text = f"non-constant curvature (turning - arc = {diff:+.1f} deg)"
-        (notes if method == "turning" else flags).append(text)
+        (notes if method in ("turning", "auto") else flags).append(text)
     if line.branched_fraction > 0.05:
         flags.append("line closes on itself or branches")
     elif line.ends_gap_px < 3.0 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
     if line.fixed_end_auto and not line.clamp_removed:
-        flags.append("fixed end guessed (nearest the border); set fixed_end")
+        flags.append("fixed end guessed (no clamp seen at either end); set fixed_end")
     status = "flagged" if flags else "ok"
     return Quality(status, "; ".join(flags + notes))

@@ -1,0 +1,75 @@
+"""Measure one photo of a photo set: the unit of work of the process pool.
+
+Only OpenCV / numpy / scipy are imported here (no pandas, no matplotlib), so worker processes
+start fast.  A task never raises: a bad photo becomes a ``failed`` row.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+
+from pipeline.measure.core import decode_for_work, failed, measure_work_image
+
+
+@dataclass(frozen=True)
+class Task:
+    """Everything needed to measure one photo (picklable)."""
+
+    path: str
+    l0_mm: float
+    mm_per_px: float | None
+    line_color: Any
+    fixed_end_px: tuple[float, float] | None
+    positive_turn: str
+    method: str
+    overlay_path: str | None = None
+    title: str = ""
+
+
+def init_worker() -> None:
+    """Pool initialiser: one OpenCV thread per process (the pool is the parallelism)."""
+    cv2.setNumThreads(1)
+
+
+def run_task(task: Task) -> dict[str, Any]:
+    """Measure one photo; return the angles.csv fields (without the manifest columns)."""
+    t0 = time.perf_counter()
+    img, f = None, 1
+    try:
+        data = np.fromfile(task.path, dtype=np.uint8)
+        if data.size:
+            img, f = decode_for_work(data)
+        res = (
+            failed(task.method, f"unreadable image: {task.path} cannot be decoded")
+            if img is None
+            else measure_work_image(
+                img, scale=float(f), l0_mm=task.l0_mm, mm_per_px=task.mm_per_px, line_color=task.line_color,
+                fixed_end_px=task.fixed_end_px, positive_turn=task.positive_turn, method=task.method,
+            )
+        )
+    except OSError as exc:
+        res = failed(task.method, f"unreadable image: {task.path}: {exc.strerror or exc}")
+    except Exception as exc:  # one bad photo never stops the set
+        res = failed(task.method, f"internal error on this photo: {type(exc).__name__}: {exc}")
+    seconds = time.perf_counter() - t0
+    if task.overlay_path is not None:
+        from pipeline.measure.overlay import draw_overlay
+
+        base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
+        out = draw_overlay(base, res, scale=float(f) if img is not None else 1.0, title=task.title)
+        cv2.imwrite(task.overlay_path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
+    return {
+        "psi_deg": res.psi_deg,
+        "kappa_per_mm": res.kappa_per_mm,
+        "length_mm": res.length_mm,
+        "method": res.method,
+        "residual_px": res.residual_px,
+        "status": res.status,
+        "reason": res.reason,
+        "seconds": seconds,
+    }

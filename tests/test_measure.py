@@ -1,0 +1,243 @@
+"""Bending-angle measurement: estimators, extraction, quality flags, photo sets and the CLI.
+
+Accuracy only (speed is in ``python -m pipeline.measure.bench``).  Synthetic photos come from
+:mod:`pipeline.synth` with exact ground truth; seeds are fixed.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline.measure import DEFAULT_METHOD, METHODS, measure_image
+from pipeline.measure.core import decode_for_work, jpeg_size, measure_work_image
+from pipeline.measure.estimators import auto, hyper, paper, paper_corrected, turning
+from pipeline.photoset import write_manifest, write_settings
+from pipeline.synth import centreline_mm, render_actuator, render_curve, scene_from
+
+L0_MM = 180.0
+
+
+def _arc(psi_deg: float, n: int = 400, length: float = 600.0) -> np.ndarray:
+    """Exact arc (y up), ccw positive, from the origin along +x."""
+    return centreline_mm(psi_deg, length, n=n)
+
+
+def _measure(rendered, scene, **kw):
+    img, f = decode_for_work(np.frombuffer(rendered.jpeg_bytes, np.uint8))
+    kw.setdefault("fixed_end_px", rendered.fixed_end_px)
+    kw.setdefault("mm_per_px", scene.mm_per_px)
+    return measure_work_image(img, scale=float(f), l0_mm=L0_MM, **kw)
+
+
+# ---------------------------------------------------------------------------------------------
+# estimators on exact and noisy point sets
+
+
+@pytest.mark.parametrize("psi", [0.0, 0.4, -2.0, 45.0, -179.0, 181.0, -300.0, 355.0])
+@pytest.mark.parametrize("name", ["pratt", "taubin", "hyper", "paper_corrected", "turning", "auto"])
+def test_estimators_exact_on_arcs(name: str, psi: float) -> None:
+    pts = _arc(psi)
+    est = METHODS[name](pts, np.random.default_rng(0))
+    assert np.rad2deg(est.kappa_per_px * 600.0) == pytest.approx(psi, abs=0.05)
+
+
+def test_paper_faithful_is_biased_near_zero_and_corrected_is_not() -> None:
+    rng = np.random.default_rng(3)
+    pts = _arc(0.0, n=300) + rng.normal(0.0, 0.2, (300, 2))
+    biased = np.rad2deg(paper(pts, np.random.default_rng(1)).kappa_per_px * 600.0)
+    fixed = np.rad2deg(paper_corrected(pts, np.random.default_rng(1)).kappa_per_px * 600.0)
+    assert abs(biased) > 10.0  # the trap: a straight line never reads 0
+    assert abs(fixed) < 0.5
+
+
+def test_turning_follows_nonconstant_curvature_where_arc_fits_cannot() -> None:
+    pts = centreline_mm(-200.0, 600.0, bulge=0.5, n=500)
+    pts = pts + np.random.default_rng(2).normal(0.0, 0.05, pts.shape)
+    rng = np.random.default_rng(0)
+    assert np.rad2deg(turning(pts, rng).turning_rad) == pytest.approx(-200.0, abs=0.5)
+    assert np.rad2deg(auto(pts, rng).turning_rad) == pytest.approx(-200.0, abs=0.5)
+    assert abs(np.rad2deg(hyper(pts, rng).turning_rad) + 200.0) > 20.0
+
+
+# ---------------------------------------------------------------------------------------------
+# synthetic photos
+
+
+@pytest.mark.parametrize("psi", [-300.0, -200.0, -2.5, 0.0, 1.5, 90.0, 250.0, 300.0])
+def test_lab_photos_accurate(psi: float) -> None:
+    scene = scene_from("lab")
+    r = render_actuator(psi, L0_MM, scene, seed=int(abs(psi) * 10) + 1)
+    res = _measure(r, scene, method=DEFAULT_METHOD)
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=0.6 if abs(psi) > 3 else 0.5)
+    assert res.kappa_per_mm == pytest.approx(np.deg2rad(res.psi_deg) / L0_MM)
+    assert res.length_mm == pytest.approx(L0_MM, rel=0.03)
+
+
+def test_sign_follows_positive_turn_and_mirroring() -> None:
+    scene = scene_from("clean")
+    r = render_actuator(120.0, L0_MM, scene, seed=5)
+    ccw = _measure(r, scene).psi_deg
+    cw = _measure(r, scene, positive_turn="cw").psi_deg
+    assert ccw == pytest.approx(120.0, abs=0.5) and cw == pytest.approx(-ccw)
+    mirrored = r.image[::-1].copy()  # upside down: the on-screen turn reverses
+    fe = (r.fixed_end_px[0], scene.height - 1 - r.fixed_end_px[1])
+    res = measure_image(mirrored, l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end_px=fe)
+    assert res.psi_deg == pytest.approx(-120.0, abs=0.5)
+
+
+def test_without_scale_psi_is_the_total_turning_angle() -> None:
+    scene = scene_from("lab")
+    r = render_actuator(-230.0, L0_MM, scene, seed=8)
+    res = _measure(r, scene, mm_per_px=None)
+    assert res.psi_deg == pytest.approx(-230.0, abs=1.5)
+    assert np.isnan(res.length_mm)
+
+
+def test_auto_fixed_end_finds_the_clamp() -> None:
+    scene = scene_from("lab")
+    r = render_actuator(150.0, L0_MM, scene, seed=9)
+    res = _measure(r, scene, fixed_end_px=None)
+    assert res.psi_deg == pytest.approx(150.0, abs=1.0)
+    # the line starts next to the clamp (the cut next to the clamp costs a few mm)
+    assert np.hypot(*(res.centreline_px[0] - r.fixed_end_px)) < 40.0
+    assert np.hypot(*(res.centreline_px[-1] - r.centreline_px[-1])) < 15.0
+
+
+def test_bulged_actuator_turning_and_auto_vs_arc() -> None:
+    scene = scene_from("lab")
+    r = render_actuator(-150.0, L0_MM, scene, seed=11, bulge=0.3)
+    arc = _measure(r, scene, method="hyper")
+    trn = _measure(r, scene, method="turning")
+    assert arc.status == "flagged" and "non-constant curvature" in arc.reason
+    assert abs(arc.psi_deg + 150.0) > 10.0
+    assert trn.psi_deg == pytest.approx(-150.0, abs=1.5)
+    assert trn.status == "ok"
+
+
+def test_centreline_matches_truth_and_starts_at_fixed_end() -> None:
+    scene = scene_from("lab")
+    r = render_actuator(200.0, L0_MM, scene, seed=12)
+    res = _measure(r, scene)
+    from scipy.spatial import cKDTree
+
+    dist, _ = cKDTree(r.centreline_px).query(res.centreline_px)
+    assert np.median(dist) < 0.5
+    assert np.hypot(*(res.centreline_px[0] - r.fixed_end_px)) < 15.0
+
+
+@pytest.mark.parametrize("preset", ["clean", "lab"])
+def test_four_k_photo_decoded_reduced(preset: str) -> None:
+    scene = scene_from(preset, width=4000, height=3000)
+    r = render_actuator(-120.0, L0_MM, scene, seed=13)
+    assert jpeg_size(r.jpeg_bytes) == (4000, 3000)
+    res = _measure(r, scene)
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(-120.0, abs=0.5)
+
+
+# ---------------------------------------------------------------------------------------------
+# never a silent wrong number
+
+
+def test_blank_photo_fails_with_reason() -> None:
+    res = measure_image(np.full((480, 640, 3), 180, np.uint8), l0_mm=L0_MM)
+    assert res.status == "failed" and "no line found" in res.reason and np.isnan(res.psi_deg)
+
+
+def test_line_leaving_the_frame_is_flagged() -> None:
+    scene = scene_from("clean")
+    r = render_actuator(30.0, L0_MM, scene, seed=14, fixed_end_px=(900.0, 480.0))
+    res = _measure(r, scene)
+    assert res.status == "flagged" and "border" in res.reason
+
+
+def test_ends_almost_touching_is_flagged() -> None:
+    scene = scene_from("clean", clamp=False, tube=False)
+    r = render_actuator(352.0, L0_MM, scene, seed=15)
+    res = _measure(r, scene)
+    assert res.status == "flagged"
+    assert "ends almost touching" in res.reason or "closes on itself" in res.reason
+
+
+def test_second_line_is_flagged() -> None:
+    scene = scene_from("clean")
+    r = render_actuator(60.0, L0_MM, scene, seed=16)
+    img = r.image.copy()
+    cv2.line(img, (100, 850), (700, 900), (25, 25, 25), 6, cv2.LINE_AA)
+    res = measure_image(img, l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end_px=r.fixed_end_px)
+    assert res.psi_deg == pytest.approx(60.0, abs=0.5)
+    assert res.status == "flagged" and "candidate lines" in res.reason
+
+
+def test_glare_gap_is_bridged_and_flagged() -> None:
+    scene = scene_from("lab", occluded_fraction=0.05)
+    r = render_actuator(-90.0, L0_MM, scene, seed=17)
+    res = _measure(r, scene)
+    assert res.status == "flagged" and "hidden" in res.reason
+    assert res.psi_deg == pytest.approx(-90.0, abs=3.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# photo sets and CLI
+
+
+@pytest.fixture(scope="module")
+def photoset(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, np.ndarray]:
+    folder = tmp_path_factory.mktemp("ps")
+    scene = scene_from("lab")
+    rows, truth = [], []
+    for i, psi in enumerate(np.linspace(210.0, -220.0, 6)):
+        r = render_actuator(float(psi), L0_MM, scene, seed=100 + i)
+        name = f"p{i:02d}.jpg"
+        (folder / name).write_bytes(r.jpeg_bytes)
+        rows.append({"image": name, "pressure_kpa": 20.0 * i, "direction": "up", "material": "DS20",
+                     "actuator": "A1", "trial": "1", "step": i, "measured_pressure_kpa": 20.0 * i + 0.3,
+                     "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+        truth.append(psi)
+    (folder / "broken.jpg").write_bytes(b"\xff\xd8 not really a jpeg")
+    rows.append({"image": "broken.jpg", "pressure_kpa": 120.0, "direction": "down", "material": "DS20",
+                 "actuator": "A1", "trial": "1", "step": 6, "measured_pressure_kpa": 120.0})
+    write_manifest(folder, pd.DataFrame(rows))
+    write_settings(folder, {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px, "line_color": "black", "positive_turn": "ccw"})
+    return folder, np.array(truth)
+
+
+def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> None:
+    from pipeline.measure import measure_photoset
+
+    folder, truth = photoset
+    serial = measure_photoset(folder)
+    par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
+    assert list(par.columns[:9]) == ["image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason", "seconds"]
+    assert list(par.columns[9:15]) == ["pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    assert "measured_pressure_kpa" in par.columns and "fixed_end_x" not in par.columns
+    assert list(par["image"]) == [f"p{i:02d}.jpg" for i in range(6)] + ["broken.jpg"]
+    np.testing.assert_allclose(par["psi_deg"][:6], truth, atol=0.6)
+    np.testing.assert_array_equal(par["psi_deg"][:6], serial["psi_deg"][:6])  # deterministic
+    assert par["status"].iloc[-1] == "failed" and "unreadable" in par["reason"].iloc[-1]
+    assert (tmp_path / "ov" / "p03.jpg").is_file() and (tmp_path / "ov" / "contact_DS20_A1_1.jpg").is_file()
+    assert cv2.imread(str(tmp_path / "ov" / "p03.jpg")).shape[1] <= 640
+
+
+def test_cli_measure(photoset, tmp_path: Path) -> None:
+    folder, truth = photoset
+    out = tmp_path / "angles.csv"
+    run = subprocess.run([sys.executable, "-m", "pipeline", "measure", str(folder), "--out", str(out), "--method", "turning"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "6 ok" in run.stdout and "1 failed" in run.stdout
+    angles = pd.read_csv(out)
+    assert (angles["method"] == "turning").all()
+    np.testing.assert_allclose(angles["psi_deg"][:6], truth, atol=1.0)
+    assert np.isnan(angles["psi_deg"].iloc[-1])
+    bad = subprocess.run([sys.executable, "-m", "pipeline", "measure", str(tmp_path / "nope"), "--out", str(out)],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "error" in bad.stderr
