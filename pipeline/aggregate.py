@@ -302,7 +302,7 @@ def status_counts(angles: pd.DataFrame) -> pd.DataFrame:
             {
                 "dataset": dataset,
                 "material": material,
-                "images": int(len(g)),
+                "images": len(g),
                 "ok": int((g["status"] == "ok").sum()),
                 "flagged": int((g["status"] == "flagged").sum()),
                 "failed": int((g["status"] == "failed").sum()),

@@ -159,10 +159,10 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
 
     Examples
     --------
-    >>> crossing_kpa([0, 10, 20], [100.0, 40.0, -20.0], 0.0)
-    16.666666666666668
-    >>> crossing_kpa([20, 10, 0], [-20.0, 40.0, 100.0], 0.0)  # decreasing-pressure walk
-    13.333333333333334
+    >>> round(crossing_kpa([0, 10, 20], [100.0, 40.0, -20.0], 0.0), 3)
+    16.667
+    >>> round(crossing_kpa([20, 10, 0], [-40.0, 20.0, 100.0], 0.0), 3)  # decreasing-pressure walk
+    13.333
     """
     p = np.asarray(pressure_kpa, dtype=float)
     s = np.asarray(psi_deg, dtype=float)

@@ -129,7 +129,7 @@ def four(tmp_path_factory):
 
 
 def test_four_materials_deterministic_and_not_blank(four, tmp_path):
-    tmp, datasets, hyst, rms, curves, config = four
+    _tmp, datasets, hyst, rms, curves, config = four
     args = ["report", "--angles", *[str(d.angles_csv) for d in datasets],
             "--photosets", *[str(d.photoset_dir) for d in datasets],
             "--overlays", *[str(d.overlays_dir) for d in datasets],
@@ -230,7 +230,7 @@ def test_missing_module_adds_no_pages(tmp_path, monkeypatch):
 
 
 def test_bad_inputs_exit_2(four, tmp_path):
-    tmp, datasets, *_ = four
+    _tmp, datasets, *_ = four
     out = str(tmp_path / "r.pdf")
     assert main(["report", "--angles", str(datasets[0].angles_csv), "--photosets", "a", "b", "--out", out]) == 2
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2

@@ -20,17 +20,23 @@ import matplotlib
 import numpy as np
 
 matplotlib.use("Agg", force=False)
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.backends import backend_pdf  # noqa: E402
-from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.backends import backend_pdf
+from matplotlib.backends.backend_pdf import PdfPages
+from matplotlib.figure import Figure
 
-from pipeline import __version__  # noqa: E402
-from pipeline.photoset import atomic_write_bytes  # noqa: E402
-from pipeline.report.data import ReportData, ReportInputs, load_report_data  # noqa: E402
-from pipeline.report.extra import extra_pages  # noqa: E402
-from pipeline.report.pages import comparison_page, material_page, overview_page, summary_lines, text_pages  # noqa: E402
-from pipeline.report.style import report_style  # noqa: E402
+from pipeline import __version__
+from pipeline.photoset import atomic_write_bytes
+from pipeline.report.data import ReportData, ReportInputs, load_report_data
+from pipeline.report.extra import extra_pages
+from pipeline.report.pages import (
+    comparison_page,
+    material_page,
+    overview_page,
+    summary_lines,
+    text_pages,
+)
+from pipeline.report.style import report_style
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from pipeline.aggregate import aggregate_hysteresis, aggregate_per_actuator, pool_hysteresis, read_angles
+from pipeline.aggregate import (
+    aggregate_hysteresis,
+    aggregate_per_actuator,
+    pool_hysteresis,
+    read_angles,
+)
 from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
 

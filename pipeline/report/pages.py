@@ -255,7 +255,7 @@ def material_page(data: ReportData, material: str) -> Figure:
     color = material_colors(data.materials)[material]
     fig = page()
     fig.suptitle(f"{material}: bending angle versus pressure")
-    top, middle, bottom = fig.subfigures(3, 1, height_ratios=[4.4, 3.4, 2.1])
+    top, middle, bottom = fig.subfigures(3, 1, height_ratios=[4.6, 3.6, 1.8])
     plot_hysteresis(top.subplots(), data, material, color,
                     title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: model")
     left, right = middle.subfigures(1, 2, width_ratios=[1.0, 1.25])
