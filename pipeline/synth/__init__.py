@@ -1,0 +1,32 @@
+"""Synthetic acquisition: a virtual rig rendering pressure-ramp photo sets with exact ground truth.
+
+Public API
+----------
+SceneParams, SCENE_PRESETS, scene_from          scene knobs and presets (``clean``, ``lab``, ``hard``)
+centreline_mm, turning_angle_deg                 exact centrelines (total turning angle psi)
+render_curve, render_actuator, RenderedImage     one photo with its exact centreline in pixels
+Backdrop, make_backdrop, make_camera             static scene reused across the photos of a ramp
+"""
+
+from pipeline.synth.backdrop import Backdrop, make_backdrop
+from pipeline.synth.camera import Camera, make_camera
+from pipeline.synth.centreline import centreline_mm, curvature_per_mm, turning_angle_deg
+from pipeline.synth.presets import SCENE_PRESETS, SceneParams, scene_from
+from pipeline.synth.scene import RenderedImage, child_seed, render_actuator, render_curve
+
+__all__ = [
+    "Backdrop",
+    "Camera",
+    "RenderedImage",
+    "SCENE_PRESETS",
+    "SceneParams",
+    "centreline_mm",
+    "child_seed",
+    "curvature_per_mm",
+    "make_backdrop",
+    "make_camera",
+    "render_actuator",
+    "render_curve",
+    "scene_from",
+    "turning_angle_deg",
+]

@@ -1,0 +1,119 @@
+"""The virtual camera: table-plane millimetres to image pixels (placement, scale, tilt).
+
+World frame: millimetres on the table, y up, origin at the fixed end of the marked line,
+the line leaving the clamp along +x.  The camera rotates that frame by ``rotation_deg``
+(ccw as seen on screen), scales by ``1 / mm_per_px``, flips y (image y is down: a ccw turn in the
+world stays a ccw turn on screen) and places the origin at ``fixed_end_px``.  A camera tilt is a
+homography ``K R K^-1`` about the image centre, applied to points (never by warping pixels).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pipeline.synth.presets import SceneParams
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Placement of the world frame in the image.
+
+    Attributes
+    ----------
+    width, height : int
+        Image size (px).
+    mm_per_px : float
+        Scale at the image centre (mm per px).
+    rotation_deg : float
+        Direction of the clamp axis (+x of the world) on screen, ccw from image +x.
+    origin_px : tuple of float
+        Where the world origin falls before the tilt (image px).
+    homography : ndarray, shape (3, 3)
+        Tilt homography (identity when the camera looks straight down).
+    """
+
+    width: int
+    height: int
+    mm_per_px: float
+    rotation_deg: float
+    origin_px: tuple[float, float]
+    homography: NDArray[np.float64]
+
+    def flat_px(self, points_mm: ArrayLike) -> NDArray[np.float64]:
+        """World mm -> image px without the tilt."""
+        p = np.asarray(points_mm, dtype=float).reshape(-1, 2)
+        c, s = np.cos(np.radians(self.rotation_deg)), np.sin(np.radians(self.rotation_deg))
+        x = (c * p[:, 0] - s * p[:, 1]) / self.mm_per_px
+        y = (s * p[:, 0] + c * p[:, 1]) / self.mm_per_px
+        return np.column_stack([self.origin_px[0] + x, self.origin_px[1] - y])
+
+    def to_px(self, points_mm: ArrayLike) -> NDArray[np.float64]:
+        """World mm -> image px (x right, y down), tilt included."""
+        flat = self.flat_px(points_mm)
+        if np.array_equal(self.homography, np.eye(3)):
+            return flat
+        return apply_homography(self.homography, flat)
+
+    @property
+    def fixed_end_px(self) -> tuple[float, float]:
+        """Where the fixed end (world origin) appears in the image."""
+        x, y = self.to_px([[0.0, 0.0]])[0]
+        return float(x), float(y)
+
+
+def apply_homography(h: NDArray[np.float64], points_px: ArrayLike) -> NDArray[np.float64]:
+    """Apply a 3x3 homography to image points."""
+    p = np.asarray(points_px, dtype=np.float64).reshape(-1, 1, 2)
+    return cv2.perspectiveTransform(p, h).reshape(-1, 2)
+
+
+def tilt_homography(scene: SceneParams) -> NDArray[np.float64]:
+    """Homography of a camera tilted by ``scene.tilt_deg`` about an axis through the image centre.
+
+    The axis lies in the image plane at ``scene.tilt_azimuth_deg``; focal length
+    ``scene.focal_px_per_width * width``.
+    """
+    if scene.tilt_deg == 0:
+        return np.eye(3)
+    f = scene.focal_px_per_width * scene.width
+    k = np.array([[f, 0, scene.width / 2], [0, f, scene.height / 2], [0, 0, 1.0]])
+    az = np.radians(scene.tilt_azimuth_deg)
+    axis = np.array([np.cos(az), np.sin(az), 0.0]) * np.radians(scene.tilt_deg)
+    r, _ = cv2.Rodrigues(axis)
+    return k @ r @ np.linalg.inv(k)
+
+
+def make_camera(
+    scene: SceneParams,
+    *,
+    rotation_deg: float,
+    fixed_end_px: tuple[float, float] | None = None,
+    extent_mm: ArrayLike | None = None,
+) -> Camera:
+    """A camera placing the fixed end at ``fixed_end_px`` (as seen, after tilt).
+
+    Parameters
+    ----------
+    scene : SceneParams
+    rotation_deg : float
+        Direction of the clamp axis on screen (deg, ccw from image +x).
+    fixed_end_px : (x, y), optional
+        Where the fixed end should appear; by default the points ``extent_mm`` are centred.
+    extent_mm : array_like (n, 2), optional
+        World points whose bounding box is centred when ``fixed_end_px`` is None.
+    """
+    h = tilt_homography(scene)
+    if fixed_end_px is None:
+        pts = np.zeros((1, 2)) if extent_mm is None else np.asarray(extent_mm, dtype=float)
+        probe = Camera(scene.width, scene.height, scene.mm_per_px, rotation_deg, (0.0, 0.0), np.eye(3))
+        flat = probe.flat_px(pts)
+        centre = (flat.min(axis=0) + flat.max(axis=0)) / 2
+        origin = (scene.width / 2 - centre[0], scene.height / 2 - centre[1])
+    else:
+        origin = tuple(apply_homography(np.linalg.inv(h), [fixed_end_px])[0])
+    return Camera(scene.width, scene.height, scene.mm_per_px, float(rotation_deg),
+                  (float(origin[0]), float(origin[1])), h)
