@@ -2,15 +2,21 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import cv2
 import numpy as np
 import pandas as pd
 import pytest
 
 from pipeline.errors import UserInputError
-from pipeline.rig.cameras import CameraError, CommandCamera, FolderCamera, OpenCVCamera, Shot, image_suffix, open_camera
+from pipeline.rig.cameras import (
+    CameraError,
+    CommandCamera,
+    FolderCamera,
+    OpenCVCamera,
+    Shot,
+    image_suffix,
+    open_camera,
+)
 from pipeline.rig.emulator import Emulator
 
 SHOT = Shot(pressure_kpa=40.0, measured_kpa=39.1, direction="up", trial=1, step=2)
