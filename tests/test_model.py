@@ -44,6 +44,12 @@ ALL_READINGS = [
         ("mean", "crown"),
         ("one_minus", "none"),
     )
+] + [  # the further readings of Eqs. 4 and 12, each flipped once on the default
+    {"thickness_pass": "recalculated"},
+    {"thickness_pass": "recalculated", "thickness_phi": "crown"},
+    {"stress": "nominal"},
+    {"base_width": "one_side"},
+    {"wall_coords": "unscaled"},
 ]
 #: a smaller set for the costlier inverse tests: the default, then each option flipped once
 FEW_READINGS = [
@@ -55,6 +61,10 @@ FEW_READINGS = [
     {"kt_scaling": "none"},
     {"jacobian": "deformed", "pressure_area": "segment"},  # has snap-through for DS20 and DS30
     {"l0_mm": 170.0},
+    {"thickness_pass": "recalculated"},
+    {"stress": "nominal"},
+    {"base_width": "one_side"},
+    {"wall_coords": "unscaled"},
 ]
 
 
@@ -167,7 +177,13 @@ def test_loading_branch_is_non_increasing(reading: dict) -> None:
 
 
 @pytest.mark.parametrize(
-    "reading", [{}, {"jacobian": "deformed", "pressure_area": "segment"}], ids=_rid
+    "reading",
+    [
+        {},
+        {"jacobian": "deformed", "pressure_area": "segment"},
+        {"thickness_pass": "recalculated", "stress": "nominal", "wall_coords": "unscaled"},
+    ],
+    ids=_rid,
 )
 def test_quadrature_converged(reading: dict) -> None:
     """Halving the node spacing (doubling every node count) changes P by < 1e-6 relative."""
@@ -360,3 +376,21 @@ def test_unloading_from_a_peak_pressure() -> None:
     np.testing.assert_allclose(pressure_kpa("DS20", above, **reading), p, atol=1e-6)
     assert np.nanmax(below - above) > 30  # hysteresis: stays curled (lower psi) on the way down
     assert np.isnan(psi_deg("DS20", [peak * 1.01], branch="unloading", unload_from_kpa=peak)).all()
+
+
+def test_eq12_readings_act_where_documented() -> None:
+    """Each Eq. 4/12 reading changes P in the documented direction; none touches P at rest."""
+    psi = np.array([150.0, 0.0, -210.0])
+    base = pressure_kpa("SS50", psi)
+    # nominal = Cauchy / lambda_1: lower where the wall is stretched (lambda_1 > 1)
+    assert np.all(pressure_kpa("SS50", psi, stress="nominal") < base)
+    # dropping the factor 2 of the base width removes part of a positive moment
+    one = pressure_kpa("SS50", psi, base_width="one_side")
+    assert np.all(one < base) and np.all(one > 0.9 * base)
+    # unscaled coordinates put wall material higher (over the whole upper half circle)
+    assert np.all(pressure_kpa("SS50", psi, wall_coords="unscaled") > base)
+    # at psi = 0 the axial stretch does not depend on the deformed heights, so a second Eq. 4
+    # pass leaves the section and P unchanged there, but not elsewhere
+    rec = pressure_kpa("SS50", psi, thickness_pass="recalculated")
+    assert rec[1] == pytest.approx(base[1], rel=1e-12)
+    assert abs(rec[2] / base[2] - 1) > 1e-3

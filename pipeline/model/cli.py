@@ -24,6 +24,12 @@ _OPTION_HELP = {
     "l0_factor": "Eq. 12 l0 prefactor (metres: as printed, l0 in m; none: dropped)",
     "pressure_area": "Eq. 13 area (half_disc: as printed; segment: real chamber cut by the base)",
     "thickness_phi": "Eq. 4 stretch over phi (mean: averaged; crown: at phi = 0)",
+    "thickness_pass": "Eq. 4 stretch on the undeformed section (first: as printed) or once more "
+    "on the deformed one (recalculated)",
+    "stress": "Eq. 12 stress (cauchy: as printed; nominal: Cauchy / lambda_1, per undeformed area)",
+    "base_width": "Eq. 12 base width (two_sides: 2 (a0 + t0) as printed; one_side: a0 + t0)",
+    "wall_coords": "Eq. 12 wall coordinates (scaled: tau', phi' as defined; unscaled: tau, phi, "
+    "contradicts the text, diagnostic only)",
 }
 
 

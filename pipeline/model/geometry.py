@@ -62,13 +62,18 @@ def rest_heights(mat: Material, tau: FloatArray, phi: FloatArray) -> FloatArray:
 
 
 def wall_thickness(
-    mat: Material, psi: FloatArray, l0: float, opts: ModelOptions
+    mat: Material,
+    psi: FloatArray,
+    l0: float,
+    opts: ModelOptions,
+    sec: Section | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Eq. 4 plus the k_t scaling: deformed wall thickness t for each angle.
 
-    The axial stretch inside Eq. 4 is taken on the undeformed section (first pass; the paper then
-    recomputes the stretches on the deformed section).  ``thickness_phi`` chooses whether
-    1/lambda is averaged over phi or taken at the crown phi = 0.
+    Without ``sec`` the axial stretch inside Eq. 4 is taken on the undeformed section (first
+    pass, as printed); with ``sec`` (``thickness_pass="recalculated"``) it is the stretch of
+    Eq. 2 on that deformed section, lambda_2 still 1 as in Eq. 4.  ``thickness_phi`` chooses
+    whether 1/lambda is averaged over phi or taken at the crown phi = 0.
 
     Parameters
     ----------
@@ -78,6 +83,8 @@ def wall_thickness(
     l0 : float
         Length of the inextensible layer (mm).
     opts : ModelOptions
+    sec : Section, optional
+        Deformed section of a previous pass (one per angle).
 
     Returns
     -------
@@ -93,7 +100,8 @@ def wall_thickness(
         w_phi = w_phi / (0.5 * math.pi)
     h0 = rest_heights(mat, tau[:, None], phi[None, :])  # (n_tau, n_phi)
     den = l0 - h0 * mat.psi0_rad
-    lam = (l0 - h0[None] * psi[:, None, None]) / den[None]
+    height = h0[None] if sec is None else wall_coordinates(mat, sec, tau, phi, opts)[2]
+    lam = (l0 - height * psi[:, None, None]) / den[None]
     bad = (lam <= 0).any(axis=(1, 2)) | (den <= 0).any()
     t = np.einsum("nij,i,j->n", 1.0 / lam, w_tau, w_phi)
     reason = np.where(bad, BAD_STRETCH, OK)
@@ -222,12 +230,63 @@ class Section:
     reason: FloatArray
 
 
-def deformed_section(mat: Material, psi: FloatArray, l0: float, opts: ModelOptions) -> Section:
-    """Deformed cross-section for bending angles ``psi`` (rad): Eqs. 4-7."""
-    t, reason_t = wall_thickness(mat, psi, l0, opts)
+def _section_from_thickness(
+    mat: Material, t: FloatArray, reason_t: FloatArray, opts: ModelOptions
+) -> Section:
+    """Eqs. 5-7 for given wall thicknesses (and the reason codes of the thickness step)."""
     phi_m, reason_p = solve_phi_m(mat, t, opts)
     reason = np.where(reason_t != OK, reason_t, reason_p)
     a = mat.area0_mm2 / (2.0 * t * phi_m) - 0.5 * t
     reason = np.where((reason == OK) & ~(a > 0), NO_EQ5_ROOT, reason)
     q = -a * np.cos(phi_m)
     return Section(t=t, phi_m=phi_m, a=a, q=q, reason=reason)
+
+
+def deformed_section(mat: Material, psi: FloatArray, l0: float, opts: ModelOptions) -> Section:
+    """Deformed cross-section for bending angles ``psi`` (rad): Eqs. 4-7.
+
+    ``opts.thickness_pass="recalculated"`` repeats Eq. 4 once on the first deformed section
+    (more passes change P by < 0.2 %; feeding lambda_2 back as well diverges, docs/model.md).
+    """
+    t, reason_t = wall_thickness(mat, psi, l0, opts)
+    sec = _section_from_thickness(mat, t, reason_t, opts)
+    if opts.thickness_pass == "recalculated":
+        t, reason_t = wall_thickness(mat, psi, l0, opts, sec)
+        reason_t = np.where(sec.reason != OK, sec.reason, reason_t)
+        sec = _section_from_thickness(mat, t, reason_t, opts)
+    return sec
+
+
+def wall_coordinates(
+    mat: Material, sec: Section, tau: FloatArray, phi: FloatArray, opts: ModelOptions
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Deformed radius a + tau', angle phi' and height of wall points (tau, phi) of the rest shape.
+
+    ``opts.wall_coords="scaled"``: tau' = tau t/t0, phi' = phi 2 phi_m/pi (the text's
+    definitions); ``"unscaled"``: tau' = tau, phi' = phi (diagnostic only).
+
+    Parameters
+    ----------
+    mat : Material
+    sec : Section
+        One deformed section per angle, shape (n,).
+    tau, phi : ndarray
+        Undeformed wall coordinates (mm, rad), 1-D.
+    opts : ModelOptions
+
+    Returns
+    -------
+    r_def, phi_def, height : ndarray, broadcastable to shape (n, n_tau, n_phi)
+        a + tau', phi' and the height b + q + (a + tau') cos(phi') above the inextensible layer.
+    """
+    a = sec.a[:, None, None]
+    tt = tau[None, :, None]
+    pp = phi[None, None, :]
+    if opts.wall_coords == "unscaled":
+        r_def = a + tt
+        phi_def = pp
+    else:
+        r_def = a + tt * (sec.t[:, None, None] / mat.t0_mm)
+        phi_def = pp * (2.0 * sec.phi_m[:, None, None] / math.pi)
+    height = mat.b_mm + sec.q[:, None, None] + r_def * np.cos(phi_def)
+    return r_def, phi_def, height

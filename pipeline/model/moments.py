@@ -14,6 +14,7 @@ from pipeline.model.geometry import (
     axial_stretch_base,
     gauss_nodes,
     rest_heights,
+    wall_coordinates,
 )
 from pipeline.model.materials import Material
 from pipeline.model.ogden import axial_stress_mpa
@@ -31,7 +32,9 @@ def stress_moment_nmm(
     of Eqs. 2-3 on the deformed section, integrated over the undeformed tau in [0, t0] and phi in
     [-pi/2, pi/2] by Gauss-Legendre, using the evenness in phi).  ``opts.jacobian="deformed"``
     multiplies the wall area element by (2 phi_m/pi)(t/t0); ``opts.l0_factor="metres"``
-    multiplies both terms by l0 in metres as printed.
+    multiplies both terms by l0 in metres as printed; ``opts.stress="nominal"`` divides the
+    Cauchy stress by lambda_1; ``opts.base_width="one_side"`` drops the factor 2 of the base
+    term; ``opts.wall_coords`` is passed to :func:`pipeline.model.geometry.wall_coordinates`.
 
     Returns
     -------
@@ -43,23 +46,23 @@ def stress_moment_nmm(
     lam_b = axial_stretch_base(mat, beta[None, :], psi[:, None], l0)
     with np.errstate(all="ignore"):
         sig_b = axial_stress_mpa(lam_b, np.ones_like(lam_b), mu, alpha)
-    m_base = 2.0 * (mat.a0_mm + mat.t0_mm) * (sig_b * beta[None, :]) @ w_beta
+        if opts.stress == "nominal":
+            sig_b = sig_b / lam_b
+    width = (2.0 if opts.base_width == "two_sides" else 1.0) * (mat.a0_mm + mat.t0_mm)
+    m_base = width * (sig_b * beta[None, :]) @ w_beta
 
     tau, w_tau = gauss_nodes(opts.n_tau, 0.0, mat.t0_mm)
     phi, w_phi = gauss_nodes(opts.n_phi, 0.0, 0.5 * math.pi)
-    t = sec.t[:, None, None]
     phi_m = sec.phi_m[:, None, None]
-    a = sec.a[:, None, None]
-    q = sec.q[:, None, None]
-    r_def = a + tau[None, :, None] * (t / mat.t0_mm)  # a + tau'
-    phi_def = phi[None, None, :] * (2.0 * phi_m / math.pi)  # phi'
-    height = mat.b_mm + q + r_def * np.cos(phi_def)
+    r_def, _, height = wall_coordinates(mat, sec, tau, phi, opts)  # a + tau', phi', height
     h0 = rest_heights(mat, tau[:, None], phi[None, :])[None]
     lam1 = (l0 - height * psi[:, None, None]) / (l0 - h0 * mat.psi0_rad)
     lam2 = 2.0 * r_def * phi_m / ((mat.a0_mm + tau[None, :, None]) * math.pi)
     bad = ~((lam1 > 0) & (lam2 > 0)).all(axis=(1, 2)) | ~(lam_b > 0).all(axis=1)
     with np.errstate(all="ignore"):
         sig = axial_stress_mpa(lam1, lam2, mu, alpha)
+        if opts.stress == "nominal":
+            sig = sig / lam1
     integrand = sig * height * r_def
     m_wall = 2.0 * np.einsum("nij,i,j->n", integrand, w_tau, w_phi)
     if opts.jacobian == "deformed":

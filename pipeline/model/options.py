@@ -31,6 +31,18 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "pressure_area": ("half_disc", "segment"),
     # Eq. 4 integrand lambda(phi, tau): "mean" averaged over phi, "crown" at phi = 0.
     "thickness_phi": ("mean", "crown"),
+    # Eq. 4 pass: "first" evaluates lambda_{phi,tau} on the undeformed section (as printed);
+    # "recalculated" recomputes Eq. 4 once more with the axial stretch of the deformed section
+    # (the paper's recalculation step applied to the thickness too; lambda_2 = 1 as in "x 1").
+    "thickness_pass": ("first", "recalculated"),
+    # Eqs. 9-12 stress: "cauchy" as printed; "nominal" Cauchy / lambda_1 (force per undeformed
+    # area, the first Piola-Kirchhoff stress).
+    "stress": ("cauchy", "nominal"),
+    # Eq. 12 base width: "two_sides" 2 (a0 + t0) as printed; "one_side" (a0 + t0) (factor 2 dropped).
+    "base_width": ("two_sides", "one_side"),
+    # Eq. 12 wall coordinates: "scaled" tau' = tau t/t0, phi' = phi 2 phi_m/pi as defined in the
+    # text; "unscaled" tau' = tau, phi' = phi (contradicts those definitions: diagnostic only).
+    "wall_coords": ("scaled", "unscaled"),
 }
 
 
@@ -41,6 +53,7 @@ class ModelOptions:
     Attributes
     ----------
     eq5, kt_scaling, jacobian, l0_factor, pressure_area, thickness_phi : str
+    thickness_pass, stress, base_width, wall_coords : str
         Readings of the ambiguous equations; see :data:`CHOICES`.
     l0_mm : float or None
         Override of the material's inextensible-layer length l0 (mm).
@@ -64,6 +77,10 @@ class ModelOptions:
     l0_factor: str = "metres"
     pressure_area: str = "half_disc"
     thickness_phi: str = "mean"
+    thickness_pass: str = "first"
+    stress: str = "cauchy"
+    base_width: str = "two_sides"
+    wall_coords: str = "scaled"
     l0_mm: float | None = None
     k_p: float | None = None
     n_tau: int = 4
