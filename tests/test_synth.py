@@ -14,8 +14,14 @@ from scipy.ndimage import map_coordinates
 from pipeline.errors import UserInputError
 from pipeline.photoset import line_color_ranges, load_photoset, validate_photoset
 from pipeline.synth import SCENE_PRESETS, centreline_mm, render_actuator, render_curve, scene_from
-from pipeline.synth.actuator import (BEHAVIOURS, TrialActuator, behaviour_for, loading_curve, plan_ramp,
-                                     ramp_pressures)
+from pipeline.synth.actuator import (
+    BEHAVIOURS,
+    TrialActuator,
+    behaviour_for,
+    loading_curve,
+    plan_ramp,
+    ramp_pressures,
+)
 from pipeline.synth.photoset_writer import render_photoset
 
 REPO = Path(__file__).resolve().parent.parent
@@ -223,7 +229,7 @@ def test_bulge_only_past_zero_and_only_for_soft_silicones():
 
 
 def small_set(tmp_path: Path, name: str, **kw) -> tuple[Path, pd.DataFrame]:
-    args = dict(actuators=2, trials=2, seed=5, scene="lab", step_kpa=40, scene_overrides=SMALL, psi_fn=toy_psi)
+    args = {"actuators": 2, "trials": 2, "seed": 5, "scene": "lab", "step_kpa": 40, "scene_overrides": SMALL, "psi_fn": toy_psi}
     args.update(kw)
     out = tmp_path / name
     return out, render_photoset(out, "DS20", **args)

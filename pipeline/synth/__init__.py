@@ -15,10 +15,10 @@ from pipeline.synth.presets import SCENE_PRESETS, SceneParams, scene_from
 from pipeline.synth.scene import RenderedImage, child_seed, render_actuator, render_curve
 
 __all__ = [
+    "SCENE_PRESETS",
     "Backdrop",
     "Camera",
     "RenderedImage",
-    "SCENE_PRESETS",
     "SceneParams",
     "centreline_mm",
     "child_seed",

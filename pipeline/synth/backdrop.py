@@ -88,7 +88,7 @@ def _table(scene: SceneParams, rng: np.random.Generator) -> NDArray[np.float32]:
 
 def _keepout_mask(scene: SceneParams, camera: Camera, keepout_mm: Sequence[NDArray[np.float64]], margin_mm: float) -> NDArray[np.uint8]:
     mask = np.zeros((scene.height, scene.width), np.uint8)
-    thick = max(1, int(round(2 * margin_mm / scene.mm_per_px)))
+    thick = max(1, round(2 * margin_mm / scene.mm_per_px))
     for pts in keepout_mm:
         px = camera.to_px(pts)
         cv2.polylines(mask, [np.round(px * (1 << SHIFT)).astype(np.int32)], False, 255, thick, cv2.LINE_8, SHIFT)
@@ -119,7 +119,7 @@ def _distractors(img: NDArray[np.float32], scene: SceneParams, keepout: NDArray[
             colour, opacity = ink, rng.uniform(0.7, 1.0)
         else:
             colour, opacity = np.full(3, rng.uniform(70, 140), np.float32), rng.uniform(0.3, 0.7)
-        thick = max(1, int(round(rng.uniform(0.4, 1.6) / scene.mm_per_px)))
+        thick = max(1, round(rng.uniform(0.4, 1.6) / scene.mm_per_px))
         mask = np.zeros((h, w), np.uint8)
         cv2.polylines(mask, [np.round(pts * (1 << SHIFT)).astype(np.int32)], False, 255, thick, cv2.LINE_AA, SHIFT)
         x0, y0, bw, bh = cv2.boundingRect(mask)
@@ -139,7 +139,7 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         bend = rng.uniform(-1, 1) * 1e-3
         tube = np.column_stack([-CLAMP_LENGTH_MM - t, bw / 2 + bend * t**2])
         px = camera.to_px(tube)
-        width = max(2, int(round(TUBE_WIDTH_MM / scene.mm_per_px)))
+        width = max(2, round(TUBE_WIDTH_MM / scene.mm_per_px))
         mask = np.zeros(img.shape[:2], np.uint8)
         cv2.polylines(mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT)
         a = mask[..., None].astype(np.float32) * (0.55 / 255)
@@ -153,7 +153,7 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         cv2.fillPoly(img, [np.round(outline * s).astype(np.int32)], (72, 74, 78), cv2.LINE_AA, SHIFT)
         inner = camera.to_px(clamp_outline_mm(bw) * 0.8 + np.array([-0.1 * CLAMP_LENGTH_MM, 0.1 * bw]))
         cv2.polylines(img, [np.round(inner * s).astype(np.int32)], True, (105, 108, 112), 2, cv2.LINE_AA, SHIFT)
-        r = max(2, int(round(2.5 / scene.mm_per_px)))
+        r = max(2, round(2.5 / scene.mm_per_px))
         for y in (0.1 * bw, 0.9 * bw):
             c = camera.to_px([[-CLAMP_LENGTH_MM / 2, y]])[0]
             cv2.circle(img, tuple(np.round(c * s).astype(int)), r * s, (150, 152, 155), -1, cv2.LINE_AA, SHIFT)

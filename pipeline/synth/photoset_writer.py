@@ -30,8 +30,15 @@ import pandas as pd
 
 from pipeline.errors import UserInputError
 from pipeline.photoset import MANIFEST, TRUTH, atomic_write_bytes, write_manifest, write_settings
-from pipeline.synth.actuator import (ActuatorBehaviour, PsiFunction, behaviour_for, draw_actuator, draw_trial,
-                                     loading_curve, plan_ramp)
+from pipeline.synth.actuator import (
+    ActuatorBehaviour,
+    PsiFunction,
+    behaviour_for,
+    draw_actuator,
+    draw_trial,
+    loading_curve,
+    plan_ramp,
+)
 from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import Camera, make_camera, tilt_homography
 from pipeline.synth.centreline import centreline_mm

@@ -17,6 +17,7 @@ True
 from __future__ import annotations
 
 import functools
+import itertools
 from dataclasses import dataclass
 
 import cv2
@@ -24,7 +25,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pipeline.errors import UserInputError
-from pipeline.synth.backdrop import END_CAP_MM, SHIFT, Backdrop, clamp_outline_mm, make_backdrop, NOISE_PAD
+from pipeline.synth.backdrop import (
+    END_CAP_MM,
+    NOISE_PAD,
+    SHIFT,
+    Backdrop,
+    clamp_outline_mm,
+    make_backdrop,
+)
 from pipeline.synth.camera import Camera, make_camera
 from pipeline.synth.centreline import DEFAULT_N, centreline_mm, turning_angle_deg
 from pipeline.synth.presets import SceneParams
@@ -100,7 +108,7 @@ def _chunks(points: NDArray[np.float64], max_turn_deg: float = 90.0) -> list[sli
     bins = np.floor((ang - ang[0]) / np.radians(max_turn_deg)).astype(int)
     starts = np.flatnonzero(np.diff(bins)) + 1
     edges = [0, *starts.tolist(), len(points) - 1]
-    return [slice(max(a - 1, 0), min(b + 2, len(points))) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+    return [slice(max(a - 1, 0), min(b + 2, len(points))) for a, b in itertools.pairwise(edges) if b > a]
 
 
 def _band_polygons(inner: NDArray[np.float64], outer: NDArray[np.float64]) -> list[NDArray[np.float64]]:
@@ -208,7 +216,7 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
         a_body = body.astype(np.float32) * (opacity / 255.0)
         edge = np.zeros(shape, np.uint8)
         cv2.polylines(edge, [np.round((body_outer_px - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
-                      max(1, int(round(0.6 / scene.mm_per_px))), cv2.LINE_AA, SHIFT)
+                      max(1, round(0.6 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
         a_body = np.maximum(a_body, edge.astype(np.float32) * (min(1.0, opacity + 0.3) / 255.0))
         f = LINE_SUPERSAMPLING
         big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
@@ -222,7 +230,7 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
             seg = centre_px[int(u0 * (n - 1)): int((u0 + scene.occluded_fraction) * (n - 1)) + 1]
             glare = np.zeros(shape, np.uint8)
             cv2.polylines(glare, [np.round((seg - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
-                          int(round(2.5 * scene.line_width_px + 4)), cv2.LINE_AA, SHIFT)
+                          round(2.5 * scene.line_width_px + 4), cv2.LINE_AA, SHIFT)
             a_glare = cv2.GaussianBlur(glare, (0, 0), 1.0 + scene.line_width_px / 4).astype(np.float32) * (
                 _GLARE_OPACITY / 255.0)
         if blur > 0:
