@@ -1,0 +1,124 @@
+"""``python -m pipeline bench``: the speed/accuracy and stability study, tables and charts.
+
+Renders the grid's synthetic scenes (exact ground truth), measures each with every angle
+method on the same decoded image, and writes into ``--out``:
+
+``results.csv``         one row per image and method (truth, psi, error, status, degree, times)
+``speed_accuracy.csv``  per method and condition: median/p95 error, failure rate, ms per image, Pareto
+``stability.csv``       per method, condition and sweep value: the same against the sweep
+``breakdown.csv``       per method and condition: first value (outward from nominal) that breaks it
+``repeatability.csv``   per method: sd and bias over one scene rendered with 20 noise seeds
+``model_choice.csv``    curve model chosen by the adaptive ``turning`` estimator per sweep value
+``model_cost.csv``      model quadrature grid size against error and time
+``*.pdf``, ``*.png``    speed_accuracy, stability, tables, model_cost charts
+
+and prints a summary of the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from pipeline.errors import UserInputError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``python -m pipeline bench``."""
+    parser.add_argument("--grid", default="default", choices=("default", "full"),
+                        help="scene grid: 'default' (~170 images, < 60 s on 2 cores) or 'full' "
+                             "(~900 images with fine sweeps, minutes) (default: %(default)s)")
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="worker processes, one core each (count, default: %(default)s)")
+    parser.add_argument("--out", type=Path, default=Path("results/bench"),
+                        help="output directory for the CSV tables and charts (default: %(default)s)")
+    parser.add_argument("--methods", default=None,
+                        help="comma-separated angle methods to compare (default: every method of "
+                             "pipeline.measure.METHODS)")
+    parser.add_argument("--seed", type=int, default=1,
+                        help="base seed of the rendered scenes (integer, default: %(default)s)")
+    parser.add_argument("--no-model", action="store_true",
+                        help="skip the model quadrature benchmark (model_cost.csv is then empty)")
+
+
+def summary(sa: pd.DataFrame, bd: pd.DataFrame, rep: pd.DataFrame, choice: pd.DataFrame,
+            cost: pd.DataFrame) -> str:
+    """Human-readable summary of the study's figures (what ``bench`` prints)."""
+    from pipeline.bench.analysis import NOMINAL, model_choice_summary
+
+    lines = ["Nominal scenes (lab preset, |psi| <= 300 deg): error (deg), failures, time per image (ms)"]
+    nom = sa[sa["condition"] == NOMINAL][["method", "n", "median_abs_error_deg", "p95_abs_error_deg",
+                                          "failure_rate", "silent_wrong_rate", "median_ms_per_image",
+                                          "median_decode_ms", "pareto"]]
+    lines.append(nom.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    if not bd.empty:
+        lines += ["", "Breakdown point (first sweep value outward from nominal with p95 > 2 deg or a failure; - = none)"]
+        piv = bd.pivot(index="condition", columns="method", values="breakdown_value")
+        piv = piv.reindex(index=list(dict.fromkeys(bd["condition"])), columns=list(dict.fromkeys(bd["method"])))
+        lines.append(piv.to_string(na_rep="-", float_format=lambda v: f"{v:g}"))
+    if not rep.empty:
+        lines += ["", "Repeatability (same scene, noise seeds): sd / bias of psi (deg)"]
+        lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "sd_deg", "bias_deg"]]
+                     .to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    if not choice.empty:
+        s = model_choice_summary(choice)
+        lines += ["", f"Adaptive 'turning' model choice: richer than an arc on {100 * s['richer_on_constant']:.1f} % "
+                      f"of {int(s['n_constant'])} constant-curvature images, on {100 * s['richer_on_bulged']:.1f} % "
+                      f"of {int(s['n_bulged'])} bulged images"]
+    if not cost.empty:
+        lines += ["", "Model: quadrature grid size vs max relative error and time (all 4 materials, forward + inverse)"]
+        c = cost[["grid_n", "seconds", "max_rel_error"]].assign(ms=lambda d: 1e3 * d["seconds"]).drop(columns="seconds")
+        lines.append(c.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the study and write the tables and charts; 0 on success."""
+    t_start = time.perf_counter()
+    from pipeline.bench import analysis, charts, grids
+    from pipeline.bench.run import run_grid
+
+    if args.jobs < 1:
+        raise UserInputError(f"--jobs {args.jobs}: give a number of worker processes >= 1")
+    grid = grids.get_grid(args.grid)
+    methods = None
+    if args.methods:
+        from pipeline.measure import METHODS
+
+        methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        unknown = [m for m in methods if m not in METHODS]
+        if unknown:
+            raise UserInputError(f"--methods: unknown method(s) {unknown}; use some of {sorted(METHODS)}")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    cases = grids.cases(grid, base_seed=args.seed)
+
+    def progress(done: int, total: int) -> None:
+        if done == total or done % 40 == 0:
+            print(f"  {done}/{total} images", file=sys.stderr, flush=True)
+
+    results = run_grid(cases, methods=methods, jobs=args.jobs, progress=progress)
+    t_measured = time.perf_counter()
+    sa = analysis.speed_accuracy(results)
+    stab = analysis.stability(results)
+    bd = analysis.breakdown(stab)
+    rep = analysis.repeatability(results)
+    choice = analysis.model_choice(results)
+    cost = pd.DataFrame(columns=["grid_n", "seconds", "max_rel_error"]) if args.no_model else analysis.model_cost()
+    tables = {"results.csv": results, "speed_accuracy.csv": sa, "stability.csv": stab, "breakdown.csv": bd,
+              "repeatability.csv": rep, "model_choice.csv": choice, "model_cost.csv": cost}
+    for name, table in tables.items():
+        table.to_csv(out / name, index=False, float_format="%.6g")
+    figs = {"speed_accuracy": charts.speed_accuracy_figure(sa), "stability": charts.stability_figure(stab),
+            "tables": charts.tables_figure(bd, choice, rep), "model_cost": charts.model_cost_figure(cost)}
+    for stem, fig in figs.items():
+        charts.save(fig, out / stem)
+    print(summary(sa, bd, rep, choice, cost))
+    total = time.perf_counter() - t_start
+    print(f"\nbench --grid {grid.name}: {len(cases)} images x {results['method'].nunique()} methods, "
+          f"jobs={args.jobs}: render+measure {t_measured - t_start:.1f} s, total {total:.1f} s -> {out}")
+    return 0
