@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     tables = {"results.csv": results, "speed_accuracy.csv": sa, "stability.csv": stab, "breakdown.csv": bd,
               "repeatability.csv": rep, "model_choice.csv": choice, "model_cost.csv": cost}
     for name, table in tables.items():
-        table.to_csv(out / name, index=False, float_format="%.6g")
+        table.to_csv(out / name, index=False, float_format="%.8g")
     figs = {"speed_accuracy": charts.speed_accuracy_figure(sa), "stability": charts.stability_figure(stab),
             "tables": charts.tables_figure(bd, choice, rep), "model_cost": charts.model_cost_figure(cost)}
     for stem, fig in figs.items():
