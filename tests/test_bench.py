@@ -122,6 +122,7 @@ def test_stability_breakdown_and_repeatability_tables():
     rep = analysis.repeatability(res).iloc[0]
     assert rep["n_seeds"] == 4 and rep["bias_deg"] == pytest.approx(0.0)
     assert rep["sd_deg"] == pytest.approx(np.std([119, 121, 120, 120], ddof=1))
+    assert rep["robust_sd_deg"] == pytest.approx(1.4826 * 0.5)  # median of |x - 120| = (1, 1, 0, 0)
 
 
 def test_model_choice_consistency():
@@ -135,8 +136,8 @@ def test_model_choice_consistency():
     assert flat.loc[0.0, "consistent"] == pytest.approx(2 / 3)
     assert flat.loc[0.5, "consistent"] == pytest.approx(2 / 3)
     assert flat.loc[0.0, "degree_counts"] == "1:2;3:1"
-    s = analysis.model_choice_summary(choice)
-    assert s["richer_on_constant"] == pytest.approx(1 / 3) and s["richer_on_bulged"] == pytest.approx(2 / 3)
+    s = analysis.model_choice_summary(choice).iloc[0]
+    assert s["method"] == "turning" and s["richer_on_constant"] == pytest.approx(1 / 3) and s["richer_on_bulged"] == pytest.approx(2 / 3)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -221,8 +222,9 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
     ok = res["psi_deg"].notna()
     assert np.allclose(res.loc[ok, "error_deg"], res.loc[ok, "psi_deg"] - res.loc[ok, "psi_true_deg"], atol=1e-4)
     # the adaptive method's model choice is recorded for every image it measured
-    trn = res[(res["method"] == "turning") & ok]
-    assert trn["degree"].notna().all() and (trn["degree"] >= 1).all()
+    for method in ("turning", "auto"):
+        trn = res[(res["method"] == method) & ok]
+        assert trn["degree"].notna().all() and (trn["degree"] >= 1).all()
     sa = pd.read_csv(out / "speed_accuracy.csv")
     assert set(sa["condition"]) == {"nominal", "psi", "bulge"}
     assert sa.groupby("condition")["pareto"].any().all()
@@ -233,7 +235,7 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
     rep = pd.read_csv(out / "repeatability.csv")
     assert (rep["n_seeds"] == 2).all() and len(rep) == len(METHODS)
     choice = pd.read_csv(out / "model_choice.csv")
-    assert set(choice["bulge"]) == {0.0, 0.6}
+    assert set(choice["bulge"]) == {0.0, 0.6} and set(choice["method"]) == {"turning", "auto"}
     cost = pd.read_csv(out / "model_cost.csv")
     assert list(cost.columns[:3]) == ["grid_n", "seconds", "max_rel_error"] and len(cost) >= 3
     for stem in ("speed_accuracy", "stability", "tables", "model_cost"):

@@ -282,13 +282,15 @@ def repeatability(results: pd.DataFrame) -> pd.DataFrame:
     -------
     DataFrame
         Columns ``psi_true_deg, method, n_seeds, n_failed, mean_psi_deg, bias_deg, sd_deg,
-        range_deg``.
+        range_deg, robust_sd_deg`` (1.4826 x median absolute deviation: insensitive to a single
+        outlier), ``n_ok, sd_ok_deg`` (over the images with status ``ok`` only).
     """
     rep = results[results["kind"] == "repeat"]
     rows = []
     for (psi, method), g in rep.groupby(["psi_true_deg", "method"], sort=False):
         good = g[~(g["status"].eq("failed") | g["psi_deg"].isna())]
         x = good["psi_deg"].to_numpy(dtype=float)
+        x_ok = g.loc[g["status"].eq("ok"), "psi_deg"].to_numpy(dtype=float)
         rows.append(
             {
                 "psi_true_deg": float(psi),
@@ -299,44 +301,52 @@ def repeatability(results: pd.DataFrame) -> pd.DataFrame:
                 "bias_deg": float(x.mean() - psi) if x.size else np.nan,
                 "sd_deg": float(x.std(ddof=1)) if x.size > 1 else np.nan,
                 "range_deg": float(np.ptp(x)) if x.size else np.nan,
+                "robust_sd_deg": float(1.4826 * np.median(np.abs(x - np.median(x)))) if x.size else np.nan,
+                "n_ok": int(x_ok.size),
+                "sd_ok_deg": float(x_ok.std(ddof=1)) if x_ok.size > 1 else np.nan,
             }
         )
     return pd.DataFrame(rows)
 
 
-def model_choice(results: pd.DataFrame, *, method: str = "turning", richer_than: int = 1) -> pd.DataFrame:
-    """Which curve model the adaptive estimator chose, per condition and sweep value.
+def model_choice(results: pd.DataFrame, *, methods: Sequence[str] = ("turning", "auto"),
+                 richer_than: int = 1) -> pd.DataFrame:
+    """Which curve model each adaptive estimator chose, per condition and sweep value.
 
     The truth is non-constant curvature exactly when the scene was rendered with ``bulge > 0``.
     A choice is *consistent* when the estimator stayed with the constant-curvature model
     (degree ``<= richer_than``) on constant-curvature scenes and chose a richer one on
     non-constant scenes; ``consistent`` in the table is the share of images that were.
+    (A tilted camera makes the imaged arc slightly non-circular: scenes count as constant
+    curvature by the rendered centre line, as a user would expect.)
 
     Parameters
     ----------
     results : DataFrame
         Per-image results with a ``degree`` column (polynomial degree of theta(s); 1 means
         constant curvature).
-    method : str
-        The adaptive method.
+    methods : sequence of str
+        The adaptive methods (those absent from ``results`` are skipped).
     richer_than : int
         Degree of the constant-curvature model.
 
     Returns
     -------
     DataFrame
-        Columns ``condition, value, bulge, truth_constant_curvature, n, degree_counts,
-        share_richer, consistent``; empty when the method is absent or exposes no degree.
+        Columns ``method, condition, value, bulge, truth_constant_curvature, n,
+        degree_counts, share_richer, consistent``; empty when no method exposes a degree.
     """
-    sel = results[(results["method"] == method) & (results["kind"] == "sweep")]
-    sel = sel[sel["degree"].notna()]
+    columns = ["method", "condition", "value", "bulge", "truth_constant_curvature", "n", "degree_counts",
+               "share_richer", "consistent"]
+    sel = results[results["method"].isin(list(methods)) & (results["kind"] == "sweep") & results["degree"].notna()]
     rows = []
-    for (cond, value, bulge), g in sel.groupby(["condition", "value", "bulge"], sort=False):
+    for (method, cond, value, bulge), g in sel.groupby(["method", "condition", "value", "bulge"], sort=False):
         deg = g["degree"].astype(int)
         richer = deg > richer_than
         constant = bool(bulge == 0)
         rows.append(
             {
+                "method": method,
                 "condition": cond,
                 "value": float(value),
                 "bulge": float(bulge),
@@ -347,29 +357,30 @@ def model_choice(results: pd.DataFrame, *, method: str = "turning", richer_than:
                 "consistent": float((~richer).mean() if constant else richer.mean()),
             }
         )
-    return pd.DataFrame(
-        rows,
-        columns=["condition", "value", "bulge", "truth_constant_curvature", "n", "degree_counts",
-                 "share_richer", "consistent"],
-    )
+    return pd.DataFrame(rows, columns=columns)
 
 
-def model_choice_summary(choice: pd.DataFrame) -> dict[str, float]:
-    """Share of constant-curvature images given a richer model, and of bulged images given one.
+def model_choice_summary(choice: pd.DataFrame) -> pd.DataFrame:
+    """Per adaptive method: share of constant-curvature images given a richer model than an
+    arc, and share of bulged images given one.
 
     Returns
     -------
-    dict
-        ``{"richer_on_constant": share, "richer_on_bulged": share, "n_constant": n,
-        "n_bulged": n}`` (NaN shares when there are no such images).
+    DataFrame
+        Columns ``method, n_constant, richer_on_constant, n_bulged, richer_on_bulged`` (NaN
+        shares when there are no such images).
     """
-    out: dict[str, float] = {}
-    for key, mask in (("constant", choice["truth_constant_curvature"]), ("bulged", ~choice["truth_constant_curvature"])):
-        sub = choice[mask.astype(bool)]
-        n = float(sub["n"].sum())
-        out[f"n_{key}"] = n
-        out[f"richer_on_{key}"] = float((sub["share_richer"] * sub["n"]).sum() / n) if n else float("nan")
-    return out
+    rows = []
+    for method, g in choice.groupby("method", sort=False):
+        row: dict[str, object] = {"method": method}
+        for key, mask in (("constant", g["truth_constant_curvature"].astype(bool)),
+                          ("bulged", ~g["truth_constant_curvature"].astype(bool))):
+            sub = g[mask]
+            n = int(sub["n"].sum())
+            row[f"n_{key}"] = n
+            row[f"richer_on_{key}"] = float((sub["share_richer"] * sub["n"]).sum() / n) if n else float("nan")
+        rows.append(row)
+    return pd.DataFrame(rows, columns=["method", "n_constant", "richer_on_constant", "n_bulged", "richer_on_bulged"])
 
 
 def model_cost(**kwargs: object) -> pd.DataFrame:

@@ -169,13 +169,13 @@ def tables_figure(bd: pd.DataFrame, choice: pd.DataFrame, rep: pd.DataFrame) -> 
         lines.append(piv.to_string(na_rep="-", float_format=lambda v: f"{v:g}"))
     lines += ["", "Repeatability: same scene, 20 noise seeds (sd and bias of psi, deg)", ""]
     if not rep.empty:
-        lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "bias_deg", "sd_deg"]]
+        lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "bias_deg", "sd_deg", "robust_sd_deg"]]
                      .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
-    lines += ["", "Adaptive 'turning' estimator: share of images given a richer curve model than a",
-              "constant-curvature arc (degree 1), per sweep value", ""]
+    lines += ["", "Adaptive estimators: share of images given a richer curve model than a",
+              "constant-curvature arc (degree 1), per sweep value (bulge sweep and values where > 0)", ""]
     if not choice.empty:
         keep = choice[(choice["condition"] == "bulge") | (choice["share_richer"] > 0)]
-        lines.append(keep[["condition", "value", "bulge", "n", "degree_counts", "share_richer"]]
+        lines.append(keep[["method", "condition", "value", "bulge", "n", "degree_counts", "share_richer"]]
                      .to_string(index=False, float_format=lambda v: f"{v:g}"))
     fig.text(0.04, 0.97, "\n".join(lines), family="monospace", fontsize=6.5, va="top")
     return fig

@@ -62,13 +62,15 @@ def summary(sa: pd.DataFrame, bd: pd.DataFrame, rep: pd.DataFrame, choice: pd.Da
         lines.append(piv.to_string(na_rep="-", float_format=lambda v: f"{v:g}"))
     if not rep.empty:
         lines += ["", "Repeatability (same scene, noise seeds): sd / bias of psi (deg)"]
-        lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "sd_deg", "bias_deg"]]
+        lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "sd_deg", "robust_sd_deg", "sd_ok_deg",
+                          "bias_deg"]]
                      .to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     if not choice.empty:
-        s = model_choice_summary(choice)
-        lines += ["", f"Adaptive 'turning' model choice: richer than an arc on {100 * s['richer_on_constant']:.1f} % "
-                      f"of {int(s['n_constant'])} constant-curvature images, on {100 * s['richer_on_bulged']:.1f} % "
-                      f"of {int(s['n_bulged'])} bulged images"]
+        lines += ["", "Adaptive estimators: share of images given a richer curve model than an arc"]
+        for _, s in model_choice_summary(choice).iterrows():
+            lines.append(f"  {s['method']}: {100 * s['richer_on_constant']:.1f} % of {int(s['n_constant'])} "
+                         f"constant-curvature images, {100 * s['richer_on_bulged']:.1f} % of {int(s['n_bulged'])} "
+                         "bulged images")
     if not cost.empty:
         lines += ["", "Model: quadrature grid size vs max relative error and time (all 4 materials, forward + inverse)"]
         c = cost[["grid_n", "seconds", "max_rel_error"]].assign(ms=lambda d: 1e3 * d["seconds"]).drop(columns="seconds")

@@ -8,11 +8,10 @@ decoded image (each call timed: ``seconds``).  The order of the methods rotates 
 to the next so that no method always runs first on a cold cache.  Workers run single-threaded
 OpenCV (``cv2.setNumThreads(1)``), so ``--jobs N`` uses N cores and times are per core.
 
-The adaptive ``turning`` estimator's chosen model (polynomial degree of the tangent angle
-against arc length; 1 = constant curvature) is not part of ``AngleResult``; it is recovered by
-running ``pipeline.measure.estimators.METHODS["turning"]`` on the centre line that
-``measure_image`` returned, in the same y-up frame ``measure_image`` uses (identical input,
-hence the identical choice).
+The adaptive estimators' chosen model (``turning`` and ``auto``: polynomial degree of the
+tangent angle against arc length; 1 = constant curvature) is not part of ``AngleResult``; it is
+recovered outside the timed call by :func:`chosen_degree`, which repeats ``measure_image``'s
+steps (identical input, hence the identical choice).
 """
 
 from __future__ import annotations
@@ -42,30 +41,40 @@ def _init_worker() -> None:
     cv2.setNumThreads(1)
 
 
-def turning_degree(centreline_px: np.ndarray) -> float:
-    """Curve-model degree the adaptive ``turning`` estimator chooses for a centre line.
+#: methods whose curve model is adaptive (their chosen degree is recorded)
+ADAPTIVE_METHODS: tuple[str, ...] = ("turning", "auto")
 
-    Parameters
-    ----------
-    centreline_px : ndarray, shape (N, 2)
-        Centre line as returned in ``AngleResult.centreline_px`` (x right, y down).
+
+def chosen_degree(image_bgr: np.ndarray, method: str, *, line_color: Any = "black",
+                  fixed_end_px: tuple[float, float] | None = None) -> float:
+    """Curve-model degree an estimator chooses on a photo (1 = constant curvature).
+
+    ``AngleResult`` does not carry the degree, so this repeats the steps of
+    :func:`pipeline.measure.measure_image` (same reduction, same centre-line extraction, same
+    seed and trimmed ends) and returns ``CurveEstimate.degree`` of ``METHODS[method]``.
 
     Returns
     -------
     float
-        The degree (1 = constant curvature), NaN when there is no line or the fit fails.
+        The degree, NaN when no line is found or the fit fails.
     """
+    import cv2
+
+    from pipeline.measure.core import SEED, WORK_WIDTH_PX, reduction_for
     from pipeline.measure.estimators import METHODS as ESTIMATORS
+    from pipeline.measure.extract import NoLineFound, extract_centreline
 
-    if centreline_px is None or len(centreline_px) < 5:
-        return float("nan")
-    from pipeline.measure.core import SEED
-
-    pts = np.asarray(centreline_px, dtype=float) * np.array([1.0, -1.0])
+    f = reduction_for(image_bgr.shape[1], WORK_WIDTH_PX)
+    work = image_bgr
+    if f > 1:
+        work = cv2.resize(image_bgr, (image_bgr.shape[1] // f, image_bgr.shape[0] // f), interpolation=cv2.INTER_AREA)
     try:
-        return float(ESTIMATORS["turning"](pts, np.random.default_rng(SEED)).degree)
-    except (ValueError, np.linalg.LinAlgError):
+        line = extract_centreline(work, line_color=line_color, fixed_end_px=fixed_end_px, scale=float(f))
+        pts = line.centreline_px * np.array([1.0, -1.0])
+        est = ESTIMATORS[method](pts, np.random.default_rng(SEED), ends_px=line.trimmed_px)
+    except (NoLineFound, ValueError, np.linalg.LinAlgError):
         return float("nan")
+    return float(est.degree)
 
 
 def measure_case(case: Case, methods: Sequence[str]) -> list[dict[str, Any]]:
@@ -106,8 +115,8 @@ def measure_case(case: Case, methods: Sequence[str]) -> list[dict[str, Any]]:
         )
         seconds = time.perf_counter() - t
         degree = getattr(res, "degree", None)
-        if degree is None and method == "turning":
-            degree = turning_degree(res.centreline_px)
+        if degree is None and method in ADAPTIVE_METHODS and res.status != "failed":
+            degree = chosen_degree(image, method, line_color=scene.line_color, fixed_end_px=rendered.fixed_end_px)
         err = res.psi_deg - case.psi_deg
         out[method] = {
             "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,
