@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from pipeline.measure import DEFAULT_METHOD, METHODS, measure_image
-from pipeline.measure.core import decode_for_work, jpeg_size, measure_work_image
+from pipeline.measure.core import decode_for_work, jpeg_size, measure_decoded
 from pipeline.measure.estimators import auto, hyper, paper, paper_corrected, turning
 from pipeline.photoset import write_manifest, write_settings
 from pipeline.synth import centreline_mm, render_actuator, render_curve, scene_from
@@ -30,10 +30,12 @@ def _arc(psi_deg: float, n: int = 400, length: float = 600.0) -> np.ndarray:
 
 
 def _measure(rendered, scene, **kw):
-    img, f = decode_for_work(np.frombuffer(rendered.jpeg_bytes, np.uint8))
+    """Measure as measure_photoset does: JPEG bytes decoded reduced, finer when needed."""
+    data = np.frombuffer(rendered.jpeg_bytes, np.uint8)
+    img, f = decode_for_work(data)
     kw.setdefault("fixed_end_px", rendered.fixed_end_px)
     kw.setdefault("mm_per_px", scene.mm_per_px)
-    return measure_work_image(img, scale=float(f), l0_mm=L0_MM, **kw)
+    return measure_decoded(data, img, f, l0_mm=L0_MM, **kw)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -20,13 +20,15 @@ import cv2
 import numpy as np
 
 from pipeline.measure.estimators import METHODS, CurveEstimate, hyper, turning_quick
-from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline
+from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, is_value_only
 from pipeline.measure.quality import assess
 
 #: default estimator (see the package docstring for the measurements behind the choice)
-DEFAULT_METHOD = "hyper"
-#: work on images at most about this wide (px); larger ones are decoded / reduced by 2, 4 or 8
+DEFAULT_METHOD = "auto"
+#: work on images at least this wide (px); larger ones are decoded / reduced by 2, 4 or 8
 WORK_WIDTH_PX = 640
+#: re-decode at twice the resolution when the line is thinner than this in the work image (px)
+MIN_WORK_LINE_WIDTH_PX = 2.5
 #: seed of the random places of the ``paper`` estimators (deterministic output)
 SEED = 20240
 
@@ -53,6 +55,8 @@ class AngleResult:
         Why flagged / failed ('' when ok), '; '-separated.
     centreline_px : ndarray, shape (N, 2)
         Centre line (x right, y down, original px), fixed end first; empty when failed.
+    line_width_px : float
+        Width of the extracted line (original px); NaN when failed.
     """
 
     psi_deg: float
@@ -63,6 +67,7 @@ class AngleResult:
     status: str
     reason: str
     centreline_px: np.ndarray
+    line_width_px: float = float("nan")
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -76,8 +81,8 @@ def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
 
     Examples
     --------
-    >>> reduction_for(4000), reduction_for(1280), reduction_for(640)
-    (4, 2, 1)
+    >>> reduction_for(4000), reduction_for(1280), reduction_for(640), reduction_for(4000, 320)
+    (4, 2, 1, 8)
     """
     f = 1
     while f < 8 and width_px / (2 * f) >= work_width_px:
@@ -132,6 +137,7 @@ def measure_work_image(
     quality = assess(
         line,
         method=method,
+        psi_deg=psi,
         length_px=length_px,
         expected_length_px=(l0_mm / mm_per_px) if mm_per_px else None,
         psi_turning_deg=_psi_from(trn, sign, l0_mm, mm_per_px, length_px),
@@ -147,6 +153,7 @@ def measure_work_image(
         status=quality.status,
         reason=quality.reason,
         centreline_px=line.centreline_px,
+        line_width_px=line.width_px,
     )
 
 
@@ -180,7 +187,8 @@ def measure_image(
     method : str
         Estimator, a key of :data:`pipeline.measure.METHODS`.
     work_width_px : int
-        Images at least twice this wide are reduced (INTER_AREA) by 2, 4 or 8 before the work.
+        Images at least twice this wide are reduced (INTER_AREA) by 2, 4 or 8 before the work
+        (less when the line would come out thinner than ``MIN_WORK_LINE_WIDTH_PX``).
 
     Returns
     -------
@@ -200,17 +208,23 @@ def measure_image(
     """
     if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
         fixed_end_px = None
-    f = reduction_for(image_bgr.shape[1], work_width_px) if image_bgr is not None and image_bgr.ndim == 3 else 1
-    work = image_bgr
-    if f > 1:
-        work = cv2.resize(image_bgr, (image_bgr.shape[1] // f, image_bgr.shape[0] // f), interpolation=cv2.INTER_AREA)
-    return measure_work_image(
-        work, scale=float(f), l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
-        fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
-    )
+    kw = dict(l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color, fixed_end_px=fixed_end_px,
+              positive_turn=positive_turn, method=method)
+    if image_bgr is None or image_bgr.ndim != 3:
+        return measure_work_image(image_bgr, scale=1.0, **kw)
+    f = reduction_for(image_bgr.shape[1], work_width_px)
+    res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+    while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
+        f //= 2
+        res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+    return res
 
 
 _REDUCED = {1: cv2.IMREAD_COLOR, 2: cv2.IMREAD_REDUCED_COLOR_2, 4: cv2.IMREAD_REDUCED_COLOR_4, 8: cv2.IMREAD_REDUCED_COLOR_8}
+_REDUCED_GREY = {
+    1: cv2.IMREAD_GRAYSCALE, 2: cv2.IMREAD_REDUCED_GRAYSCALE_2, 4: cv2.IMREAD_REDUCED_GRAYSCALE_4,
+    8: cv2.IMREAD_REDUCED_GRAYSCALE_8,
+}
 
 
 def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
@@ -243,8 +257,21 @@ def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
     return None
 
 
-def decode_for_work(data: np.ndarray, work_width_px: int = WORK_WIDTH_PX) -> tuple[np.ndarray | None, int]:
+def decode_for_work(
+    data: np.ndarray, work_width_px: int = WORK_WIDTH_PX, factor: int | None = None, grey: bool = False
+) -> tuple[np.ndarray | None, int]:
     """Decode image bytes, directly at reduced size for large JPEGs (DCT scaling: much faster).
+
+    Parameters
+    ----------
+    data : ndarray of uint8
+        The file's bytes.
+    work_width_px : int
+        See :func:`reduction_for`.
+    factor : int, optional
+        Force this reduction (1, 2, 4 or 8) for a JPEG.
+    grey : bool
+        Decode only the luma (enough for a black line; skips chroma and colour conversion).
 
     Returns
     -------
@@ -254,13 +281,20 @@ def decode_for_work(data: np.ndarray, work_width_px: int = WORK_WIDTH_PX) -> tup
         Original px per decoded px.
     """
     size = jpeg_size(data)
-    f = reduction_for(size[0], work_width_px) if size else 1
-    img = cv2.imdecode(data, _REDUCED[f])
-    if img is not None and f == 1 and size is None:
-        f = reduction_for(img.shape[1], work_width_px)
-        if f > 1:
-            img = cv2.resize(img, (img.shape[1] // f, img.shape[0] // f), interpolation=cv2.INTER_AREA)
-    return img, f
+    if size is not None:
+        f = factor if factor is not None else reduction_for(size[0], work_width_px)
+        return cv2.imdecode(data, (_REDUCED_GREY if grey else _REDUCED)[f]), f
+    img = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE if grey else cv2.IMREAD_COLOR)
+    if img is None:
+        return None, 1
+    f = factor if factor is not None else reduction_for(img.shape[1], work_width_px)
+    return _reduce(img, f), f
+
+
+def _reduce(image: np.ndarray, factor: int) -> np.ndarray:
+    if factor <= 1:
+        return image
+    return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
 
 
 def measure_file(
@@ -287,13 +321,33 @@ def measure_file(
         data = np.fromfile(str(path), dtype=np.uint8)
     except OSError as exc:
         return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
-    img, f = decode_for_work(data, work_width_px) if data.size else (None, 1)
+    grey = is_value_only(line_color)
+    img, f = decode_for_work(data, work_width_px, grey=grey) if data.size else (None, 1)
     if img is None:
         return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
     if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
         fixed_end_px = None
-    res = measure_work_image(
-        img, scale=float(f), l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
+    res = measure_decoded(
+        data, img, f, l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
         fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
     )
     return res, time.perf_counter() - t0
+
+
+def measure_decoded(data: np.ndarray, img: np.ndarray, factor: int, **kw: Any) -> AngleResult:
+    """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
+
+    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``; ``kw`` are the
+    keyword arguments of :func:`measure_work_image` except ``scale``.  While the line is
+    narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the image was
+    reduced, it is decoded again at twice the resolution: thin lines cost a second decode, the
+    usual photo only one small one.
+    """
+    res = measure_work_image(img, scale=float(factor), **kw)
+    while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
+        factor //= 2
+        finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)
+        if finer is None:
+            break
+        res = measure_work_image(finer, scale=float(factor), **kw)
+    return res

@@ -320,12 +320,19 @@ def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.nd
     s_mid = 0.5 * (s[1:] + s[:-1])
     u = 2.0 * s_mid / s[-1] - 1.0
     n = len(theta)
+    top = min(max_degree, n - 2)
+    # one weighted QR of the Legendre Vandermonde gives the RSS of every nested degree
+    wt = np.sqrt(seg / seg.mean())
+    vand = np.polynomial.legendre.legvander(u, top) * wt[:, None]
+    q, r = np.linalg.qr(vand)
+    proj = q.T @ (theta * wt)
+    total = float(np.sum((theta * wt) ** 2))
     best: tuple[float, np.ndarray, int, float] | None = None
-    for deg in range(1, min(max_degree, n - 2) + 1):
-        coef, diag = np.polynomial.legendre.legfit(u, theta, deg, w=np.sqrt(seg), full=True)
-        rss = float(np.sum(seg * (np.polynomial.legendre.legval(u, coef) - theta) ** 2) / seg.mean())
-        bic = n * np.log(max(rss, 1e-300) / n) + (deg + 1) * np.log(n)
+    for deg in range(1, top + 1):
+        rss = max(total - float(np.sum(proj[: deg + 1] ** 2)), 1e-300)
+        bic = n * np.log(rss / n) + (deg + 1) * np.log(n)
         if best is None or bic < best[0]:
+            coef = np.linalg.solve(r[: deg + 1, : deg + 1], proj[: deg + 1])
             best = (bic, coef, deg, rss)
     assert best is not None
     return s_mid, best[1], best[2], best[3]

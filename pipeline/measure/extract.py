@@ -109,6 +109,11 @@ def resolve_ranges(line_color: Any) -> tuple[tuple[tuple[int, int, int], tuple[i
     return line_color_ranges(line_color)
 
 
+def is_value_only(line_color: Any) -> bool:
+    """True when the colour range bounds only the value (black): a grey decode is enough."""
+    return all(lo[0] == 0 and hi[0] == 179 and lo[1] == 0 and hi[1] == 255 for lo, hi in resolve_ranges(line_color))
+
+
 def _kernel_px(shape: tuple[int, ...]) -> int:
     """Side of the black-hat square: wider than any marker line, narrower than the clamp."""
     return int(max(11, shape[1] // 40) | 1)
@@ -125,7 +130,8 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
 
     Parameters
     ----------
-    image_bgr : ndarray, shape (H, W, 3), uint8
+    image_bgr : ndarray, shape (H, W, 3) or (H, W), uint8
+        Colour photo, or its grey (luma) decoding for value-only ranges.
     line_color : str or mapping or resolved ranges
         See :func:`pipeline.photoset.line_color_ranges`.
 
@@ -135,9 +141,8 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
     weight : ndarray, shape (H, W), uint8
         Line strength (black-hat response, or the mask for colour ranges).
     """
-    ranges = resolve_ranges(line_color)
-    if all(lo[0] == 0 and hi[0] == 179 and lo[1] == 0 and hi[1] == 255 for lo, hi in ranges):
-        v = cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
+    if is_value_only(line_color):
+        v = image_bgr if image_bgr.ndim == 2 else cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
         k = _kernel_px(image_bgr.shape)
         bh = cv2.morphologyEx(v, cv2.MORPH_BLACKHAT, cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)))
         hist = cv2.calcHist([bh], [0], None, [256], [0, 256]).ravel()
@@ -148,6 +153,7 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
         return mask, bh
     hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
     out = None
+    ranges = resolve_ranges(line_color)
     for lo, hi in ranges:
         m = cv2.inRange(hsv, lo, hi)
         out = m if out is None else cv2.bitwise_or(out, m)
@@ -343,6 +349,11 @@ def _contrast(image: np.ndarray, points: np.ndarray, half_width: float) -> float
     return float(np.linalg.norm(inside - outside))
 
 
+def _value(image: np.ndarray) -> np.ndarray:
+    """V = max(B, G, R) of a colour image; a grey image is its own value."""
+    return image if image.ndim == 2 else image.max(axis=2)
+
+
 def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """Cut the line where it runs into a dark block (a clamp the black-hat mask left out).
 
@@ -353,7 +364,7 @@ def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> t
     y0, x0 = max(cand.y0 - pad, 0), max(cand.x0 - pad, 0)
     y1, x1 = min(cand.y0 + h + pad, image.shape[0]), min(cand.x0 + w + pad, image.shape[1])
     roi = image[y0:y1, x0:x1]
-    v = cv2.blur(roi.max(axis=2), (5, 5))
+    v = cv2.blur(_value(roi), (5, 5))
     dark = (v <= 110).astype(np.uint8)
     radius = int(np.ceil(max(2.5 * cand.half_width, cand.half_width + 3.0)))
     k = 2 * radius + 1
@@ -378,7 +389,7 @@ def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> 
     roi = image[max(y - r, 0) : min(y + r + 1, h), max(x - r, 0) : min(x + r + 1, w)]
     if roi.size == 0:
         return 0.0
-    return float(255.0 - roi.max(axis=2).mean())
+    return float(255.0 - _value(roi).mean())
 
 
 def _bridge(
@@ -453,8 +464,10 @@ def extract_centreline(
     NoLineFound
         If no line-like component of the colour exists.
     """
-    if image_bgr is None or image_bgr.ndim != 3 or image_bgr.shape[2] != 3:
-        raise NoLineFound("unreadable image (not a 3-channel colour image)")
+    if image_bgr is None or not (image_bgr.ndim == 2 or (image_bgr.ndim == 3 and image_bgr.shape[2] == 3)):
+        raise NoLineFound("unreadable image (not a colour or grey image)")
+    if image_bgr.ndim == 2 and not is_value_only(line_color):
+        raise NoLineFound(f"a grey image cannot show line_color={line_color!r}; decode it in colour")
     h, w = image_bgr.shape[:2]
     fe = None
     if fixed_end_px is not None and np.all(np.isfinite(fixed_end_px)):

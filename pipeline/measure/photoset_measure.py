@@ -97,7 +97,8 @@ def measure_photoset(
     if jobs == 1 or len(tasks) <= 1:
         rows = [run_task(t) for t in tasks]
     else:
-        ctx = multiprocessing.get_context("forkserver")
+        # fork: workers start at once (the pool initialiser pins OpenCV to one thread each)
+        ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
         chunk = max(1, len(tasks) // (4 * jobs))
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
             rows = list(pool.map(run_task, tasks, chunksize=chunk))

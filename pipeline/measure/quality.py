@@ -11,6 +11,8 @@ Never a silent wrong number: whatever the estimator returns, a row is ``flagged`
   fit needs degree >= 2 *and* its psi differs from the Hyper circle fit's by more than
   ``NONCONSTANT_DEG``); the ``turning`` and ``auto`` methods measure such lines correctly, so for it this is
   only noted in ``reason`` and the row stays ``ok``;
+- the estimator disagrees with both the arc and the turning fits by more than
+  ``DISAGREE_DEG`` (e.g. the faithful ``paper`` average, biased by pixel noise);
 - the two ends almost touch, or the line closes on itself / branches;
 - the fixed end had to be guessed (``fixed_end: auto``) and no clamp was seen at either end
   -- the sign may be wrong.
@@ -29,6 +31,8 @@ from pipeline.measure.extract import LineExtraction
 LOW_CONTRAST = 45.0
 #: turning-vs-arc difference (deg) beyond which the curvature is called non-constant
 NONCONSTANT_DEG = 1.5
+#: an estimator farther than this from both the arc and the turning fit is flagged (deg)
+DISAGREE_DEG = 5.0
 #: measured / expected length outside [LENGTH_LOW, LENGTH_HIGH] -> flagged
 LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
 
@@ -45,6 +49,7 @@ def assess(
     line: LineExtraction,
     *,
     method: str,
+    psi_deg: float,
     length_px: float,
     expected_length_px: float | None,
     psi_turning_deg: float,
@@ -59,6 +64,8 @@ def assess(
         The extracted line.
     method : str
         Estimator used for psi.
+    psi_deg : float
+        psi from that estimator.
     length_px : float
         Measured line length (original px).
     expected_length_px : float or None
@@ -94,6 +101,9 @@ def assess(
     if turning_degree >= 2 and abs(diff) > NONCONSTANT_DEG:
         text = f"non-constant curvature (turning - arc = {diff:+.1f} deg)"
         (notes if method in ("turning", "auto") else flags).append(text)
+    off = min(abs(psi_deg - psi_arc_deg), abs(psi_deg - psi_turning_deg))
+    if off > DISAGREE_DEG:
+        flags.append(f"{method} differs from the arc and turning fits by {off:.0f} deg")
     if line.branched_fraction > 0.05:
         flags.append("line closes on itself or branches")
     elif line.ends_gap_px < 3.0 * line.width_px + 4.0:

@@ -13,7 +13,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipeline.measure.core import decode_for_work, failed, measure_work_image
+from pipeline.measure.core import decode_for_work, failed, measure_decoded
+from pipeline.measure.extract import is_value_only
 
 
 @dataclass(frozen=True)
@@ -43,12 +44,12 @@ def run_task(task: Task) -> dict[str, Any]:
     try:
         data = np.fromfile(task.path, dtype=np.uint8)
         if data.size:
-            img, f = decode_for_work(data)
+            img, f = decode_for_work(data, grey=is_value_only(task.line_color))
         res = (
             failed(task.method, f"unreadable image: {task.path} cannot be decoded")
             if img is None
-            else measure_work_image(
-                img, scale=float(f), l0_mm=task.l0_mm, mm_per_px=task.mm_per_px, line_color=task.line_color,
+            else measure_decoded(
+                data, img, f, l0_mm=task.l0_mm, mm_per_px=task.mm_per_px, line_color=task.line_color,
                 fixed_end_px=task.fixed_end_px, positive_turn=task.positive_turn, method=task.method,
             )
         )
@@ -61,6 +62,8 @@ def run_task(task: Task) -> dict[str, Any]:
         from pipeline.measure.overlay import draw_overlay
 
         base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
+        if base.ndim == 2:
+            base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
         out = draw_overlay(base, res, scale=float(f) if img is not None else 1.0, title=task.title)
         cv2.imwrite(task.overlay_path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
     return {
