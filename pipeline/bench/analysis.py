@@ -189,7 +189,7 @@ def speed_accuracy(results: pd.DataFrame) -> pd.DataFrame:
     )
     table["n"] = table["n"].astype(int)
     table["pareto"] = False
-    for _, idx in table.groupby("condition", sort=False).groups.items():
+    for idx in table.groupby("condition", sort=False).groups.values():
         sub = table.loc[idx]
         table.loc[idx, "pareto"] = pareto_front(sub["median_ms_per_image"], sub["p95_abs_error_deg"])
     first = table["condition"].eq(NOMINAL)

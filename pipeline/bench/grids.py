@@ -144,10 +144,10 @@ def scene_overrides(knob: str, value: float) -> tuple[tuple[str, object], ...]:
         return ()
     if knob == "line_length_px":
         nominal_px = L0_MM / NOMINAL_MM_PER_PX
-        width = int(round(NOMINAL_WIDTH_PX * value / nominal_px / 4.0)) * 4
+        width = round(NOMINAL_WIDTH_PX * value / nominal_px / 4.0) * 4
         return (("width", width), ("height", width * 3 // 4))
     if knob in ("jpeg_quality", "distractor_marks"):
-        return ((knob, int(round(value))),)
+        return ((knob, round(value)),)
     return ((knob, float(value)),)
 
 
