@@ -171,14 +171,22 @@ def tables_figure(bd: pd.DataFrame, choice: pd.DataFrame, rep: pd.DataFrame) -> 
     if not rep.empty:
         lines.append(rep[["psi_true_deg", "method", "n_seeds", "n_failed", "bias_deg", "sd_deg", "robust_sd_deg"]]
                      .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
-    lines += ["", "Adaptive estimators: share of images given a richer curve model than a",
-              "constant-curvature arc (degree 1), per sweep value (bulge sweep and values where > 0)", ""]
+    lines += ["", "Adaptive estimators: share of images given a richer curve model than a constant-curvature",
+              "arc (degree 1); per condition over all its sweep values, the bulge sweep per value", ""]
     if not choice.empty:
-        keep = choice[(choice["condition"] == "bulge") | (choice["share_richer"] > 0)]
-        lines.append(keep[["method", "condition", "value", "bulge", "n", "degree_counts", "share_richer"]]
-                     .to_string(index=False, float_format=lambda v: f"{v:g}"))
-    fig.text(0.04, 0.97, "\n".join(lines), family="monospace", fontsize=6.5, va="top")
+        lines.append(_choice_table(choice).to_string(float_format=lambda v: f"{v:.2f}"))
+    fig.text(0.04, 0.97, "\n".join(lines), family="monospace", fontsize=7.5, va="top")
     return fig
+
+
+def _choice_table(choice: pd.DataFrame) -> pd.DataFrame:
+    """Share of images given a richer model, rows = condition (bulge: per value), cols = method."""
+    label = np.where(choice["condition"] == "bulge", "bulge " + choice["value"].map("{:g}".format),
+                     choice["condition"])
+    c = choice.assign(row=label, richer=choice["share_richer"] * choice["n"])
+    agg = c.groupby(["row", "method"], sort=False)[["richer", "n"]].sum()
+    share = (agg["richer"] / agg["n"]).unstack("method")
+    return share.reindex(index=list(dict.fromkeys(label)), columns=list(dict.fromkeys(choice["method"])))
 
 
 def save(fig: Figure, stem: Path) -> list[Path]:
