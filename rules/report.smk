@@ -9,6 +9,7 @@ rule report:
         config=f"{RESULTS}/config.resolved.yaml",
         curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS),
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
+        force=FORCE_OUTPUTS,
     output:
         f"{RESULTS}/report.pdf",
     params:
@@ -16,6 +17,7 @@ rule report:
         overlays=per_dataset("{results}/datasets/{dataset}/overlays"),
         names=list(DATASETS),
         bench=lambda wc, input: f"--bench-dir {input.bench}" if input.bench else "",
+        force=f"--force-dir {RESULTS}/force" if FORCE_OUTPUTS else "",
         title=config["report"]["title"],
     log:
         f"{LOGS}/report.log",
@@ -30,7 +32,7 @@ rule report:
     shell:
         "python -m pipeline report --datasets {params.names} --angles {input.angles}"
         " --hysteresis {input.hysteresis} --rms {input.rms} --model-curves {input.curves}"
-        " --photosets {params.photosets} --overlays {params.overlays} {params.bench}"
+        " --photosets {params.photosets} --overlays {params.overlays} {params.bench} {params.force}"
         " --config {input.config} --title '{params.title}' --out {output} > {log} 2>&1"
 
 

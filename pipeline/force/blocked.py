@@ -167,7 +167,7 @@ def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple
 
     from pipeline.measure.extract import line_mask
 
-    mask = (line_mask(image_bgr, line_color) > 0).astype(np.uint8)
+    mask = (line_mask(image_bgr, line_color)[0] > 0).astype(np.uint8)
     if not mask.any():
         return image_bgr, 0
     dt = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
