@@ -19,7 +19,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipeline.measure.estimators import METHODS, CurveEstimate, hyper, turning_quick
+from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, is_value_only
 from pipeline.measure.quality import assess
 
@@ -127,9 +127,14 @@ def measure_work_image(
     sign = 1.0 if positive_turn == "ccw" else -1.0
     try:
         ends = line.trimmed_px
-        est = METHODS[method](pts, rng, ends_px=ends)
-        arc = est if method == "hyper" else hyper(pts, rng, ends_px=ends)
-        trn = est if method == "turning" else turning_quick(pts, rng, ends_px=ends)
+        arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
+        trn = turning_quick(pts, rng, ends_px=ends)
+        if method == "hyper":
+            est = arc
+        elif method == "auto":
+            est = auto_choice(pts, rng, arc, trn, ends_px=ends)
+        else:
+            est = METHODS[method](pts, rng, ends_px=ends)
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     length_px = est.length_px

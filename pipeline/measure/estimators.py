@@ -23,10 +23,10 @@ Methods
     regular at zero curvature (``A -> 0`` is a straight line), unlike Kasa, which over-reads
     curvature on short arcs.  Hyper is unbiased to second order in the noise.
 ``turning``
-    Tangent angle theta(s) against arc length s, a Legendre polynomial of degree 1..9 whose
-    integrated curve is fitted to the centre line, the degree chosen by BIC (constant
-    curvature unless the photo demands more); psi = theta(L) - theta(0).  Right when curvature
-    is not constant.
+    Tangent angle theta(s) against arc length s: a smooth model (cosine series of the
+    curvature, up to 9 terms) whose integrated curve is fitted to the centre line, the number
+    of terms chosen by BIC (constant curvature unless the photo demands more);
+    psi = theta(L) - theta(0).  Right when curvature is not constant.
 ``auto``
     ``hyper``, switching to ``turning`` only when the curvature is visibly not constant.
 
@@ -55,7 +55,7 @@ N_SAMPLES = 100
 NEARBY_FRACTION = 0.02
 #: turning: information criterion choosing the degree ("bic" or "aic")
 CRITERION = "bic"
-#: turning: highest polynomial degree of theta(s) tried
+#: turning: most terms of the curvature series tried (and highest degree of turning_quick)
 MAX_DEGREE = 9
 
 
@@ -338,17 +338,25 @@ def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.nd
     return s_mid, best[1], best[2], best[3]
 
 
-def _shape_model(params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]) -> np.ndarray:
-    """Chunk means of the curve p(s) = p0 + int (cos theta, sin theta) ds, theta Legendre in v.
+def _cosine_theta(u: np.ndarray, coef: np.ndarray) -> np.ndarray:
+    """theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi): curvature psi + sum b_k cos(k pi u)."""
+    theta = coef[0] + coef[1] * u
+    for k, b in enumerate(coef[2:], start=1):
+        theta = theta + b * np.sin(k * np.pi * u) / (k * np.pi)
+    return theta
 
-    ``v`` runs over the whole line, [-1, 1] from the fixed end to the free end; the data (the
+
+def _shape_model(params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]) -> np.ndarray:
+    """Chunk means of the curve p(s) = p0 + stretch * int (cos theta, sin theta) ds.
+
+    ``u`` runs over the whole line, [0, 1] from the fixed end to the free end; the data (the
     ``n`` chunk means, ``q`` fine points each) cover its part ``[ends[0], ends[0] + span]``.
     """
     p0, stretch, coef = params[:2], np.exp(params[2]), params[3:]
     total = span + ends[0] + ends[1]
     ds = span / (n * q)
     s_f = (np.arange(n * q) + 0.5) * ds
-    theta = np.polynomial.legendre.legval(2.0 * (s_f + ends[0]) / total - 1.0, coef)
+    theta = _cosine_theta((s_f + ends[0]) / total, coef)
     step = np.c_[np.cos(theta), np.sin(theta)] * (ds * stretch)
     pos = p0 + np.cumsum(step, axis=0) - 0.5 * step
     return pos.reshape(n, q, 2).mean(axis=1)
@@ -359,17 +367,20 @@ def turning(
     rng: np.random.Generator,
     *,
     ends_px: tuple[float, float] = (0.0, 0.0),
-    max_degree: int = MAX_DEGREE,
+    max_degree: int | None = None,
 ) -> CurveEstimate:
-    """Total turning angle theta(L) - theta(0) from a BIC-chosen smooth model of theta(s).
+    """Total turning angle theta(L) - theta(0) from a BIC-chosen smooth model of the curvature.
 
-    theta(s) is a Legendre polynomial over the whole line; for each degree 1..``max_degree``
+    The curvature along the line is a cosine series, ``kappa(u) = (psi + sum_k b_k cos(k pi u))
+    / L`` with ``u = s / L`` in [0, 1] (a DCT basis: smooth, no polynomial blow-up at the ends),
+    so the tangent angle is ``theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi)`` and
+    ``theta(1) - theta(0) = psi`` exactly, whatever the shape terms.  For K = 0, 1, ... terms
     the curve it defines (integrated tangent, free start point and length scale) is fitted to
-    the centre line's chunk means by Levenberg-Marquardt (:func:`scipy.optimize.least_squares`),
-    started from a linear fit to the chord angles.  The degree with the lowest BIC on the
-    positional residuals wins: degree 1 is a circular arc, higher degrees only when the photo
-    demands them.  Fitting positions (an integral of theta) rather than noisy chord angles keeps
-    the end tangents, and so psi, stable.
+    the centre line's chunk means by Levenberg-Marquardt (:func:`scipy.optimize.least_squares`);
+    the K with the lowest BIC on the positional residuals wins: K = 0 is a circular arc, more
+    terms only when the photo demands them.  Fitting positions (an integral of theta) rather than
+    noisy chord angles, and reading psi as the mean curvature rather than from the end
+    tangents, keeps psi stable.  ``degree`` in the result is K + 1.
     """
     from scipy.optimize import least_squares  # lazy: only this method needs it
 
@@ -381,31 +392,29 @@ def turning(
     total = span + ends_px[0] + ends_px[1]
     d = np.diff(means, axis=0)
     theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
-    s_mid = (np.arange(1, n) * piece) + ends_px[0]
-    v_mid = 2.0 * s_mid / total - 1.0
+    u_mid = ((np.arange(1, n) * piece) + ends_px[0]) / total
+    slope, theta0 = np.polyfit(u_mid, theta, 1)
+    start = means[0] - 0.5 * piece * np.array([np.cos(theta0), np.sin(theta0)])
+    x0 = np.r_[start, 0.0, theta0, slope]
     best: tuple[float, np.ndarray, int, float] | None = None
     worse = 0
-    for deg in range(1, min(max_degree, n - 3) + 1):
-        coef0 = np.polynomial.legendre.legfit(v_mid, theta, deg)
-        th0 = np.polynomial.legendre.legval(2.0 * (ends_px[0] + piece / 2) / total - 1.0, coef0)
-        start = means[0] - 0.5 * piece * np.array([np.cos(th0), np.sin(th0)])
-        x0 = np.r_[start, 0.0, coef0]
+    for k in range(0, min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
         fit = least_squares(
             lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(), x0, method="lm", xtol=1e-10, ftol=1e-10
         )
         rss = float(np.sum(fit.fun**2))
         m = 2 * n
-        bic = m * np.log(max(rss, 1e-300) / m) + (deg + 4) * (np.log(m) if CRITERION == "bic" else 2.0)
+        bic = m * np.log(max(rss, 1e-300) / m) + (k + 5) * (np.log(m) if CRITERION == "bic" else 2.0)
         if best is None or bic < best[0]:
-            best, worse = (bic, fit.x, deg, rss), 0
+            best, worse = (bic, fit.x, k + 1, rss), 0
         else:
             worse += 1
             if worse >= 2:
                 break
+        x0 = np.r_[fit.x, 0.0]
     assert best is not None
     _, params, deg, rss = best
-    coef = params[3:]
-    psi = float(np.polynomial.legendre.legval(1.0, coef) - np.polynomial.legendre.legval(-1.0, coef))
+    psi = float(params[4])
     length = total * float(np.exp(params[2]))
     resid_px = float(np.sqrt(rss / n))
     return CurveEstimate(psi / length, psi, length, resid_px, deg)
@@ -448,6 +457,18 @@ def auto(
     """
     arc = hyper(points, rng, ends_px=ends_px)
     quick = turning_quick(points, rng, ends_px=ends_px)
+    return auto_choice(points, rng, arc, quick, ends_px=ends_px)
+
+
+def auto_choice(
+    points: np.ndarray,
+    rng: np.random.Generator,
+    arc: CurveEstimate,
+    quick: CurveEstimate,
+    *,
+    ends_px: tuple[float, float] = (0.0, 0.0),
+) -> CurveEstimate:
+    """The ``auto`` decision given the Hyper and quick turning estimates already computed."""
     if quick.degree >= 2 and abs(np.rad2deg(quick.kappa_per_px - arc.kappa_per_px) * arc.length_px) > AUTO_SWITCH_DEG:
         return turning(points, rng, ends_px=ends_px)
     return arc

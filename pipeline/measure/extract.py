@@ -334,6 +334,7 @@ def order_pixels(
 
 def _contrast(image: np.ndarray, points: np.ndarray, half_width: float) -> float:
     """Colour distance between the line and the background beside it, sampled across the line."""
+    points = points[:: max(len(points) // 60, 1)]
     d = np.gradient(points, axis=0)
     n = np.c_[-d[:, 1], d[:, 0]] / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)[:, None]
     off = 2.0 * half_width + 3.0

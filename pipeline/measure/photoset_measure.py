@@ -97,8 +97,12 @@ def measure_photoset(
     if jobs == 1 or len(tasks) <= 1:
         rows = [run_task(t) for t in tasks]
     else:
-        # fork: workers start at once (the pool initialiser pins OpenCV to one thread each)
-        ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
+        # forkserver (never plain fork: forking a process that runs OpenCV / BLAS threads can
+        # deadlock); the server preloads the light worker module once, so workers start fast
+        methods = multiprocessing.get_all_start_methods()
+        ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+        if "forkserver" in methods:
+            ctx.set_forkserver_preload(["pipeline.measure.worker"])
         chunk = max(1, len(tasks) // (4 * jobs))
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
             rows = list(pool.map(run_task, tasks, chunksize=chunk))

@@ -32,7 +32,7 @@ LOW_CONTRAST = 45.0
 #: turning-vs-arc difference (deg) beyond which the curvature is called non-constant
 NONCONSTANT_DEG = 1.5
 #: an estimator farther than this from both the arc and the turning fit is flagged (deg)
-DISAGREE_DEG = 5.0
+DISAGREE_DEG = 3.0
 #: measured / expected length outside [LENGTH_LOW, LENGTH_HIGH] -> flagged
 LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
 
