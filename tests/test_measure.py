@@ -95,6 +95,20 @@ def test_sign_follows_positive_turn_and_mirroring() -> None:
     assert res.psi_deg == pytest.approx(-120.0, abs=0.5)
 
 
+def test_coloured_line_from_file(tmp_path: Path) -> None:
+    from pipeline.measure import measure_file
+
+    scene = scene_from("lab", line_color="blue")
+    r = render_actuator(-170.0, L0_MM, scene, seed=21)
+    path = tmp_path / "blue.jpg"
+    path.write_bytes(r.jpeg_bytes)
+    res, seconds = measure_file(path, l0_mm=L0_MM, mm_per_px=scene.mm_per_px, line_color="blue", fixed_end_px=r.fixed_end_px)
+    assert res.status == "ok" and res.psi_deg == pytest.approx(-170.0, abs=0.5) and seconds > 0
+    black, _ = measure_file(path, l0_mm=L0_MM, mm_per_px=scene.mm_per_px, line_color="black", fixed_end_px=r.fixed_end_px)
+    # the wrong colour may find something else, but never reports it as a silent "ok"
+    assert not (black.status == "ok" and abs(black.psi_deg + 170.0) > 5.0)
+
+
 def test_without_scale_psi_is_the_total_turning_angle() -> None:
     scene = scene_from("lab")
     r = render_actuator(-230.0, L0_MM, scene, seed=8)
@@ -120,8 +134,9 @@ def test_bulged_actuator_turning_and_auto_vs_arc() -> None:
     trn = _measure(r, scene, method="turning")
     assert arc.status == "flagged" and "non-constant curvature" in arc.reason
     assert abs(arc.psi_deg + 150.0) > 10.0
-    assert trn.psi_deg == pytest.approx(-150.0, abs=1.5)
+    assert trn.psi_deg == pytest.approx(-150.0, abs=1.0)
     assert trn.status == "ok"
+    assert _measure(r, scene, method="auto").psi_deg == pytest.approx(trn.psi_deg)
 
 
 def test_centreline_matches_truth_and_starts_at_fixed_end() -> None:

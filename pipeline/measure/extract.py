@@ -28,7 +28,7 @@ from typing import Any
 import cv2
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import breadth_first_order, dijkstra
 
 
 #: components shorter than this (work px) are never the marker line
@@ -204,8 +204,15 @@ def _candidates(mask: np.ndarray, fixed_xy: tuple[float, float] | None, max_cand
         if fixed_xy is not None:
             pts = c.reshape(-1, 2).astype(float)
             dist = float(np.sqrt(np.min((pts[:, 0] - fixed_xy[0]) ** 2 + (pts[:, 1] - fixed_xy[1]) ** 2)))
-        out.append(_Candidate(x0, y0, sub, _ridge_half_width(sub), float(length), dist))
+        out.append(_Candidate(x0, y0, sub, float("nan"), float(length), dist))
     return out
+
+
+def _with_width(c: _Candidate) -> _Candidate:
+    """The candidate with its line half-width measured (distance transform; only when needed)."""
+    if np.isfinite(c.half_width):
+        return c
+    return _Candidate(c.x0, c.y0, c.sub, _ridge_half_width(c.sub), c.length, c.dist_fixed)
 
 
 def _choose(cands: list[_Candidate], near_px: float) -> tuple[_Candidate, bool]:
@@ -301,9 +308,7 @@ def order_pixels(
     ys, xs = np.nonzero(sub)
     graph = _pixel_graph(ys, xs, sub.shape)
     seed = 0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
-    d0 = dijkstra(graph, directed=False, indices=seed)
-    d0[~np.isfinite(d0)] = -1.0
-    a = int(np.argmax(d0))  # the far (free) end
+    a = int(breadth_first_order(graph, seed, directed=False, return_predecessors=False)[-1])  # the far (free) end
     da = dijkstra(graph, directed=False, indices=a)
     reach = np.isfinite(da)
     if start_xy is not None:
@@ -482,6 +487,8 @@ def extract_centreline(
     diag = float(np.hypot(h, w))
     best, at_fixed = _choose(cands, near_px=0.03 * diag)
     others = [c for c in cands if c is not best]
+    best = _with_width(best)
+    others = [_with_width(c) if c.length >= RIVAL_FRACTION * best.length else c for c in others]
     rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
     line, thick = _cut_thick_parts(best.sub, best.half_width)
     if fe is None and thick is None:
