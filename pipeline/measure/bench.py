@@ -38,6 +38,8 @@ from pipeline.measure.extract import _candidates, _choose, line_mask
 from pipeline.synth import render_actuator, scene_from
 
 L0_MM = 180.0
+#: the --jobs scaling set lists every rendered photo this many times (as separate trials)
+COPIES = 4
 
 
 def _profile_curve(psi_deg: float, kind: str, n: int = 20001) -> np.ndarray:
@@ -155,9 +157,13 @@ def scaling(n: int, seed: int, workdir: Path) -> dict[str, float]:
     for i, psi in enumerate(np.linspace(210, -220, n)):
         r = render_actuator(float(psi), L0_MM, scene, seed=seed + i)
         (folder / f"p{i:03d}.jpg").write_bytes(r.jpeg_bytes)
-        rows.append({"image": f"p{i:03d}.jpg", "pressure_kpa": float(i), "direction": "up", "material": "DS20",
-                     "actuator": "A1", "trial": "1", "step": i,
-                     "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+        for trial in range(COPIES):  # more photos without more rendering: hard links, new names
+            name = f"p{i:03d}.jpg" if trial == 0 else f"p{i:03d}_t{trial}.jpg"
+            if trial:
+                (folder / name).hardlink_to(folder / f"p{i:03d}.jpg")
+            rows.append({"image": name, "pressure_kpa": float(i), "direction": "up", "material": "DS20",
+                         "actuator": "A1", "trial": str(trial + 1), "step": i,
+                         "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
     write_manifest(folder, pd.DataFrame(rows))
     write_settings(folder, {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px})
     out = {}
@@ -198,7 +204,7 @@ def main(argv: list[str] | None = None) -> int:
         })
         print(tab.to_string(float_format=lambda v: f"{v:.3f}"))
         sc = scaling(args.n_set, args.seed, Path(tmp))
-        print(f"\n== measure_photoset on {args.n_set} lab photos (4000x3000 JPEG): "
+        print(f"\n== measure_photoset on {COPIES * args.n_set} lab photos (4000x3000 JPEG): "
               + ", ".join(f"{k}: {v:.2f} s" for k, v in sc.items())
               + f", speed-up {sc['jobs=1'] / sc['jobs=2']:.2f}x")
     print(f"\n(bench took {time.perf_counter() - t0:.0f} s)")

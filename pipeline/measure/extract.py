@@ -28,7 +28,7 @@ from typing import Any
 import cv2
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import breadth_first_order, dijkstra
+from scipy.sparse.csgraph import dijkstra
 
 
 #: components shorter than this (work px) are never the marker line
@@ -308,7 +308,9 @@ def order_pixels(
     ys, xs = np.nonzero(sub)
     graph = _pixel_graph(ys, xs, sub.shape)
     seed = 0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
-    a = int(breadth_first_order(graph, seed, directed=False, return_predecessors=False)[-1])  # the far (free) end
+    d0 = dijkstra(graph, directed=False, indices=seed)
+    d0[~np.isfinite(d0)] = -1.0
+    a = int(np.argmax(d0))  # the far (free) end
     da = dijkstra(graph, directed=False, indices=a)
     reach = np.isfinite(da)
     if start_xy is not None:
