@@ -136,7 +136,10 @@ def test_bulged_actuator_turning_and_auto_vs_arc() -> None:
     assert abs(arc.psi_deg + 150.0) > 10.0
     assert trn.psi_deg == pytest.approx(-150.0, abs=1.0)
     assert trn.status == "ok"
-    assert _measure(r, scene, method="auto").psi_deg == pytest.approx(trn.psi_deg)
+    auto_res = _measure(r, scene, method="auto")
+    assert auto_res.psi_deg == pytest.approx(trn.psi_deg)
+    # the model each used: an arc for hyper, the richer series the photo demanded for the others
+    assert arc.degree == 1 and trn.degree >= 2 and auto_res.degree == trn.degree
 
 
 def test_centreline_matches_truth_and_starts_at_fixed_end() -> None:
@@ -233,8 +236,11 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:9]) == ["image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason", "seconds"]
-    assert list(par.columns[9:15]) == ["pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    assert list(par.columns[:10]) == ["image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px",
+                                      "status", "reason", "seconds", "degree"]
+    assert list(par.columns[10:16]) == ["pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    # constant curvature: auto stays with the arc; the failed row has no degree
+    assert (par["degree"][:6] == 1).all() and pd.isna(par["degree"].iloc[-1])
     assert "measured_pressure_kpa" in par.columns and "fixed_end_x" not in par.columns
     assert list(par["image"]) == [f"p{i:02d}.jpg" for i in range(6)] + ["broken.jpg"]
     np.testing.assert_allclose(par["psi_deg"][:6], truth, atol=0.6)
@@ -253,6 +259,8 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "6 ok" in run.stdout and "1 failed" in run.stdout
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
+    assert list(angles.columns[8:11]) == ["seconds", "degree", "pressure_kpa"]
+    assert (angles["degree"][:6] >= 1).all() and np.isnan(angles["degree"].iloc[-1])
     np.testing.assert_allclose(angles["psi_deg"][:6], truth, atol=1.0)
     assert np.isnan(angles["psi_deg"].iloc[-1])
     bad = subprocess.run([sys.executable, "-m", "pipeline", "measure", str(tmp_path / "nope"), "--out", str(out)],

@@ -8,10 +8,8 @@ decoded image (each call timed: ``seconds``).  The order of the methods rotates 
 to the next so that no method always runs first on a cold cache.  Workers run single-threaded
 OpenCV (``cv2.setNumThreads(1)``), so ``--jobs N`` uses N cores and times are per core.
 
-The adaptive estimators' chosen model (``turning`` and ``auto``: polynomial degree of the
-tangent angle against arc length; 1 = constant curvature) is not part of ``AngleResult``; it is
-recovered outside the timed call by :func:`chosen_degree`, which repeats ``measure_image``'s
-steps (identical input, hence the identical choice).
+The adaptive estimators' chosen model (``turning`` and ``auto``: complexity of the curve model,
+1 = constant curvature) is read from ``AngleResult.degree`` by :func:`chosen_degree`.
 """
 
 from __future__ import annotations
@@ -45,36 +43,20 @@ def _init_worker() -> None:
 ADAPTIVE_METHODS: tuple[str, ...] = ("turning", "auto")
 
 
-def chosen_degree(image_bgr: np.ndarray, method: str, *, line_color: Any = "black",
-                  fixed_end_px: tuple[float, float] | None = None) -> float:
-    """Curve-model degree an estimator chooses on a photo (1 = constant curvature).
+def chosen_degree(res: Any) -> float:
+    """Curve-model degree an estimator chose on a photo (1 = constant curvature).
 
-    ``AngleResult`` does not carry the degree, so this repeats the steps of
-    :func:`pipeline.measure.measure_image` (same reduction, same centre-line extraction, same
-    seed and trimmed ends) and returns ``CurveEstimate.degree`` of ``METHODS[method]``.
+    Parameters
+    ----------
+    res : pipeline.measure.AngleResult
+        The measurement.
 
     Returns
     -------
     float
-        The degree, NaN when no line is found or the fit fails.
+        ``res.degree``; NaN when the measurement failed.
     """
-    import cv2
-
-    from pipeline.measure.core import SEED, WORK_WIDTH_PX, reduction_for
-    from pipeline.measure.estimators import METHODS as ESTIMATORS
-    from pipeline.measure.extract import NoLineFound, extract_centreline
-
-    f = reduction_for(image_bgr.shape[1], WORK_WIDTH_PX)
-    work = image_bgr
-    if f > 1:
-        work = cv2.resize(image_bgr, (image_bgr.shape[1] // f, image_bgr.shape[0] // f), interpolation=cv2.INTER_AREA)
-    try:
-        line = extract_centreline(work, line_color=line_color, fixed_end_px=fixed_end_px, scale=float(f))
-        pts = line.centreline_px * np.array([1.0, -1.0])
-        est = ESTIMATORS[method](pts, np.random.default_rng(SEED), ends_px=line.trimmed_px)
-    except (NoLineFound, ValueError, np.linalg.LinAlgError):
-        return float("nan")
-    return float(est.degree)
+    return float("nan") if res.status == "failed" else float(res.degree)
 
 
 def measure_case(case: Case, methods: Sequence[str]) -> list[dict[str, Any]]:
@@ -114,9 +96,7 @@ def measure_case(case: Case, methods: Sequence[str]) -> list[dict[str, Any]]:
             fixed_end_px=rendered.fixed_end_px, positive_turn="ccw", method=method,
         )
         seconds = time.perf_counter() - t
-        degree = getattr(res, "degree", None)
-        if degree is None and method in ADAPTIVE_METHODS and res.status != "failed":
-            degree = chosen_degree(image, method, line_color=scene.line_color, fixed_end_px=rendered.fixed_end_px)
+        degree = chosen_degree(res) if method in ADAPTIVE_METHODS else None
         err = res.psi_deg - case.psi_deg
         out[method] = {
             "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,

@@ -57,6 +57,10 @@ class AngleResult:
         Centre line (x right, y down, original px), fixed end first; empty when failed.
     line_width_px : float
         Width of the extracted line (original px); NaN when failed.
+    degree : int
+        Complexity of the curve model the estimator used: 1 for a circular arc (constant
+        curvature, also the ``paper`` averages), higher for the turning-angle series actually
+        chosen (``turning``, and ``auto`` when it switched to it); 0 when failed.
     """
 
     psi_deg: float
@@ -68,6 +72,7 @@ class AngleResult:
     reason: str
     centreline_px: np.ndarray
     line_width_px: float = float("nan")
+    degree: int = 0
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -159,6 +164,7 @@ def measure_work_image(
         reason=quality.reason,
         centreline_px=line.centreline_px,
         line_width_px=line.width_px,
+        degree=int(est.degree),
     )
 
 

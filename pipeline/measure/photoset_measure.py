@@ -24,8 +24,11 @@ from pipeline.measure.worker import Task, init_worker, run_task
 from pipeline.photoset import OVERRIDE_COLUMNS, atomic_write_bytes, load_photoset
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
+#: (``degree``: curve-model complexity the estimator used, see :class:`~pipeline.measure.AngleResult`;
+#: empty on failed rows)
 RESULT_COLUMNS: tuple[str, ...] = (
     "image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason", "seconds",
+    "degree",
 )
 #: manifest columns carried over first (when present), then any others
 CARRIED_FIRST: tuple[str, ...] = ("pressure_kpa", "direction", "material", "actuator", "trial", "step")
@@ -107,6 +110,7 @@ def measure_photoset(
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
             rows = list(pool.map(run_task, tasks, chunksize=chunk))
     result = pd.DataFrame(rows, index=manifest.index)
+    result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]

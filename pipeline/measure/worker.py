@@ -75,4 +75,5 @@ def run_task(task: Task) -> dict[str, Any]:
         "status": res.status,
         "reason": res.reason,
         "seconds": seconds,
+        "degree": res.degree if res.status != "failed" else None,
     }
