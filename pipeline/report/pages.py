@@ -166,8 +166,8 @@ def overview_page(data: ReportData) -> Figure:
         plot_hysteresis(ax, data, m, colors[m], legend=(m == materials[0]))
     for ax in list(axes.flat)[len(materials):]:
         ax.set_axis_off()
-    fig.supxlabel("Shaded: mean ± 1 standard deviation over actuators and trials; darker = increasing, "
-                  "lighter = decreasing pressure; dashed: analytical model (loading branch).", fontsize=7.5)
+    fig.supxlabel("Shaded: mean ± 1 standard deviation over actuators and trials; darker = increasing,\n"
+                  "lighter = decreasing pressure; dashed: analytical model (loading branch).\n", fontsize=7.5)
     return fig
 
 
