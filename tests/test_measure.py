@@ -83,6 +83,31 @@ def test_lab_photos_accurate(psi: float) -> None:
     assert res.length_mm == pytest.approx(L0_MM, rel=0.03)
 
 
+@pytest.mark.parametrize("psi", [-250.0, -1.2, 0.6, 140.0])
+def test_grey_decode_coarse_extraction_refined(psi: float) -> None:
+    """The photo-set path: grey decode, extraction on a halved copy, centre line refined."""
+    from pipeline.measure.core import COARSE_WIDTH_PX, _reduce
+    from pipeline.measure.extract import extract_centreline
+    from pipeline.measure.refine import refine_centreline
+    from scipy.spatial import cKDTree
+
+    scene = scene_from("lab")
+    r = render_actuator(psi, L0_MM, scene, seed=int(abs(psi) * 10) + 40)
+    data = np.frombuffer(r.jpeg_bytes, np.uint8)
+    img, f = decode_for_work(data, grey=True)
+    assert img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX  # the coarse path applies
+    res = measure_decoded(data, img, f, l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end_px=r.fixed_end_px)
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=0.5 if abs(psi) > 3 else 0.3)
+    assert res.degree == 1
+    # the refinement brings the coarse centre line much closer to the true one
+    line = extract_centreline(_reduce(img, 2), fixed_end_px=r.fixed_end_px, scale=2.0 * f)
+    fine = refine_centreline(img, line.centreline_px, scale=float(f), half_width_px=0.5 * line.width_px)
+    tree = cKDTree(r.centreline_px)
+    before, after = np.median(tree.query(line.centreline_px)[0]), np.median(tree.query(fine)[0])
+    assert after < 0.6 * before and after < 0.5
+
+
 def test_sign_follows_positive_turn_and_mirroring() -> None:
     scene = scene_from("clean")
     r = render_actuator(120.0, L0_MM, scene, seed=5)

@@ -12,7 +12,7 @@ measured line (mean curvature x measured length).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, is_value_only
 from pipeline.measure.quality import assess
+from pipeline.measure.refine import refine_centreline
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
@@ -29,6 +30,11 @@ DEFAULT_METHOD = "auto"
 WORK_WIDTH_PX = 640
 #: re-decode at twice the resolution when the line is thinner than this in the work image (px)
 MIN_WORK_LINE_WIDTH_PX = 2.5
+#: grey photos: the extraction runs on a further halved copy when that is at least this wide (px);
+#: the centre line is then refined on the decoded image (:mod:`pipeline.measure.refine`)
+COARSE_WIDTH_PX = 320
+#: ... provided the line is at least this wide there (coarse px); else the decoded image is used
+MIN_COARSE_LINE_WIDTH_PX = 1.2
 #: seed of the random places of the ``paper`` estimators (deterministic output)
 SEED = 20240
 
@@ -111,11 +117,15 @@ def measure_work_image(
     fixed_end_px: tuple[float, float] | None = None,
     positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
+    fine: np.ndarray | None = None,
+    fine_scale: float = 1.0,
 ) -> AngleResult:
     """Measure an image already reduced by ``scale`` (original px per work px).
 
     Same parameters and result as :func:`measure_image`; used by :func:`measure_file`, which
-    decodes JPEGs directly at reduced size.
+    decodes JPEGs directly at reduced size.  With ``fine`` (a grey image reduced by
+    ``fine_scale`` < ``scale``) the centre line extracted from ``image_bgr`` is refined on it
+    before the curvature fit.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
@@ -127,6 +137,9 @@ def measure_work_image(
         line: LineExtraction = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px, scale=scale)
     except NoLineFound as exc:
         return failed(method, str(exc))
+    if fine is not None:
+        refined = refine_centreline(fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px)
+        line = replace(line, centreline_px=refined)
     pts = line.centreline_px * np.array([1.0, -1.0])  # y-up: on-screen ccw is positive
     rng = np.random.default_rng(SEED)
     sign = 1.0 if positive_turn == "ccw" else -1.0
@@ -144,6 +157,8 @@ def measure_work_image(
         return failed(method, f"curvature fit failed: {exc}")
     length_px = est.length_px
     psi = _psi_from(est, sign, l0_mm, mm_per_px, length_px)
+    if method in ("turning", "auto") and est is not arc:
+        trn = est  # the full turning fit was run: it, not its quick linear proxy, is the check
     quality = assess(
         line,
         method=method,
@@ -354,6 +369,11 @@ def measure_decoded(data: np.ndarray, img: np.ndarray, factor: int, **kw: Any) -
     reduced, it is decoded again at twice the resolution: thin lines cost a second decode, the
     usual photo only one small one.
     """
+    if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
+        coarse = _reduce(img, 2)
+        res = measure_work_image(coarse, scale=2.0 * factor, fine=img, fine_scale=float(factor), **kw)
+        if res.status != "failed" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
+            return res
     res = measure_work_image(img, scale=float(factor), **kw)
     while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
         factor //= 2

@@ -276,7 +276,8 @@ def _pixel_graph(ys: np.ndarray, xs: np.ndarray, shape: tuple[int, int]) -> csr_
         cols.append(nb[ok])
         wts.append(np.full(int(ok.sum()), wt))
     r, c, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(wts)
-    return csr_matrix((v, (r, c)), shape=(len(ys), len(ys)))
+    # both directions stored: the graph is searched as directed (no transpose per search)
+    return csr_matrix((np.r_[v, v], (np.r_[r, c], np.r_[c, r])), shape=(len(ys), len(ys)))
 
 
 def order_pixels(
@@ -308,10 +309,10 @@ def order_pixels(
     ys, xs = np.nonzero(sub)
     graph = _pixel_graph(ys, xs, sub.shape)
     seed = 0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
-    d0 = dijkstra(graph, directed=False, indices=seed)
+    d0 = dijkstra(graph, directed=True, indices=seed)
     d0[~np.isfinite(d0)] = -1.0
     a = int(np.argmax(d0))  # the far (free) end
-    da = dijkstra(graph, directed=False, indices=a)
+    da = dijkstra(graph, directed=True, indices=a)
     reach = np.isfinite(da)
     if start_xy is not None:
         # the line ends at the fixed end: drop what lies beyond it (clamp outline, tube edge)
