@@ -157,8 +157,12 @@ def measure_work_image(
         return failed(method, f"curvature fit failed: {exc}")
     length_px = est.length_px
     psi = _psi_from(est, sign, l0_mm, mm_per_px, length_px)
-    if method in ("turning", "auto") and est is not arc:
-        trn = est  # the full turning fit was run: it, not its quick linear proxy, is the check
+    if method in ("turning", "auto") and est is not arc and np.isfinite(est.neighbour_turning_rad):
+        # the full turning fit was run: its quick linear proxy is too crude a check (it
+        # extrapolates a polynomial to the ends); the fit with one term more or less is the check
+        trn = CurveEstimate(
+            est.neighbour_turning_rad / est.length_px, est.neighbour_turning_rad, est.length_px, est.residual_px, est.degree
+        )
     quality = assess(
         line,
         method=method,

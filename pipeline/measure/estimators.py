@@ -75,6 +75,9 @@ class CurveEstimate:
         RMS distance of the points from the fitted model (px); NaN when the method has none.
     degree : int
         Model complexity used (1 for a circle / constant curvature).
+    neighbour_turning_rad : float
+        :func:`turning` only: the turning angle of the fit with one term more (one less when the
+        most terms were chosen), a stability check; NaN otherwise.
     """
 
     kappa_per_px: float
@@ -82,6 +85,7 @@ class CurveEstimate:
     length_px: float
     residual_px: float
     degree: int = 1
+    neighbour_turning_rad: float = float("nan")
 
 
 class Estimator(Protocol):
@@ -327,15 +331,14 @@ def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.nd
     q, r = np.linalg.qr(vand)
     proj = q.T @ (theta * wt)
     total = float(np.sum((theta * wt) ** 2))
-    best: tuple[float, np.ndarray, int, float] | None = None
-    for deg in range(1, top + 1):
-        rss = max(total - float(np.sum(proj[: deg + 1] ** 2)), 1e-300)
-        bic = n * np.log(rss / n) + (deg + 1) * np.log(n)
-        if best is None or bic < best[0]:
-            coef = np.linalg.solve(r[: deg + 1, : deg + 1], proj[: deg + 1])
-            best = (bic, coef, deg, rss)
-    assert best is not None
-    return s_mid, best[1], best[2], best[3]
+    # RSS of degree d = total - sum of the first d + 1 squared projections (nested fits)
+    degs = np.arange(1, top + 1)
+    rss = np.maximum(total - np.cumsum(proj**2)[1 : top + 1], 1e-300)
+    bic = n * np.log(rss / n) + (degs + 1) * np.log(n)
+    k = int(np.argmin(bic))  # first minimum: the simplest of equally good degrees
+    deg = int(degs[k])
+    coef = linalg.solve_triangular(r[: deg + 1, : deg + 1], proj[: deg + 1])
+    return s_mid, coef, deg, float(rss[k])
 
 
 def _cosine_theta(u: np.ndarray, coef: np.ndarray) -> np.ndarray:
@@ -397,12 +400,14 @@ def turning(
     start = means[0] - 0.5 * piece * np.array([np.cos(theta0), np.sin(theta0)])
     x0 = np.r_[start, 0.0, theta0, slope]
     best: tuple[float, np.ndarray, int, float] | None = None
+    psi_of: dict[int, float] = {}
     worse = 0
     for k in range(0, min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
         fit = least_squares(
             lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(), x0, method="lm", xtol=1e-10, ftol=1e-10
         )
         rss = float(np.sum(fit.fun**2))
+        psi_of[k + 1] = float(fit.x[4])
         m = 2 * n
         bic = m * np.log(max(rss, 1e-300) / m) + (k + 5) * (np.log(m) if CRITERION == "bic" else 2.0)
         if best is None or bic < best[0]:
@@ -417,7 +422,9 @@ def turning(
     psi = float(params[4])
     length = total * float(np.exp(params[2]))
     resid_px = float(np.sqrt(rss / n))
-    return CurveEstimate(psi / length, psi, length, resid_px, deg)
+    # one term more (one less when the cap stopped the search): psi should barely move
+    neighbour = psi_of.get(deg + 1, psi_of.get(deg - 1, float("nan")))
+    return CurveEstimate(psi / length, psi, length, resid_px, deg, neighbour)
 
 
 def turning_quick(

@@ -262,22 +262,21 @@ def _cut_thick_parts(sub: np.ndarray, half_width: float) -> tuple[np.ndarray, np
 # ordering
 
 
-_STEPS = ((0, 1, 1.0), (1, 0, 1.0), (1, 1, np.sqrt(2.0)), (1, -1, np.sqrt(2.0)))
+#: the 8 neighbours (dy, dx) and their distances
+_NEIGHBOURS = np.array([(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)])
+_NEIGHBOUR_PX = np.hypot(_NEIGHBOURS[:, 0], _NEIGHBOURS[:, 1])
 
 
 def _pixel_graph(ys: np.ndarray, xs: np.ndarray, shape: tuple[int, int]) -> csr_matrix:
-    idx = np.full((shape[0] + 2, shape[1] + 2), -1, np.int64)
-    idx[ys + 1, xs + 1] = np.arange(len(ys))
-    rows, cols, wts = [], [], []
-    for dy, dx, wt in _STEPS:
-        nb = idx[ys + 1 + dy, xs + 1 + dx]
-        ok = nb >= 0
-        rows.append(np.nonzero(ok)[0])
-        cols.append(nb[ok])
-        wts.append(np.full(int(ok.sum()), wt))
-    r, c, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(wts)
-    # both directions stored: the graph is searched as directed (no transpose per search)
-    return csr_matrix((np.r_[v, v], (np.r_[r, c], np.r_[c, r])), shape=(len(ys), len(ys)))
+    """8-neighbour graph of the pixels ``(ys, xs)``, both directions stored, built as CSR directly."""
+    idx = np.full((shape[0] + 2, shape[1] + 2), -1, np.int32)
+    idx[ys + 1, xs + 1] = np.arange(len(ys), dtype=np.int32)
+    nb = idx[ys[:, None] + 1 + _NEIGHBOURS[:, 0], xs[:, None] + 1 + _NEIGHBOURS[:, 1]]  # (n, 8)
+    ok = nb >= 0
+    indptr = np.zeros(len(ys) + 1, np.int32)
+    np.cumsum(ok.sum(axis=1), out=indptr[1:])
+    data = np.broadcast_to(_NEIGHBOUR_PX, nb.shape)[ok]
+    return csr_matrix((data, nb[ok], indptr), shape=(len(ys), len(ys)))
 
 
 def order_pixels(
