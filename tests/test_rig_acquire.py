@@ -295,6 +295,11 @@ def test_synthetic_camera_virtual_rig(tmp_path):
     top = cv2.imread(str(out / ps.manifest["image"].iloc[3]))
     assert first is not None and top is not None and first.shape == top.shape
     assert np.mean(np.abs(first.astype(int) - top.astype(int))) > 1  # the actuator moved
+    # the virtual camera frames the whole line at every step (it zooms out for a long actuator)
+    from pipeline.measure import measure_photoset
+
+    angles = measure_photoset(out)
+    assert (angles["status"] == "ok").all(), angles[["image", "status", "reason"]]
 
 
 def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):

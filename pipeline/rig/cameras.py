@@ -21,6 +21,8 @@ under; the session writes them atomically.
 
 from __future__ import annotations
 
+import dataclasses
+
 import hashlib
 import os
 import shlex
@@ -246,7 +248,14 @@ class SyntheticCamera:
             curves = [synth_blocked.blocked_arc_mm(float(e), self.l0_mm).points_mm for e in (0.0, 0.45, 0.9)]
         else:
             curves = [synth.centreline_mm(float(p), self.l0_mm, n=400) for p in np.linspace(-psi_frame_deg, psi_frame_deg, 17)]
-        camera = synth.make_camera(self.scene, rotation_deg=0.0, extent_mm=np.vstack(curves))
+        # zoom out just enough (as render_photoset does) and turn the clamp so every shape fits
+        from pipeline.synth.photoset_writer import choose_layout
+
+        rotation_deg, _, need = choose_layout(curves, self.scene)
+        if need > 1.0:
+            mm_per_px = float(np.ceil(self.scene.mm_per_px * need * 1000) / 1000)
+            self.scene = dataclasses.replace(self.scene, mm_per_px=mm_per_px)
+        camera = synth.make_camera(self.scene, rotation_deg=rotation_deg, extent_mm=np.vstack(curves))
         self.backdrop = synth.make_backdrop(self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=curves)
         probe = synth.render_actuator(0.0, self.l0_mm, self.scene, seed=0, backdrop=self.backdrop, n=400)
         self._fixed_end = (float(probe.fixed_end_px[0]), float(probe.fixed_end_px[1]))
