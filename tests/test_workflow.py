@@ -138,3 +138,26 @@ def test_slurm_profile_plans_the_workflow(repo, tmp_path):
     )
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     assert _planned_jobs(out.stdout)["measure"] == 5
+
+
+def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, repo):
+    """A `rig` dataset: Snakemake runs `acquire` against the pty emulator, photos land outside results/."""
+    from pipeline.rig.emulator import Emulator
+
+    with Emulator(seed=4) as emu:
+        cfg = {
+            "datasets": [
+                {"name": "rigA1", "source": "rig", "path": "data/rigA1", "port": emu.port, "camera": "synthetic",
+                 "material": "SS50", "actuator": "A1", "trials": 1, "step_kpa": 100, "max_kpa": 200,
+                 "settle_s": 0, "l0_mm": 270},
+            ],
+            "bench": {"in_report": False},
+        }
+        (tmp_path / "config.yaml").write_text(yaml.safe_dump(cfg))
+        out = _snakemake(tmp_path, repo, "--cores", "1", "results/datasets/rigA1/hysteresis.csv")
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    photos = sorted((tmp_path / "data" / "rigA1").glob("*.jpg"))
+    assert len(photos) == 5  # 0, 100, 200 kPa up; 100, 0 down
+    angles = pd.read_csv(tmp_path / "results" / "datasets" / "rigA1" / "angles.csv")
+    assert (angles["status"] == "ok").all()
+    assert angles["psi_deg"].iloc[0] > angles["psi_deg"].iloc[2]  # pressure uncurls it
