@@ -90,10 +90,11 @@ def test_lab_photos_accurate(psi: float) -> None:
 @pytest.mark.parametrize("psi", [-250.0, -1.2, 0.6, 140.0])
 def test_grey_decode_coarse_extraction_refined(psi: float) -> None:
     """The photo-set path: grey decode, extraction on a halved copy, centre line refined."""
+    from scipy.spatial import cKDTree
+
     from pipeline.measure.core import COARSE_WIDTH_PX, _reduce
     from pipeline.measure.extract import extract_centreline
     from pipeline.measure.refine import refine_centreline
-    from scipy.spatial import cKDTree
 
     scene = scene_from("lab")
     r = render_actuator(psi, L0_MM, scene, seed=int(abs(psi) * 10) + 40)

@@ -16,6 +16,14 @@ positive_turn="ccw", method=DEFAULT_METHOD) -> AngleResult``
 Pipeline: :mod:`~pipeline.measure.extract` (mask, components, clamp cut, geodesic ordering,
 sub-pixel centre line) -> :mod:`~pipeline.measure.estimators` -> :mod:`~pipeline.measure.quality`
 (``ok`` / ``flagged`` / ``failed`` with reasons) -> :mod:`~pipeline.measure.overlay`.
+``AngleResult.degree`` (angles.csv column ``degree``, after ``seconds``) is the complexity of the
+curve model used: 1 = circular arc, more = the turning-angle series ``turning`` / ``auto`` chose.
+
+Files (``measure_file``, ``measure_photoset``) with a black line are decoded in grey at reduced
+size; the extraction runs on a further halved copy and the centre line is refined on the decoded
+image (:mod:`~pipeline.measure.refine`: darkness-profile centroids across the line), which
+costs a third of the work and is as precise; a result that is not ``ok`` there is measured again
+at the decoded size.  ``measure_image`` on a colour array uses the decoded-size path only.
 
 Default method: ``auto``
 ------------------------
@@ -27,17 +35,17 @@ uneven light, distractor marks, clamp, tube, tilt 0-3 deg; |error| in deg):
 ==================  ===========================  ===========================
 case                hyper (median / p95 / max)   turning (median / p95 / max)
 ==================  ===========================  ===========================
-nominal, n=60       0.075 / 0.37 / 0.59          0.081 / 0.42 / 0.60
-near straight, 30   0.048 / 0.11 / 0.12          0.059 / 0.39 / 0.69
-bulged, 30          18.6 / 53 / 71               0.16 / 0.30 / 0.33
-other profiles, 30  11.4 / 35 / 44               1.0 / 1.7 / 2.3
+nominal, n=60       0.086 / 0.36 / 0.65          0.100 / 0.44 / 0.54
+near straight, 30   0.021 / 0.070 / 0.091        0.035 / 0.42 / 0.56
+bulged, 30          18.6 / 53 / 71               0.13 / 0.48 / 0.78
+other profiles, 30  11.4 / 35 / 44               0.35 / 0.95 / 0.98
 ==================  ===========================  ===========================
 
 ``auto`` equals Hyper on constant curvature (it is the most precise there, notably near
 straight) and equals ``turning`` on non-constant curvature (where every arc fit is tens of
 degrees off), so it is best or tied-best in every case; it costs one extra linear fit per photo.
-The paper's own estimator (``paper``) reads 36-96 deg off (a straight line never reads 0);
-``paper_corrected`` removes that bias.
+The paper's own estimator (``paper``) reads 36-96 deg off on nominal / near-straight photos (a
+straight line never reads 0); ``paper_corrected`` removes that bias.
 """
 
 from pipeline.measure.core import DEFAULT_METHOD, AngleResult, measure_file, measure_image

@@ -14,7 +14,8 @@ Accuracy, on synthetic photos with exact ground truth (:mod:`pipeline.synth`):
   count of ``ok`` rows wrong by more than 5 deg.
 
 Speed, per image, single OpenCV thread (as in the pool workers): the whole measurement from the
-file (read, decode once at reduced size, extract, fit) against ``cv2.imread`` alone on the same
+file (read, decode once at reduced size in grey, extract on a halved copy, refine the centre line
+on the decoded image, fit) against ``cv2.imread`` alone on the same
 JPEG, at 1280x960 and 4000x3000; and a skeletonize-then-circle-fit baseline (full decode, same
 mask, :func:`skimage.morphology.skeletonize` of the frame, the skeleton pixels of the chosen
 line fitted by Hyper; scikit-image is used here only).  The baseline has no ordering of its points, so its psi sign is taken from

@@ -12,7 +12,9 @@ Never a silent wrong number: whatever the estimator returns, a row is ``flagged`
   ``NONCONSTANT_DEG``); the ``turning`` and ``auto`` methods measure such lines correctly, so for it this is
   only noted in ``reason`` and the row stays ``ok``;
 - the estimator disagrees with both the arc and the turning fits by more than
-  ``DISAGREE_DEG`` (e.g. the faithful ``paper`` average, biased by pixel noise);
+  ``DISAGREE_DEG`` (e.g. the faithful ``paper`` average, biased by pixel noise); when the full
+  ``turning`` fit gave psi (``turning``, or ``auto`` on non-constant curvature) its "turning
+  fit" for this check is the same model with one term more: an unstable fit is flagged;
 - the two ends almost touch, or the line closes on itself / branches;
 - the fixed end had to be guessed (``fixed_end: auto``) and no clamp was seen at either end
   -- the sign may be wrong.

@@ -82,7 +82,7 @@ def refine_centreline(
     q = (centreline_px - (scale - 1) / 2) / scale
     hw = max(half_width_px / scale, 0.75)
     nrm = _normals(q)
-    shift, good = _profile_shift(fine, q, nrm, 2.0 * hw + 2.5)
+    shift, _ = _profile_shift(fine, q, nrm, 2.0 * hw + 2.5)
     q = q + shift[:, None] * nrm
     shift2, good2 = _profile_shift(fine, q, nrm, 1.5 * hw + 1.5)
     q = q + (shift2 * good2)[:, None] * nrm
