@@ -120,21 +120,9 @@ def line_flags(line: Any, length_px: float, expected_length_px: float | None) ->
     -------
     list of str
     """
-    from pipeline.measure.quality import LENGTH_HIGH, LENGTH_LOW, LOW_CONTRAST
+    from pipeline.measure.quality import line_flags as extraction_flags
 
-    flags = []
-    if line.touches_border:
-        flags.append("line touches the image border")
-    if expected_length_px:
-        ratio = length_px / expected_length_px
-        if ratio < LENGTH_LOW:
-            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
-        elif ratio > LENGTH_HIGH:
-            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
-    if line.n_candidates > 1:
-        flags.append(f"{line.n_candidates} candidate lines")
-    if line.contrast < LOW_CONTRAST:
-        flags.append(f"low contrast ({line.contrast:.0f})")
+    flags = extraction_flags(line, length_px, expected_length_px)
     if line.branched_fraction > 0.05:
         flags.append("line closes on itself or branches")
     return flags

@@ -47,6 +47,40 @@ class Quality:
     reason: str
 
 
+
+def line_flags(line: LineExtraction, length_px: float, expected_length_px: float | None) -> list[str]:
+    """Reasons to distrust an extracted line, whatever is computed from it (angle or ellipse).
+
+    Parameters
+    ----------
+    line : LineExtraction
+        The extracted line.
+    length_px : float
+        Measured centre-line length (original px).
+    expected_length_px : float or None
+        ``l0_mm / mm_per_px`` when the scale is known.
+
+    Returns
+    -------
+    list of str
+        Border touch, partly hidden or too long for l0, several candidate lines, low contrast.
+    """
+    flags: list[str] = []
+    if line.touches_border:
+        flags.append("line touches the image border")
+    if expected_length_px:
+        ratio = length_px / expected_length_px
+        if ratio < LENGTH_LOW:
+            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
+        elif ratio > LENGTH_HIGH:
+            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
+    if line.n_candidates > 1:
+        flags.append(f"{line.n_candidates} candidate lines")
+    if line.contrast < LOW_CONTRAST:
+        flags.append(f"low contrast ({line.contrast:.0f})")
+    return flags
+
+
 def assess(
     line: LineExtraction,
     *,
@@ -81,24 +115,12 @@ def assess(
     -------
     Quality
     """
-    flags: list[str] = []
+    flags = line_flags(line, length_px, expected_length_px)
     notes: list[str] = []
-    if line.touches_border:
-        flags.append("line touches the image border")
-    if expected_length_px:
-        ratio = length_px / expected_length_px
-        if ratio < LENGTH_LOW:
-            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
-        elif ratio > LENGTH_HIGH:
-            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
     if line.gap_bridged:
         flags.append("line partly hidden: gap bridged")
     if not line.fixed_end_found:
         flags.append("no line reaches fixed_end; used the longest")
-    if line.n_candidates > 1:
-        flags.append(f"{line.n_candidates} candidate lines")
-    if line.contrast < LOW_CONTRAST:
-        flags.append(f"low contrast ({line.contrast:.0f})")
     diff = psi_turning_deg - psi_arc_deg
     if turning_degree >= 2 and abs(diff) > NONCONSTANT_DEG:
         text = f"non-constant curvature (turning - arc = {diff:+.1f} deg)"
