@@ -19,7 +19,7 @@ from pipeline.measure import DEFAULT_METHOD, METHODS, measure_image
 from pipeline.measure.core import decode_for_work, jpeg_size, measure_decoded
 from pipeline.measure.estimators import auto, hyper, paper, paper_corrected, turning
 from pipeline.photoset import write_manifest, write_settings
-from pipeline.synth import centreline_mm, render_actuator, render_curve, scene_from
+from pipeline.synth import centreline_mm, render_actuator, scene_from
 
 L0_MM = 180.0
 

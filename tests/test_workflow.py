@@ -48,7 +48,7 @@ def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedPro
 
 def _planned_jobs(stdout: str) -> dict[str, int]:
     table = stdout.split("Job stats:")[-1]
-    return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.M) if m[1] != "total"}
+    return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
 
 
 @pytest.fixture(scope="module")

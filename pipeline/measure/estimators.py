@@ -402,7 +402,7 @@ def turning(
     best: tuple[float, np.ndarray, int, float] | None = None
     psi_of: dict[int, float] = {}
     worse = 0
-    for k in range(0, min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
+    for k in range(min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
         fit = least_squares(
             lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(), x0, method="lm", xtol=1e-10, ftol=1e-10
         )

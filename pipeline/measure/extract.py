@@ -30,7 +30,6 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-
 #: components shorter than this (work px) are never the marker line
 MIN_LENGTH_PX = 25.0
 #: another component at least this fraction of the chosen line's length is a rival candidate

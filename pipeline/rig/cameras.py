@@ -22,7 +22,6 @@ under; the session writes them atomically.
 from __future__ import annotations
 
 import dataclasses
-
 import hashlib
 import os
 import shlex
