@@ -244,3 +244,31 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
     figs = pages.figures(out)
     assert len(figs) == 4
     assert pages.figures(tmp_path / "missing") == []
+    _assert_same_as_measure_photoset(res, tmp_path / "photoset")
+
+
+def _assert_same_as_measure_photoset(res: pd.DataFrame, folder: Path) -> None:
+    """The bench's psi for the default method is what ``measure_photoset`` gives on the same JPEGs."""
+    from pipeline.bench.run import render_case
+    from pipeline.measure import DEFAULT_METHOD, measure_photoset
+    from pipeline.photoset import write_manifest, write_settings
+
+    cases = grids.cases(TINY)
+    folder.mkdir()
+    rows = []
+    for case in cases:
+        scene, rendered = render_case(case)
+        image = f"case_{case.case_id:03d}.jpg"
+        (folder / image).write_bytes(rendered.jpeg_bytes)
+        rows.append({"image": image, "pressure_kpa": float(case.case_id), "direction": "up", "material": "synthetic",
+                     "actuator": "A1", "trial": "1", "step": case.case_id, "mm_per_px": scene.mm_per_px,
+                     "line_color": scene.line_color, "fixed_end_x": rendered.fixed_end_px[0],
+                     "fixed_end_y": rendered.fixed_end_px[1]})
+    write_settings(folder, {"l0_mm": TINY.l0_mm, "positive_turn": "ccw"})
+    write_manifest(folder, pd.DataFrame(rows))
+    angles = measure_photoset(folder, method=DEFAULT_METHOD)
+    bench = res[res["method"] == DEFAULT_METHOD].set_index("case_id").loc[[c.case_id for c in cases]]
+    assert angles["status"].tolist() == bench["status"].tolist()
+    assert angles["degree"].astype(float).tolist() == bench["degree"].tolist()
+    # results.csv holds 8 significant digits
+    np.testing.assert_allclose(angles["psi_deg"].to_numpy(float), bench["psi_deg"].to_numpy(float), rtol=1e-7, atol=1e-9)

@@ -3,7 +3,9 @@
 Every function here is pure: a DataFrame in, a DataFrame out.  The input is the long table
 written by :func:`pipeline.bench.run.run_grid` (one row per image and method) with at least the
 columns ``case_id, kind, condition, value, nominal, psi_true_deg, bulge, seed, method, psi_deg,
-abs_error_deg, status, degree, seconds, decode_seconds``.
+abs_error_deg, status, degree, seconds, decode_seconds``.  ``seconds`` is the time per image
+as ``python -m pipeline measure`` spends it (file read + JPEG decode + measurement, one core);
+``decode_seconds`` the first decode alone (part of ``seconds``).
 
 Definitions used throughout
 ---------------------------

@@ -72,7 +72,7 @@ def speed_accuracy_figure(table: pd.DataFrame) -> Figure:
     ax.axhline(BREAKDOWN_P95_DEG, color="grey", linestyle="--", linewidth=0.8)
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("median time per image (ms, one core, decode excluded)")
+    ax.set_xlabel("median time per image (ms, one core: file read + JPEG decode + measurement)")
     ax.set_ylabel("95th-percentile |psi error| (deg)")
     ax.set_title("Speed against accuracy: large points = nominal scenes, small = one per sweep condition",
                  fontsize=10)

@@ -1,7 +1,9 @@
 """``python -m pipeline bench``: the speed/accuracy and stability study, tables and charts.
 
-Renders the grid's synthetic scenes (exact ground truth), measures each with every angle
-method on the same decoded image, and writes into ``--out``:
+Renders the grid's synthetic scenes (exact ground truth), writes each as a JPEG file and
+measures that file with every angle method through the per-photo function of
+``python -m pipeline measure`` (:func:`pipeline.measure.worker.run_task`; times include the file
+read and decode), and writes into ``--out``:
 
 ``results.csv``         one row per image and method (truth, psi, error, status, degree, times)
 ``speed_accuracy.csv``  per method and condition: median/p95 error, failure rate, ms per image, Pareto

@@ -1,23 +1,32 @@
-"""Render every scene of a grid and measure it with every angle method, side by side.
+"""Render every scene of a grid and measure it with every angle method the way the pipeline does.
 
 For each :class:`~pipeline.bench.grids.Case` one worker renders the photo with
-:func:`pipeline.synth.render_actuator`, encodes it as JPEG with the scene's quality, decodes it
-once (timed on its own: ``decode_seconds``) and runs every method of
-:data:`pipeline.measure.METHODS` through :func:`pipeline.measure.measure_image` on that *same*
-decoded image (each call timed: ``seconds``).  The order of the methods rotates from one image
-to the next so that no method always runs first on a cold cache.  Workers run single-threaded
-OpenCV (``cv2.setNumThreads(1)``), so ``--jobs N`` uses N cores and times are per core.
+:func:`pipeline.synth.render_actuator`, writes its JPEG bytes (the scene's quality) to a file and
+measures that file once per method of :data:`pipeline.measure.METHODS` through
+:func:`pipeline.measure.worker.run_task` -- the very function
+:func:`pipeline.measure.measure_photoset` runs per photo: file read, reduced (grey for a black
+line) JPEG decode, extraction on a halved copy refined on the decoded image, and the fall-back
+to the decoded-size path when that is not ``ok``.  ``seconds`` is that call's own timing (the
+``seconds`` column of angles.csv: read + decode + measurement); ``decode_seconds`` is the first
+decode alone (:func:`pipeline.measure.core.decode_for_work`, timed once per image, already
+contained in ``seconds``).  The methods run side by side on the same file, their order rotating
+from one image to the next so that no method always runs first on a cold cache.  Workers run
+single-threaded OpenCV (``cv2.setNumThreads(1)``), so ``--jobs N`` uses N cores and times are
+per core.
 
-The adaptive estimators' chosen model (``turning`` and ``auto``: complexity of the curve model,
-1 = constant curvature) is read from ``AngleResult.degree`` by :func:`chosen_degree`.
+``degree`` is the complexity of the curve model the method used (``AngleResult.degree``,
+the angles.csv column: 1 = circular arc; more only for the adaptive ``turning`` / ``auto``);
+NaN when the photo failed.
 """
 
 from __future__ import annotations
 
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,84 +43,80 @@ RESULT_COLUMNS: tuple[str, ...] = (
 
 
 def _init_worker() -> None:
-    import cv2
+    from pipeline.measure.worker import init_worker
 
-    cv2.setNumThreads(1)
-
-
-#: methods whose curve model is adaptive (their chosen degree is recorded)
-ADAPTIVE_METHODS: tuple[str, ...] = ("turning", "auto")
+    init_worker()
 
 
-def chosen_degree(res: Any) -> float:
-    """Curve-model degree an estimator chose on a photo (1 = constant curvature).
-
-    Parameters
-    ----------
-    res : pipeline.measure.AngleResult
-        The measurement.
+def render_case(case: Case) -> tuple[Any, Any]:
+    """The scene and the rendered photo of one case (deterministic in the case).
 
     Returns
     -------
-    float
-        ``res.degree``; NaN when the measurement failed.
+    scene : pipeline.synth.SceneParams
+    rendered : pipeline.synth.RenderedImage
+        ``jpeg_bytes`` (the photo file), ``fixed_end_px`` (clamp pixel) among others.
     """
-    return float("nan") if res.status == "failed" else float(res.degree)
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from(case.preset, **dict(case.overrides))
+    return scene, render_actuator(case.psi_deg, case.l0_mm, scene, seed=case.seed, bulge=case.bulge)
 
 
-def measure_case(case: Case, methods: Sequence[str]) -> list[dict[str, Any]]:
-    """Render one case and measure it with every method; one result row per method.
+def measure_case(case: Case, methods: Sequence[str], workdir: str | Path) -> list[dict[str, Any]]:
+    """Render one case, write it as a JPEG file and measure the file with every method.
 
     Parameters
     ----------
     case : Case
     methods : sequence of str
         Keys of :data:`pipeline.measure.METHODS`.
+    workdir : path
+        Existing folder for the photo file (removed again before returning).
 
     Returns
     -------
     list of dict
-        Rows with the keys of :data:`RESULT_COLUMNS`.
+        Rows with the keys of :data:`RESULT_COLUMNS`, in the order of ``methods``.
     """
-    import cv2
-
-    from pipeline.measure import measure_image
-    from pipeline.synth import render_actuator, scene_from
+    from pipeline.measure.core import decode_for_work
+    from pipeline.measure.extract import is_value_only, resolve_ranges
+    from pipeline.measure.worker import Task, run_task
 
     t0 = time.perf_counter()
-    scene = scene_from(case.preset, **dict(case.overrides))
-    rendered = render_actuator(case.psi_deg, case.l0_mm, scene, seed=case.seed, bulge=case.bulge)
-    data = np.frombuffer(rendered.jpeg_bytes, dtype=np.uint8)
+    scene, rendered = render_case(case)
+    render_s = time.perf_counter() - t0
+    path = Path(workdir) / f"case_{case.case_id:06d}.jpg"
+    path.write_bytes(rendered.jpeg_bytes)
+    ranges = resolve_ranges(scene.line_color)  # as measure_photoset hands the colour to its workers
+    fixed = tuple(float(v) for v in rendered.fixed_end_px)
     t1 = time.perf_counter()
-    image = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    decode_for_work(np.frombuffer(rendered.jpeg_bytes, dtype=np.uint8), grey=is_value_only(ranges))
     decode_s = time.perf_counter() - t1
-    render_s = t1 - t0
     k = case.case_id % max(len(methods), 1)
     order = list(methods[k:]) + list(methods[:k])
     out: dict[str, dict[str, Any]] = {}
-    for method in order:
-        t = time.perf_counter()
-        res = measure_image(
-            image, l0_mm=case.l0_mm, mm_per_px=scene.mm_per_px, line_color=scene.line_color,
-            fixed_end_px=rendered.fixed_end_px, positive_turn="ccw", method=method,
-        )
-        seconds = time.perf_counter() - t
-        degree = chosen_degree(res) if method in ADAPTIVE_METHODS else None
-        err = res.psi_deg - case.psi_deg
-        out[method] = {
-            "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,
-            "nominal": case.nominal, "psi_true_deg": case.psi_deg, "bulge": case.bulge, "seed": case.seed,
-            "width_px": scene.width, "line_length_px": case.l0_mm / scene.mm_per_px, "method": method,
-            "psi_deg": res.psi_deg, "error_deg": err, "abs_error_deg": abs(err), "status": res.status,
-            "reason": res.reason, "degree": np.nan if degree is None else float(degree),
-            "residual_px": res.residual_px, "seconds": seconds, "decode_seconds": decode_s,
-            "render_seconds": render_s,
-        }
+    try:
+        for method in order:
+            row = run_task(Task(str(path), case.l0_mm, scene.mm_per_px, ranges, fixed, "ccw", method))
+            err = row["psi_deg"] - case.psi_deg
+            out[method] = {
+                "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,
+                "nominal": case.nominal, "psi_true_deg": case.psi_deg, "bulge": case.bulge, "seed": case.seed,
+                "width_px": scene.width, "line_length_px": case.l0_mm / scene.mm_per_px, "method": method,
+                "psi_deg": row["psi_deg"], "error_deg": err, "abs_error_deg": abs(err), "status": row["status"],
+                "reason": row["reason"], "degree": np.nan if row["degree"] is None else float(row["degree"]),
+                "residual_px": row["residual_px"], "seconds": row["seconds"], "decode_seconds": decode_s,
+                "render_seconds": render_s,
+            }
+    finally:
+        path.unlink(missing_ok=True)
     return [out[m] for m in methods]
 
 
 def _measure_chunk(chunk: list[Case], methods: tuple[str, ...]) -> list[dict[str, Any]]:
-    return [row for case in chunk for row in measure_case(case, methods)]
+    with tempfile.TemporaryDirectory(prefix="pipeline_bench_") as workdir:
+        return [row for case in chunk for row in measure_case(case, methods, workdir)]
 
 
 def run_grid(
