@@ -30,6 +30,7 @@ rule acquire_rig:
         touch(f"{RESULTS}/acquired/{{dataset}}.done"),
     params:
         ds=lambda wc: DATASETS[wc.dataset],
+        camera=lambda wc: DATASETS[wc.dataset]["camera"],
     log:
         f"{LOGS}/acquire/{{dataset}}.log",
     benchmark:
@@ -41,7 +42,7 @@ rule acquire_rig:
         mem_mb=1000,
         runtime=240,
     shell:
-        "python -m pipeline acquire --port {params.ds[port]} --camera '{params.ds[camera]}'"
+        "python -m pipeline acquire --port {params.ds[port]} --camera {params.camera:q}"
         " --material {params.ds[material]} --actuator {params.ds[actuator]}"
         " --trials {params.ds[trials]} --step-kpa {params.ds[step_kpa]} --max-kpa {params.ds[max_kpa]}"
         " --settle-s {params.ds[settle_s]} --l0-mm {params.ds[l0_mm]} --out {params.ds[path]} > {log} 2>&1"

@@ -33,7 +33,7 @@ rule report:
         "python -m pipeline report --datasets {params.names} --angles {input.angles}"
         " --hysteresis {input.hysteresis} --rms {input.rms} --model-curves {input.curves}"
         " --photosets {params.photosets} --overlays {params.overlays} {params.bench} {params.force}"
-        " --config {input.config} --title '{params.title}' --out {output} > {log} 2>&1"
+        " --config {input.config} --title {params.title:q} --out {output} > {log} 2>&1"
 
 
 rule resolved_config:
