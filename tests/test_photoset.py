@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -109,3 +110,12 @@ def test_append_rows_is_idempotent(tmp_path):
     df = pd.read_csv(tmp_path / "manifest.csv")
     assert list(df["image"]) == ["a.jpg", "b.jpg"]
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_atomic_write_gives_normal_permissions(tmp_path):
+    old = os.umask(0o022)
+    try:
+        ps.atomic_write_bytes(tmp_path / "report.pdf", b"%PDF")
+    finally:
+        os.umask(old)
+    assert (tmp_path / "report.pdf").stat().st_mode & 0o777 == 0o644
