@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.tables import read_table
 
 #: columns angles.csv must have for aggregation
 REQUIRED_ANGLE_COLUMNS: tuple[str, ...] = (
@@ -82,12 +83,8 @@ def read_angles(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
     frames = []
     for path in paths:
         p = Path(path)
-        try:
-            df = pd.read_csv(p, dtype={"actuator": str, "trial": str, "image": str, "reason": str})
-        except FileNotFoundError:
-            raise UserInputError(f"{p}: file not found; pass an angles.csv written by 'measure'") from None
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise UserInputError(f"{p}: not a readable CSV ({exc}); regenerate it with 'measure'") from None
+        df = read_table(p, "an angles.csv written by 'measure'",
+                        dtype={"actuator": str, "trial": str, "image": str, "reason": str})
         check_angles(df, str(p))
         df.insert(0, "dataset", str(path))
         frames.append(df)

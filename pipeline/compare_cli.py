@@ -13,6 +13,7 @@ from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, model_callables
 from pipeline.errors import UserInputError
 from pipeline.photoset import atomic_write_bytes
+from pipeline.tables import read_table
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -54,12 +55,7 @@ def read_hysteresis(paths: list[Path]) -> pd.DataFrame:
     """Read and concatenate hysteresis.csv files (checked with :func:`check_hysteresis`)."""
     frames = []
     for p in paths:
-        try:
-            df = pd.read_csv(p)
-        except FileNotFoundError:
-            raise UserInputError(f"{p}: file not found; pass a hysteresis.csv written by 'aggregate'") from None
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise UserInputError(f"{p}: not a readable CSV ({exc}); regenerate it with 'aggregate'") from None
+        df = read_table(p, "a hysteresis.csv written by 'aggregate'")
         check_hysteresis(df, str(p))
         frames.append(df)
     return pd.concat(frames, ignore_index=True)

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.tables import read_table
 
 REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "actuator", "trial", "force_n")
 
@@ -60,18 +61,12 @@ def read_tables(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
         raise UserInputError("no input table given; pass one or more eccentricity.csv (or blocked manifest.csv) files")
     frames = []
     for p in map(Path, paths):
-        if not p.is_file():
-            raise UserInputError(f"{p}: not found; run 'python -m pipeline force measure' first")
-        try:
-            df = pd.read_csv(p, dtype={"actuator": str, "trial": str, "material": str, "direction": str})
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise UserInputError(f"{p}: cannot be read as CSV ({exc})") from exc
-        missing = [c for c in REQUIRED if c not in df.columns]
-        if missing:
-            raise UserInputError(
-                f"{p}: missing column(s) {missing}; is this a blocked-force table? "
-                "It needs force_n (newtons) per row: record with 'acquire --mode blocked' or 'force synth'"
-            )
+        df = read_table(
+            p, "an eccentricity.csv from 'python -m pipeline force measure' (or a blocked manifest.csv)",
+            required=REQUIRED,
+            hint="a blocked-force table needs force_n (newtons) per row: record with 'acquire --mode blocked' or 'force synth'",
+            dtype={"actuator": str, "trial": str, "material": str, "direction": str},
+        )
         df["source"] = str(p)
         frames.append(df)
     return pd.concat(frames, ignore_index=True)

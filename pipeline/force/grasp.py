@@ -33,6 +33,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from pipeline.errors import UserInputError
+from pipeline.tables import read_table
 
 #: the example log shipped with the package (values transcribed from the paper's text, Fig. 8B/8C)
 EXAMPLE_LOG = Path(__file__).with_name("data") / "grasp_example.csv"
@@ -70,12 +71,8 @@ def read_grasp_log(path: str | os.PathLike[str]) -> pd.DataFrame:
         (every problem is listed with its line number and the fix).
     """
     path = Path(path)
-    if not path.is_file():
-        raise UserInputError(f"{path}: grasp log not found; give the CSV file the lab filled in")
-    try:
-        raw = pd.read_csv(path, dtype=str, keep_default_na=False, comment=None, skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise UserInputError(f"{path}: cannot be read as CSV ({exc}); fix the file") from exc
+    raw = read_table(path, "the grasp-log CSV the lab filled in", dtype=str, keep_default_na=False,
+                     skipinitialspace=True)
     raw.columns = [str(c).strip().lower() for c in raw.columns]
     missing = [c for c in GRASP_COLUMNS if c not in raw.columns]
     if missing:

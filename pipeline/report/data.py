@@ -22,6 +22,7 @@ from pipeline.aggregate import (
 )
 from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
+from pipeline.tables import read_table
 
 
 @dataclass(frozen=True)
@@ -117,16 +118,7 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
 
 
 def _read_csv(path: Path, what: str, required: Sequence[str]) -> pd.DataFrame:
-    try:
-        df = pd.read_csv(path)
-    except FileNotFoundError:
-        raise UserInputError(f"{path}: file not found; pass an existing {what}") from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise UserInputError(f"{path}: not a readable CSV ({exc}); regenerate the {what}") from None
-    missing = [c for c in required if c not in df.columns]
-    if missing:
-        raise UserInputError(f"{path}: missing column(s) {missing}; pass a {what}")
-    return df
+    return read_table(path, f"a {what}", required=required)
 
 
 def load_report_data(inputs: ReportInputs) -> ReportData:
