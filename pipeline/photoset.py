@@ -320,13 +320,15 @@ def resolve_settings(manifest: pd.DataFrame, settings: Mapping[str, Any]) -> pd.
     }
     for key, value in folder_values.items():
         fill = np.nan if value is None else value
-        if key in df.columns:
-            df[key] = df[key].where(df[key].notna(), fill) if not isinstance(fill, (list, dict)) else df[key]
-        else:
-            df[key] = [fill] * len(df) if isinstance(fill, (list, dict)) else fill
+        rows = df[key] if key in df.columns else [None] * len(df)
+        df[key] = pd.Series([fill if _is_missing(v) else v for v in rows], index=df.index, dtype=object)
     for key in ("l0_mm", "mm_per_px", "fixed_end_x", "fixed_end_y", "pressure_kpa"):
         df[key] = pd.to_numeric(df[key], errors="coerce")
     return df
+
+
+def _is_missing(value: Any) -> bool:
+    return value is None or (isinstance(value, (float, np.floating)) and np.isnan(value))
 
 
 def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:

@@ -119,3 +119,13 @@ def test_atomic_write_gives_normal_permissions(tmp_path):
     finally:
         os.umask(old)
     assert (tmp_path / "report.pdf").stat().st_mode & 0o777 == 0o644
+
+
+def test_folder_hsv_range_fills_rows_without_their_own_colour(photo_folder):
+    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": {"lower": [0, 0, 0], "upper": [179, 255, 60]}})
+    m = pd.read_csv(photo_folder / "manifest.csv")
+    m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
+    m.to_csv(photo_folder / "manifest.csv", index=False)
+    rows = ps.load_photoset(photo_folder).manifest
+    assert rows["line_color"].iloc[0] == "blue"
+    assert all(v == {"lower": [0, 0, 0], "upper": [179, 255, 60]} for v in rows["line_color"].iloc[1:])
