@@ -16,6 +16,7 @@ from pipeline.model import (
     MATERIAL_NAMES,
     ModelOptions,
     anchor_table,
+    fit_eq12_scale,
     fit_k_p,
     load_materials,
     model_curve,
@@ -39,7 +40,7 @@ ALL_READINGS = [
     )
     for combo in itertools.product(
         ("none", "deformed"),
-        ("metres", "none"),
+        ("calibrated", "metres", "none"),
         ("half_disc", "segment"),
         ("mean", "crown"),
         ("one_minus", "none"),
@@ -319,6 +320,31 @@ def test_anchor_table_reports_every_anchor() -> None:
     assert (df.group == "experiment").sum() == 7 and (df.group == "rms").sum() == 4
 
 
+def test_default_reading_meets_the_model_anchor_bar() -> None:
+    """Issue bar: both of the paper's own model results within +-5 % (SS50 0 deg, SS40 -psi0)."""
+    model = anchor_table()
+    model = model[model.group == "model"]
+    assert (model.pct_off.abs() <= 5.0).all(), model[["anchor", "ours", "pct_off"]]
+    # the ratio of the two anchors is the model's shape, untouched by the fitted prefactor
+    ss50, ss40 = model.ours
+    assert ss40 / ss50 == pytest.approx(378.0 / 674.0, rel=0.05)
+
+
+def test_eq12_scale_is_the_documented_fit_and_only_scales() -> None:
+    assert ModelOptions().l0_factor == "calibrated"
+    assert ModelOptions().eq12_scale == pytest.approx(fit_eq12_scale(), abs=1e-4)
+    # another l0 or reading gives another fit, and the fit ignores the scale in use
+    assert fit_eq12_scale(l0_mm=200.0) < fit_eq12_scale()
+    assert fit_eq12_scale(eq12_scale=9.0, l0_factor="metres") == pytest.approx(fit_eq12_scale())
+    for name in MATERIAL_NAMES:
+        raw = pressure_kpa(name, PSI, l0_factor="none")
+        np.testing.assert_allclose(
+            pressure_kpa(name, PSI, eq12_scale=0.5), 0.5 * raw, rtol=1e-12, equal_nan=True
+        )
+    with pytest.raises(UserInputError, match="eq12_scale"):
+        pressure_kpa("SS50", 0.0, eq12_scale=0.0)
+
+
 def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
     assert cli_main(["model", "pressure", "--material", "SS50", "--psi-deg", "0"]) == 0
     printed = float(capsys.readouterr().out.strip())
@@ -343,6 +369,10 @@ def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
     assert cli_main(["model", "calibrate"]) == 0
     text = capsys.readouterr().out
     assert "674.0" in text and "378.0" in text
+    assert f"fitted to the two model results with these readings and l0: {fit_eq12_scale():.4f}" in text
+    assert cli_main(["model", "calibrate", "--l0-mm", "200", "--eq12-scale", "0.25"]) == 0
+    text = capsys.readouterr().out
+    assert f"{fit_eq12_scale(l0_mm=200.0):.4f} (l0_factor=calibrated, eq12_scale in use 0.2500)" in text
     assert cli_main(["model", "pressure", "--material", "NOPE", "--psi-deg", "0"]) == 2
 
 

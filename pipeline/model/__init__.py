@@ -9,12 +9,13 @@ load_materials(path=None) -> dict[str, Material]
 model_curve(material, psi_deg=None, **options) -> DataFrame   (with the reason for every NaN)
 snap_regions(material, **options) -> DataFrame                 (snap-through jumps)
 anchor_table(**options) -> DataFrame                           (paper anchors: paper, ours, % off)
+fit_eq12_scale(**options) -> float                             (Eq. 12 prefactor fitted to them)
 
 ``options`` are the readings of the ambiguous equations and the quadrature sizes, see
 :class:`ModelOptions` and ``docs/model.md``.  Material names: "DS20", "DS30", "SS40", "SS50".
 """
 
-from pipeline.model.calibrate import anchor_table, fit_k_p
+from pipeline.model.calibrate import anchor_table, fit_eq12_scale, fit_k_p
 from pipeline.model.forward import model_curve, pressure_kpa
 from pipeline.model.geometry import REASONS
 from pipeline.model.inverse import psi_deg, snap_regions
@@ -31,6 +32,7 @@ __all__ = [
     "Material",
     "ModelOptions",
     "anchor_table",
+    "fit_eq12_scale",
     "fit_k_p",
     "load_materials",
     "model_curve",

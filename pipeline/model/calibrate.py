@@ -223,6 +223,44 @@ def anchor_table(materials: dict[str, Material] | None = None, **options: Any) -
     return pd.DataFrame(rows)
 
 
+def fit_eq12_scale(materials: dict[str, Material] | None = None, **options: Any) -> float:
+    """The number that, standing for Eq. 12's l0 prefactor, reproduces the paper's model results.
+
+    Least squares on the log ratios of the two model anchors (SS50 straight at 674 kPa, SS40 at
+    -psi0 at 378 kPa) with the prefactor dropped: the geometric mean of paper / ours.  One
+    number fits two anchors, so the +-5 % bar then tests their ratio (the shape of the model),
+    and the measured anchors stay an independent check.
+
+    Parameters
+    ----------
+    materials : dict of str to Material, optional
+        Defaults to the packaged table (needs SS40 and SS50).
+    **options
+        Readings and ``l0_mm``; ``l0_factor`` and ``eq12_scale`` are ignored.
+
+    Returns
+    -------
+    float
+        The dimensionless scale; :data:`pipeline.model.options.EQ12_SCALE` is this value for the
+        default readings at l0 = 270 mm.
+
+    Examples
+    --------
+    >>> round(fit_eq12_scale(), 3)
+    0.321
+    """
+    from pipeline.model.materials import load_materials
+
+    table = materials or load_materials()
+    kw = {k: v for k, v in options.items() if k not in ("l0_factor", "eq12_scale")}
+    logs = [
+        math.log(anchor.paper / _evaluate(anchor, table[anchor.material], {**kw, "l0_factor": "none"}))
+        for anchor in ANCHORS
+        if anchor.group == "model"
+    ]
+    return math.exp(float(np.mean(logs)))
+
+
 def search_readings(
     l0_mm: ArrayLike = (
         170.0,
@@ -250,7 +288,9 @@ def search_readings(
     Returns
     -------
     pandas.DataFrame
-        One row per combination: the readings, ``l0_mm``, ``undefined_anchors`` (anchors where
+        One row per combination: the readings, ``l0_mm``, ``eq12_scale`` (refitted with
+        :func:`fit_eq12_scale` for every combination and l0 when ``l0_factor`` is
+        ``"calibrated"``, the default when ``keys`` leaves it out), ``undefined_anchors`` (anchors where
         the model gives NaN; RMS columns skip them), ``model_max_abs_pct`` (worst of the two
         model anchors), ``exp_pressure_rms_pct`` (RMS % error of the three measured psi = 0
         pressures) and ``exp_psi_rms_deg`` (RMS of the four measured angles, deg).
@@ -262,6 +302,8 @@ def search_readings(
     for combo in itertools.product(*(CHOICES[k] for k in keys)):
         kw = dict(zip(keys, combo, strict=True))
         for l0 in np.asarray(l0_mm, dtype=float):
+            if kw.get("l0_factor", "calibrated") == "calibrated":  # refit the prefactor here
+                kw["eq12_scale"] = fit_eq12_scale(table, l0_mm=float(l0), **kw)
             df = anchor_table(table, l0_mm=float(l0), **kw)
             model = df[df.group == "model"]
             exp = df[df.group == "experiment"]

@@ -11,7 +11,7 @@ import pandas as pd
 
 from pipeline.errors import UserInputError
 from pipeline.model.materials import Material, load_materials
-from pipeline.model.options import CHOICES, ModelOptions
+from pipeline.model.options import CHOICES, ModelOptions, make_options
 
 _DEFAULTS = ModelOptions()
 
@@ -21,7 +21,8 @@ _OPTION_HELP = {
     "kt_scaling": "Dragon Skin thickness scaling (one_minus: t (1 - k_t|psi-psi0|/psi0); "
     "as_printed: t k_t (1 - |psi-psi0|/psi0))",
     "jacobian": "Eq. 12 wall area element (none: as printed; deformed: times (2 phi_m/pi)(t/t0))",
-    "l0_factor": "Eq. 12 l0 prefactor (metres: as printed, l0 in m; none: dropped)",
+    "l0_factor": "Eq. 12 l0 prefactor (calibrated: replaced by --eq12-scale, fitted to the "
+    "paper's two model results; metres: as printed, l0 in m; none: dropped)",
     "pressure_area": "Eq. 13 area (half_disc: as printed; segment: real chamber cut by the base)",
     "thickness_phi": "Eq. 4 stretch over phi (mean: averaged; crown: at phi = 0)",
     "thickness_pass": "Eq. 4 stretch on the undeformed section (first: as printed) or once more "
@@ -58,6 +59,13 @@ def _reading_parent() -> argparse.ArgumentParser:
     )
     parent.add_argument(
         "--k-p", type=float, default=None, help="override the pressure scale k_P (dimensionless)"
+    )
+    parent.add_argument(
+        "--eq12-scale",
+        type=float,
+        default=None,
+        help="number standing for Eq. 12's l0 prefactor with --l0-factor calibrated "
+        f"(dimensionless); default {_DEFAULTS.eq12_scale}",
     )
     return parent
 
@@ -126,7 +134,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _options(args: argparse.Namespace) -> dict[str, object]:
-    keys = [*CHOICES, "l0_mm", "k_p", "unload_from_kpa"]
+    keys = [*CHOICES, "l0_mm", "k_p", "eq12_scale", "unload_from_kpa"]
     return {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
 
 
@@ -143,6 +151,7 @@ def _material(args: argparse.Namespace, name: str) -> Material:
 def run(args: argparse.Namespace) -> int:
     """Run one ``model`` action; returns the exit code."""
     from pipeline.model import anchor_table, model_curve, pressure_kpa, psi_deg, snap_regions
+    from pipeline.model.calibrate import fit_eq12_scale
 
     cmd = args.model_command
     if cmd == "bench":
@@ -182,6 +191,12 @@ def run(args: argparse.Namespace) -> int:
             print(
                 df.drop(columns=["group"]).to_string(index=False, float_format=lambda v: f"{v:.1f}")
             )
+        in_use = make_options(**opts)
+        fitted = fit_eq12_scale(load_materials(args.materials), **opts)
+        print(
+            f"\neq12_scale fitted to the two model results with these readings and l0: {fitted:.4f}"
+            f" (l0_factor={in_use.l0_factor}, eq12_scale in use {in_use.eq12_scale:.4f})"
+        )
     elif cmd == "snaps":
         table = load_materials(args.materials)
         names = [args.material] if args.material else list(table)

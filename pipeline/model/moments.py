@@ -31,8 +31,9 @@ def stress_moment_nmm(
     The base (width 2 (a0 + t0), stretch of Eq. 1, lambda_2 = 1) plus the deformed wall (stretches
     of Eqs. 2-3 on the deformed section, integrated over the undeformed tau in [0, t0] and phi in
     [-pi/2, pi/2] by Gauss-Legendre, using the evenness in phi).  ``opts.jacobian="deformed"``
-    multiplies the wall area element by (2 phi_m/pi)(t/t0); ``opts.l0_factor="metres"``
-    multiplies both terms by l0 in metres as printed; ``opts.stress="nominal"`` divides the
+    multiplies the wall area element by (2 phi_m/pi)(t/t0); ``opts.l0_factor`` puts in place of
+    the printed l0 prefactor the fitted number ``opts.eq12_scale`` ("calibrated"), l0 in metres
+    ("metres") or nothing ("none"); ``opts.stress="nominal"`` divides the
     Cauchy stress by lambda_1; ``opts.base_width="one_side"`` drops the factor 2 of the base
     term; ``opts.wall_coords`` is passed to :func:`pipeline.model.geometry.wall_coordinates`.
 
@@ -70,6 +71,8 @@ def stress_moment_nmm(
     moment = m_base + m_wall
     if opts.l0_factor == "metres":
         moment = moment * (l0 / 1000.0)
+    elif opts.l0_factor == "calibrated":
+        moment = moment * opts.eq12_scale
     reason = np.where((sec.reason == OK) & bad, BAD_STRETCH, sec.reason)
     return np.where(reason == OK, moment, np.nan), reason
 

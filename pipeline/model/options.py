@@ -23,9 +23,12 @@ CHOICES: dict[str, tuple[str, ...]] = {
     # Eq. 12 area element: "none" (as printed, (a+tau') dphi dtau) or "deformed"
     # ((a+tau') dphi' dtau' = (a+tau') (2 phi_m/pi)(t/t0) dphi dtau).
     "jacobian": ("none", "deformed"),
-    # Eq. 12 l0 prefactor, absent from Eq. 13: "none" drops it (dimensionally consistent);
-    # "metres" keeps it as printed with l0 in metres (SI code), i.e. scales P by l0/1 m.
-    "l0_factor": ("metres", "none"),
+    # Eq. 12 l0 prefactor, absent from Eq. 13 (so P is dimensionally a pressure times a length):
+    # "calibrated" drops l0 and puts the dimensionless number ``eq12_scale`` in its place, fitted
+    # to the paper's own two model results (pipeline.model.calibrate.fit_eq12_scale);
+    # "metres" keeps it as printed with l0 in metres (SI code), i.e. scales P by l0/1 m;
+    # "none" drops it (dimensionally consistent, P about 3x the paper's model).
+    "l0_factor": ("calibrated", "metres", "none"),
     # Eq. 13 pressure area: "half_disc" as printed; "segment" the real chamber (circle of radius a
     # cut by the base plane, = half disc at rest).
     "pressure_area": ("half_disc", "segment"),
@@ -46,6 +49,13 @@ CHOICES: dict[str, tuple[str, ...]] = {
 }
 
 
+#: Eq. 12's l0 prefactor read as this dimensionless number (``l0_factor="calibrated"``): the
+#: geometric-mean fit of the two model results the paper reports (SS50 straight at 674 kPa, SS40
+#: at -psi0 at 378 kPa) with the default readings and l0 = 270 mm; reproduce it with
+#: ``python -m pipeline model calibrate`` (docs/model.md).  Within 1 % of 1/pi.
+EQ12_SCALE = 0.3214
+
+
 @dataclass(frozen=True)
 class ModelOptions:
     """Options of the analytical model.
@@ -55,6 +65,10 @@ class ModelOptions:
     eq5, kt_scaling, jacobian, l0_factor, pressure_area, thickness_phi : str
     thickness_pass, stress, base_width, wall_coords : str
         Readings of the ambiguous equations; see :data:`CHOICES`.
+    eq12_scale : float
+        Dimensionless factor standing for Eq. 12's l0 prefactor with ``l0_factor="calibrated"``.
+        The default :data:`EQ12_SCALE` is ``fit_eq12_scale()`` for the default readings at the
+        packaged l0 = 270 mm (a test keeps the two equal).
     l0_mm : float or None
         Override of the material's inextensible-layer length l0 (mm).
     k_p : float or None
@@ -74,13 +88,14 @@ class ModelOptions:
     eq5: str = "arc_length"
     kt_scaling: str = "one_minus"
     jacobian: str = "none"
-    l0_factor: str = "metres"
+    l0_factor: str = "calibrated"
     pressure_area: str = "half_disc"
     thickness_phi: str = "mean"
     thickness_pass: str = "first"
     stress: str = "cauchy"
     base_width: str = "two_sides"
     wall_coords: str = "scaled"
+    eq12_scale: float = EQ12_SCALE
     l0_mm: float | None = None
     k_p: float | None = None
     n_tau: int = 4
@@ -124,6 +139,8 @@ def make_options(base: ModelOptions | None = None, **options: Any) -> ModelOptio
             raise UserInputError(f"model options: {key} must be an integer >= 2, got {value!r}")
         if key == "unload_from_kpa" and value is not None and not float(value) >= 0:
             raise UserInputError(f"model options: unload_from_kpa must be >= 0 kPa, got {value!r}")
+        if key == "eq12_scale" and not float(value) > 0:
+            raise UserInputError(f"model options: eq12_scale must be > 0, got {value!r}")
         if key in ("l0_mm", "k_p") and value is not None and not float(value) > 0:
             raise UserInputError(f"model options: {key} must be > 0, got {value!r}")
     return replace(opts, **options)
