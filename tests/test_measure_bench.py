@@ -89,22 +89,19 @@ def _verdict(sp: pd.DataFrame) -> str:
     return bench.verdicts(bench.speed_table(sp), bench.paired_accuracy(sp, seed=0, resamples=500)).loc["100x100"]
 
 
-def test_verdict_met_when_20x_faster_and_more_accurate() -> None:
+@pytest.mark.parametrize(
+    ("ours_s", "skel_s", "ours_sd", "skel_sd", "expected"),
+    [
+        (0.001, 0.020, 0.02, 0.5, "met"),  # 20x faster and more accurate
+        (0.020, 0.010, 0.02, 0.5, "not met"),  # slower
+        (0.001, 0.020, 0.5, 0.02, "not met"),  # fast but less accurate
+    ],
+    ids=["20x-and-more-accurate", "slower", "fast-but-less-accurate"],
+)
+def test_verdict(ours_s: float, skel_s: float, ours_sd: float, skel_sd: float, expected: str) -> None:
     rng = np.random.default_rng(0)
-    sp = _made_up_sp(0.001, 0.020, rng.normal(0, 0.02, 12), rng.normal(0, 0.5, 12))
-    assert _verdict(sp) == "met"
-
-
-def test_verdict_not_met_when_slower() -> None:
-    rng = np.random.default_rng(1)
-    sp = _made_up_sp(0.020, 0.010, rng.normal(0, 0.02, 12), rng.normal(0, 0.5, 12))
-    assert _verdict(sp) == "not met"
-
-
-def test_verdict_not_met_when_fast_but_less_accurate() -> None:
-    rng = np.random.default_rng(2)
-    sp = _made_up_sp(0.001, 0.020, rng.normal(0, 0.5, 12), rng.normal(0, 0.02, 12))
-    assert _verdict(sp) == "not met"
+    sp = _made_up_sp(ours_s, skel_s, rng.normal(0, ours_sd, 12), rng.normal(0, skel_sd, 12))
+    assert _verdict(sp) == expected
 
 
 def test_failed_measurement_counts_as_worse() -> None:
