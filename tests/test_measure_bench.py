@@ -119,3 +119,11 @@ def test_verdict_threshold_is_on_the_ci_upper_bound() -> None:
     paired = pd.DataFrame({"size": ["a", "a", "b", "b"], "tilt_deg": [0.0, 1.0, 0.0, 1.0],
                            "ci_hi": [0.009, 5.0, 0.011, -1.0]})
     assert bench.verdicts(tab, paired).to_dict() == {"a": "met", "b": "not met"}
+
+
+def test_scaling_measures_both_job_counts_and_the_pool_start_up(tmp_path) -> None:
+    out = bench.scaling(2, seed=3, workdir=tmp_path, copies=2)
+    assert set(out) == {"jobs=1", "jobs=2", "start-up, jobs=2"}
+    assert all(np.isfinite(v) and v > 0 for v in out.values())
+    angles = pd.read_csv(tmp_path / "set" / "manifest.csv")
+    assert len(angles) == 4  # 2 renders x 2 copies
