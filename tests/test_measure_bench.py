@@ -6,6 +6,7 @@ skeletonize baseline); the verdict rule is checked as a pure function on made-up
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -13,7 +14,7 @@ import pytest
 from pipeline.measure import bench
 
 SPEED_COLUMNS = ["n", "imread_ms", "ours_ms", "ours/imread", "skeleton_ms", "skeleton/ours",
-                 "decode_floor_ms", "max_speedup"]
+                 "decode_floor_ms", "bare_ms", "max_speedup"]
 PAIRED_COLUMNS = ["size", "tilt_deg", "n", "ours_med_err", "ours_|psi|_med_err", "skel_|psi|_med_err",
                   "med_diff", "ci_lo", "ci_hi", "ours_as_good"]
 
@@ -81,7 +82,7 @@ def _made_up_sp(ours_s: float, skel_s: float, ours_err: np.ndarray, skel_err: np
                          "ours_psi": 50.0 + ours_err[i], "ours_status": "ok", "skeleton_psi": 50.0 + skel_err[i],
                          "ours_abs_err": abs(ours_err[i]), "ours_absmag_err": abs(ours_err[i]),
                          "skeleton_absmag_err": abs(skel_err[i]), "imread_s": 0.001, "ours_s": ours_s,
-                         "skeleton_s": skel_s, "decode_floor_s": 0.0005})
+                         "skeleton_s": skel_s, "decode_floor_s": 0.0005, "bare_s": 0.0006})
     return pd.DataFrame(rows)
 
 
@@ -127,3 +128,11 @@ def test_scaling_measures_both_job_counts_and_the_pool_start_up(tmp_path) -> Non
     assert all(np.isfinite(v) and v > 0 for v in out.values())
     angles = pd.read_csv(tmp_path / "set" / "manifest.csv")
     assert len(angles) == 4  # 2 renders x 2 copies
+
+
+def test_bare_path_fits_the_dark_arc() -> None:
+    img = np.full((960, 1280), 220, np.uint8)
+    cv2.ellipse(img, (640, 480), (300, 300), 0, 200, 340, 20, 24)  # dark arc, radius 300 px
+    ok, buf = cv2.imencode(".jpg", img)
+    assert ok
+    assert bench._bare_circle_px(buf) * 4 == pytest.approx(300.0, rel=0.03)  # decoded at 1/4

@@ -62,8 +62,9 @@ size        imread  ours   ours/imread  skeleton   skel/ours    accuracy, camera
 At 4000x3000 we are 19x faster at equal accuracy. At 1280x960 the 10x target is out of reach of
 any method that decodes the file: decoding alone, at 1/8 size in grey, takes 1.16 ms, so even
 with no other work the ceiling is 11.7x. 10x would leave 0.2 ms for extraction, quality checks
-and the fit. A bare threshold + largest component + circle fit, with no checks, already takes
-0.7 ms on top of decoding.
+and the fit. The bench's ``bare`` column is decoding at 1/4, an Otsu threshold, the largest
+component and a Hyper fit, with no checks and often the wrong blob. It alone takes 2.7 ms, so it
+is 5x at best.
 """
 
 from pipeline.measure.core import DEFAULT_METHOD, AngleResult, measure_file, measure_image

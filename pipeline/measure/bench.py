@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work, measure_decoded, measure_file
-from pipeline.measure.estimators import METHODS, hyper
+from pipeline.measure.estimators import METHODS, algebraic_circle, hyper
 from pipeline.measure.extract import _candidates, _choose, line_mask
 from pipeline.synth import render_actuator, scene_from
 
@@ -143,6 +143,22 @@ TARGET_SPEEDUP = 10.0
 EQUAL_ACCURACY_TOL_DEG = 0.01
 
 
+def _bare_circle_px(data: np.ndarray) -> float:
+    """The least a measurement could do: radius (decoded px) of a Hyper circle through the biggest dark blob.
+
+    Decode at 1/4 size in grey, Otsu threshold, largest connected component, algebraic fit of
+    its pixels: no colour, no clamp cut, no ordering or sign, no quality checks, and often the
+    wrong blob.  Timed only, as a floor for the cost of any real measurement; never scored.
+    """
+    grey = cv2.imdecode(data, cv2.IMREAD_REDUCED_GRAYSCALE_4)
+    _, mask = cv2.threshold(grey, 0, 255, cv2.THRESH_BINARY_INV | cv2.THRESH_OTSU)
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    k = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    ys, xs = np.nonzero(labels == k)
+    (a, b, c, d), scale = algebraic_circle(np.c_[xs, ys].astype(float), "hyper")
+    return float(np.sqrt(b * b + c * c - 4 * a * d) / (2 * abs(a)) * scale)
+
+
 def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] = SPEED_SIZES,
           repeats: int = 3) -> pd.DataFrame:
     """Per image: seconds of imread, ours, the skeleton baseline and the decode floor; errors at two tilts.
@@ -174,7 +190,8 @@ def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] =
         ``ours_abs_err`` (signed psi), ``ours_absmag_err`` and ``skeleton_absmag_err`` (on |psi|,
         deg), and the tilt-0 file's timings repeated on both rows: ``imread_s``, ``ours_s``,
         ``skeleton_s``, ``decode_floor_s`` (``cv2.imdecode`` of the in-memory bytes with
-        ``IMREAD_REDUCED_GRAYSCALE_8``, no file read).
+        ``IMREAD_REDUCED_GRAYSCALE_8``, no file read) and ``bare_s`` (:func:`_bare_circle_px`
+        on the same bytes).
     """
     rng = np.random.default_rng(seed + 7)
     rows = []
@@ -201,6 +218,7 @@ def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] =
                             partial(_skeleton_psi, path, scene.mm_per_px, r.fixed_end_px), repeats),
                         "decode_floor_s": _median_time(
                             partial(cv2.imdecode, data, cv2.IMREAD_REDUCED_GRAYSCALE_8), repeats),
+                        "bare_s": _median_time(partial(_bare_circle_px, data), repeats),
                     }
                 rows.append({"size": f"{width}x{height}", "image": i, "tilt_deg": tilt, "psi_true": psi,
                              "ours_psi": res.psi_deg, "ours_status": res.status, "skeleton_psi": skel,
@@ -215,7 +233,8 @@ def speed_table(sp: pd.DataFrame) -> pd.DataFrame:
 
     Ratios ``ours/imread`` and ``skeleton/ours`` are medians of per-image ratios;
     ``max_speedup`` = skeleton ms / decode-floor ms is the largest speed-up over the baseline that
-    any method which has to decode the file (even at 1/8 scale in grey) could reach.
+    any method which has to decode the file (even at 1/8 scale in grey) could reach;
+    ``bare_ms`` is :func:`_bare_circle_px`, the least any measurement does after decoding.
 
     Parameters
     ----------
@@ -237,6 +256,7 @@ def speed_table(sp: pd.DataFrame) -> pd.DataFrame:
         "skeleton_ms": g["skeleton_s"].median() * 1e3,
         "skeleton/ours": g.apply(lambda d: float(np.median(d["skeleton_s"] / d["ours_s"]))),
         "decode_floor_ms": g["decode_floor_s"].median() * 1e3,
+        "bare_ms": g["bare_s"].median() * 1e3,
     })
     tab["max_speedup"] = tab["skeleton_ms"] / tab["decode_floor_ms"]
     return tab
@@ -323,6 +343,7 @@ def print_speed(sp: pd.DataFrame, seed: int) -> None:
     tab = speed_table(sp)
     print("\n== speed per image (ms, median over images; median of 3 runs each; 1 OpenCV thread)")
     print("   decode_floor = cv2.imdecode(bytes, IMREAD_REDUCED_GRAYSCALE_8); max_speedup = skeleton / decode_floor")
+    print("   bare = decode at 1/4 + Otsu + largest component + Hyper fit, no checks (timed, never scored)")
     print(tab.to_string(float_format=fmt))
     paired = paired_accuracy(sp, seed)
     print("\n== accuracy on the same images (deg; errors on |psi|, the baseline has no sign; "
