@@ -415,13 +415,18 @@ def compare(
     return pd.DataFrame(records, columns=list(RMS_COLUMNS))
 
 
-def model_callables(materials_path: str | None = None) -> tuple[ModelPsi, FitKp, dict[str, float]]:
+def model_callables(
+    materials_path: str | None = None, **options: Any
+) -> tuple[ModelPsi, FitKp, dict[str, float]]:
     """Model callables and psi0 per material from :mod:`pipeline.model`.
 
     Parameters
     ----------
     materials_path : str, optional
         Materials YAML (the packaged one when ``None``).
+    **options
+        Model readings (:class:`pipeline.model.ModelOptions`), applied to both callables;
+        validated here, so a bad one fails before any data is read.
 
     Returns
     -------
@@ -433,6 +438,7 @@ def model_callables(materials_path: str | None = None) -> tuple[ModelPsi, FitKp,
     from pipeline import model  # imported lazily: heavy and owned by the model helper
 
     table = model.load_materials(materials_path)
+    model.make_options(**options)  # unknown names or values: a clear error now
 
     def _material(name: str) -> Any:
         if name not in table:
@@ -443,9 +449,11 @@ def model_callables(materials_path: str | None = None) -> tuple[ModelPsi, FitKp,
         return table[name]
 
     def model_psi(name: str, pressure_kpa: np.ndarray) -> np.ndarray:
-        return np.asarray(model.psi_deg(_material(name), np.asarray(pressure_kpa, float), branch="loading"))
+        return np.asarray(
+            model.psi_deg(_material(name), np.asarray(pressure_kpa, float), branch="loading", **options)
+        )
 
     def fit(name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray) -> tuple[float, Any]:
-        return model.fit_k_p(_material(name), pressure_kpa, psi_deg)
+        return model.fit_k_p(_material(name), pressure_kpa, psi_deg, **options)
 
     return model_psi, fit, {n: float(m.psi0_deg) for n, m in table.items()}

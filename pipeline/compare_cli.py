@@ -12,6 +12,7 @@ import pandas as pd
 from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, model_callables
 from pipeline.errors import UserInputError
+from pipeline.model.cli import add_reading_arguments, reading_options
 from pipeline.photoset import atomic_write_bytes
 from pipeline.tables import read_table
 
@@ -49,6 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--include-flagged", action="store_true",
         help="also fit k_P on rows with status 'flagged' (default: only 'ok')",
     )
+    model_group = parser.add_argument_group("model readings (as in 'python -m pipeline model'; default: the calibrated reading)")
+    add_reading_arguments(model_group)
 
 
 def read_hysteresis(paths: list[Path]) -> pd.DataFrame:
@@ -72,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserInputError(f"--bootstrap must be >= 0 resamples, got {args.n_boot}")
     hyst = read_hysteresis(args.hysteresis)
     angles = read_angles(args.angles) if args.angles else None
-    model_psi, fit_k_p, psi0 = model_callables(args.materials)
+    model_psi, fit_k_p, psi0 = model_callables(args.materials, **reading_options(args))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         table = compare(

@@ -72,6 +72,12 @@ def materials_option():
     return f"--materials {path}" if path else ""
 
 
+def model_readings_option():
+    """`--<reading> VALUE` flags for `model` and `compare` from config key model.readings."""
+    readings = config["model"]["readings"]
+    return " ".join(f"--{key.replace('_', '-')} {value}" for key, value in sorted(readings.items()))
+
+
 def measure_method_option():
     """`--method NAME` unless the config asks for the package default."""
     method = config["measure"]["method"]

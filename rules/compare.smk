@@ -10,6 +10,7 @@ rule compare:
     params:
         names=list(DATASETS),
         materials=materials_option(),
+        readings=model_readings_option(),
         bootstrap=config["compare"]["bootstrap"],
         seed=config["compare"]["seed"],
     log:
@@ -24,4 +25,4 @@ rule compare:
         runtime=10,
     shell:
         "python -m pipeline compare {input.hysteresis} --angles {input.angles} --datasets {params.names}"
-        " --bootstrap {params.bootstrap} --seed {params.seed} {params.materials} --out {output} > {log} 2>&1"
+        " --bootstrap {params.bootstrap} --seed {params.seed} {params.materials} {params.readings} --out {output} > {log} 2>&1"

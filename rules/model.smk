@@ -6,6 +6,7 @@ rule model_curve:
         f"{RESULTS}/model/{{material}}.csv",
     params:
         materials=materials_option(),
+        readings=model_readings_option(),
     log:
         f"{LOGS}/model/{{material}}.log",
     benchmark:
@@ -18,4 +19,5 @@ rule model_curve:
         runtime=5,
     shell:
         "python -m pipeline model curve --material {wildcards.material} {params.materials}"
+        " {params.readings}"
         " --out {output} > {log} 2>&1"

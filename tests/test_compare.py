@@ -182,3 +182,11 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     assert abs(out["k_p_fit"] - 2.2) < 0.1
     assert out["p_zero_up_kpa"] == pytest.approx(crossing_kpa(p, truth, 0.0), abs=3.0)
     assert main(["compare", str(tmp_path / "missing.csv"), "--out", str(rms)]) == 2
+    # another reading of the model reaches the comparison: the printed l0 factor (l0 in metres)
+    # is 16 % softer, so data drawn from the calibrated model need a larger k_P
+    other = tmp_path / "rms_metres.csv"
+    assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(other), "--seed", "3",
+                 "--l0-factor", "metres"]) == 0
+    metres = pd.read_csv(other).iloc[0]
+    assert metres["k_p_fit"] > out["k_p_fit"] * 1.1 and metres["rms_deg"] > out["rms_deg"]
+    assert main(["compare", str(hyst), "--out", str(other), "--eq12-scale", "-1"]) == 2

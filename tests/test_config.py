@@ -60,3 +60,21 @@ def test_unknown_key_lists_allowed_keys(tmp_path):
 def test_digest_is_stable_and_order_free():
     assert config_digest({"a": 1, "b": [1, 2]}) == config_digest({"b": [1, 2], "a": 1})
     assert config_digest({"a": 1}) != config_digest({"a": 2})
+
+
+def test_model_readings_in_the_schema_are_the_model_options():
+    from pipeline.model import CHOICES
+
+    readings = load_schema()["properties"]["model"]["properties"]["readings"]["properties"]
+    assert set(readings) == set(CHOICES) | {"eq12_scale", "l0_mm"}
+    for key, choices in CHOICES.items():
+        assert readings[key]["enum"] == list(choices), key
+
+
+def test_a_bad_model_reading_is_refused(tmp_path):
+    with pytest.raises(UserInputError) as exc:
+        validate_config({"model": {"readings": {"l0_factor": "inches"}}}, workdir=tmp_path)
+    assert "model.readings.l0_factor: 'inches' is not one of" in str(exc.value)
+    synthetic = [{"name": "a", "source": "synthetic", "material": "SS50"}]
+    cfg = validate_config({"datasets": synthetic, "model": {"readings": {"l0_factor": "metres"}}}, workdir=tmp_path)
+    assert cfg["model"] == {"materials_file": None, "readings": {"l0_factor": "metres"}}

@@ -107,6 +107,22 @@ def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     assert "results/datasets/tiny/angles.csv" not in re.findall(r"output: (\S+)", out.stdout)
 
 
+def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
+    repo, workdir = finished_run
+    cfg = _tiny_config(repo)
+    cfg["model"] = {"readings": {"l0_factor": "metres", "jacobian": "deformed"}}
+    (workdir / "config3.yaml").write_text(yaml.safe_dump(cfg))
+    out = _snakemake(workdir, repo, "-n", "-p", "--cores", "2", "--configfile", str(workdir / "config3.yaml"))
+    assert out.returncode == 0, out.stderr[-3000:]
+    jobs = _planned_jobs(out.stdout)
+    assert jobs.get("model_curve") == 2 and jobs.get("compare") == 1  # DS20 (sample) and SS50
+    assert "measure" not in jobs and "synth_photoset" not in jobs  # photos and angles stay
+    commands = [line for line in out.stdout.splitlines() if "python -m pipeline model curve" in line
+                or "python -m pipeline compare" in line]
+    assert len(commands) == 3
+    assert all("--jacobian deformed --l0-factor metres" in c for c in commands)
+
+
 def test_broken_config_is_refused_before_any_job(tmp_path, repo):
     cfg = _tiny_config(repo)
     cfg["datasets"][1]["material"] = "DS25"

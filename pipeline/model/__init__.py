@@ -20,7 +20,7 @@ from pipeline.model.forward import model_curve, pressure_kpa
 from pipeline.model.geometry import REASONS
 from pipeline.model.inverse import psi_deg, snap_regions
 from pipeline.model.materials import DEFAULT_MATERIALS_PATH, Material, load_materials
-from pipeline.model.options import CHOICES, ModelOptions
+from pipeline.model.options import CHOICES, ModelOptions, make_options
 
 MATERIAL_NAMES: tuple[str, ...] = ("DS20", "DS30", "SS40", "SS50")
 
@@ -35,6 +35,7 @@ __all__ = [
     "fit_eq12_scale",
     "fit_k_p",
     "load_materials",
+    "make_options",
     "model_curve",
     "pressure_kpa",
     "psi_deg",

@@ -34,6 +34,40 @@ _OPTION_HELP = {
 }
 
 
+def add_reading_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add one ``--<option>`` flag per model reading, plus ``--l0-mm`` and ``--eq12-scale``.
+
+    Shared by ``model`` and ``compare``; :func:`reading_options` collects what was given.
+    """
+    for key, choices in CHOICES.items():
+        parser.add_argument(
+            f"--{key.replace('_', '-')}",
+            dest=key,
+            choices=choices,
+            default=None,
+            help=f"{_OPTION_HELP[key]}; default {getattr(_DEFAULTS, key)}",
+        )
+    parser.add_argument(
+        "--l0-mm",
+        type=float,
+        default=None,
+        help="override the inextensible-layer length l0 (mm); default from the materials file",
+    )
+    parser.add_argument(
+        "--eq12-scale",
+        type=float,
+        default=None,
+        help="number standing for Eq. 12's l0 prefactor with --l0-factor calibrated "
+        f"(dimensionless); default {_DEFAULTS.eq12_scale}",
+    )
+
+
+def reading_options(args: argparse.Namespace) -> dict[str, object]:
+    """The model options given on the command line (readings, l0, eq12_scale, k_P, unloading)."""
+    keys = [*CHOICES, "l0_mm", "k_p", "eq12_scale", "unload_from_kpa"]
+    return {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
+
+
 def _reading_parent() -> argparse.ArgumentParser:
     parent = argparse.ArgumentParser(add_help=False)
     parent.add_argument(
@@ -43,29 +77,9 @@ def _reading_parent() -> argparse.ArgumentParser:
         default=None,
         help="materials YAML (default: the packaged pipeline/model/materials.yaml)",
     )
-    for key, choices in CHOICES.items():
-        parent.add_argument(
-            f"--{key.replace('_', '-')}",
-            dest=key,
-            choices=choices,
-            default=None,
-            help=f"{_OPTION_HELP[key]}; default {getattr(_DEFAULTS, key)}",
-        )
-    parent.add_argument(
-        "--l0-mm",
-        type=float,
-        default=None,
-        help="override the inextensible-layer length l0 (mm); default from the materials file",
-    )
+    add_reading_arguments(parent)
     parent.add_argument(
         "--k-p", type=float, default=None, help="override the pressure scale k_P (dimensionless)"
-    )
-    parent.add_argument(
-        "--eq12-scale",
-        type=float,
-        default=None,
-        help="number standing for Eq. 12's l0 prefactor with --l0-factor calibrated "
-        f"(dimensionless); default {_DEFAULTS.eq12_scale}",
     )
     return parent
 
@@ -133,11 +147,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _options(args: argparse.Namespace) -> dict[str, object]:
-    keys = [*CHOICES, "l0_mm", "k_p", "eq12_scale", "unload_from_kpa"]
-    return {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
-
-
 def _material(args: argparse.Namespace, name: str) -> Material:
     table = load_materials(args.materials)
     if name not in table:
@@ -160,7 +169,7 @@ def run(args: argparse.Namespace) -> int:
         df = benchmark_model(grid_sizes=args.grid_sizes)
         print(format_benchmark(df))
         return 0
-    opts = _options(args)
+    opts = reading_options(args)
     if cmd == "curve":
         mat = _material(args, args.material)
         if args.n < 2:
