@@ -14,6 +14,7 @@ import pandas as pd
 import pytest
 
 from pipeline.cli import main
+from pipeline.errors import UserInputError
 from pipeline.report import Dataset, ReportInputs, build_report
 
 pdfium = pytest.importorskip("pypdfium2")
@@ -149,6 +150,22 @@ def test_four_materials_deterministic_and_not_blank(four, tmp_path):
     c = tmp_path / "c.pdf"
     assert cli_in_fresh_process(args + ["--out", str(c)]) == ""
     assert c.read_bytes() != raw
+
+
+def test_the_summary_says_which_model_readings_were_used(tmp_path):
+    from pipeline.report.data import load_report_data
+
+    d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
+    config = tmp_path / "config.yaml"
+    config.write_text("model: {readings: {l0_factor: metres, jacobian: deformed}}\n")
+    notes = load_report_data(ReportInputs(datasets=(d,), config=config)).notes
+    assert "readings set in the config: jacobian=deformed, l0_factor=metres" in " ".join(notes)
+    config.write_text("model: {materials_file: null, readings: {}}\n")
+    notes = load_report_data(ReportInputs(datasets=(d,), config=config)).notes
+    assert "with the default readings" in " ".join(notes)
+    config.write_text("model: [unclosed\n")
+    with pytest.raises(UserInputError, match="cannot read it as YAML"):
+        load_report_data(ReportInputs(datasets=(d,), config=config))
 
 
 def test_one_material_without_optional_tables(tmp_path):

@@ -172,6 +172,8 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
     ) if inputs.model_curves else pd.DataFrame(columns=["material", "psi_deg", "pressure_kpa"])
     if not inputs.model_curves:
         notes.append("no --model-curves given: plots show the measurements only")
+    if inputs.config is not None:
+        notes.append(model_readings_note(inputs.config))
     files: list[Path] = [d.angles_csv for d in inputs.datasets]
     files += list(inputs.hysteresis) + list(inputs.rms) + list(inputs.model_curves)
     if inputs.config is not None:
@@ -181,6 +183,28 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         inputs=inputs, angles=angles, hysteresis=hysteresis, per_actuator=per_actuator, rms=rms,
         model_curves=curves, digests=digests, notes=notes,
     )
+
+
+def model_readings_note(config_path: Path) -> str:
+    """One line saying which readings of the paper's model the run used (config ``model.readings``).
+
+    Raises
+    ------
+    UserInputError
+        If the config file cannot be read as YAML.
+    """
+    import yaml
+
+    try:
+        cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
+    except (OSError, yaml.YAMLError) as exc:
+        raise UserInputError(f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config") from None
+    readings = ((cfg.get("model") or {}) if isinstance(cfg, dict) else {}).get("readings") or {}
+    if not readings:
+        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md; Eq. 12's l0 "
+                "prefactor is a number fitted to the paper's own model results)")
+    given = ", ".join(f"{k}={v}" for k, v in sorted(readings.items()))
+    return f"model: the paper's Eqs. 1-13 with readings set in the config: {given} (others default; docs/model.md)"
 
 
 def rms_row(data: ReportData, material: str) -> dict[str, float]:
