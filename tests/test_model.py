@@ -343,6 +343,9 @@ def test_eq12_scale_is_the_documented_fit_and_only_scales() -> None:
         )
     with pytest.raises(UserInputError, match="eq12_scale"):
         pressure_kpa("SS50", 0.0, eq12_scale=0.0)
+    only_ds = {k: v for k, v in load_materials().items() if k.startswith("DS")}
+    with pytest.raises(UserInputError, match="no SS40, SS50"):
+        fit_eq12_scale(only_ds)
 
 
 def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
@@ -391,6 +394,9 @@ def test_cli_materials_option(tmp_path, capsys) -> None:
     value = float(capsys.readouterr().out.strip())
     assert value == pytest.approx(float(pressure_kpa(load_materials(path)["NEW"], 0.0)), rel=1e-5)
     assert math.isfinite(value) and value > 0
+    # a file without the paper's materials still prints a calibrate table, and says why no fit
+    assert cli_main(["model", "calibrate", "--materials", str(path)]) == 0
+    assert "n/a (needs SS40 and SS50 in the materials file)" in capsys.readouterr().out
 
 
 def test_unloading_from_a_peak_pressure() -> None:

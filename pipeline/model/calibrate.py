@@ -244,6 +244,11 @@ def fit_eq12_scale(materials: dict[str, Material] | None = None, **options: Any)
         The dimensionless scale; :data:`pipeline.model.options.EQ12_SCALE` is this value for the
         default readings at l0 = 270 mm.
 
+    Raises
+    ------
+    pipeline.errors.UserInputError
+        If the table lacks SS40 or SS50.
+
     Examples
     --------
     >>> round(fit_eq12_scale(), 3)
@@ -252,11 +257,17 @@ def fit_eq12_scale(materials: dict[str, Material] | None = None, **options: Any)
     from pipeline.model.materials import load_materials
 
     table = materials or load_materials()
+    model_anchors = [a for a in ANCHORS if a.group == "model"]
+    missing = sorted({a.material for a in model_anchors} - set(table))
+    if missing:
+        raise UserInputError(
+            f"fit_eq12_scale: the materials table has no {', '.join(missing)}; the paper's model "
+            "results are for SS40 and SS50, so keep those entries in your materials file to refit"
+        )
     kw = {k: v for k, v in options.items() if k not in ("l0_factor", "eq12_scale")}
     logs = [
         math.log(anchor.paper / _evaluate(anchor, table[anchor.material], {**kw, "l0_factor": "none"}))
-        for anchor in ANCHORS
-        if anchor.group == "model"
+        for anchor in model_anchors
     ]
     return math.exp(float(np.mean(logs)))
 

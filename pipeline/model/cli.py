@@ -201,9 +201,13 @@ def run(args: argparse.Namespace) -> int:
                 df.drop(columns=["group"]).to_string(index=False, float_format=lambda v: f"{v:.1f}")
             )
         in_use = make_options(**opts)
-        fitted = fit_eq12_scale(load_materials(args.materials), **opts)
+        table = load_materials(args.materials)
+        if {"SS40", "SS50"} <= set(table):
+            fitted = f"{fit_eq12_scale(table, **opts):.4f}"
+        else:  # a user's own file without the paper's materials: nothing to fit to
+            fitted = "n/a (needs SS40 and SS50 in the materials file)"
         print(
-            f"\neq12_scale fitted to the two model results with these readings and l0: {fitted:.4f}"
+            f"\neq12_scale fitted to the two model results with these readings and l0: {fitted}"
             f" (l0_factor={in_use.l0_factor}, eq12_scale in use {in_use.eq12_scale:.4f})"
         )
     elif cmd == "snaps":
