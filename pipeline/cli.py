@@ -28,7 +28,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "synth": ("pipeline.synth.cli", "render a synthetic pressure-ramp photo set with exact ground truth"),
     "acquire": ("pipeline.rig.acquire_cli", "run the pressure ramp on a rig (real or emulated) and photograph it"),
     "rig": ("pipeline.rig.cli", "rig utilities: emulate the Pico over a pseudo-terminal, calibrate the regulator"),
-    "measure": ("pipeline.measure.cli", "measure the bending angle psi (deg) of every photo of a photo set"),
+    "measure": ("pipeline.measure_cli", "measure the bending angle psi (deg) of every photo of a photo set"),
     "aggregate": ("pipeline.aggregate_cli", "aggregate angles.csv into mean/sd hysteresis curves per pressure (kPa)"),
     "model": ("pipeline.model.cli", "analytical model of the paper: P(psi) curves, inverse, k_P calibration"),
     "compare": ("pipeline.compare_cli", "compare measured hysteresis with the model: RMS (deg), crossings (kPa), k_P"),

@@ -13,8 +13,8 @@ from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, model_callables
 from pipeline.errors import UserInputError
 from pipeline.model.cli import add_reading_arguments, reading_options
-from pipeline.photoset import atomic_write_bytes
-from pipeline.tables import read_table
+from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import read_table
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

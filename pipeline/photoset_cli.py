@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from pipeline import photoset
+from pipeline import photoset, photoset_init
+from pipeline.measure.settings import POSITIVE_TURNS
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -29,7 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument("--l0-mm", type=float, help="length of the marked inextensible layer, mm (written to photoset.yaml)")
     init.add_argument("--mm-per-px", type=float, help="image scale, mm per pixel (optional)")
     init.add_argument("--line-color", default="black", help="marker colour: black, blue, red, green or 'h,s,v-h,s,v' (default black)")
-    init.add_argument("--positive-turn", choices=photoset.POSITIVE_TURNS, default="ccw", help="turning direction on screen, fixed end to free end, that counts as positive psi (default ccw)")
+    init.add_argument("--positive-turn", choices=POSITIVE_TURNS, default="ccw", help="turning direction on screen, fixed end to free end, that counts as positive psi (default ccw)")
     init.add_argument("--overwrite", action="store_true", help="replace an existing manifest.csv")
     check = sub.add_parser(
         "check",
@@ -50,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
             "line_color": args.line_color,
             "positive_turn": args.positive_turn,
         }
-        df = photoset.init_photoset(args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite)
+        df = photoset_init.init_photoset(args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite)
         n_up = int((df["direction"] == "up").sum())
         print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} down)")
         if args.l0_mm is None:

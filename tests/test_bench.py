@@ -250,7 +250,8 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
 def _assert_same_as_measure_photoset(res: pd.DataFrame, folder: Path) -> None:
     """The bench's psi for the default method is what ``measure_photoset`` gives on the same JPEGs."""
     from pipeline.bench.run import render_case
-    from pipeline.measure import DEFAULT_METHOD, measure_photoset
+    from pipeline.measure import DEFAULT_METHOD
+    from pipeline.photoset_measure import measure_photoset
     from pipeline.photoset import write_manifest, write_settings
 
     cases = grids.cases(TINY)

@@ -153,7 +153,7 @@ def test_two_datasets_of_one_material_are_pooled():
 
 def test_cli_with_the_real_model(tmp_path, capsys):
     """Angles drawn from the model itself (SS40, k_P 2.2) + 2 deg noise: small RMS, k_P ~ 2.2."""
-    model = pytest.importorskip("pipeline.model")
+    from pipeline import model
     from pipeline.cli import main
 
     rng = np.random.default_rng(7)

@@ -269,13 +269,6 @@ def test_watched_folder_camera(tmp_path, photo, capsys):
     assert photo.read_bytes() not in images
 
 
-def _need(module: str, name: str):
-    mod = pytest.importorskip(module)
-    if not hasattr(mod, name):
-        pytest.skip(f"{module}.{name} not available yet")
-    return getattr(mod, name)
-
-
 def synthetic_cmd(port: str, out: Path, *extra: str, step: int = 40, top: int = 120) -> list[str]:
     return [sys.executable, "-m", "pipeline", "acquire", "--port", port, "--camera", "synthetic:clean",
             "--material", "DS20", "--actuator", "A1", "--trials", "1", "--step-kpa", str(step), "--max-kpa", str(top),
@@ -283,7 +276,6 @@ def synthetic_cmd(port: str, out: Path, *extra: str, step: int = 40, top: int = 
 
 
 def test_synthetic_camera_virtual_rig(tmp_path):
-    _need("pipeline.synth", "render_actuator")
     out = tmp_path / "set"
     with Emulator(seed=2) as emu:
         done = run(synthetic_cmd(emu.port, out, "--no-stop-at-psi0"), timeout=120)
@@ -296,7 +288,7 @@ def test_synthetic_camera_virtual_rig(tmp_path):
     assert first is not None and top is not None and first.shape == top.shape
     assert np.mean(np.abs(first.astype(int) - top.astype(int))) > 1  # the actuator moved
     # the virtual camera frames the whole line at every step (it zooms out for a long actuator)
-    from pipeline.measure import measure_photoset
+    from pipeline.photoset_measure import measure_photoset
 
     angles = measure_photoset(out)
     assert (angles["status"] == "ok").all(), angles[["image", "status", "reason"]]
@@ -304,8 +296,7 @@ def test_synthetic_camera_virtual_rig(tmp_path):
 
 def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     """Live measurement ends the up leg once psi <= -psi0; the down leg mirrors it; resume keeps it."""
-    measure_image = _need("pipeline.measure", "measure_image")
-    _need("pipeline.synth", "render_actuator")
+    from pipeline.measure import measure_image
     from pipeline.model import load_materials, psi_deg
 
     psi0 = load_materials()["DS20"].psi0_deg
@@ -329,16 +320,13 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     assert list(down["pressure_kpa"]) == sorted(up["pressure_kpa"][:-1], reverse=True)
     assert df["step"].tolist() == list(range(len(df)))
     # the stop is where the measured psi first reaches -psi0 (and not before)
-    fe = tuple(ps.settings["fixed_end"])
-    psis = [measure_image(cv2.imread(str(out / name)), l0_mm=ps.settings["l0_mm"], mm_per_px=ps.settings["mm_per_px"],
-                          fixed_end_px=fe, positive_turn="ccw").psi_deg for name in up["image"]]
+    psis = [measure_image(cv2.imread(str(out / name)), settings).psi_deg for name, settings in zip(df["image"], ps.rows)
+            if name in set(up["image"])]
     assert psis[-1] <= -psi0 and all(p > -psi0 for p in psis[:-1])
     assert float(psi_deg("DS20", np.array([peak]))[0]) < -psi0 + 30
 
 
 def test_synthetic_blocked_rig(tmp_path, capsys):
-    _need("pipeline.synth", "render_curve")
-    _need("pipeline.force.synth_blocked", "blocked_arc_mm")
     out = tmp_path / "set"
     with Emulator(seed=3) as emu:
         code, _, err = main_inprocess(synthetic_cmd(emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100), capsys)

@@ -12,7 +12,8 @@ import pytest
 from scipy.ndimage import map_coordinates
 
 from pipeline.errors import UserInputError
-from pipeline.photoset import line_color_ranges, load_photoset, validate_photoset
+from pipeline.measure.colors import parse_color
+from pipeline.photoset import load_photoset, validate_photoset
 from pipeline.synth import SCENE_PRESETS, centreline_mm, render_actuator, render_curve, scene_from
 from pipeline.synth.actuator import (
     BEHAVIOURS,
@@ -135,7 +136,7 @@ def test_line_colour_is_inside_the_photoset_hsv_range(colour, preset):
     r = render_actuator(120.0, 195.0, scene_from(preset, line_color=colour, line_width_px=5.0, **SMALL), seed=4)
     hsv = cv2.cvtColor(r.image, cv2.COLOR_BGR2HSV)
     mask = np.zeros(hsv.shape[:2], np.uint8)
-    for lo, hi in line_color_ranges(colour):
+    for lo, hi in parse_color(colour).ranges:
         mask |= cv2.inRange(hsv, np.array(lo), np.array(hi))
     pts = np.round(r.centreline_px[::200]).astype(int)
     assert mask[pts[:, 1], pts[:, 0]].mean() / 255 > 0.95
@@ -262,9 +263,8 @@ def test_same_seed_same_bytes_whatever_the_jobs(tmp_path):
 
 
 def test_default_loading_curve_is_the_model():
-    model = pytest.importorskip("pipeline.model")
-    if not hasattr(model, "psi_deg"):
-        pytest.skip("pipeline.model.psi_deg not available yet")
+    from pipeline import model
+
     curve = loading_curve("DS20", max_kpa=150)
     p = np.array([0.0, 30.0, 60.0])
     assert np.allclose(curve(p), model.psi_deg("DS20", p), atol=0.5)

@@ -329,7 +329,8 @@ def render_blocked_photoset(
     pandas.DataFrame
         The manifest written.
     """
-    from pipeline.photoset import TRUTH, atomic_write_bytes, write_manifest, write_settings
+    from pipeline.fileio import atomic_write_bytes
+    from pipeline.photoset import TRUTH, write_manifest, write_settings
     from pipeline.synth import child_seed, render_curve, scene_from
 
     out = Path(out_dir)

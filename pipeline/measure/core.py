@@ -14,15 +14,15 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
 
 from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, turning_quick
-from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, is_value_only
+from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.quality import assess
 from pipeline.measure.refine import refine_centreline
+from pipeline.measure.settings import MeasureSettings
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
@@ -109,13 +109,9 @@ def _psi_from(est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | 
 
 def measure_work_image(
     image_bgr: np.ndarray,
+    settings: MeasureSettings,
     *,
     scale: float,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     fine: np.ndarray | None = None,
     fine_scale: float = 1.0,
@@ -129,12 +125,13 @@ def measure_work_image(
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
-    if positive_turn not in ("ccw", "cw"):
-        raise ValueError(f"positive_turn {positive_turn!r}: use 'ccw' or 'cw'")
-    if mm_per_px is not None and not np.isfinite(mm_per_px):
-        mm_per_px = None
+    l0_mm, mm_per_px = settings.l0_mm, settings.mm_per_px
+    assert settings.color is not None
+    region = None if image_bgr is None else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     try:
-        line: LineExtraction = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px, scale=scale)
+        line: LineExtraction = extract_centreline(
+            image_bgr, color=settings.color, fixed_end_px=settings.fixed_end_px, scale=scale, region=region
+        )
     except NoLineFound as exc:
         return failed(method, str(exc))
     if fine is not None:
@@ -142,7 +139,7 @@ def measure_work_image(
         line = replace(line, centreline_px=refined)
     pts = line.centreline_px * np.array([1.0, -1.0])  # y-up: on-screen ccw is positive
     rng = np.random.default_rng(SEED)
-    sign = 1.0 if positive_turn == "ccw" else -1.0
+    sign = settings.sign
     try:
         ends = line.trimmed_px
         arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
@@ -189,12 +186,8 @@ def measure_work_image(
 
 def measure_image(
     image_bgr: np.ndarray,
+    settings: MeasureSettings,
     *,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     work_width_px: int = WORK_WIDTH_PX,
 ) -> AngleResult:
@@ -204,16 +197,9 @@ def measure_image(
     ----------
     image_bgr : ndarray, shape (H, W, 3), uint8
         The photo (OpenCV BGR).
-    l0_mm : float
-        Length of the marked inextensible layer (mm).
-    mm_per_px : float, optional
-        Image scale (mm per px); without it psi is the total turning angle of the measured line.
-    line_color : str or mapping
-        Marker colour name or HSV range (see :func:`pipeline.photoset.line_color_ranges`).
-    fixed_end_px : (x, y), optional
-        Pixel near the clamped end; None or NaN: guessed.
-    positive_turn : {"ccw", "cw"}
-        Turning direction (fixed end -> free end, as seen on screen) that counts positive.
+    settings : MeasureSettings
+        How to measure it (l0, scale, colour, fixed end, sign, ...), see
+        :func:`pipeline.measure.settings.resolve_settings`.
     method : str
         Estimator, a key of :data:`pipeline.measure.METHODS`.
     work_width_px : int
@@ -228,25 +214,23 @@ def measure_image(
     Examples
     --------
     >>> import cv2, numpy as np
+    >>> from pipeline.measure.settings import resolve_settings
     >>> img = np.full((480, 640, 3), 200, np.uint8)
     >>> t = np.linspace(0, np.pi, 200)                      # half circle, radius 150 px
     >>> pts = np.c_[320 + 150 * np.cos(t), 300 - 150 * np.sin(t)]
     >>> _ = cv2.polylines(img, [np.round(pts * 16).astype(np.int32)], False, (20, 20, 20), 5, cv2.LINE_AA, 4)
-    >>> r = measure_image(img, l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end_px=(470, 300))
+    >>> s = resolve_settings(l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end=[470, 300])
+    >>> r = measure_image(img, s)
     >>> print(round(r.psi_deg), r.status)
     180 ok
     """
-    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
-        fixed_end_px = None
-    kw = dict(l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color, fixed_end_px=fixed_end_px,
-              positive_turn=positive_turn, method=method)
     if image_bgr is None or image_bgr.ndim != 3:
-        return measure_work_image(image_bgr, scale=1.0, **kw)
+        return measure_work_image(image_bgr, settings, scale=1.0, method=method)
     f = reduction_for(image_bgr.shape[1], work_width_px)
-    res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+    res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
-        res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+        res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
     return res
 
 
@@ -327,14 +311,15 @@ def _reduce(image: np.ndarray, factor: int) -> np.ndarray:
     return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
 
 
+def decodes_grey(settings: MeasureSettings) -> bool:
+    """Whether a grey (luma) decoding is enough: a black drawn line, nothing needing colour."""
+    return settings.target == "line" and settings.color is not None and settings.color.dark_line
+
+
 def measure_file(
     path: str | Path,
+    settings: MeasureSettings,
     *,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     work_width_px: int = WORK_WIDTH_PX,
 ) -> tuple[AngleResult, float]:
@@ -351,41 +336,35 @@ def measure_file(
         data = np.fromfile(str(path), dtype=np.uint8)
     except OSError as exc:
         return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
-    grey = is_value_only(line_color)
-    img, f = decode_for_work(data, work_width_px, grey=grey) if data.size else (None, 1)
+    img, f = decode_for_work(data, work_width_px, grey=decodes_grey(settings)) if data.size else (None, 1)
     if img is None:
         return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
-    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
-        fixed_end_px = None
-    res = measure_decoded(
-        data, img, f, l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
-        fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
-    )
-    return res, time.perf_counter() - t0
+    return measure_decoded(data, img, f, settings, method=method), time.perf_counter() - t0
 
 
-def measure_decoded(data: np.ndarray, img: np.ndarray, factor: int, **kw: Any) -> AngleResult:
+def measure_decoded(
+    data: np.ndarray, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD
+) -> AngleResult:
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
 
-    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``; ``kw`` are the
-    keyword arguments of :func:`measure_work_image` except ``scale``.  A grey image at least
-    ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line refined
-    on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While the line is
-    narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the image was
-    reduced, it is decoded again at twice the resolution: thin lines cost a second decode, the
-    usual photo only one small one.
+    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``.  A grey image at
+    least ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line
+    refined on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While
+    the line is narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the
+    image was reduced, it is decoded again at twice the resolution: thin lines cost a second
+    decode, the usual photo only one small one.
     """
     if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
         coarse = _reduce(img, 2)
-        res = measure_work_image(coarse, scale=2.0 * factor, fine=img, fine_scale=float(factor), **kw)
+        res = measure_work_image(coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor))
         # anything doubtful (gaps, rivals, border, ...) is measured again at the decoded size
         if res.status == "ok" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
             return res
-    res = measure_work_image(img, scale=float(factor), **kw)
+    res = measure_work_image(img, settings, scale=float(factor), method=method)
     while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
         factor //= 2
         finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)
         if finer is None:
             break
-        res = measure_work_image(finer, scale=float(factor), **kw)
+        res = measure_work_image(finer, settings, scale=float(factor), method=method)
     return res

@@ -26,7 +26,7 @@ from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from pipeline import __version__
-from pipeline.photoset import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
 from pipeline.report.extra import extra_pages
 from pipeline.report.pages import (

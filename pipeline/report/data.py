@@ -22,7 +22,7 @@ from pipeline.aggregate import (
 )
 from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 
 @dataclass(frozen=True)

@@ -28,13 +28,9 @@ from typing import Any, TextIO
 import numpy as np
 from tqdm import tqdm
 
-from pipeline.photoset import (
-    MANIFEST,
-    append_manifest_rows,
-    atomic_write_bytes,
-    write_manifest,
-    write_settings,
-)
+from pipeline.fileio import atomic_write_bytes
+from pipeline.measure.settings import MeasureSettings, SettingsError, resolve_settings
+from pipeline.photoset import MANIFEST, append_manifest_rows, write_manifest, write_settings
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
 from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
@@ -46,7 +42,7 @@ EXIT_CODES: dict[str, int] = {
     "done": 0, "error": 1, "estop": 3, "port_lost": 4, "camera": 5, "limit": 6, "interrupted": 130,
 }
 
-StopCriterion = Callable[[bytes, dict[str, Any]], bool]
+StopCriterion = Callable[[bytes, MeasureSettings], bool]
 
 
 @dataclass(frozen=True)
@@ -213,7 +209,8 @@ def run_session(
     cfg : SessionConfig
         The run.
     stop_up : callable, optional
-        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached -psi0).
+        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached -psi0);
+        ``settings`` are the photo set's, resolved once.
     progress : bool or None
         Show the tqdm bar (``None``: only on a terminal).
     stream : text stream, optional
@@ -227,9 +224,17 @@ def run_session(
     stream = stream or sys.stderr
     result = SessionResult()
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
-    settings = {**cfg.settings, **camera.photoset_settings()}
-    if session.check_settings(cfg.out_dir, settings):
-        write_settings(cfg.out_dir, settings)
+    raw_settings = {**cfg.settings, **camera.photoset_settings()}
+    if session.check_settings(cfg.out_dir, raw_settings):
+        write_settings(cfg.out_dir, raw_settings)
+    settings: MeasureSettings | None = None
+    if stop_up is not None:
+        try:
+            settings = resolve_settings({k: v for k, v in raw_settings.items() if v is not None}, folder=cfg.out_dir)
+        except SettingsError as exc:
+            result.status, result.message = "error", f"the psi0 stop needs valid photo-set settings: {exc}; nothing was done"
+            print(f"acquire: {result.message}", file=stream)
+            return result
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     if up[-1] > driver.max_kpa + 1e-9:
         result.status, result.message = "limit", f"--max-kpa {cfg.max_kpa:g} is above the driver limit {driver.max_kpa:g} kPa (calibration max_kpa); nothing was done"
@@ -276,7 +281,7 @@ def run_session(
 
 
 def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: int, seq: list[session.StepPlan],
-               recorded: set[int], up: list[float], stop_up: StopCriterion | None, settings: dict[str, Any],
+               recorded: set[int], up: list[float], stop_up: StopCriterion | None, settings: MeasureSettings | None,
                bar: tqdm, interrupts: _Interrupts, result: SessionResult) -> None:
     """Run one trial from its first missing step."""
     start = session.first_missing(seq, recorded)
@@ -286,7 +291,7 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
     if stop_up is not None and not peak_known and start > 0:
         # the up leg may already have ended early: re-check the recorded up photos
         for plan in seq[:start]:
-            if plan.direction == "up" and 0 < plan.step and _recorded_image_stops(cfg, plan, stop_up, settings):
+            if plan.direction == "up" and 0 < plan.step and settings is not None and _recorded_image_stops(cfg, plan, stop_up, settings):
                 seq = session.trial_sequence(trial, up, plan.step)
                 bar.total -= len(session.trial_sequence(trial, up)) - len(seq)
                 start = session.first_missing(seq, recorded)
@@ -309,7 +314,7 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
         image_bytes = _record_step(driver, camera, cfg, plan, interrupts)
         result.photos_taken += 1
         bar.update(1)
-        if (stop_up is not None and plan.direction == "up" and 0 < plan.step < len(up) - 1
+        if (stop_up is not None and settings is not None and plan.direction == "up" and 0 < plan.step < len(up) - 1
                 and stop_up(image_bytes, settings)):
             new_seq = session.trial_sequence(trial, up, plan.step)
             bar.total -= len(seq) - len(new_seq)
@@ -365,7 +370,7 @@ def _append_row(cfg: SessionConfig, row: dict[str, Any]) -> None:
 
 
 def _recorded_image_stops(cfg: SessionConfig, plan: session.StepPlan, stop_up: StopCriterion,
-                          settings: dict[str, Any]) -> bool:
+                          settings: MeasureSettings) -> bool:
     rows = session.recorded_steps(cfg.out_dir, cfg.material, cfg.actuator)
     hit = rows[(rows["trial_n"] == plan.trial) & (rows["step_n"] == plan.step)]
     if hit.empty:
@@ -403,20 +408,14 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
     if measure_image is None:
         from pipeline.measure import measure_image
 
-    def stop(image_bytes: bytes, settings: dict[str, Any]) -> bool:
+    def stop(image_bytes: bytes, settings: MeasureSettings) -> bool:
         import cv2
 
         image = cv2.imdecode(np.frombuffer(image_bytes, np.uint8), cv2.IMREAD_COLOR)
         if image is None:
             return False
-        fe = settings.get("fixed_end", "auto")
         try:
-            r = measure_image(
-                image, l0_mm=float(settings["l0_mm"]), mm_per_px=settings.get("mm_per_px"),
-                line_color=settings.get("line_color", "black"),
-                fixed_end_px=None if fe in (None, "auto") else (float(fe[0]), float(fe[1])),
-                positive_turn=settings.get("positive_turn", "ccw"),
-            )
+            r = measure_image(image, settings)
         except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
             log.warning("live psi measurement failed (%s: %s); the ramp continues to --max-kpa", type(exc).__name__, exc)
             return False

@@ -29,7 +29,8 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.photoset import MANIFEST, TRUTH, atomic_write_bytes, write_manifest, write_settings
+from pipeline.fileio import atomic_write_bytes
+from pipeline.photoset import MANIFEST, TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
     PsiFunction,

@@ -23,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Measure the set, write angles.csv, print a one-line summary."""
-    from pipeline.measure.photoset_measure import measure_photoset, summary, write_angles
+    from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
     angles = measure_photoset(args.photoset, method=args.method, jobs=args.jobs, overlays_dir=args.overlays)
