@@ -11,6 +11,7 @@ measured line (mean curvature x measured length).
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -18,9 +19,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, turning_quick
+from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
-from pipeline.measure.quality import assess
+from pipeline.measure.quality import assess, assess_body
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
 
@@ -125,6 +126,8 @@ def measure_work_image(
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
+    if settings.target == "body":
+        return measure_body(image_bgr, settings, scale=scale, method=method)
     l0_mm, mm_per_px = settings.l0_mm, settings.mm_per_px
     assert settings.color is not None
     region = None if image_bgr is None else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
@@ -175,6 +178,71 @@ def measure_work_image(
         kappa_per_mm=float(np.deg2rad(psi) / l0_mm),
         length_mm=float(length_px * mm_per_px) if mm_per_px else float("nan"),
         method=method,
+        residual_px=est.residual_px,
+        status=quality.status,
+        reason=quality.reason,
+        centreline_px=line.centreline_px,
+        line_width_px=line.width_px,
+        degree=int(est.degree),
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def _background(path: str, shape: tuple[int, int]) -> np.ndarray | None:
+    """The empty-scene photo, resized to the work image (cached per worker: one decode)."""
+    img = cv2.imread(path, cv2.IMREAD_COLOR)
+    if img is None:
+        return None
+    return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+
+
+def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD) -> AngleResult:
+    """psi of the actuator's body (``target: body``): its centre line's total turning.
+
+    ``auto`` is :func:`~pipeline.measure.estimators.tangents` here (the tip angle: a body is
+    rarely an arc); any other method may be asked for.  A known ``fixed_direction_deg`` replaces
+    the measured base tangent.
+    """
+    from pipeline.measure.body import extract_body
+
+    background = None
+    if settings.background_path is not None and image_bgr is not None:
+        background = _background(settings.background_path, image_bgr.shape[:2])
+        if background is None:
+            return failed(method, f"background photo {Path(settings.background_path).name} cannot be decoded")
+    try:
+        body = extract_body(image_bgr, settings, scale=scale, background_bgr=background)
+    except NoLineFound as exc:
+        return failed(method, str(exc))
+    line = body.line
+    pts = line.centreline_px * np.array([1.0, -1.0])
+    rng = np.random.default_rng(SEED)
+    base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    try:
+        tip = tangents(pts, rng, ends_px=line.trimmed_px, base_rad=base)
+        free = tangents(pts, rng, ends_px=line.trimmed_px) if base is not None else tip
+        est = tip if method in ("auto", "tangents") or base is not None else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        return failed(method, f"curvature fit failed: {exc}")
+    sign = settings.sign
+    psi = float(np.rad2deg(sign * est.turning_rad))
+    mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
+    quality = assess_body(
+        line,
+        psi_deg=psi,
+        psi_check_deg=float(np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))),
+        widths_px=body.widths_px,
+        expected_length_px=settings.l0_mm / settings.mm_per_px if settings.mm_per_px else None,
+        length_px=est.length_px,
+        base_mismatch_deg=mismatch,
+        selected_fraction=body.selected_fraction,
+    )
+    mm = settings.mm_per_px
+    return AngleResult(
+        psi_deg=psi,
+        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
+        length_mm=float(est.length_px * mm) if mm else float("nan"),
+        method="tangents" if method == "auto" or base is not None else method,
         residual_px=est.residual_px,
         status=quality.status,
         reason=quality.reason,

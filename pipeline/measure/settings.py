@@ -46,6 +46,7 @@ pipeline.measure.settings.SettingsError: l0_mm = -1 must be a positive number (f
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -180,14 +181,14 @@ def _points(value: Any, key: str) -> Polygon:
             raise ValueError(f"{key} {value!r} is not a list ({exc})") from None
     if not isinstance(value, (list, tuple)):
         raise ValueError(f"{key} = {value!r} is not a box [x0, y0, x1, y1] or a polygon [[x, y], ...]")
-    if len(value) == 4 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+    if len(value) == 4 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value):
         x0, y0, x1, y1 = (float(v) for v in value)
         if not (x1 > x0 and y1 > y0):
             raise ValueError(f"{key} box {list(value)} needs x1 > x0 and y1 > y0")
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
     pts = []
     for p in value:
-        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(c, (int, float)) for c in p)):
+        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in p)):
             raise ValueError(f"{key} point {p!r} is not [x, y]")
         pts.append((float(p[0]), float(p[1])))
     if len(pts) < 3:
@@ -210,7 +211,7 @@ def _fixed_end(raw: Mapping[str, Any], problems: list[SettingProblem]) -> tuple[
     fe = raw.get("fixed_end", "auto")
     if is_missing(fe) or fe == "auto":
         return None
-    if isinstance(fe, (list, tuple)) and len(fe) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in fe):
+    if isinstance(fe, (list, tuple)) and len(fe) == 2 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in fe):
         return float(fe[0]), float(fe[1])
     problems.append(SettingProblem("fixed_end", f"fixed_end = {fe!r}", "use 'auto' or a pixel position [x, y] near the clamped end"))
     return None
@@ -282,7 +283,7 @@ def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[Me
             except yaml.YAMLError:
                 pass
         items = ex if isinstance(ex, (list, tuple)) else [ex]
-        if items and all(isinstance(v, (int, float)) for v in items):
+        if items and all(isinstance(v, numbers.Real) for v in items):
             items = [items]  # one box
         for i, item in enumerate(items):
             try:
