@@ -19,6 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--overlays", metavar="DIR", default=None, help="also write per-photo overlays (<= 640 px wide) and contact sheets per ramp into DIR")
     parser.add_argument("--jobs", type=int, default=1, help="worker processes (photos measured in parallel; default 1)")
+    parser.add_argument("--no-ramp-check", dest="ramp_check", action="store_false",
+                        help="do not check each photo's psi against its ramp's trend (flagging jumps, re-trusting cosmetic flags)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -26,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
-    angles = measure_photoset(args.photoset, method=args.method, jobs=args.jobs, overlays_dir=args.overlays)
+    angles = measure_photoset(args.photoset, method=args.method, jobs=args.jobs, overlays_dir=args.overlays, ramp_check=args.ramp_check)
     write_angles(angles, args.out)
     print(f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}")
     return 0

@@ -22,13 +22,14 @@ from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task, run_task
 from pipeline.photoset import PhotoSet, load_photoset
 from pipeline.pool import map_photos
+from pipeline.ramp_check import check_ramps
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see :class:`~pipeline.measure.AngleResult`;
 #: empty on failed rows; ``l0_mm``: the length psi was computed with)
 RESULT_COLUMNS: tuple[str, ...] = (
-    "image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason", "seconds",
-    "degree", "l0_mm",
+    "image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px", "status", "reason",
+    "seconds", "degree", "l0_mm",
 )
 #: manifest columns carried over first (when present), then any others
 CARRIED_FIRST: tuple[str, ...] = ("pressure_kpa", "direction", "material", "actuator", "trial", "step")
@@ -50,6 +51,7 @@ def measure_photoset(
     method: str = DEFAULT_METHOD,
     jobs: int = 1,
     overlays_dir: str | os.PathLike[str] | None = None,
+    ramp_check: bool = True,
 ) -> pd.DataFrame:
     """Measure psi on every photo of a photo set; a bad photo or manifest row is a ``failed`` row.
 
@@ -63,6 +65,9 @@ def measure_photoset(
         Worker processes (1 = measure in this process).
     overlays_dir : path, optional
         Write ``<image stem>.jpg`` overlays and ``contact_<material>_<actuator>_<trial>.jpg``.
+    ramp_check : bool
+        Check every photo against its ramp (:mod:`pipeline.ramp_check`): flag the ones that
+        break its trend, trust again the cosmetically flagged ones that follow it.
 
     Returns
     -------
@@ -95,6 +100,8 @@ def measure_photoset(
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
+    if ramp_check:
+        out = check_ramps(out)
     if odir is not None:
         write_contact_sheets(out, odir)
     return out

@@ -314,19 +314,83 @@ def _resample(points: np.ndarray, step: float) -> np.ndarray:
 
 
 def _smooth(points: np.ndarray, sigma: float) -> np.ndarray:
-    if sigma <= 0 or len(points) < 5:
+    """Smooth a 1-px-spaced polyline over about ``sigma`` px with local quadratic fits.
+
+    Savitzky-Golay (order 2, ends fitted, not mirrored) keeps the curvature at the ends, where
+    a mirrored Gaussian would straighten them and bias the end tangents.
+    """
+    from scipy.signal import savgol_filter
+
+    win = int(2 * round(1.5 * sigma) + 1)
+    if sigma <= 0 or len(points) < max(win, 5):
         return points
-    r = int(3 * sigma)
-    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
-    k /= k.sum()
-    pad = np.pad(points, ((r, r), (0, 0)), mode="reflect", reflect_type="odd")
-    return np.c_[np.convolve(pad[:, 0], k, "valid"), np.convolve(pad[:, 1], k, "valid")]
+    return np.c_[savgol_filter(points[:, 0], win, 2, mode="interp"), savgol_filter(points[:, 1], win, 2, mode="interp")]
 
 
 def _normals(points: np.ndarray) -> np.ndarray:
     t = np.gradient(points, axis=0)
     t /= np.maximum(np.hypot(t[:, 0], t[:, 1]), 1e-9)[:, None]
     return np.c_[-t[:, 1], t[:, 0]]
+
+
+#: edge-to-edge width outside [END_WIDTH_LOW, END_WIDTH_HIGH] x the median at an end of the centre
+#: line: the normal there runs into the clamp or round the tip, and that end is dropped
+END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
+#: the centre line holds where the body is at least this fraction of its usual half-width ...
+TIP_THICKNESS = 0.7
+#: ... and at most this multiple of it (thicker: the clamp or a blob the body runs into)
+BLOB_THICKNESS = 1.6
+
+
+def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[np.ndarray, tuple[float, float]]:
+    """Drop the path's ends where the body tapers (tips, corners) or thickens (clamp, blobs).
+
+    Returns the kept path and the length dropped at each end (px): the line goes on that far.
+    """
+    xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
+    thick = dt[yi, xi]
+    good = (thick >= TIP_THICKNESS * half) & (thick <= BLOB_THICKNESS * half)
+    if good.sum() < 8:
+        return path, (0.0, 0.0)
+    i0, i1 = int(np.argmax(good)), len(good) - 1 - int(np.argmax(good[::-1]))
+    s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+    # a tapering tip ends about one half-width beyond the last thick point
+    return path[i0 : i1 + 1], (float(s[i0]), float(s[-1] - s[i1]))
+
+
+def _extensions(
+    comp: np.ndarray, pts: np.ndarray, half: float, fixed_xy: tuple[float, float] | None, capped: bool
+) -> tuple[float, float]:
+    """How far the body goes on beyond each end of the centre line, along the end tangents (px).
+
+    The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel.
+    The free end: to the body's last pixel within the body's width around the tangent -- unless
+    the centre line stopped where the width changed (a tip cap, which does not bend): then 0.
+    """
+    ys, xs = np.nonzero(comp)
+    q = np.c_[xs, ys].astype(float)
+    out = []
+    k = min(len(pts) - 1, 5)
+    for end, inner in ((0, k), (-1, -1 - k)):
+        p = pts[end]
+        t = pts[end] - pts[inner]
+        t = t / max(float(np.hypot(*t)), 1e-9)  # outward tangent
+        if end == 0 and fixed_xy is not None:
+            out.append(max(0.0, float((np.asarray(fixed_xy) - p) @ t)))
+            continue
+        if end == -1 and capped:
+            out.append(0.0)
+            continue
+        d = q - p
+        along, across = d @ t, np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
+        sel = (across <= half) & (along > 0) & (along <= 2.5 * half + 2.0)  # this end's tip, not what lies beyond a gap
+        if sel.any():  # the tip's pixels run on from the end without a gap
+            a = np.sort(along[sel])
+            gap = np.nonzero(np.diff(np.r_[0.0, a]) > 2.0)[0]
+            out.append(float(a[gap[0] - 1]) if gap.size and gap[0] > 0 else (0.0 if gap.size else float(a[-1])))
+        else:
+            out.append(0.0)
+    return out[0], out[1]
 
 
 def _midpoints(soft: np.ndarray, points: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
@@ -414,23 +478,24 @@ def extract_body(
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
+    path, _ = _trim_by_thickness(path, dt, half)
     soft = cv2.GaussianBlur(comp.astype(np.float32), (0, 0), 0.7)
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
     widths = np.full(len(pts), np.nan)
+    capped = False  # the free end was cut where the width changed (a tip cap, a blob)
     for _ in range(2):
-        moved, widths = _midpoints(soft, pts, reach=3.0 * half + 4.0)
+        moved, wid = _midpoints(soft, pts, reach=3.0 * half + 4.0)
+        med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
+        bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * med) | (wid < END_WIDTH_LOW * med)
+        moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
+        if (~bad).sum() >= 8:  # the ends where the profile runs into the clamp or the tip: dropped
+            i0, i1 = int(np.argmax(~bad)), len(bad) - 1 - int(np.argmax(~bad[::-1]))
+            capped = capped or bool(np.isfinite(wid[i1 + 1 :]).any() and (wid[i1 + 1 :] > END_WIDTH_HIGH * med).any())
+            moved, wid = moved[i0 : i1 + 1], wid[i0 : i1 + 1]
         pts = _smooth(_resample(moved, 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))
-        widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(widths)), np.nan_to_num(widths, nan=np.nanmedian(widths) if np.isfinite(widths).any() else 0.0))
-    # drop the caps: within about one half-width of either end the normal no longer spans the body
-    s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
-    cap = 1.2 * half + 1.0
-    keep = (s >= cap) & (s <= s[-1] - cap)
-    if keep.sum() >= 8:
-        i0, i1 = int(np.argmax(keep)), len(keep) - 1 - int(np.argmax(keep[::-1]))
-        trimmed = (float(s[i0]), float(s[-1] - s[i1]))
-        pts, widths = pts[i0 : i1 + 1], widths[i0 : i1 + 1]
-    else:
-        trimmed = (0.0, 0.0)
+        fill = np.nan_to_num(wid, nan=med)
+        widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(fill)), fill)
+    trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
     ys, xs = np.nonzero(comp)
     touches = bool(xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1)
     contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)

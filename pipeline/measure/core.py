@@ -64,6 +64,8 @@ class AngleResult:
         Centre line (x right, y down, original px), fixed end first; empty when failed.
     line_width_px : float
         Width of the extracted line (original px); NaN when failed.
+    length_px : float
+        Measured line length (original px); NaN when failed.
     degree : int
         Complexity of the curve model the estimator used: 1 for a circular arc (constant
         curvature, also the ``paper`` averages), higher for the turning-angle series actually
@@ -80,6 +82,7 @@ class AngleResult:
     centreline_px: np.ndarray
     line_width_px: float = float("nan")
     degree: int = 0
+    length_px: float = float("nan")
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -184,6 +187,7 @@ def measure_work_image(
         centreline_px=line.centreline_px,
         line_width_px=line.width_px,
         degree=int(est.degree),
+        length_px=float(est.length_px),
     )
 
 
@@ -218,9 +222,10 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     pts = line.centreline_px * np.array([1.0, -1.0])
     rng = np.random.default_rng(SEED)
     base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    ends = line.trimmed_px  # the tangents are carried to the clamp face and to the tip (not over a cap)
     try:
-        tip = tangents(pts, rng, ends_px=line.trimmed_px, base_rad=base)
-        free = tangents(pts, rng, ends_px=line.trimmed_px) if base is not None else tip
+        tip = tangents(pts, rng, ends_px=ends, base_rad=base)
+        free = tangents(pts, rng, ends_px=ends) if base is not None else tip
         est = tip if method in ("auto", "tangents") or base is not None else METHODS[method](pts, rng, ends_px=line.trimmed_px)
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
@@ -249,6 +254,7 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         centreline_px=line.centreline_px,
         line_width_px=line.width_px,
         degree=int(est.degree),
+        length_px=float(est.length_px),
     )
 
 

@@ -37,6 +37,9 @@ NONCONSTANT_DEG = 1.5
 DISAGREE_DEG = 3.0
 #: measured / expected length outside [LENGTH_LOW, LENGTH_HIGH] -> flagged
 LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
+#: flags that doubt only how much of the line was seen, not the angle read from it: a photo
+#: flagged for these alone is trusted again when its psi agrees with its ramp (pipeline.ramp_check)
+COSMETIC_FLAGS: tuple[str, ...] = ("line partly hidden", "line touches the image border", "body partly hidden")
 
 
 @dataclass(frozen=True)

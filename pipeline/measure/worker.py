@@ -66,6 +66,7 @@ def run_task(task: Task) -> dict[str, Any]:
         "psi_deg": res.psi_deg,
         "kappa_per_mm": res.kappa_per_mm,
         "length_mm": res.length_mm,
+        "length_px": res.length_px,
         "method": res.method,
         "residual_px": res.residual_px,
         "status": res.status,
