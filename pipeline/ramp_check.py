@@ -2,18 +2,20 @@
 of its neighbours is doubtful, and one that follows it is trustworthy.
 
 After the photos of a set are measured, each ramp (material, actuator, trial) is split into its
-legs (``up`` then ``down``, in step order) and every measured photo is compared with what its
-neighbours on the same leg predict (linear in pressure between the previous and the next photo;
-extrapolated from the two nearest at the ends of a leg):
+legs (``up`` then ``down``, in step order).  On a leg psi is monotone in pressure, however fast it
+changes (DS20 passes psi = 0 at more than 100 deg per 10 kPa step), so every measured photo
+should lie between its two neighbours on the leg, and an end photo no farther beyond its
+neighbour than twice the neighbouring step:
 
-- a photo farther from that prediction than :data:`JUMP_FACTOR` times the leg's own typical
-  step-to-step change (and at least :data:`MIN_JUMP_DEG`) is ``flagged``, with the reason
-  ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo;
+- a photo more than :data:`SLACK_DEG` outside that range is ``flagged``, with the reason
+  ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
+  The worst photo goes first and the leg is checked again without it, so one wrong photo
+  never drags its neighbours down;
 - a photo whose measured line length is far from the ramp's median is ``flagged`` (a partial
   line);
 - a photo ``flagged`` only for a cosmetic reason (line partly hidden, touching the border) whose
-  psi agrees with its ramp within :data:`AGREE_DEG` and whose neighbours are ``ok`` is ``ok`` again,
-  the reason saying why.
+  psi lies between its ``ok`` neighbours (within :data:`AGREE_DEG`) is ``ok`` again, the reason
+  saying why.
 
 Nothing is changed for a leg of fewer than 3 measured photos.
 
@@ -37,11 +39,8 @@ import pandas as pd
 
 from pipeline.measure.quality import COSMETIC_FLAGS
 
-#: a photo is off its ramp beyond this many typical steps of its leg (the median step-to-step
-#: change, leaving out the photo's own two steps) ...
-JUMP_FACTOR = 4.0
-#: ... and beyond this many degrees in any case
-MIN_JUMP_DEG = 12.0
+#: a photo this far (deg) outside the range its neighbours allow breaks its ramp
+SLACK_DEG = 12.0
 #: a cosmetically flagged photo within this of its ramp's prediction (deg) is trusted again
 AGREE_DEG = 3.0
 #: measured length outside [LENGTH_LOW, LENGTH_HIGH] x the ramp's median -> partial line
@@ -49,18 +48,18 @@ LENGTH_LOW, LENGTH_HIGH = 0.85, 1.15
 RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
 
 
-def _predict(p: np.ndarray, psi: np.ndarray, i: int) -> tuple[float, bool]:
-    """psi at photo ``i`` from its neighbours on the leg (interpolated inside, extrapolated at the ends)."""
-    n = len(p)
+def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
+    """The range of psi that photo ``i`` of a monotone leg may take, from its neighbours."""
+    n = len(psi)
     if 0 < i < n - 1:
-        j, k, inner = i - 1, i + 1, True
-    elif i == 0:
-        j, k, inner = 1, 2, False
-    else:
-        j, k, inner = n - 2, n - 3, False
-    if p[k] == p[j]:
-        return float(0.5 * (psi[j] + psi[k])), inner
-    return float(psi[j] + (psi[k] - psi[j]) * (p[i] - p[j]) / (p[k] - p[j])), inner
+        return float(min(psi[i - 1], psi[i + 1])), float(max(psi[i - 1], psi[i + 1]))
+    j, k = (1, 2) if i == 0 else (n - 2, n - 3)
+    far = psi[j] + 2.0 * (psi[j] - psi[k])  # at most twice the neighbouring step beyond it
+    return float(min(psi[j], far)), float(max(psi[j], far))
+
+
+def _outside(value: float, lo: float, hi: float) -> float:
+    return max(lo - value, value - hi, 0.0)
 
 
 def _is_cosmetic(reason: str) -> bool:
@@ -110,36 +109,26 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
 
 
 def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np.ndarray) -> None:
-    """Flag the leg's outliers one at a time (worst first, then re-predict without it); re-trust."""
+    """Flag the leg's outliers one at a time (worst first, then check again without it); re-trust."""
     keep = list(range(len(leg)))
-    p_all = leg["pressure_kpa"].to_numpy(float)
     psi_all = leg["psi_deg"].to_numpy(float)
     while len(keep) >= 3:
-        p, psi = p_all[keep], psi_all[keep]
-        steps = np.abs(np.diff(psi))
-        scores = []
-        for i in range(len(keep)):
-            # the leg's typical step, without the two steps that touch this photo
-            others = np.delete(steps, [j for j in (i - 1, i) if 0 <= j < len(steps)])
-            typical = float(np.median(others)) if others.size else float(np.median(steps))
-            pred, inner = _predict(p, psi, i)
-            limit = max(JUMP_FACTOR * typical, MIN_JUMP_DEG) * (1.0 if inner else 1.5)
-            scores.append((abs(psi[i] - pred) / limit, i, pred))
-        worst, i, pred = max(scores)
-        if worst <= 1.0:
+        psi = psi_all[keep]
+        worst, i, lo, hi = max((_outside(psi[i], *_allowed(psi, i)), i, *_allowed(psi, i)) for i in range(len(keep)))
+        if worst <= SLACK_DEG:
             break
         k = position[leg.index[keep[i]]]
         status[k] = "flagged"
-        reason[k] = _join(f"breaks its ramp: psi {psi[i]:+.0f} deg where its neighbours give {pred:+.0f}", reason[k])
+        reason[k] = _join(f"breaks its ramp: psi {psi[i]:+.0f} deg where its neighbours allow {lo:+.0f} to {hi:+.0f}", reason[k])
         del keep[i]
     if len(keep) < 3:
         return
-    p, psi = p_all[keep], psi_all[keep]
+    psi = psi_all[keep]
     for i in range(1, len(keep) - 1):
         k = position[leg.index[keep[i]]]
-        pred, _ = _predict(p, psi, i)
+        off = _outside(psi[i], *_allowed(psi, i))
         neighbours = (position[leg.index[keep[i - 1]]], position[leg.index[keep[i + 1]]])
-        if (status[k] == "flagged" and abs(psi[i] - pred) <= AGREE_DEG and _is_cosmetic(reason[k])
+        if (status[k] == "flagged" and off <= AGREE_DEG and _is_cosmetic(reason[k])
                 and all(status[n] == "ok" for n in neighbours)):
             status[k] = "ok"
-            reason[k] = f"psi agrees with its ramp within {abs(psi[i] - pred):.1f} deg (was flagged: {reason[k]})"
+            reason[k] = f"psi agrees with its ramp (between its neighbours) (was flagged: {reason[k]})"

@@ -337,7 +337,7 @@ def _normals(points: np.ndarray) -> np.ndarray:
 #: line: the normal there runs into the clamp or round the tip, and that end is dropped
 END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
 #: the centre line holds where the body is at least this fraction of its usual half-width ...
-TIP_THICKNESS = 0.7
+TIP_THICKNESS = 0.95
 #: ... and at most this multiple of it (thicker: the clamp or a blob the body runs into)
 BLOB_THICKNESS = 1.6
 
@@ -356,6 +356,25 @@ def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[n
     s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
     # a tapering tip ends about one half-width beyond the last thick point
     return path[i0 : i1 + 1], (float(s[i0]), float(s[-1] - s[i1]))
+
+
+def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
+    """The body as a 0..1 field whose 0.5 level is its sub-pixel edge.
+
+    Inside and outside it is the chosen component; in a band along its outline it is the colour
+    difference scaled so that the body's typical difference is 1 (the 0.5 crossing of a blurred
+    step is the edge), which follows the true, anti-aliased outline instead of the mask's pixel
+    staircase.  Without a difference (a colour-only selection) the mask is blurred instead.
+    """
+    body = comp.astype(np.float32)
+    inner = cv2.erode(comp, np.ones((5, 5), np.uint8))
+    level = float(np.median(strength[inner > 0])) if inner.any() else 0.0
+    if level <= 1.0:  # no difference image, or too faint to locate edges by
+        return cv2.GaussianBlur(body, (0, 0), 0.7)
+    band = (cv2.dilate(comp, np.ones((5, 5), np.uint8)) > 0) & (inner == 0)
+    soft = body.copy()
+    soft[band] = np.clip(strength[band] / level, 0.0, 1.0)
+    return soft
 
 
 def _extensions(
@@ -455,7 +474,7 @@ def extract_body(
     if image_bgr is None or image_bgr.ndim != 3:
         raise NoLineFound("unreadable image (not a colour image)")
     h, w = image_bgr.shape[:2]
-    raw, _, contrast = body_mask(image_bgr, settings, scale=scale, background_bgr=background_bgr)
+    raw, strength, contrast = body_mask(image_bgr, settings, scale=scale, background_bgr=background_bgr)
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     allowed_px = float(h * w if region is None else region.sum())
     selected = float(raw.sum()) / max(allowed_px, 1.0)
@@ -479,7 +498,7 @@ def extract_body(
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
     path, _ = _trim_by_thickness(path, dt, half)
-    soft = cv2.GaussianBlur(comp.astype(np.float32), (0, 0), 0.7)
+    soft = _soft_body(comp, strength)
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
     widths = np.full(len(pts), np.nan)
     capped = False  # the free end was cut where the width changed (a tip cap, a blob)
