@@ -9,10 +9,8 @@ from pipeline.errors import UserInputError
 
 
 if workflow.exec_mode.name == "DEFAULT":
+    _resources = workflow.resource_settings.default_resources or {}
     try:
-        check_slurm_resources(
-            {name: getattr(res, "raw", res) for name, res in (workflow.resource_settings.default_resources or {}).items()},
-            os.environ,
-        )
+        check_slurm_resources({k: getattr(v, "raw", v) for k, v in _resources.items()}, os.environ)
     except UserInputError as exc:
         raise WorkflowError(str(exc)) from None
