@@ -253,3 +253,22 @@ def test_bad_inputs_exit_2(four, tmp_path):
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2
     assert main(["report", "--angles", str(datasets[0].angles_csv), "--rms", str(datasets[0].angles_csv),
                  "--model-curves", str(datasets[0].angles_csv), "--out", out]) == 2
+
+
+def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_path):
+    """angles.csv records seconds per photo; two runs on the same photos (a workstation and a
+    cluster) differ only there, and the report (which prints the table's digest) must not.
+    The pages are pure functions of ReportData, so equal data means equal bytes (the SLURM test
+    compares whole PDFs)."""
+    from pipeline.report.data import load_report_data, sha256_file, sha256_measurements
+
+    d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
+    first = load_report_data(ReportInputs(datasets=(d,))).digests
+    angles = pd.read_csv(d.angles_csv)
+    angles.assign(seconds=angles["seconds"] * 3.7 + 0.011).to_csv(d.angles_csv, index=False)
+    assert load_report_data(ReportInputs(datasets=(d,))).digests == first
+    digest = sha256_measurements(d.angles_csv)
+    angles.assign(psi_deg=angles["psi_deg"] + 0.001).to_csv(d.angles_csv, index=False)
+    assert sha256_measurements(d.angles_csv) != digest
+    angles.drop(columns="seconds").to_csv(d.angles_csv, index=False)
+    assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -151,6 +152,7 @@ def test_slurm_profile_plans_the_workflow(repo, tmp_path):
     out = subprocess.run(
         [*SNAKEMAKE, "--executor", "slurm", "--profile", "rules/profiles/slurm", "-n"],
         cwd=work, capture_output=True, text=True,
+        env={**os.environ, "SBATCH_ACCOUNT": "lab", "SBATCH_PARTITION": "debug"},
     )
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     assert _planned_jobs(out.stdout)["measure"] == 5

@@ -5,7 +5,9 @@ The pages are pure functions of this object, so the PDF depends on the inputs' c
 
 from __future__ import annotations
 
+import csv
 import hashlib
+import io
 import math
 import os
 from collections.abc import Sequence
@@ -79,7 +81,8 @@ class ReportData:
     model_curves : pandas.DataFrame
         ``material``, ``psi_deg``, ``pressure_kpa`` (may be empty).
     digests : dict of str to str
-        sha256 of every input file (path as given -> hex digest).
+        sha256 of every input file (path as given -> hex digest); for angles tables without
+        their timing column (:func:`sha256_measurements`).
     notes : list of str
         Things the reader should know (e.g. hysteresis recomputed from angles).
     """
@@ -115,6 +118,37 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
     except OSError as exc:
         raise UserInputError(f"{path}: cannot read ({exc.strerror}); check the path") from None
     return h.hexdigest()
+
+
+TIMING_COLUMNS: tuple[str, ...] = ("seconds",)
+
+
+def sha256_measurements(path: str | os.PathLike[str], timing: Sequence[str] = TIMING_COLUMNS) -> str:
+    """Hex sha256 of a CSV table without its run-time columns (``seconds``).
+
+    A measure job records how long each photo took; two runs on the same photos (on a
+    workstation or on a cluster) differ only there. The rest of the table, re-written with
+    ``\\n`` line ends, identifies the measurements. A table without such a column gets the
+    digest of its bytes, as :func:`sha256_file`.
+
+    Raises
+    ------
+    UserInputError
+        If the file cannot be read.
+    """
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserInputError(f"{path}: cannot read ({exc}); check the path") from None
+    rows = list(csv.reader(io.StringIO(text)))
+    drop = {i for i, name in enumerate(rows[0] if rows else []) if name in timing}
+    if not drop:
+        return sha256_file(path)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerows([v for i, v in enumerate(row) if i not in drop] for row in rows)
+    return hashlib.sha256(out.getvalue().encode("utf-8")).hexdigest()
 
 
 def _read_csv(path: Path, what: str, required: Sequence[str]) -> pd.DataFrame:
@@ -174,11 +208,11 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         notes.append("no --model-curves given: plots show the measurements only")
     if inputs.config is not None:
         notes.append(model_readings_note(inputs.config))
-    files: list[Path] = [d.angles_csv for d in inputs.datasets]
-    files += list(inputs.hysteresis) + list(inputs.rms) + list(inputs.model_curves)
+    files: list[Path] = list(inputs.hysteresis) + list(inputs.rms) + list(inputs.model_curves)
     if inputs.config is not None:
         files.append(inputs.config)
-    digests = {str(p): sha256_file(p) for p in files}
+    digests = {str(d.angles_csv): sha256_measurements(d.angles_csv) for d in inputs.datasets}
+    digests |= {str(p): sha256_file(p) for p in files}
     return ReportData(
         inputs=inputs, angles=angles, hysteresis=hysteresis, per_actuator=per_actuator, rms=rms,
         model_curves=curves, digests=digests, notes=notes,

@@ -57,7 +57,7 @@ def summary_lines(data: ReportData, version: str, config_digest: str | None, war
     counts = status_counts(data.angles)
     for d in data.inputs.datasets:
         c = counts[counts["dataset"] == d.name]
-        body(f"{d.name}: {d.angles_csv} (sha256 {data.digests[str(d.angles_csv)][:16]})")
+        body(f"{d.name}: {d.angles_csv} (sha256 {data.digests[str(d.angles_csv)][:16]} without the seconds column)")
         body(f"photos {d.photoset_dir or 'not given'}; overlays {d.overlays_dir or 'not given'}", "    ")
         for r in c.itertuples():
             body(f"{r.material}: {r.images} images, {r.ok} ok, {r.flagged} flagged, {r.failed} failed", "    ")
