@@ -48,7 +48,7 @@ OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa
 SETTING_DEFAULTS: dict[str, Any] = {"l0_mm": None, "mm_per_px": None, "fixed_end": "auto", "positive_turn": "ccw"}
 #: manifest columns read as text
 _TEXT_COLUMNS = ("image", "material", "actuator", "direction", "trial", "line_color", "positive_turn", "target",
-                 "background", "roi", "exclude")
+                 "background", "roi", "exclude", "method")
 
 IMAGE_SUFFIXES: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp")
 

@@ -5,7 +5,7 @@ After the photos of a set are measured, each ramp (material, actuator, trial) is
 legs (``up`` then ``down``, in step order).  On a leg psi is monotone in pressure, however fast it
 changes (DS20 passes psi = 0 at more than 100 deg per 10 kPa step), so every measured photo
 should lie between its two neighbours on the leg, and an end photo no farther beyond its
-neighbour than twice the neighbouring step:
+neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in its fastest part):
 
 - a photo more than :data:`SLACK_DEG` outside that range is ``flagged``, with the reason
   ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
@@ -41,6 +41,8 @@ from pipeline.measure.quality import COSMETIC_FLAGS
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
+#: an end photo of a leg may lie this many neighbouring steps beyond its neighbour
+END_STEPS = 4.0
 #: a cosmetically flagged photo within this of its ramp's prediction (deg) is trusted again
 AGREE_DEG = 3.0
 #: measured length outside [LENGTH_LOW, LENGTH_HIGH] x the ramp's median -> partial line
@@ -54,7 +56,7 @@ def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
     if 0 < i < n - 1:
         return float(min(psi[i - 1], psi[i + 1])), float(max(psi[i - 1], psi[i + 1]))
     j, k = (1, 2) if i == 0 else (n - 2, n - 3)
-    far = psi[j] + 2.0 * (psi[j] - psi[k])  # at most twice the neighbouring step beyond it
+    far = psi[j] + END_STEPS * (psi[j] - psi[k])
     return float(min(psi[j], far)), float(max(psi[j], far))
 
 

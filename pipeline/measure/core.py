@@ -127,6 +127,7 @@ def measure_work_image(
     ``fine_scale`` < ``scale``) the centre line extracted from ``image_bgr`` is refined on it
     before the curvature fit.
     """
+    method = settings.method or method
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
     if settings.target == "body":

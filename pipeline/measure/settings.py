@@ -31,6 +31,9 @@ Keys
 ``fixed_direction_deg``
     Direction in which the actuator leaves the clamp, on screen, degrees counter-clockwise from
     +x: psi is then the free end's tangent against this direction.
+``method``
+    The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
+    run's method (``--method``, config ``measure.method``) applies.
 
 Examples
 --------
@@ -61,12 +64,12 @@ POSITIVE_TURNS: tuple[str, ...] = ("ccw", "cw")
 #: every settings key, as it may appear in photoset.yaml (fixed_end as fixed_end_x/_y in rows)
 KEYS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
-    "exclude", "fixed_direction_deg",
+    "exclude", "fixed_direction_deg", "method",
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y", "positive_turn", "target", "background",
-    "roi", "exclude", "fixed_direction_deg",
+    "roi", "exclude", "fixed_direction_deg", "method",
 )
 
 
@@ -116,6 +119,8 @@ class MeasureSettings:
         Regions to ignore (px).
     fixed_direction_deg : float or None
         Known direction (deg, ccw from +x on screen) in which the actuator leaves the clamp.
+    method : str or None
+        Estimator for these photos; None: the run's.
     """
 
     l0_mm: float
@@ -128,6 +133,7 @@ class MeasureSettings:
     roi: Polygon | None = None
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None
+    method: str | None = None
 
     @property
     def sign(self) -> float:
@@ -290,6 +296,13 @@ def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[Me
                 exclude.append(_points(item, f"exclude[{i}]"))
             except ValueError as exc:
                 problems.append(SettingProblem("exclude", str(exc), "write exclude as a list of polygons [[[x, y], [x, y], [x, y]], ...] or boxes [[x0, y0, x1, y1], ...]"))
+    method: str | None = None
+    if not is_missing(raw.get("method")):
+        from pipeline.measure.estimators import METHODS
+
+        method = str(raw["method"]).strip()
+        if method not in METHODS:
+            problems.append(SettingProblem("method", f"method = {raw['method']!r} is unknown", f"use one of {', '.join(METHODS)}"))
     background: str | None = None
     if not is_missing(raw.get("background")):
         path = Path(str(raw["background"]))
@@ -303,6 +316,7 @@ def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[Me
     return MeasureSettings(
         l0_mm=l0, mm_per_px=mpp, color=color, fixed_end_px=fixed_end, positive_turn=turn, target=target,
         background_path=background, roi=roi, exclude=tuple(exclude), fixed_direction_deg=fixed_direction,
+        method=method,
     ), []
 
 
