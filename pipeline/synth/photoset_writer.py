@@ -20,6 +20,7 @@ import concurrent.futures
 import dataclasses
 import multiprocessing
 import os
+import signal
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
@@ -165,6 +166,11 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
     return rot, (float(origin[0]), float(origin[1])), float(need)
 
 
+def _worker_init() -> None:
+    """Ctrl-C reaches the whole process group: a worker just stops, the main process cleans up."""
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(128 + signum))
+
+
 def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     """Render and write the photos of one ramp (runs in a worker process)."""
     import cv2
@@ -285,8 +291,11 @@ def render_photoset(
             results = [_render_ramp(task) for task in tasks]
         else:
             ctx = multiprocessing.get_context("spawn")
-            with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+            pool = concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+            try:
                 results = list(pool.map(_render_ramp, tasks))
+            finally:  # on Ctrl-C/SIGTERM: drop the ramps not started, wait for the (dead) workers
+                pool.shutdown(wait=True, cancel_futures=True)
         rendered = pd.DataFrame([r for res in results for r in res])
         truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
         truth = truth.assign(
