@@ -71,10 +71,11 @@ def staged_folder(final: str | os.PathLike[str], *, marker: str) -> Iterator[Pat
         If ``final`` exists, is not empty and holds no ``marker``.
     """
     final = Path(final)
-    if final.exists() and (not final.is_dir() or (any(final.iterdir()) and not any(final.glob(marker)))):
+    ours = final.is_dir() and (not any(final.iterdir()) or any(final.glob(marker)))
+    if final.exists() and not ours:
         raise UserInputError(
-            f"{final}: exists and is not an output of this command (no {marker} in it), so it is not replaced; "
-            "choose a new or empty folder"
+            f"{final}: exists and is not an output of this command (no {marker} in it), so it is "
+            "not replaced; choose a new or empty folder"
         )
     tmp, old = _partial(final), _old(final)
     for stale in (tmp, old):
@@ -114,7 +115,9 @@ def folder_files(folder: str | os.PathLike[str]) -> list[Path]:
     return sorted(out)
 
 
-def update_folder_digest(folder: str | os.PathLike[str], digest_file: str | os.PathLike[str]) -> Path:
+def update_folder_digest(
+    folder: str | os.PathLike[str], digest_file: str | os.PathLike[str]
+) -> Path:
     """Write ``digest_file`` with a SHA-256 over every file of ``folder``, only when it changed.
 
     The digest covers each file's path (relative to ``folder``), size and content hash, so it
@@ -162,7 +165,8 @@ def update_folder_digest(folder: str | os.PathLike[str], digest_file: str | os.P
         rel = path.relative_to(folder).as_posix()
         key = [st.st_size, st.st_mtime_ns, st.st_ctime_ns]
         hit = cache.get(rel)
-        sha = hit[3] if isinstance(hit, list) and len(hit) == 4 and hit[:3] == key else _sha256(path)
+        known = isinstance(hit, list) and len(hit) == 4 and hit[:3] == key
+        sha = hit[3] if known else _sha256(path)
         new_cache[rel] = [*key, sha]
         lines.append(f"{sha}  {st.st_size:>12d}  {rel}\n")
     text = "".join(lines)

@@ -20,8 +20,9 @@ rule synth_photoset:
     shell:
         logged(
             "python -m pipeline synth {output:q} --material {params.ds[material]:q}"
-            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q} --seed {params.ds[seed]:q}"
-            " --scene {params.ds[scene]:q} --step-kpa {params.ds[step_kpa]:q} --max-kpa {params.ds[max_kpa]:q}"
+            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q}"
+            " --seed {params.ds[seed]:q} --scene {params.ds[scene]:q}"
+            " --step-kpa {params.ds[step_kpa]:q} --max-kpa {params.ds[max_kpa]:q}"
             " {params.overrides:q} --jobs {threads}"
         )
 
@@ -45,6 +46,7 @@ rule acquire_rig:
         logged(
             "python -m pipeline acquire --port {params.ds[port]:q} --camera {params.ds[camera]:q}"
             " --material {params.ds[material]:q} --actuator {params.ds[actuator]:q}"
-            " --trials {params.ds[trials]:q} --step-kpa {params.ds[step_kpa]:q} --max-kpa {params.ds[max_kpa]:q}"
-            " --settle-s {params.ds[settle_s]:q} --l0-mm {params.ds[l0_mm]:q} --out {params.ds[path]:q}"
+            " --trials {params.ds[trials]:q} --step-kpa {params.ds[step_kpa]:q}"
+            " --max-kpa {params.ds[max_kpa]:q} --settle-s {params.ds[settle_s]:q}"
+            " --l0-mm {params.ds[l0_mm]:q} --out {params.ds[path]:q}"
         )

@@ -69,15 +69,19 @@ def logged(command):
 
 
 def _digest(kind, name, folder):
-    """Digest file of a photo-set folder, rewritten (at DAG build) only when a file in it changed."""
+    """Digest file of a photo-set folder, rewritten (at DAG build) only when a file changed."""
     return str(update_folder_digest(folder, f"{RESULTS}/digests/{kind}/{name}.sha256"))
 
 
 # A folder's measure job depends on the bytes of every file in it (a photo replaced, added or
 # removed, or manifest.csv/photoset.yaml edited), through a digest kept under results/digests/.
-FOLDER_DIGESTS = {n: _digest("datasets", n, ds["path"]) for n, ds in DATASETS.items() if ds["source"] == "folder"}
+FOLDER_DIGESTS = {
+    n: _digest("datasets", n, ds["path"]) for n, ds in DATASETS.items() if ds["source"] == "folder"
+}
 FORCE_FOLDER_DIGESTS = {
-    n: _digest("force", n, ds["path"]) for n, ds in FORCE_DATASETS.items() if ds["source"] == "folder"
+    n: _digest("force", n, ds["path"])
+    for n, ds in FORCE_DATASETS.items()
+    if ds["source"] == "folder"
 }
 
 
@@ -124,7 +128,7 @@ def materials_option():
 
 
 def model_readings_option():
-    """`--<reading> VALUE` for `model` and `compare`: the readings the config gives (model.readings)."""
+    """`--<reading> VALUE` for `model` and `compare`: the readings model.readings gives."""
     readings = config["model"]["readings"]
     return [
         arg
@@ -147,7 +151,8 @@ def overlays_option(folder):
 
 def scene_overrides(ds):
     """`--set KEY=VALUE` options of a synthetic dataset's scene overrides."""
-    return [arg for k, v in sorted(ds.get("scene_set", {}).items()) for arg in ("--set", f"{k}={v}")]
+    pairs = sorted(ds.get("scene_set", {}).items())
+    return [arg for k, v in pairs for arg in ("--set", f"{k}={v}")]
 
 
 def force_photoset_dir(name):

@@ -24,7 +24,7 @@ rule compare:
         CONDA_ENV
     shell:
         logged(
-            "python -m pipeline compare {input.hysteresis:q} --angles {input.angles:q} --datasets {params.names:q}"
-            " --bootstrap {params.bootstrap:q} --seed {params.seed:q} {params.materials:q} {params.readings:q}"
-            " --out {output:q}"
+            "python -m pipeline compare {input.hysteresis:q} --angles {input.angles:q}"
+            " --datasets {params.names:q} --bootstrap {params.bootstrap:q} --seed {params.seed:q}"
+            " {params.materials:q} {params.readings:q} --out {output:q}"
         )

@@ -19,8 +19,9 @@ rule force_synth_photoset:
     shell:
         logged(
             "python -m pipeline force synth {output:q} --material {params.ds[material]:q}"
-            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q} --seed {params.ds[seed]:q}"
-            " --scene {params.ds[scene]:q} --step-kpa {params.ds[step_kpa]:q}"
+            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q}"
+            " --seed {params.ds[seed]:q} --scene {params.ds[scene]:q}"
+            " --step-kpa {params.ds[step_kpa]:q}"
         )
 
 
@@ -41,7 +42,9 @@ rule force_measure:
     conda:
         CONDA_ENV
     shell:
-        logged("python -m pipeline force measure {params.folder:q} --out {output:q} --jobs {threads}")
+        logged(
+            "python -m pipeline force measure {params.folder:q} --out {output:q} --jobs {threads}"
+        )
 
 
 rule force_aggregate:

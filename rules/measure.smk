@@ -22,6 +22,6 @@ rule measure:
         CONDA_ENV
     shell:
         logged(
-            "mkdir -p {output.overlays:q} && python -m pipeline measure {params.folder:q} --out {output.angles:q}"
-            " {params.method:q} {params.overlays:q} --jobs {threads}"
+            "mkdir -p {output.overlays:q} && python -m pipeline measure {params.folder:q}"
+            " --out {output.angles:q} {params.method:q} {params.overlays:q} --jobs {threads}"
         )

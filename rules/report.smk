@@ -32,8 +32,9 @@ rule report:
         logged(
             "python -m pipeline report --datasets {params.names:q} --angles {input.angles:q}"
             " --hysteresis {input.hysteresis:q} --rms {input.rms:q} --model-curves {input.curves:q}"
-            " --photosets {params.photosets:q} --overlays {params.overlays:q} {params.bench:q} {params.force:q}"
-            " --config {input.config:q} --title {params.title:q} --out {output:q}"
+            " --photosets {params.photosets:q} --overlays {params.overlays:q}"
+            " {params.bench:q} {params.force:q} --config {input.config:q} --title {params.title:q}"
+            " --out {output:q}"
         )
 
 

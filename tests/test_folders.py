@@ -1,4 +1,4 @@
-"""Folders written whole (staged_folder) and the digest that changes exactly when a folder's bytes do."""
+"""Folders written whole (staged_folder); a digest that changes exactly when a folder's bytes do."""
 
 from __future__ import annotations
 
@@ -25,7 +25,8 @@ def test_staged_folder_replaces_a_previous_output_only_when_complete(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]  # and no partial folder
     with staged_folder(final, marker="truth.csv") as tmp:
         (tmp / "truth.csv").write_text("v3")
-    assert (final / "truth.csv").read_text() == "v3" and sorted(p.name for p in tmp_path.iterdir()) == ["set"]
+    assert (final / "truth.csv").read_text() == "v3"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]
 
 
 def test_staged_folder_clears_what_a_killed_run_left_and_never_replaces_a_users_folder(tmp_path):
@@ -47,12 +48,15 @@ def test_staged_folder_clears_what_a_killed_run_left_and_never_replaces_a_users_
 
 def _photos(folder):
     folder.mkdir()
-    for name, data in {"a.jpg": b"photo a", "b.jpg": b"photo b", "manifest.csv": b"image\na.jpg\nb.jpg\n"}.items():
+    files = {"a.jpg": b"photo a", "b.jpg": b"photo b", "manifest.csv": b"image\na.jpg\nb.jpg\n"}
+    for name, data in files.items():
         (folder / name).write_bytes(data)
     return folder
 
 
-@pytest.mark.parametrize("change", ["replace", "add", "remove", "rename", "edit manifest", "same size"])
+@pytest.mark.parametrize(
+    "change", ["replace", "add", "remove", "rename", "edit manifest", "same size"]
+)
 def test_digest_changes_with_the_bytes_of_any_file(tmp_path, change):
     folder = _photos(tmp_path / "set")
     digest = update_folder_digest(folder, tmp_path / "d" / "set.sha256")
@@ -74,7 +78,9 @@ def test_digest_changes_with_the_bytes_of_any_file(tmp_path, change):
     assert update_folder_digest(folder, digest).read_text() != before
 
 
-def test_digest_is_rewritten_only_when_it_changes_and_reads_only_changed_files(tmp_path, monkeypatch):
+def test_digest_is_rewritten_only_when_it_changes_and_reads_only_changed_files(
+    tmp_path, monkeypatch
+):
     folder = _photos(tmp_path / "set")
     (folder / ".DS_Store").write_bytes(b"finder")  # hidden files are not photos
     digest = update_folder_digest(folder, tmp_path / "d" / "set.sha256")
