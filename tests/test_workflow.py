@@ -25,7 +25,7 @@ from pipeline.bench.campaign import run_accuracy
 pytestmark = pytest.mark.slow
 
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
-PHOTOS = "photos/sample"  # the folder dataset: a copy of sample_images/ inside the work folder
+PHOTOS = "photos/sample"  # the folder dataset: the first ramp of sample_images/, copied per test
 
 
 def _tiny_config() -> dict:
@@ -58,9 +58,16 @@ def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedPro
 
 
 def _workdir(path: Path, repo: Path, config: dict) -> Path:
-    """A work folder holding the tests' own config and a copy of the sample photo set."""
-    path.mkdir(parents=True, exist_ok=True)
-    shutil.copytree(repo / "sample_images", path / PHOTOS)
+    """A work folder holding the tests' own config and the first ramp of the sample photo set."""
+    photos = path / PHOTOS
+    photos.mkdir(parents=True)
+    shutil.copy(repo / "sample_images" / "photoset.yaml", photos)
+    for table in ("manifest.csv", "truth.csv"):
+        rows = pd.read_csv(repo / "sample_images" / table, dtype=str)
+        rows = rows[rows["trial"] == "1"]
+        rows.to_csv(photos / table, index=False)
+    for image in rows["image"]:
+        shutil.copy2(repo / "sample_images" / image, photos)
     (path / "config.yaml").write_text(yaml.safe_dump(config))
     return path
 
@@ -159,12 +166,18 @@ def test_broken_config_is_refused_before_any_job(tmp_path, repo):
 
 
 def _users_checkout(repo: Path, path: Path) -> Path:
-    """A checkout after the README's "add a dataset" step: one more folder dataset in config.yaml."""
-    shutil.copytree(repo, path, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__", "tests"))
+    """A checkout after the README's "add a dataset" step: a config.yaml with the user's own set.
+
+    Written here, not derived from this checkout's config.yaml, which the tests never read.
+    """
+    ignore = shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__", "tests")
+    shutil.copytree(repo, path, ignore=ignore)
     shutil.copytree(repo / "sample_images", path / "my_photos")
-    cfg = yaml.safe_load((path / "config.yaml").read_text())
-    cfg["datasets"].append({"name": "my_photos", "source": "folder", "path": "my_photos"})
-    (path / "config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    (path / "config.yaml").write_text(
+        "datasets:\n"
+        "  - {name: sample, source: folder, path: sample_images}\n"
+        "  - {name: my_photos, source: folder, path: my_photos}  # the README's step\n"
+    )
     return path
 
 
