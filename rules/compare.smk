@@ -14,15 +14,17 @@ rule compare:
         bootstrap=config["compare"]["bootstrap"],
         seed=config["compare"]["seed"],
     log:
-        f"{LOGS}/compare.log",
+        log_file("compare"),
     benchmark:
-        f"{BENCHMARKS}/compare.tsv"
+        benchmark_file("compare")
     threads: 1
+    resources:
+        **TABLE_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=1000,
-        runtime=10,
     shell:
-        "python -m pipeline compare {input.hysteresis} --angles {input.angles} --datasets {params.names}"
-        " --bootstrap {params.bootstrap} --seed {params.seed} {params.materials} {params.readings} --out {output} > {log} 2>&1"
+        logged(
+            "python -m pipeline compare {input.hysteresis:q} --angles {input.angles:q}"
+            " --datasets {params.names:q} --bootstrap {params.bootstrap:q} --seed {params.seed:q}"
+            " {params.materials:q} {params.readings:q} --out {output:q}"
+        )

@@ -23,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define the ``synth`` options."""
     from pipeline.synth.presets import SCENE_PRESETS
 
-    parser.add_argument("out_dir", metavar="OUT_DIR", help="photo-set folder to write (created; files in it are replaced)")
+    parser.add_argument("out_dir", metavar="OUT_DIR", help="photo-set folder to write; it appears only when complete (a previous synthetic set there is replaced)")
     parser.add_argument("--material", required=True, help="material name: DS20, DS30, SS40, SS50 (model's materials)")
     parser.add_argument("--actuators", type=int, default=3, help="number of actuators (default 3)")
     parser.add_argument("--trials", type=int, default=6, help="ramps per actuator (default 6)")

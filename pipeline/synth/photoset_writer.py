@@ -20,6 +20,7 @@ import concurrent.futures
 import dataclasses
 import multiprocessing
 import os
+import signal
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
@@ -30,6 +31,7 @@ import pandas as pd
 
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
+from pipeline.folders import staged_folder
 from pipeline.photoset import MANIFEST, TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
@@ -165,6 +167,11 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
     return rot, (float(origin[0]), float(origin[1])), float(need)
 
 
+def _worker_init() -> None:
+    """Ctrl-C reaches the whole process group: a worker just stops, the main process cleans up."""
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(128 + signum))
+
+
 def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     """Render and write the photos of one ramp (runs in a worker process)."""
     import cv2
@@ -215,7 +222,9 @@ def render_photoset(
     Parameters
     ----------
     out_dir : path
-        Folder to write (created).
+        Folder to write.  It is written under a temporary name beside it and renamed when
+        complete (:func:`pipeline.folders.staged_folder`): an interrupted render leaves no partial
+        set, and an existing synthetic set (one with ``truth.csv``) is replaced as a whole.
     material : str
         Material name (``DS20``, ``DS30``, ``SS40``, ``SS50`` or any name ``psi_fn`` knows).
     actuators, trials : int
@@ -236,7 +245,8 @@ def render_photoset(
     l0_mm : float, optional
         Marked length (default: the model's material file, else 195 mm).
     overwrite : bool
-        Allow writing into a folder that already holds a photo set.
+        Allow replacing a folder that already holds a synthetic photo set (a folder holding other
+        files, such as a real photo set without ``truth.csv``, is never replaced).
     fit_view : bool
         When the campaign's shapes do not fit the frame at ``scene.mm_per_px``, increase
         ``mm_per_px`` just enough (the value used is written to ``photoset.yaml``).
@@ -267,38 +277,41 @@ def render_photoset(
     jit = 2.5 * sc.rotation_jitter_deg
     keepout = [_rotate(e, d) for e in extents for d in ({-jit, 0.0, jit})]
     mk = material_key(material)
-    out.mkdir(parents=True, exist_ok=True)
-    tasks = []
-    for (act, trial), g in plan.groupby(["actuator", "trial"], sort=False):
-        a, t = int(act[1:]), int(trial)
-        rot = base_rot + float(np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(0, sc.rotation_jitter_deg))
-        tasks.append({
-            "scene": sc, "rotation_deg": rot, "base_rotation_deg": base_rot, "fixed_end_px": fixed_end_px,
-            "keepout_mm": keepout, "table_seed": child_seed(seed, mk, _TABLE), "out_dir": str(out), "l0_mm": l0,
-            "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
-            "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
+    with staged_folder(out, marker=TRUTH) as tmp:  # the set appears complete or not at all
+        tasks = []
+        for (act, trial), g in plan.groupby(["actuator", "trial"], sort=False):
+            a, t = int(act[1:]), int(trial)
+            rot = base_rot + float(np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(0, sc.rotation_jitter_deg))
+            tasks.append({
+                "scene": sc, "rotation_deg": rot, "base_rotation_deg": base_rot, "fixed_end_px": fixed_end_px,
+                "keepout_mm": keepout, "table_seed": child_seed(seed, mk, _TABLE), "out_dir": str(tmp), "l0_mm": l0,
+                "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
+                "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
+            })
+        if jobs == 1 or len(tasks) == 1:
+            results = [_render_ramp(task) for task in tasks]
+        else:
+            ctx = multiprocessing.get_context("spawn")
+            pool = concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+            try:
+                results = list(pool.map(_render_ramp, tasks))
+            finally:  # on Ctrl-C/SIGTERM: drop the ramps not started, wait for the (dead) workers
+                pool.shutdown(wait=True, cancel_futures=True)
+        rendered = pd.DataFrame([r for res in results for r in res])
+        truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
+        truth = truth.assign(
+            scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
+            blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
+            occluded_fraction=sc.occluded_fraction, seed=seed,
+        )
+        first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
+                 "bulge"]
+        truth = truth[first + [c for c in truth.columns if c not in first]]
+        manifest = truth[["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]]
+        write_manifest(tmp, manifest)
+        write_settings(tmp, {
+            "l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
+            "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw",
         })
-    if jobs == 1 or len(tasks) == 1:
-        results = [_render_ramp(task) for task in tasks]
-    else:
-        ctx = multiprocessing.get_context("spawn")
-        with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-            results = list(pool.map(_render_ramp, tasks))
-    rendered = pd.DataFrame([r for res in results for r in res])
-    truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
-    truth = truth.assign(
-        scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
-        blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
-        occluded_fraction=sc.occluded_fraction, seed=seed,
-    )
-    first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
-             "bulge"]
-    truth = truth[first + [c for c in truth.columns if c not in first]]
-    manifest = truth[["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]]
-    write_manifest(out, manifest)
-    write_settings(out, {
-        "l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
-        "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw",
-    })
-    atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth
