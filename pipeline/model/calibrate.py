@@ -232,7 +232,9 @@ def anchor_table(materials: Mapping[str, Material] | None = None, **options: Any
             row["ours_range_deg"] = mat.psi0_deg - ours
             row["pct_off"] = 100.0 * (row["ours_range_deg"] - paper_range) / paper_range
         rows.append(row)
-    return pd.DataFrame(rows)
+    columns = ["group", "anchor", "material", "unit", "at", "paper", "ours", "off", "pct_off",
+               "paper_range_deg", "ours_range_deg", "l0_mm"]
+    return pd.DataFrame(rows, columns=columns)
 
 
 def scores(table: pd.DataFrame) -> dict[str, float]:
@@ -286,8 +288,8 @@ def fit_l0(
 ) -> float:
     """The l0 (mm) at which the paper's two model results are best met: step 2 of the protocol.
 
-    Minimises the worse of the two relative errors over ``bounds``: a scan every 5 mm,
-    then Brent's method around the best point (to 1e-3 mm).  This is the one physical
+    Minimises the worse of the two relative errors over ``bounds``: a scan every 10 mm,
+    then Brent's method around the best point (to 0.01 mm).  This is the one physical
     parameter the two anchors may fix; with ``l0_factor="fitted_scale"`` they already fix the
     scale, so fitting l0 as well is refused.
 
@@ -319,7 +321,7 @@ def fit_l0(
             "they may fix at most one parameter, so pass l0_mm instead of fitting it"
         )
     lo, hi = bounds
-    grid = np.linspace(lo, hi, max(2, int(round((hi - lo) / 5.0)) + 1))
+    grid = np.linspace(lo, hi, max(2, int(round((hi - lo) / 10.0)) + 1))
     values = [_model_worst(table, opts, float(v)) for v in grid]
     i = int(np.argmin(values))
     if not math.isfinite(values[i]):
@@ -327,7 +329,7 @@ def fit_l0(
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
     res = optimize.minimize_scalar(
         lambda v: _model_worst(table, opts, v), bounds=(a, b), method="bounded",
-        options={"xatol": 1e-3},
+        options={"xatol": 1e-2},
     )
     best = float(res.x) if res.fun <= values[i] else float(grid[i])
     return best

@@ -49,7 +49,7 @@ def as_numbers(values: ArrayLike, what: str) -> FloatArray:
     if arr.dtype.kind in "USO":
         for v in arr.ravel():
             if isinstance(v, (str, bytes)):
-                raise UserInputError(f"{what} must be numbers, got the text {v!r}; pass numbers (not quoted)")
+                raise UserInputError(f"{what} must be numbers, got the text {str(v)!r}; pass numbers (not quoted)")
         try:
             return arr.astype(float)
         except (TypeError, ValueError):
