@@ -1,4 +1,5 @@
-# Model versus data: RMS, crossings, range of motion, fitted k_P, for every dataset and material.
+# Model versus data: RMS, crossings, range of motion, fitted k_P, per material and l0 (each
+# dataset's own actuator), with the model curve every RMS was computed against.
 
 
 rule compare:
@@ -6,9 +7,11 @@ rule compare:
         hysteresis=per_dataset("{results}/datasets/{dataset}/hysteresis.csv"),
         angles=per_dataset("{results}/datasets/{dataset}/angles.csv"),
     output:
-        f"{RESULTS}/rms.csv",
+        rms=f"{RESULTS}/rms.csv",
+        curves=f"{RESULTS}/compare_curves.csv",
     params:
         names=list(DATASETS),
+        photosets=[photoset_dir(n) for n in DATASETS],
         materials=materials_option(),
         readings=model_readings_option(),
         bootstrap=config["compare"]["bootstrap"],
@@ -25,4 +28,5 @@ rule compare:
         runtime=10,
     shell:
         "python -m pipeline compare {input.hysteresis} --angles {input.angles} --datasets {params.names}"
-        " --bootstrap {params.bootstrap} --seed {params.seed} {params.materials} {params.readings} --out {output} > {log} 2>&1"
+        " --photosets {params.photosets:q} --bootstrap {params.bootstrap} --seed {params.seed} {params.materials}"
+        " {params.readings} --out {output.rms} --curves {output.curves} > {log} 2>&1"

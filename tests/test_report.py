@@ -92,7 +92,7 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         hyst.append(out)
     h = pd.concat([pd.read_csv(p) for p in hyst])
     table = compare(h, read_angles([d.angles_csv for d in datasets]),
-                    model_psi=lambda m, p: fake_psi(m, p, "up") + 10.0, fit_k_p=None)
+                    model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0, fit_k_p=None)
     rms = tmp / "rms.csv"
     table.to_csv(rms, index=False)
     return hyst, rms

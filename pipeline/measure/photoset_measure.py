@@ -80,7 +80,9 @@ def measure_photoset(
     pandas.DataFrame
         The angles.csv table: :data:`RESULT_COLUMNS`, then the manifest's columns
         (pressure_kpa, direction, material, actuator, trial, step, and any others such as
-        measured_pressure_kpa, timestamp or force columns).  One row per manifest row, same order.
+        measured_pressure_kpa, timestamp or force columns) and ``l0_mm``, the marked length
+        each photo was measured with (the row's or the folder's setting).  One row per manifest
+        row, same order.
 
     Raises
     ------
@@ -112,7 +114,8 @@ def measure_photoset(
     result = pd.DataFrame(rows, index=manifest.index)
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
-    drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
+    # per-row settings are not carried, except l0_mm: compare models each photo's own actuator
+    drop = {"image", "manifest_line", *OVERRIDE_COLUMNS} - {"l0_mm"}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
