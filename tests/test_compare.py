@@ -292,3 +292,68 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
     assert not np.allclose(expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3)
     assert main(["compare", str(folders[0] / "hysteresis.csv"), "--photosets", "a", "b",
                  "--out", str(rms)]) == 2
+
+
+@pytest.mark.slow
+def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
+    """End to end (real snakemake, tiny config in a temporary folder): two SS50 photo sets, one of
+    an actuator with l0 = 220 mm; its model curve and its RMS use 220 mm, the other's the default,
+    and the report says which l0 each curve used and that synthetic RMS is a self-check."""
+    import subprocess
+    import sys
+
+    import pypdfium2 as pdfium
+    import yaml
+
+    from pipeline import model
+    from pipeline.cli import main
+
+    short = tmp_path / "short"  # a folder photo set of a shorter actuator (rendered by synth)
+    assert main(["synth", str(short), "--material", "SS50", "--actuators", "1", "--trials", "1",
+                 "--step-kpa", "80", "--max-kpa", "240", "--scene", "clean", "--set", "width=400",
+                 "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
+    config = {
+        "datasets": [
+            {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
+             "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
+            {"name": "short", "source": "folder", "path": str(short)},
+        ],
+        "compare": {"bootstrap": 5},
+        "bench": {"in_report": False},
+    }
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    run = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
+                          str(tmp_path), "--cores", "2"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-5000:]
+    res = tmp_path / "results"
+    angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
+    assert (angles["l0_mm"] == 220.0).all()  # measure carries each photo's l0
+    default = model.load_materials()["SS50"].l0_mm
+    assert default != 220.0
+    rms = pd.read_csv(res / "rms.csv").set_index("datasets")
+    assert rms.loc["short", "curve"] == "SS50, l0 220 mm" and rms.loc["short", "l0_mm"] == 220.0
+    assert rms.loc["short", "l0_source"] == "photo set"
+    assert rms.loc["std", "l0_mm"] == default
+    assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
+    # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
+    hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
+    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
+    at_220 = rms_deg(psi, model.psi_deg("SS50", p, l0_mm=220.0))[0]
+    at_default = rms_deg(psi, model.psi_deg("SS50", p))[0]
+    assert rms.loc["short", "rms_deg"] == pytest.approx(at_220, rel=1e-4)
+    assert abs(at_220 - at_default) > 1e-3
+    curves = pd.read_csv(res / "compare_curves.csv")
+    c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
+    assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
+    np.testing.assert_allclose(c220["pressure_kpa"], model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
+                               rtol=1e-5, atol=1e-9)
+    doc = pdfium.PdfDocument(str(res / "report.pdf"))
+    pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
+    doc.close()
+    comparison = next(t for t in pages if "Model versus measurements, beside" in t)
+    assert "photos rendered from this model, so the RMS is a self-check, not a validation" in comparison
+    provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
+    assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
+    assert f"SS50, l0 {default:g} mm" in provenance
+    material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
+    assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material

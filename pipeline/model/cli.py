@@ -302,10 +302,17 @@ def format_calibration(
         if has_paper:
             fitted = fit_l0(table, **options)
             lo, hi = l0_interval_meeting_bar(table, **options)
-            span = (f"both within +-{MODEL_BAR_PCT:g} % for l0 = {lo:.0f}-{hi:.0f} mm"
-                    if math.isfinite(lo) else f"no l0 in 170-270 mm meets +-{MODEL_BAR_PCT:g} %")
+            if not math.isfinite(lo):
+                span = f"no l0 in 170-270 mm meets +-{MODEL_BAR_PCT:g} %"
+            elif lo == hi:
+                span = f"both within +-{MODEL_BAR_PCT:g} % only at l0 = {lo:.0f} mm (1 mm steps)"
+            else:
+                span = f"both within +-{MODEL_BAR_PCT:g} % for l0 = {lo:.0f}-{hi:.0f} mm"
             out.append(f"l0 in use: {l0:g} mm ({source}); the two model results fix l0 = "
                        f"{fitted:.1f} mm for this reading (170-270 mm); {span}")
+            if abs(fitted - l0) > 0.5:
+                out.append(f"  the tables below are at the l0 in use; to see this reading at its own "
+                           f"l0 pass --l0-mm {fitted:.1f}")
         else:
             out.append(f"l0 in use: {l0:g} mm ({source})")
     df = anchor_table(table, **options)
