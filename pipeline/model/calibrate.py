@@ -455,7 +455,9 @@ def search_readings(
     return df.reset_index(drop=True)
 
 
-def select_reading(search: pd.DataFrame, keys: Sequence[str] = DERIVED_KEYS) -> dict[str, Any] | None:
+def select_reading(
+    search: pd.DataFrame, keys: Sequence[str] = DERIVED_KEYS
+) -> dict[str, Any] | None:
     """The protocol's choice from :func:`search_readings`: readings and l0, or ``None``.
 
     ``None`` means no derived reading meets the bar on both model results.

@@ -288,7 +288,7 @@ def format_calibration(
     source = "--l0-mm" if opts.l0_mm is not None else "materials file"
     if opts.l0_factor == "fitted_scale":
         scale = resolve_scale(opts, l0).eq12_scale if has_paper else math.nan
-        given = "given" if opts.eq12_scale is not None else "FITTED to the paper's two model results"
+        given = "given" if opts.eq12_scale is not None else "FITTED to the two model results"
         out.append(f"Constants fitted to the paper's numbers: eq12_scale = {scale:.4f} ({given}); "
                    "with it fitted the in-sample agreement is by construction up to the ratio of "
                    "the two model results, and l0 is not fitted.")
@@ -311,8 +311,8 @@ def format_calibration(
             out.append(f"l0 in use: {l0:g} mm ({source}); the two model results fix l0 = "
                        f"{fitted:.1f} mm for this reading (170-270 mm); {span}")
             if abs(fitted - l0) > 0.5:
-                out.append(f"  the tables below are at the l0 in use; to see this reading at its own "
-                           f"l0 pass --l0-mm {fitted:.1f}")
+                out.append(f"  the tables below are at the l0 in use; to see this reading at "
+                           f"its own l0 pass --l0-mm {fitted:.1f}")
         else:
             out.append(f"l0 in use: {l0:g} mm ({source})")
     df = anchor_table(table, **options)
@@ -331,11 +331,12 @@ def format_calibration(
         out += ["", "Out of sample: Section III measurements (chose nothing)"]
         out += _anchor_lines(measured)
         out.append(f"  RMS: psi = 0 pressures {sc['exp_pressure_rms_pct']:.1f} %; angles "
-                   f"{sc['exp_psi_rms_deg']:.1f} deg; ranges of motion {sc['exp_range_rms_pct']:.1f} %"
-                   f"; undefined {sc['undefined_anchors']}")
+                   f"{sc['exp_psi_rms_deg']:.1f} deg; ranges of motion "
+                   f"{sc['exp_range_rms_pct']:.1f} %; undefined {sc['undefined_anchors']}")
     rms = "/".join(f"{v:g}" for v in PAPER_RMS_DEG.values())
     out.append(f"  (the paper's RMS of model vs mean data, {rms} deg for "
-               f"{'/'.join(PAPER_RMS_DEG)}, needs measured curves: see 'python -m pipeline compare')")
+               f"{'/'.join(PAPER_RMS_DEG)}, needs measured curves: see "
+               "'python -m pipeline compare')")
     if has_paper:
         out.append(_area_line(table["SS40"], opts, l0))
     if search:
@@ -349,10 +350,11 @@ def format_calibration(
         out.append(shown.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
         choice = select_reading(res)
         if choice is None:
-            best = res.iloc[0]
+            best = res.sort_values("model_worst_pct", kind="stable").iloc[0]
+            which = ", ".join(f"{k}={best[k]}" for k in DERIVED_KEYS)
             out.append(f"No derived reading meets +-{MODEL_BAR_PCT:g} % on both model results; the "
-                       f"best derived reading is {', '.join(f'{k}={best[k]}' for k in DERIVED_KEYS)} "
-                       f"(worst {best['model_worst_pct']:.1f} % at l0 = {best['l0_fit_mm']:.1f} mm).")
+                       f"best derived reading is {which} (worst {best['model_worst_pct']:.1f} % at "
+                       f"l0 = {best['l0_fit_mm']:.1f} mm).")
         else:
             is_default = all(getattr(ModelOptions(), k) == choice[k] for k in DERIVED_KEYS)
             out.append("Protocol's choice: " + ", ".join(f"{k}={choice[k]}" for k in DERIVED_KEYS)
@@ -378,4 +380,5 @@ def _area_line(mat: Material, opts: ModelOptions, l0: float) -> str:
     consistent = float(np.max(np.abs(area / a0 - 1.0))) < 1e-6
     return (f"  wall area of this reading's Eq. 12 element, psi0..-psi0: {area.min():.2f}-"
             f"{area.max():.2f} cm^2 against A0 = {a0:.3f} cm^2 "
-            + ("(area-consistent)" if consistent else "(NOT area-consistent; jacobian=deformed is)"))
+            + ("(area-consistent)" if consistent
+               else "(NOT area-consistent; jacobian=deformed is)"))

@@ -40,16 +40,18 @@ def as_numbers(values: ArrayLike, what: str) -> FloatArray:
 
     Examples
     --------
-    >>> as_numbers(["10"], "psi_deg")
+    >>> as_numbers(["10"], "psi_deg")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pipeline.errors.UserInputError: psi_deg must be numbers, got the text '10'; pass numbers (not quoted)
+    pipeline.errors.UserInputError: psi_deg must be numbers, got the text '10'; pass numbers ...
     """
     arr = np.asarray(values)
     if arr.dtype.kind in "USO":
         for v in arr.ravel():
             if isinstance(v, (str, bytes)):
-                raise UserInputError(f"{what} must be numbers, got the text {str(v)!r}; pass numbers (not quoted)")
+                raise UserInputError(
+                    f"{what} must be numbers, got the text {str(v)!r}; pass numbers (not quoted)"
+                )
         try:
             return arr.astype(float)
         except (TypeError, ValueError):
@@ -58,7 +60,7 @@ def as_numbers(values: ArrayLike, what: str) -> FloatArray:
 
 
 def l0_in_use(mat: Material, opts: ModelOptions) -> float:
-    """The l0 (mm) of a model evaluation: the override or the material's, checked against the wall."""
+    """The l0 (mm) of a model evaluation: the override or the material's."""
     if opts.l0_mm is None:
         return mat.l0_mm
     return mat.check_l0(float(opts.l0_mm))
@@ -88,7 +90,8 @@ def resolve_scale(opts: ModelOptions, l0_mm: float) -> ModelOptions:
     if opts.l0_factor != "fitted_scale" or opts.eq12_scale is not None:
         return opts
     table = load_materials()
-    return replace(opts, eq12_scale=scale_fitted_to_anchors(table["SS50"], table["SS40"], opts, l0_mm))
+    scale = scale_fitted_to_anchors(table["SS50"], table["SS40"], opts, l0_mm)
+    return replace(opts, eq12_scale=scale)
 
 
 def pressure_core(
@@ -202,9 +205,9 @@ def check_psi_min(mat: Material, opts: ModelOptions) -> None:
     """Raise :class:`UserInputError` unless -360 <= ``opts.psi_min_deg`` < psi0 of ``mat``."""
     if not -PSI_LIMIT_DEG <= opts.psi_min_deg < mat.psi0_deg:
         raise UserInputError(
-            f"model options: psi_min_deg = {opts.psi_min_deg:g} deg must lie in [-{PSI_LIMIT_DEG:g}, "
-            f"psi0 = {mat.psi0_deg:g}) for {mat.name}: the inverse walks from psi0 down to it; "
-            "pass e.g. -360 (the default) or -210"
+            f"model options: psi_min_deg = {opts.psi_min_deg:g} deg must lie in "
+            f"[-{PSI_LIMIT_DEG:g}, psi0 = {mat.psi0_deg:g}) for {mat.name}: the inverse walks "
+            "from psi0 down to it; pass e.g. -360 (the default) or -210"
         )
 
 

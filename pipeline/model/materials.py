@@ -81,18 +81,19 @@ class Material:
         Examples
         --------
         >>> from pipeline.model import load_materials
-        >>> load_materials()["SS40"].check_l0(30.0)
+        >>> load_materials()["SS40"].check_l0(30.0)  # doctest: +ELLIPSIS
         Traceback (most recent call last):
         ...
-        pipeline.errors.UserInputError: l0_mm = 30 mm is shorter than SS40's own wall allows: at psi0 = 210 deg the top of the section (b + a0 + t0 = 14 mm above the inextensible layer) would have a rest length l0 - 14 mm x psi0 <= 0, so l0 must exceed 51.3 mm; pass the length of the marked layer in mm (the paper's actuators: 170-270 mm)
+        pipeline.errors.UserInputError: l0_mm = 30 mm is shorter ... l0 must exceed 51.3 mm; ...
         """
         if not l0_mm > self.min_l0_mm:
             raise UserInputError(
-                f"{where} = {l0_mm:g} mm is shorter than {self.name}'s own wall allows: at psi0 = "
-                f"{self.psi0_deg:g} deg the top of the section (b + a0 + t0 = {self.height_mm:g} mm "
-                f"above the inextensible layer) would have a rest length l0 - {self.height_mm:g} mm "
-                f"x psi0 <= 0, so l0 must exceed {self.min_l0_mm:.1f} mm; pass the length of the "
-                "marked layer in mm (the paper's actuators: 170-270 mm)"
+                f"{where} = {l0_mm:g} mm is shorter than {self.name}'s own wall allows: at "
+                f"psi0 = {self.psi0_deg:g} deg the top of the section (b + a0 + t0 = "
+                f"{self.height_mm:g} mm above the inextensible layer) would have a rest length "
+                f"l0 - {self.height_mm:g} mm x psi0 <= 0, so l0 must exceed "
+                f"{self.min_l0_mm:.1f} mm; pass the length of the marked layer in mm (the "
+                "paper's actuators: 170-270 mm)"
             )
         return float(l0_mm)
 

@@ -34,9 +34,10 @@ def stress_moment_nmm(
     multiplies the wall area element by (2 phi_m/pi)(t/t0), ``"deformed_angle"`` by (2 phi_m/pi)
     only (the integral over phi' without dtau'/dtau); ``opts.l0_factor`` keeps the printed l0
     prefactor with l0 in metres ("metres"), drops it ("none") or puts the FITTED number
-    ``opts.eq12_scale`` in its place ("fitted_scale", resolved by the caller); ``opts.stress="nominal"`` divides the
-    Cauchy stress by lambda_1; ``opts.base_width="one_side"`` drops the factor 2 of the base
-    term; ``opts.wall_coords`` is passed to :func:`pipeline.model.geometry.wall_coordinates`.
+    ``opts.eq12_scale`` in its place ("fitted_scale", resolved by the caller);
+    ``opts.stress="nominal"`` divides the Cauchy stress by lambda_1;
+    ``opts.base_width="one_side"`` drops the factor 2 of the base term; ``opts.wall_coords`` is
+    passed to :func:`pipeline.model.geometry.wall_coordinates`.
 
     Returns
     -------

@@ -46,7 +46,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     # Eqs. 9-12 stress: "cauchy" as printed; "nominal" Cauchy / lambda_1 (force per undeformed
     # area, the first Piola-Kirchhoff stress).
     "stress": ("cauchy", "nominal"),
-    # Eq. 12 base width: "two_sides" 2 (a0 + t0) as printed; "one_side" (a0 + t0) (factor 2 dropped).
+    # Eq. 12 base width: "two_sides" 2 (a0 + t0) as printed; "one_side" (a0 + t0) (no factor 2).
     "base_width": ("two_sides", "one_side"),
     # Eq. 12 wall coordinates: "scaled" tau' = tau t/t0, phi' = phi 2 phi_m/pi as defined in the
     # text; "unscaled" tau' = tau, phi' = phi (contradicts those definitions: diagnostic only).
@@ -136,13 +136,17 @@ _POSITIVE_OR_NONE = ("eq12_scale", "l0_mm", "k_p")
 def _number(key: str, value: Any) -> float:
     """``value`` as a finite float, or a UserInputError naming the option (strings refused)."""
     if isinstance(value, (str, bytes)) or isinstance(value, bool):
-        raise UserInputError(f"model options: {key} must be a number, got the text {value!r}; pass a number")
+        raise UserInputError(
+            f"model options: {key} must be a number, got the text {value!r}; pass a number"
+        )
     try:
         out = float(value)
     except (TypeError, ValueError):
         raise UserInputError(f"model options: {key} must be a number, got {value!r}") from None
     if not math.isfinite(out):
-        raise UserInputError(f"model options: {key} must be finite, got {value!r}; pass a finite number")
+        raise UserInputError(
+            f"model options: {key} must be finite, got {value!r}; pass a finite number"
+        )
     return out
 
 
@@ -192,10 +196,10 @@ def make_options(base: ModelOptions | None = None, **options: Any) -> ModelOptio
 
     Examples
     --------
-    >>> make_options(eq12_scale=float("inf"))
+    >>> make_options(eq12_scale=float("inf"))  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pipeline.errors.UserInputError: model options: eq12_scale must be finite, got inf; pass a finite number
+    pipeline.errors.UserInputError: model options: eq12_scale must be finite, got inf; ...
     """
     opts = base or ModelOptions()
     if not options:

@@ -31,6 +31,7 @@ RMS_KIND_TEXT: dict[str, str] = {
     "unknown": "source of the photos not stated: read the RMS as a prediction only if they are real",
 }
 
+
 def _has(data: ReportData, column: str) -> bool:
     return column in data.rms.columns
 
