@@ -447,6 +447,21 @@ def test_the_protocol_chooses_the_default_reading() -> None:
     assert departures({"jacobian": "deformed_angle", "stress": "nominal"}) == 2
 
 
+def test_calibrate_search_prints_the_choice_or_says_plainly_that_nothing_passes() -> None:
+    from pipeline.model.cli import format_calibration
+
+    table = load_materials()
+    text = format_calibration(table, {}, search=True, search_keys=("jacobian", "thickness_phi"))
+    assert "Search (steps 1-4): 6 derived readings, 2 meet +-5 % on both model results" in text
+    assert ("Protocol's choice: jacobian=deformed_angle, thickness_phi=crown at l0 = "
+            f"{fit_l0():.1f} mm (the default reading)") in text
+    # with Eq. 12's element as printed, no derived reading passes: said plainly, best one named
+    text = format_calibration(table, {"jacobian": "none"}, search=True,
+                              search_keys=("thickness_phi", "base_width"))
+    assert "No derived reading meets +-5 % on both model results; the best derived reading is " \
+           "thickness_phi=mean, base_width=two_sides (worst 16.6 % at l0 = 270.0 mm)." in text
+
+
 def test_fitted_scale_is_a_fit_and_only_scales() -> None:
     # the former default: eq12_scale 0.3214 fitted at l0 = 270 mm with jacobian none, phi mean
     old = {"jacobian": "none", "thickness_phi": "mean", "l0_mm": 270.0}

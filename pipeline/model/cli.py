@@ -247,7 +247,11 @@ def _anchor_lines(df: pd.DataFrame) -> list[str]:
 
 
 def format_calibration(
-    table: dict[str, Material], options: dict[str, object], *, search: bool = False
+    table: dict[str, Material],
+    options: dict[str, object],
+    *,
+    search: bool = False,
+    search_keys: tuple[str, ...] | None = None,
 ) -> str:
     """What ``model calibrate`` prints: protocol, in-sample and out-of-sample tables, verdict.
 
@@ -259,6 +263,9 @@ def format_calibration(
         Model options given on the command line (the default reading when empty).
     search : bool
         Also run :func:`pipeline.model.search_readings` and print its passing readings and choice.
+    search_keys : tuple of str, optional
+        Options the search varies (default: all of ``DERIVED_KEYS``); the other options given
+        are held fixed.
     """
     from pipeline.model.anchors import MODEL_BAR_PCT, PAPER_RMS_DEG
     from pipeline.model.calibrate import (
@@ -340,24 +347,26 @@ def format_calibration(
     if has_paper:
         out.append(_area_line(table["SS40"], opts, l0))
     if search:
-        res = search_readings(materials=table)
+        keys = tuple(search_keys or DERIVED_KEYS)
+        fixed = {k: v for k, v in options.items() if k not in keys and k != "l0_mm"}
+        res = search_readings(keys, materials=table, **fixed)
         passing = res[res["passes"]]
         out += ["", f"Search (steps 1-4): {len(res)} derived readings, {len(passing)} meet "
                 f"+-{MODEL_BAR_PCT:g} % on both model results at their l0:"]
-        cols = [*DERIVED_KEYS, "departures", "l0_fit_mm", "ss50_pct", "ss40_pct",
+        cols = [*keys, "departures", "l0_fit_mm", "ss50_pct", "ss40_pct",
                 "exp_pressure_rms_pct", "exp_psi_rms_deg", "exp_range_rms_pct"]
         shown = (passing if len(passing) else res.head(5))[cols]
         out.append(shown.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
-        choice = select_reading(res)
+        choice = select_reading(res, keys)
         if choice is None:
             best = res.sort_values("model_worst_pct", kind="stable").iloc[0]
-            which = ", ".join(f"{k}={best[k]}" for k in DERIVED_KEYS)
+            which = ", ".join(f"{k}={best[k]}" for k in keys)
             out.append(f"No derived reading meets +-{MODEL_BAR_PCT:g} % on both model results; the "
                        f"best derived reading is {which} (worst {best['model_worst_pct']:.1f} % at "
                        f"l0 = {best['l0_fit_mm']:.1f} mm).")
         else:
-            is_default = all(getattr(ModelOptions(), k) == choice[k] for k in DERIVED_KEYS)
-            out.append("Protocol's choice: " + ", ".join(f"{k}={choice[k]}" for k in DERIVED_KEYS)
+            is_default = all(getattr(ModelOptions(), k) == choice[k] for k in keys)
+            out.append("Protocol's choice: " + ", ".join(f"{k}={choice[k]}" for k in keys)
                        + f" at l0 = {choice['l0_mm']:.1f} mm"
                        + (" (the default reading)" if is_default else " (NOT the default reading)"))
     return "\n".join(out)
