@@ -513,8 +513,9 @@ def compare(
         angles.csv rows (with the same ``dataset`` names) for each dataset's ``l0_mm`` and for the
         k_P fit and its bootstrap; ``None``: default l0, no fit.
     model_psi, fit_k_p : callable or None
-        Model callables taking the l0 (mm, or None for the model's default) last; a material the model does not know (callable
-        raises :class:`UserInputError`) gets NaN model columns and a warning.
+        Model callables taking the l0 (mm, or None for the model's default) last; a material
+        the model does not know, or an l0 it refuses (the callable raises
+        :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
         Rest angle per material (deg); 210 deg (the paper's) for materials not listed.
     default_l0_mm : mapping, optional
