@@ -351,7 +351,7 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
     doc.close()
     comparison = next(t for t in pages if "Model versus measurements, beside" in t)
-    assert "photos rendered from this model, so the RMS is a self-check, not a validation" in comparison
+    assert "photos rendered from this package's model, so the RMS is a self-check, not a validation" in comparison
     provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
     assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
     assert f"SS50, l0 {default:g} mm" in provenance

@@ -22,11 +22,11 @@ from pipeline.report.style import LANDSCAPE_SIZE_IN
 
 #: what each ``rms_kind`` means, in words for the reader
 RMS_KIND_TEXT: dict[str, str] = {
-    "self-check": "SELF-CHECK: the photos were rendered from this model (synthetic), so the RMS "
-    "checks the measurement chain against the model that drew them; it is not a validation",
+    "self-check": "SELF-CHECK: the photos are synthetic, rendered from this package's model (synth), "
+    "so the RMS checks the measurement chain against the model that drew them; it is not a validation",
     "prediction": "prediction: no model parameter was fitted to these data (k_P is the paper's); "
     "only k_P fitted is a fit to them",
-    "mixed": "mixed: synthetic photos (rendered from this model) pooled with measured ones; "
+    "mixed": "mixed: synthetic photos (rendered from this package's model) pooled with measured ones; "
     "the RMS is neither a clean self-check nor a validation",
     "unknown": "source of the photos not stated: read the RMS as a prediction only if they are real",
 }
@@ -52,8 +52,8 @@ def comparison_note(data: ReportData) -> str:
     parts = []
     if len(checks):
         names = ", ".join(f"{r.curve} ({r.datasets})" for r in checks.itertuples())
-        parts.append(f"Synthetic: {names}: photos rendered from this model, so the RMS is a "
-                     "self-check, not a validation.")
+        parts.append(f"Synthetic: {names}: photos rendered from this package's model, so the RMS "
+                     "is a self-check, not a validation.")
     parts.append("Which l0 each model curve used, and what was fitted: next page.")
     return " ".join(parts)
 
