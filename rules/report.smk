@@ -7,7 +7,8 @@ rule report:
         hysteresis=per_dataset("{results}/datasets/{dataset}/hysteresis.csv"),
         rms=f"{RESULTS}/rms.csv",
         config=f"{RESULTS}/config.resolved.yaml",
-        curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS),
+        curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS)
+        + [f"{RESULTS}/compare_curves.csv"],
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
         force=FORCE_OUTPUTS,
     output:
