@@ -191,8 +191,11 @@ def world_extent_mm(points_mm: NDArray[np.float64], body_width_mm: float, tip_mm
     return np.vstack(parts)
 
 
-def _fixed_direction_deg(curve_px: NDArray[np.float64]) -> float:
-    d = curve_px[min(4, len(curve_px) - 1)] - curve_px[0]
+def _fixed_direction_deg(camera: Camera, curve_mm: NDArray[np.float64]) -> float:
+    """On-screen direction (deg, ccw from +x) of the tangent of ``curve_mm`` at its first point."""
+    t = -3 * curve_mm[0] + 4 * curve_mm[1] - curve_mm[2]  # one-sided, second order
+    ends = camera.to_px([curve_mm[0], curve_mm[0] + 1e-3 * t / np.hypot(*t)])
+    d = ends[1] - ends[0]
     return float(np.degrees(np.arctan2(-d[1], d[0])))
 
 
@@ -350,7 +353,8 @@ def _result(image: NDArray[np.uint8], scene: SceneParams, camera: Camera, pts_mm
             dots_px: NDArray[np.float64] | None = None) -> RenderedImage:
     """The photo with its truth: the target's exact centre line through the camera and its turning."""
     h, w = scene.height, scene.width
-    curve = layer_px if scene.target == "line" else camera.to_px(pts_mm + nrm_mm * (body_w / 2))
+    curve_mm = pts_mm if scene.target == "line" else pts_mm + nrm_mm * (body_w / 2)
+    curve = layer_px if scene.target == "line" else camera.to_px(curve_mm)
     in_frame = bool(((curve >= 0) & (curve <= [w - 1, h - 1])).all())
     return RenderedImage(
         image=image,
@@ -361,7 +365,7 @@ def _result(image: NDArray[np.uint8], scene: SceneParams, camera: Camera, pts_mm
         jpeg_quality=scene.jpeg_quality,
         target=scene.target,
         layer_px=layer_px,
-        fixed_direction_deg=_fixed_direction_deg(curve),
+        fixed_direction_deg=_fixed_direction_deg(camera, curve_mm),
         dots_px=np.zeros((0, 2)) if dots_px is None else dots_px,
     )
 
