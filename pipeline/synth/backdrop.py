@@ -41,7 +41,8 @@ TUBE_WIDTH_MM = 6.0
 SHIFT = 4
 NOISE_PAD = 64
 
-_GLARE_BGR = (250, 250, 250)
+#: colour of a glare spot (BGR, before lighting)
+GLARE_BGR = (250, 250, 250)
 #: seed stream of the body's look (independent of the table's, so older scenes keep their bytes)
 _STYLE_KEY = 7
 
@@ -63,24 +64,24 @@ class Backdrop:
         Placement of the world frame (the clamp) in the image.
     image : ndarray (H, W, 3) uint8
         Lit, blurred table with clamp, tube and distractor marks.
-    body_layer, ink_layer, glare_layer : ndarray (H, W, 3) uint8
-        Silicone, marker ink and glare colours under the same lighting.
     noise_pool : ndarray (H + 64, W + 64, 3) int16 or None
         Sensor noise; each photo adds a randomly offset window of it.
-    gain : ndarray (H, W) float32 or None
-        The light field (multiplies every colour).
-    style : BodyStyle or None
+    gain : ndarray (H, W) float32
+        The light field (multiplies every colour: silicone, ink, glare, fibres, dots).
+    style : BodyStyle
         Seeded look of the body (light side, fibre spacing, dot positions, shadow direction).
     """
 
     camera: Camera
     image: NDArray[np.uint8]
-    body_layer: NDArray[np.uint8]
-    ink_layer: NDArray[np.uint8]
-    glare_layer: NDArray[np.uint8]
     noise_pool: NDArray[np.int16] | None
-    gain: NDArray[np.float32] | None = None
-    style: BodyStyle | None = None
+    gain: NDArray[np.float32]
+    style: BodyStyle
+
+    def lit(self, colour: ArrayLike, roi: tuple[int, int, int, int]) -> NDArray[np.uint8]:
+        """A colour (BGR) under the scene's light over ``roi = (x0, y0, x1, y1)``."""
+        x0, y0, x1, y1 = roi
+        return _lit(colour, self.gain[y0:y1, x0:x1])
 
 
 def clamp_outline_mm(body_width_mm: float, style: str = "block") -> NDArray[np.float64]:
@@ -206,12 +207,14 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
     if px is not None:
         mask = np.zeros(img.shape[:2], np.uint8)
         cv2.polylines(mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT)
-        a = mask[..., None].astype(np.float32) * (0.55 / 255)
-        img += (np.asarray((215, 222, 225), np.float32) - img) * a
         edge = np.zeros_like(mask)
         cv2.polylines(edge, [np.round(px * s).astype(np.int32)], False, 255, width + 2, cv2.LINE_AA, SHIFT)
         edge = cv2.subtract(edge, cv2.erode(mask, np.ones((3, 3), np.uint8)))
-        img += (np.asarray((120, 125, 128), np.float32) - img) * (edge[..., None].astype(np.float32) * (0.35 / 255))
+        bx, by, bw_, bh = cv2.boundingRect(cv2.bitwise_or(mask, edge))  # only where the tube is
+        if bw_ > 0:
+            win, m, e = img[by:by + bh, bx:bx + bw_], mask[by:by + bh, bx:bx + bw_], edge[by:by + bh, bx:bx + bw_]
+            win += (np.asarray((215, 222, 225), np.float32) - win) * (m[..., None].astype(np.float32) * (0.55 / 255))
+            win += (np.asarray((120, 125, 128), np.float32) - win) * (e[..., None].astype(np.float32) * (0.35 / 255))
     if not scene.clamp:
         return
     outline_mm = clamp_outline_mm(bw, scene.clamp_style)
@@ -237,14 +240,16 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         # a black anodised plate, lit unevenly, a bevel along its front edge and a clamp bar
         mask = np.zeros(img.shape[:2], np.uint8)
         cv2.fillPoly(mask, [np.round(camera.to_px(outline_mm) * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT)
-        a = mask.astype(np.float32)[..., None] / 255.0
         h, w = mask.shape
-        yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
         ang = rng.uniform(0, 2 * np.pi)
-        sheen = 8.0 + 8.0 * ((xx / w) * np.cos(ang) + (yy / h) * np.sin(ang))
-        plate = np.float32([29, 29, 32])[None, None, :] + sheen[..., None]
-        img *= 1 - a
-        img += plate * a
+        bx, by, bw_, bh = cv2.boundingRect(mask)
+        if bw_ > 0:
+            a = mask[by:by + bh, bx:bx + bw_].astype(np.float32)[..., None] / 255.0
+            yy, xx = np.mgrid[by:by + bh, bx:bx + bw_].astype(np.float32)
+            sheen = 8.0 + 8.0 * ((xx / w) * np.cos(ang) + (yy / h) * np.sin(ang))
+            win = img[by:by + bh, bx:bx + bw_]
+            win *= 1 - a
+            win += (np.float32([29, 29, 32])[None, None, :] + sheen[..., None]) * a
         bevel = camera.to_px([[0.0, outline_mm[1, 1]], [0.0, outline_mm[2, 1]]])
         cv2.polylines(img, [np.round(bevel * s).astype(np.int32)], False, (68, 69, 73),
                       max(1, round(0.8 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
@@ -302,13 +307,4 @@ def make_backdrop(
     if scene.noise_sigma > 0:
         shape = (scene.height + NOISE_PAD, scene.width + NOISE_PAD, 3)
         pool = np.rint(rng.standard_normal(shape, dtype=np.float32) * scene.noise_sigma).astype(np.int16)
-    return Backdrop(
-        camera=camera,
-        image=image,
-        body_layer=_lit(scene.body_bgr, gain),
-        ink_layer=_lit(LINE_INK_BGR[scene.line_color], gain),
-        glare_layer=_lit(_GLARE_BGR, gain),
-        noise_pool=pool,
-        gain=gain,
-        style=style,
-    )
+    return Backdrop(camera=camera, image=image, noise_pool=pool, gain=gain, style=style)

@@ -8,7 +8,8 @@ Presets: ``clean``, ``lab``, ``hard`` (the paper's drawn marker line on a bench)
 of actuators that carry no drawn line (``target: body``), modelled on the real photo kinds kept
 back for checking: ``green_fibre`` (translucent fibre-wound body, green chroma backdrop, white
 clamp, supply tube), ``grey_dots`` (opaque silicone with motion-capture dots, grey backdrop,
-black clamp plate) and ``dark_translucent`` (translucent ribbed body over a black backdrop).
+black clamp plate), ``grey_dots_clear`` (the same rig, a translucent body) and
+``dark_translucent`` (translucent ribbed body with a tip cap over a black backdrop).
 
 Examples
 --------
@@ -330,6 +331,15 @@ SCENE_PRESETS: dict[str, SceneParams] = {
         specular=0.35, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
         shadow=0.2, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
         known_fixed_direction=True,
+    ),
+    # (B) the same rig with a translucent (clear) silicone actuator: the body over the plate is faint
+    "grey_dots_clear": SceneParams(
+        background="textured", table_bgr=NAMED_BGR["grey"], texture_strength=3.0, lighting_gradient=0.25,
+        vignetting=0.25, marker_line=False, target="body", shape="distal", straight_base_fraction=0.3,
+        body_width_mm=18.0, body_bgr=NAMED_BGR["clear"], body_translucency=0.7, body_shading=0.7,
+        specular=0.5, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
+        shadow=0.15, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
+        known_fixed_direction=True, background_photo=True,
     ),
     # (B) a translucent ribbed silicone actuator over a black backdrop, with a printed tip cap
     "dark_translucent": SceneParams(

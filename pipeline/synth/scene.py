@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pipeline.errors import UserInputError
 from pipeline.synth.backdrop import (
+    GLARE_BGR,
     NOISE_PAD,
     SHIFT,
     Backdrop,
@@ -49,7 +50,6 @@ from pipeline.synth.body import (
     END_CAP_MM,
     RIB_BULGE,
     BodyFrame,
-    make_body_style,
     over,
     paint_body,
     paint_cap,
@@ -59,7 +59,7 @@ from pipeline.synth.body import (
 )
 from pipeline.synth.camera import Camera, make_camera
 from pipeline.synth.centreline import DEFAULT_N, actuator_centreline_mm, turning_angle_deg
-from pipeline.synth.presets import SceneParams
+from pipeline.synth.presets import LINE_INK_BGR, SceneParams
 
 #: supersampling factor of the marker-line mask
 LINE_SUPERSAMPLING = 4
@@ -324,9 +324,9 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
             a_body = cv2.GaussianBlur(a_body, (0, 0), blur)
             a_ink = cv2.GaussianBlur(a_ink, (0, 0), blur)
         out = image[y0:y1, x0:x1]
-        for layer, alpha in ((backdrop.body_layer, a_body), (backdrop.ink_layer, a_ink), (backdrop.glare_layer, a_glare)):
+        for colour, alpha in ((scene.body_bgr, a_body), (LINE_INK_BGR[scene.line_color], a_ink), (GLARE_BGR, a_glare)):
             if alpha is not None:
-                out = cv2.blendLinear(out, layer[y0:y1, x0:x1], 1.0 - alpha, alpha)
+                out = cv2.blendLinear(out, backdrop.lit(colour, roi), 1.0 - alpha, alpha)
         image[y0:y1, x0:x1] = out
     if backdrop.noise_pool is not None:
         dy, dx = rng.integers(0, NOISE_PAD, size=2)
@@ -375,8 +375,7 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
     """One photo of a rounded / textured / dotted body (see :mod:`pipeline.synth.body`)."""
     h, w = scene.height, scene.width
     mpp = scene.mm_per_px
-    style = backdrop.style if backdrop.style is not None else make_body_style(scene, np.random.default_rng(0))
-    gain_full = backdrop.gain if backdrop.gain is not None else np.ones((h, w), np.float32)
+    style, gain_full = backdrop.style, backdrop.gain
     layer_px = camera.to_px(pts_mm)
     nrm_mm = _normals(pts_mm)
     hw = body_w / 2
@@ -445,7 +444,7 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
             _fill(big, line_polys, off, f)
             a_ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32) * (
                 scene.line_contrast / 255.0)
-            prem, alpha = over(prem, alpha, backdrop.ink_layer[y0:y1, x0:x1].astype(np.float32), a_ink)
+            prem, alpha = over(prem, alpha, backdrop.lit(LINE_INK_BGR[scene.line_color], roi).astype(np.float32), a_ink)
         out = image[y0:y1, x0:x1].astype(np.float32)
         if scene.shadow > 0:
             out *= (1.0 - scene.shadow * shadow_of(alpha, style, mpp))[..., None]
@@ -455,7 +454,7 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
         out = out * (1.0 - alpha[..., None]) + prem
         a_glare = _glare(layer_px, scene, rng, shape, off)
         if a_glare is not None:
-            out += (backdrop.glare_layer[y0:y1, x0:x1].astype(np.float32) - out) * a_glare[..., None]
+            out += (backdrop.lit(GLARE_BGR, roi).astype(np.float32) - out) * a_glare[..., None]
         image[y0:y1, x0:x1] = np.clip(out + 0.5, 0, 255).astype(np.uint8)
     if backdrop.noise_pool is not None:
         dy, dx = rng.integers(0, NOISE_PAD, size=2)
