@@ -396,6 +396,11 @@ def scene_from(preset: str | SceneParams = "lab", **overrides: Any) -> ScenePara
     return dataclasses.replace(base, **values)
 
 
+def _items(text: str) -> list[str]:
+    """``"0,1,1"``, ``"[0, 1, 1]"`` or ``"(0,1,1)"`` -> ``["0", "1", "1"]``."""
+    return [x for x in text.strip().strip("[]()").replace(" ", "").split(",") if x != ""]
+
+
 def _convert(key: str, value: Any) -> Any:
     kind = str(_FIELD_TYPES[key])
     try:
@@ -413,12 +418,12 @@ def _convert(key: str, value: Any) -> Any:
                 return low in ("true", "yes", "1", "on")
             return bool(value)
         if kind == "tuple[float, ...]":
-            items = value.split(",") if isinstance(value, str) else list(np.atleast_1d(value))
+            items = _items(value) if isinstance(value, str) else list(np.atleast_1d(value))
             return tuple(float(x) for x in items)
         if kind.startswith("tuple"):
             if isinstance(value, str) and value.strip().lower() in NAMED_BGR:
                 return NAMED_BGR[value.strip().lower()]
-            items = value.split(",") if isinstance(value, str) else list(value)
+            items = _items(value) if isinstance(value, str) else list(value)
             out = tuple(int(x) for x in items)
             if len(out) != 3:
                 raise ValueError(value)
