@@ -2,10 +2,13 @@
 
 Work is split per ramp (one actuator, one trial): the static backdrop (table, light, clamp, tube:
 the same for every ramp, only the actuator's mounting angle varies) is built once per ramp and
-ramps run in parallel processes.  Scenes with ``target: body`` write ``target: body`` and no
-line colour, the fixed end at the body's centre line, optionally ``background.jpg`` (the empty
-scene) and a per-photo ``fixed_direction_deg`` column; their truth is the body's centre line.  Everything random is derived from ``seed`` and fixed keys
+ramps run in parallel processes.  Everything random is derived from ``seed`` and fixed keys
 (material, actuator, trial, step), so the bytes written do not depend on ``jobs``.
+
+Scenes with ``target: body`` write ``target: body`` and no line colour, the fixed end at the
+body's centre line, optionally ``background.jpg`` (the empty scene, ``background_photo``) and a
+per-photo ``fixed_direction_deg`` column (``known_fixed_direction``); their truth is the body's
+centre line (``psi_image_deg``: its total turning as seen through the camera).
 
 Examples
 --------
@@ -271,8 +274,7 @@ def render_photoset(
                          max_kpa=max_kpa, psi_fn=psi_fn, behaviour=behaviour)
     if sc.target == "body":  # refuse before writing anything: a folded body has no centre line
         for r in plan.loc[[plan["psi_deg"].idxmax(), plan["psi_deg"].idxmin()]].itertuples():
-            check_body_fits(actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001),
-                            sc.body_width_mm)
+            check_body_fits(actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001), sc)
     extents = _sample_extents(plan, l0, sc)
     base_rot, fixed_flat, need = choose_layout(extents, sc)
     if need > 1.0 and fit_view:
@@ -307,7 +309,8 @@ def render_photoset(
         scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
         blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
         occluded_fraction=sc.occluded_fraction, seed=seed, target=sc.target, shape=sc.shape,
-        marker_line=sc.marker_line, body_width_mm=sc.body_width_mm,
+        marker_line=sc.marker_line, body_width_mm=sc.body_width_mm, body_translucency=sc.body_translucency,
+        texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style,
     )
     first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
              "bulge"]

@@ -199,26 +199,28 @@ def _fixed_direction_deg(camera: Camera, curve_mm: NDArray[np.float64]) -> float
     return float(np.degrees(np.arctan2(-d[1], d[0])))
 
 
-def check_body_fits(points_mm: NDArray[np.float64], body_width_mm: float) -> None:
+def check_body_fits(points_mm: NDArray[np.float64], scene: SceneParams, body_width_mm: float | None = None) -> None:
     """Refuse a body whose outline would fold over itself on the inside of a bend.
 
     The body lies on the left of the layer (ccw side), so where the layer turns ccw with
-    curvature ``kappa``, the far edge at ``body_width_mm`` must stay inside the radius
-    ``1 / kappa``: ``kappa * width < FOLD_LIMIT``.
+    curvature ``kappa``, the far edge (``body_width_mm``, default the scene's, plus the ribs'
+    bulge) must stay inside the radius ``1 / kappa``: ``kappa * width < FOLD_LIMIT``.
 
     Raises
     ------
     UserInputError
         Naming the curvature and the knobs that relieve it.
     """
+    width = (scene.body_width_mm if body_width_mm is None else body_width_mm) * (
+        1 + (RIB_BULGE if scene.texture == "ribs" else 0.0))
     d = np.diff(points_mm, axis=0)
     ds = np.hypot(d[:, 0], d[:, 1])
     k = np.diff(np.unwrap(np.arctan2(d[:, 1], d[:, 0]))) / np.maximum((ds[1:] + ds[:-1]) / 2, 1e-12)
     k_max = float(k.max()) if len(k) else 0.0
-    if k_max * body_width_mm >= FOLD_LIMIT:
+    if k_max * width >= FOLD_LIMIT:
         raise UserInputError(
             f"the body would fold over itself: curvature {k_max:.4f} /mm (radius {1 / k_max:.1f} mm) on the side of a "
-            f"{body_width_mm:g} mm wide body; use a smaller |psi|, a narrower body (body_width_mm), a longer l0 or a "
+            f"{width:g} mm wide body; use a smaller |psi|, a narrower body (body_width_mm), a longer l0 or a "
             "gentler shape (straight_base_fraction, chamber_bend)")
 
 
@@ -281,7 +283,7 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
              body_w: float, rng: np.random.Generator) -> RenderedImage:
     """One photo of the actuator whose layer is ``pts_mm`` over ``backdrop``, seen by ``camera``."""
     if scene.target == "body":
-        check_body_fits(pts_mm, body_w * (1 + (RIB_BULGE if scene.texture == "ribs" else 0.0)))
+        check_body_fits(pts_mm, scene, body_w)
     if not scene.plain_body:
         return _compose_body(pts_mm, scene, camera, backdrop, body_w, rng)
     h, w = scene.height, scene.width
