@@ -44,7 +44,7 @@ def load_schema() -> dict[str, Any]:
     --------
     >>> readings = load_schema()["properties"]["model"]["properties"]["readings"]["properties"]
     >>> readings["l0_factor"]["enum"], readings["l0_factor"]["default"]
-    (['calibrated', 'metres', 'none'], 'calibrated')
+    (['metres', 'none', 'fitted_scale'], 'metres')
     """
     text = resources.files("pipeline").joinpath("config.schema.yaml").read_text(encoding="utf-8")
     schema = yaml.safe_load(text)

@@ -133,3 +133,12 @@ def test_the_built_package_ships_the_schema_and_validates_without_the_workflow(r
         cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(lib)}, capture_output=True, text=True,
     )
     assert check.returncode == 0 and check.stdout.strip() == "lab", check.stderr[-2000:]
+
+
+def test_scene_enums_are_the_synth_presets():
+    from pipeline.config import load_schema
+    from pipeline.synth.presets import SCENE_PRESETS
+
+    props = load_schema()["properties"]
+    dataset = props["datasets"]["items"]["properties"]
+    assert dataset["scene"]["enum"] == list(SCENE_PRESETS)

@@ -1,8 +1,14 @@
 """Render a whole synthetic campaign of one material as a photo set (DESIGN.md format + truth.csv).
 
-Work is split per ramp (one actuator, one trial): the static backdrop is built once per ramp and
+Work is split per ramp (one actuator, one trial): the static backdrop (table, light, clamp, tube:
+the same for every ramp, only the actuator's mounting angle varies) is built once per ramp and
 ramps run in parallel processes.  Everything random is derived from ``seed`` and fixed keys
 (material, actuator, trial, step), so the bytes written do not depend on ``jobs``.
+
+Scenes with ``target: body`` write ``target: body`` and no line colour, the fixed end at the
+body's centre line, optionally ``background.jpg`` (the empty scene, ``background_photo``) and a
+per-photo ``fixed_direction_deg`` column (``known_fixed_direction``); their truth is the body's
+centre line (``psi_image_deg``: its total turning as seen through the camera).
 
 Examples
 --------
@@ -44,12 +50,14 @@ from pipeline.synth.actuator import (
 )
 from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import Camera, make_camera, tilt_homography
-from pipeline.synth.centreline import centreline_mm
+from pipeline.synth.centreline import actuator_centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
-from pipeline.synth.scene import _compose, child_seed, world_extent_mm
+from pipeline.synth.scene import _compose, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
 
 #: seed streams (second key after the material)
-_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT = range(6)
+_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND = range(7)
+#: file name of the empty-scene photo of ``background_photo`` scenes
+BACKGROUND_IMAGE = "background.jpg"
 DEFAULT_L0_MM = 195.0
 LAYOUT_MARGIN_PX = 16
 
@@ -118,11 +126,12 @@ def plan_photoset(
     return df
 
 
-def _sample_extents(plan: pd.DataFrame, l0_mm: float, body_w: float, n_curves: int = 48) -> list[np.ndarray]:
+def _sample_extents(plan: pd.DataFrame, l0_mm: float, scene: SceneParams, n_curves: int = 48) -> list[np.ndarray]:
     order = plan.sort_values("psi_deg")
     pick = np.unique(np.round(np.linspace(0, len(order) - 1, min(n_curves, len(order)))).astype(int))
     rows = order.iloc[pick]
-    return [world_extent_mm(centreline_mm(float(r.psi_deg), l0_mm, bulge=float(r.bulge), n=241), body_w)
+    return [world_extent_mm(actuator_centreline_mm(float(r.psi_deg), l0_mm, scene, bulge=float(r.bulge), n=241),
+                            scene.body_width_mm, scene.tip_cap_mm)
             for r in rows.itertuples()]
 
 
@@ -179,20 +188,27 @@ def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     cv2.setNumThreads(1)
     scene: SceneParams = task["scene"]
     camera = make_camera(scene, rotation_deg=task["rotation_deg"], fixed_end_px=task["fixed_end_px"])
-    keepout = [_rotate(k, task["base_rotation_deg"] - task["rotation_deg"]) for k in task["keepout_mm"]]
-    backdrop = make_backdrop(scene, camera, seed=task["table_seed"], keepout_mm=keepout)
+    backdrop = _static_scene(scene, task["base_rotation_deg"], task["fixed_end_px"], task["table_seed"], task["keepout_mm"])
     out_dir = Path(task["out_dir"])
     results = []
     for row in task["rows"]:
-        pts = centreline_mm(row["psi_deg"], task["l0_mm"], bulge=row["bulge"])
+        pts = actuator_centreline_mm(row["psi_deg"], task["l0_mm"], scene, bulge=row["bulge"])
         rng = np.random.default_rng(child_seed(*task["image_seed"], row["step"]))
         r = _compose(pts, scene, camera, backdrop, scene.body_width_mm, rng)
         tmp = out_dir / f".{row['image']}.tmp"
         tmp.write_bytes(r.jpeg_bytes)
         os.replace(tmp, out_dir / row["image"])
         results.append({"image": row["image"], "psi_image_deg": r.psi_image_deg, "line_in_frame": r.line_in_frame,
-                        "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+                        "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1],
+                        "fixed_direction_deg": r.fixed_direction_deg})
     return results
+
+
+def _static_scene(scene: SceneParams, rotation_deg: float, fixed_end_px: tuple[float, float], seed: Any,
+                  keepout_mm: list[np.ndarray]) -> Any:
+    """The backdrop every ramp shares (clamp at the base mounting angle), as a background photo shows it."""
+    camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px)
+    return make_backdrop(scene, camera, seed=seed, keepout_mm=keepout_mm)
 
 
 def render_photoset(
@@ -266,7 +282,10 @@ def render_photoset(
     l0 = float(l0_mm) if l0_mm is not None else default_l0_mm(material)
     plan = plan_photoset(material, actuators=actuators, trials=trials, seed=seed, step_kpa=step_kpa,
                          max_kpa=max_kpa, psi_fn=psi_fn, behaviour=behaviour)
-    extents = _sample_extents(plan, l0, sc.body_width_mm)
+    if sc.target == "body":  # refuse before writing anything: a folded body has no centre line
+        for r in plan.loc[[plan["psi_deg"].idxmax(), plan["psi_deg"].idxmin()]].itertuples():
+            check_body_fits(actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001), sc)
+    extents = _sample_extents(plan, l0, sc)
     base_rot, fixed_flat, need = choose_layout(extents, sc)
     if need > 1.0 and fit_view:
         # zoom the camera out (as the experimenter would) until every shape is in the frame
@@ -302,16 +321,31 @@ def render_photoset(
         truth = truth.assign(
             scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
             blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
-            occluded_fraction=sc.occluded_fraction, seed=seed,
+            occluded_fraction=sc.occluded_fraction, seed=seed, target=sc.target, shape=sc.shape,
+            marker_line=sc.marker_line, body_width_mm=sc.body_width_mm, body_translucency=sc.body_translucency,
+            texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style,
         )
         first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
                  "bulge"]
         truth = truth[first + [c for c in truth.columns if c not in first]]
-        manifest = truth[["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]]
+        columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+        manifest = truth[columns + (["fixed_direction_deg"] if sc.known_fixed_direction else [])].round(
+            {"fixed_direction_deg": 3})
         write_manifest(tmp, manifest)
-        write_settings(tmp, {
-            "l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
-            "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw",
-        })
+        settings: dict[str, Any] = {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px)}
+        if sc.target == "body":
+            # the fixed end of the body's centre line, at the clamp face (base mounting angle)
+            base = Camera(sc.width, sc.height, sc.mm_per_px, base_rot, fixed_flat, tilt_homography(sc))
+            fixed_end_px = tuple(float(v) for v in base.to_px([[0.0, sc.body_width_mm / 2]])[0])
+            settings["target"] = "body"
+        else:
+            settings["line_color"] = sc.line_color
+        settings.update({"fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw"})
+        if sc.background_photo:
+            backdrop = _static_scene(sc, base_rot, tasks[0]["fixed_end_px"], child_seed(seed, mk, _TABLE), keepout)
+            image = render_background(backdrop, sc, seed=child_seed(seed, mk, _BACKGROUND))
+            atomic_write_bytes(tmp / BACKGROUND_IMAGE, encode_jpeg(image, sc.jpeg_quality))
+            settings["background"] = BACKGROUND_IMAGE
+        write_settings(tmp, settings)
         atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth
