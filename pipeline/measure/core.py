@@ -242,6 +242,8 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         length_px=est.length_px,
         base_mismatch_deg=mismatch,
         selected_fraction=body.selected_fraction,
+        continues=body.continues,
+        start_gap_px=body.start_gap_px,
     )
     mm = settings.mm_per_px
     return AngleResult(
