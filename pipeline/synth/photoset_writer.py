@@ -41,7 +41,7 @@ from pipeline.synth.actuator import (
     plan_ramp,
 )
 from pipeline.synth.backdrop import make_backdrop
-from pipeline.synth.camera import Camera, make_camera, tilt_homography
+from pipeline.synth.camera import Camera, camera_for, make_camera
 from pipeline.synth.centreline import centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
 from pipeline.synth.scene import _compose, child_seed, world_extent_mm
@@ -155,9 +155,8 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
             best = (need, float(rot), (px.max(axis=0) + px.min(axis=0)) / 2)
     _, rot, centre = best
     origin = np.array([scene.width / 2, scene.height / 2]) - centre
-    h = tilt_homography(scene)
     for _ in range(3):  # centre the shapes as seen through the tilted camera
-        px = Camera(scene.width, scene.height, scene.mm_per_px, rot, tuple(origin), h).to_px(pts)
+        px = camera_for(scene, rotation_deg=rot, origin_px=tuple(origin)).to_px(pts)
         lo, hi = px.min(axis=0), px.max(axis=0)
         origin = origin + np.array([scene.width / 2, scene.height / 2]) - (lo + hi) / 2
     size = hi - lo
@@ -263,7 +262,7 @@ def render_photoset(
         sc = dataclasses.replace(sc, mm_per_px=float(np.ceil(sc.mm_per_px * need * 1000) / 1000))
         base_rot, fixed_flat, need = choose_layout(extents, sc)
     # the fixed end as seen (after the tilt) of the chosen placement; the same for every ramp
-    fixed_end_px = Camera(sc.width, sc.height, sc.mm_per_px, base_rot, fixed_flat, tilt_homography(sc)).fixed_end_px
+    fixed_end_px = camera_for(sc, rotation_deg=base_rot, origin_px=fixed_flat).fixed_end_px
     jit = 2.5 * sc.rotation_jitter_deg
     keepout = [_rotate(e, d) for e in extents for d in ({-jit, 0.0, jit})]
     mk = material_key(material)

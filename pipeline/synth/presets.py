@@ -89,6 +89,9 @@ class SceneParams:
         Fraction of the marker length hidden under a glare spot (0-0.5).
     rotation_jitter_deg : float
         Standard deviation of the mounting angle from one actuator/trial to the next, degrees.
+    lens_k1 : float
+        Radial lens distortion (OpenCV's k1 at ``focal_px_per_width``; > 0 pincushion, < 0
+        barrel, 0 an ideal lens), see :mod:`pipeline.synth.camera`.
     """
 
     width: int = 1280
@@ -117,6 +120,7 @@ class SceneParams:
     jpeg_quality: int = 92
     occluded_fraction: float = 0.0
     rotation_jitter_deg: float = 1.5
+    lens_k1: float = 0.0
 
     def __post_init__(self) -> None:
         problems = _problems(self)
@@ -150,6 +154,8 @@ def _problems(s: SceneParams) -> list[str]:
         out.append(f"jpeg_quality = {s.jpeg_quality!r} must be 1..100")
     if not 0 <= s.occluded_fraction <= 0.5:
         out.append(f"occluded_fraction = {s.occluded_fraction!r} must be 0..0.5")
+    if not abs(s.lens_k1) <= 0.3:
+        out.append(f"lens_k1 = {s.lens_k1!r} must be within -0.3..0.3 (a phone or action camera is about -0.1)")
     if s.tilt_deg > 20:
         out.append(f"tilt_deg = {s.tilt_deg} is more than 20 deg; a copy stand is never that far off")
     for key in ("table_bgr", "body_bgr"):
