@@ -17,12 +17,16 @@ Examples
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pipeline.fileio import atomic_write_bytes
 from pipeline.synth.backdrop import SHIFT, light_gain, make_backdrop
 from pipeline.synth.camera import Camera
 from pipeline.synth.presets import SceneParams
@@ -157,3 +161,14 @@ def render_board(
     corners_mm = world(grid)
     return BoardPhoto(np.clip(np.rint(img), 0, 255).astype(np.uint8), camera.to_px(corners_mm), corners_mm,
                       (cols, rows), sq)
+
+
+def write_board_photo(path: str | os.PathLike[str], scene: SceneParams, camera: Camera, *,
+                      seed: int | np.random.SeedSequence) -> dict[str, Any]:
+    """Render the board for ``camera``, write it as a JPEG and return its ``calibration:`` value."""
+    board = render_board(scene, camera, seed=seed)
+    ok, buf = cv2.imencode(".jpg", board.image, [cv2.IMWRITE_JPEG_QUALITY, int(scene.jpeg_quality)])
+    if not ok:  # pragma: no cover - OpenCV always encodes a valid uint8 image
+        raise RuntimeError("JPEG encoding failed")
+    atomic_write_bytes(Path(path), buf.tobytes())
+    return {"board": Path(path).name, "square_mm": board.square_mm, "inner_corners": list(board.inner_corners)}

@@ -47,7 +47,9 @@ from pipeline.synth.presets import SceneParams, scene_from
 from pipeline.synth.scene import _compose, child_seed, world_extent_mm
 
 #: seed streams (second key after the material)
-_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT = range(6)
+_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BOARD = range(7)
+#: the checkerboard photo of a set rendered with ``board=True``
+BOARD_PHOTO = "board.jpg"
 DEFAULT_L0_MM = 195.0
 LAYOUT_MARGIN_PX = 16
 
@@ -204,6 +206,7 @@ def render_photoset(
     l0_mm: float | None = None,
     overwrite: bool = True,
     fit_view: bool = True,
+    board: bool = False,
 ) -> pd.DataFrame:
     """Render the pressure-ramp photos of ``actuators`` x ``trials`` of one material.
 
@@ -239,6 +242,10 @@ def render_photoset(
     fit_view : bool
         When the campaign's shapes do not fit the frame at ``scene.mm_per_px``, increase
         ``mm_per_px`` just enough (the value used is written to ``photoset.yaml``).
+    board : bool
+        Also photograph a checkerboard lying in the actuator's plane with the same camera
+        (``board.jpg``, :mod:`pipeline.synth.board`) and name it in ``photoset.yaml``'s
+        ``calibration``.
 
     Returns
     -------
@@ -288,16 +295,23 @@ def render_photoset(
     truth = truth.assign(
         scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
         blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
-        occluded_fraction=sc.occluded_fraction, seed=seed,
+        occluded_fraction=sc.occluded_fraction, seed=seed, lens_k1=sc.lens_k1,
     )
     first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
              "bulge"]
     truth = truth[first + [c for c in truth.columns if c not in first]]
     manifest = truth[["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]]
     write_manifest(out, manifest)
-    write_settings(out, {
+    settings: dict[str, Any] = {
         "l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
         "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw",
-    })
+    }
+    if board:
+        from pipeline.synth.board import write_board_photo
+
+        del settings["mm_per_px"]  # the board gives the scale (truth.csv keeps the scene's)
+        settings["calibration"] = write_board_photo(out / BOARD_PHOTO, sc, make_camera(
+            sc, rotation_deg=base_rot, fixed_end_px=fixed_end_px), seed=child_seed(seed, mk, _BOARD))
+    write_settings(out, settings)
     atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth
