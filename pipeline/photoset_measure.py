@@ -44,7 +44,7 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
         title = f"{image}  {pressure:g} kPa {direction}"
         cal = None if ps.rows[i] is None else ps.rows[i].calibration
         if cal is not None and cal.plane is not None:
-            title += f"  calibrated ({Path(cal.boards[0]).name}: {cal.plane.rms_px:.2f} px, {cal.plane.rms_mm:.3f} mm)"
+            title += f"  calibrated ({cal.plane.rms_px:.2f} px)"
         tasks.append(Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i)))
     return tasks
 

@@ -323,7 +323,8 @@ def calibrate_files(
     corners, size = [], None
     for path in boards:
         name = Path(path).name
-        grey = cv2.imdecode(np.fromfile(str(path), np.uint8), cv2.IMREAD_GRAYSCALE)
+        data = np.fromfile(str(path), np.uint8)
+        grey = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
         if grey is None:
             raise CalibrationError(f"calibration board photo {name!r} cannot be decoded")
         this = (grey.shape[1], grey.shape[0])
