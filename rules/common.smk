@@ -6,7 +6,7 @@ from snakemake.exceptions import WorkflowError
 
 from pipeline.config import validate_config
 from pipeline.errors import UserInputError
-from pipeline.photoset import read_manifest
+from pipeline.photoset import calibration_inputs, read_manifest
 
 try:
     _schema = Path(workflow.basedir) / "rules" / "config.schema.yaml"
@@ -43,7 +43,7 @@ def photoset_input(wildcards):
         return f"{RESULTS}/photosets/{wildcards.dataset}"
     if ds["source"] == "rig":
         return f"{RESULTS}/acquired/{wildcards.dataset}.done"
-    return [f"{ds['path']}/manifest.csv", f"{ds['path']}/photoset.yaml"]
+    return [f"{ds['path']}/manifest.csv", f"{ds['path']}/photoset.yaml"] + calibration_inputs(ds["path"])
 
 
 def dataset_materials(ds):

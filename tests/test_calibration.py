@@ -29,7 +29,7 @@ from pipeline.measure.calibration import (
 from pipeline.measure.core import measure_image
 from pipeline.measure.extract import LineExtraction
 from pipeline.measure.settings import SettingsError, resolve_settings
-from pipeline.photoset import load_photoset, validate_photoset, write_settings
+from pipeline.photoset import calibration_inputs, load_photoset, validate_photoset, write_settings
 from pipeline.photoset_measure import measure_photoset
 from pipeline.synth import make_camera, scene_from
 from pipeline.synth.board import render_board
@@ -240,6 +240,7 @@ def test_per_row_calibration_for_sets_of_several_sessions(calibrated, tmp_path: 
     ps = load_photoset(folder)
     boards = {Path(r.calibration.boards[0]).name for r in ps.rows}
     assert boards == {"board.jpg", "board_s2.jpg"}
+    assert [Path(b).name for b in calibration_inputs(folder)] == ["board.jpg", "board_s2.jpg"]  # measure re-runs on a new board
     angles = measure_photoset(folder)
     truth = np.r_[calibrated[1]["psi_deg"], truth2["psi_deg"]]
     err = np.abs(angles["psi_deg"] - truth)
