@@ -340,3 +340,22 @@ def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
     assert lines[i + 1] == ("b", "bench: calibrated, 4 of 4 photos; reprojection error 0.05 px (0.017 mm on the plane)")
     assert lines[i + 2][1].startswith("old: not calibrated")
     assert lines[i + 3][0] == "w" and "1.40 px" in lines[i + 3][1] and "flagged" in " ".join(t for _, t in lines[i + 3:])
+
+
+def test_body_mode_on_a_calibrated_plane_keeps_the_clamp_direction() -> None:
+    """Body mode's one hook: the centre line and ``fixed_direction_deg`` are both taken to the plane."""
+    from pipeline.measure.calibration import Calibration
+    from test_body import body_photo
+
+    img, fe, _ = body_photo(100.0, seed=5)
+    base = resolve_settings(l0_mm=180.0, target="body", fixed_end=[float(v) for v in fe], fixed_direction_deg=0.0)
+    a = np.deg2rad(30.0)  # the plane turned 30 deg against the photo, 0.3 mm per plane px
+    rot = np.array([[np.cos(a), np.sin(a), 0.0], [-np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    plane = PlaneCalibration((1280, 960), (1500.0, 0, 639.5, 0, 1500.0, 479.5, 0, 0, 1), (0.0,) * 5,
+                             tuple(rot.ravel()), 0.3, 0.05, 0.01, 1, 54)
+    calibrated = dataclasses.replace(base, calibration=Calibration(("b.jpg",), 20.0, (9, 6), plane))
+    plain, cal = measure_image(img, base), measure_image(img, calibrated)
+    assert plain.status == cal.status == "ok", (plain.reason, cal.reason)
+    assert cal.psi_deg == pytest.approx(plain.psi_deg, abs=0.05) and cal.psi_deg == pytest.approx(100.0, abs=2.5)
+    assert cal.length_mm == pytest.approx(0.3 * plain.length_px, rel=0.01)  # plane mm
+    np.testing.assert_array_equal(cal.centreline_px, plain.centreline_px)  # overlays stay in the photo's pixels
