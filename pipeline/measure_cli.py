@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
+from pipeline.folders import staged_folder
 from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
 
@@ -28,7 +29,12 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
-    angles = measure_photoset(args.photoset, method=args.method, jobs=args.jobs, overlays_dir=args.overlays, ramp_check=args.ramp_check)
+    kw = dict(method=args.method, jobs=args.jobs, ramp_check=args.ramp_check)
+    if args.overlays is None:
+        angles = measure_photoset(args.photoset, **kw)
+    else:  # the overlay folder appears only when complete
+        with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
+            angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
     print(f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}")
     return 0

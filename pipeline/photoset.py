@@ -160,27 +160,6 @@ def write_settings(folder: str | os.PathLike[str], settings: Mapping[str, Any]) 
     atomic_write_bytes(Path(folder) / SETTINGS, text.encode())
 
 
-def calibration_inputs(folder: str | os.PathLike[str]) -> list[str]:
-    """Board photos the calibrations of a photo set name, as paths (a measure job re-runs when one changes).
-
-    Unreadable settings or manifests give what can be read; ``photoset check`` reports them.
-    """
-    from pipeline.measure.settings import board_names
-
-    folder = Path(folder)
-    raw, _ = _read_yaml(folder)
-    folder_value = None if raw is None else raw.get("calibration")
-    values = [folder_value]
-    try:
-        df = read_manifest(folder)
-        if "calibration" in df.columns:
-            values += [merge_calibration(folder_value, v) for v in df["calibration"].dropna().unique() if not is_missing(v)]
-    except UserInputError:
-        pass
-    names = {name for v in values for name in board_names(v)}
-    return sorted(str(folder / n) for n in names if (folder / n).is_file())
-
-
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """Read ``manifest.csv`` as written (text columns kept as text), adding ``manifest_line``.
 

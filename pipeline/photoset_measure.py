@@ -78,7 +78,9 @@ def measure_photoset(
     pandas.DataFrame
         The angles.csv table: :data:`RESULT_COLUMNS`, then the manifest's columns
         (pressure_kpa, direction, material, actuator, trial, step, and any others such as
-        measured_pressure_kpa, timestamp or force columns).  One row per manifest row, same order.
+        measured_pressure_kpa, timestamp or force columns) and ``l0_mm``, the marked length
+        each photo was measured with (the row's or the folder's setting).  One row per manifest
+        row, same order.
 
     Raises
     ------

@@ -92,7 +92,7 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         hyst.append(out)
     h = pd.concat([pd.read_csv(p) for p in hyst])
     table = compare(h, read_angles([d.angles_csv for d in datasets]),
-                    model_psi=lambda m, p: fake_psi(m, p, "up") + 10.0, fit_k_p=None)
+                    model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0, fit_k_p=None)
     rms = tmp / "rms.csv"
     table.to_csv(rms, index=False)
     return hyst, rms
@@ -143,7 +143,8 @@ def test_four_materials_deterministic_and_not_blank(four, tmp_path):
     raw = a.read_bytes()
     assert b"CreationDate" not in raw
     images = page_images(a)
-    assert len(images) == 1 + 1 + 4 + 1  # summary, overview, one per material, comparison table
+    # summary, overview, one per material, comparison table, which model curve (l0) each used
+    assert len(images) == 1 + 1 + 4 + 1 + 1
     assert_not_blank(images)
     # the config digest changes the bytes (it is printed on the summary page)
     config.write_text("datasets: [changed]\n")
@@ -191,7 +192,7 @@ def test_increasing_only_photoset(tmp_path):
     hyst, rms = pipeline_tables(tmp_path, [d])
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)), out)
-    assert res.pages == 4
+    assert res.pages == 5  # summary, overview, DS20, comparison, model provenance
     assert_not_blank(page_images(out))
     table = pd.read_csv(rms)
     assert np.isnan(table["rms_down_deg"].iloc[0]) and np.isfinite(table["rms_up_deg"].iloc[0])

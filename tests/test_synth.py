@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import cv2
@@ -280,6 +285,29 @@ def test_cli_writes_a_photoset_and_rejects_bad_keys(tmp_path, capsys):
     assert validate_photoset(out) == []
     assert main(["synth", str(out), "--material", "SS50", "--set", "colour=red"]) == 2
     assert main(["synth", str(out), "--material", "SS50", "--behaviour", "hysteresis=0.9"]) == 2
+
+
+def test_ctrl_c_mid_synth_leaves_no_partial_set_and_keeps_the_previous_one(tmp_path):
+    """SIGINT to the process group (Ctrl-C in a terminal) while `synth` renders with two workers."""
+    out = tmp_path / "set"
+    cmd = [sys.executable, "-m", "pipeline", "synth", str(out), "--material", "SS50", "--actuators", "2",
+           "--trials", "1", "--step-kpa", "20", "--scene", "clean", "--set", "width=320", "--set", "height=240",
+           "--jobs", "2"]
+    render_photoset(out, "SS50", actuators=1, trials=1, step_kpa=130, scene="clean", scene_overrides=SMALL,
+                    psi_fn=toy_psi)  # a previous set in the same place
+    previous = sha(out)
+    proc = subprocess.Popen(cmd, cwd=REPO, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    partial = tmp_path / ".set.partial"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (partial.is_dir() and any(partial.glob("*.jpg"))):
+        time.sleep(0.01)
+    assert proc.poll() is None, "synth finished before it could be interrupted"
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and err.rstrip().endswith("synth: interrupted"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]  # no partial set beside it
+    assert sha(out) == previous  # the previous set is untouched
 
 
 def test_committed_sample_images():

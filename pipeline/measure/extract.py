@@ -401,6 +401,39 @@ def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> t
     return (labels == keep).astype(np.uint8), block
 
 
+def _face_distance(image: np.ndarray, points: np.ndarray, half_width: float) -> float:
+    """Distance (work px) back from the line's first point, along its start tangent, to the face of
+    the clamp that was cut off (0 when no clear face is seen).
+
+    Beside the line, on both sides, the photo goes from table to clamp at the face: the two side
+    profiles are sampled (sub-pixel) and the face is where their mean crosses halfway between
+    the table's and the clamp's brightness.
+    """
+    k = min(len(points) - 1, max(len(points) // 20, 3))
+    t = points[0] - points[k]
+    t = t / max(float(np.hypot(*t)), 1e-9)  # pointing back, towards the clamp
+    nrm = np.array([-t[1], t[0]])
+    steps = np.arange(0.0, 14.0 * half_width + 14.0, 0.25, dtype=np.float32)
+    side = 2.0 * half_width + 3.0
+    v = _value(image).astype(np.float32)
+    prof = np.zeros_like(steps)
+    for sgn in (-1.0, 1.0):
+        cx = (points[0, 0] + steps * t[0] + sgn * side * nrm[0]).astype(np.float32)[None, :]
+        cy = (points[0, 1] + steps * t[1] + sgn * side * nrm[1]).astype(np.float32)[None, :]
+        prof += 0.5 * cv2.remap(v, cx, cy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0]
+    table = float(np.median(prof[: max(4, len(prof) // 12)]))
+    dark = float(prof.min())
+    if table - dark < 25.0:
+        return 0.0
+    below = np.nonzero(prof <= 0.5 * (table + dark))[0]
+    if not below.size or below[0] == 0:
+        return 0.0
+    j = int(below[0])
+    a, b = prof[j - 1], prof[j]
+    frac = (a - 0.5 * (table + dark)) / max(a - b, 1e-6)
+    return float(steps[j - 1] + frac * (steps[j] - steps[j - 1]))
+
+
 def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> float:
     """Mean darkness (255 - V) in a square around a line end: high next to a dark clamp."""
     r = int(6 * half_width + 8)
@@ -536,11 +569,22 @@ def extract_centreline(
         raise NoLineFound(f"no line found: the longest candidate is only {len(points)} bands long")
     fixed_auto = fe is None
     clamp_seen = thick is not None
+    clamp_face: np.ndarray | None = None  # (x, y) pixels of the clamp's face, work image
     if fixed_auto:
         ends_g = ends + np.array([x0, y0], float)
-        darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
-        clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
-        if darkness[1] > darkness[0]:  # the clamp (dark block) sits at the fixed end
+        clamp_end = None
+        if thick is not None:
+            # the clamp that was cut off sits at the fixed end: the end nearer to it
+            ty, tx = np.nonzero(thick)
+            face = np.c_[tx + best.x0, ty + best.y0].astype(float)
+            d = [float(np.min(np.hypot(*(face - e).T))) for e in ends_g]
+            if min(d) < 0.5 * max(d):
+                clamp_end, clamp_face = int(np.argmin(d)), face
+        if clamp_end is None:
+            darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
+            clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
+            clamp_end = 1 if darkness[1] > darkness[0] else 0  # the clamp (dark block) sits at the fixed end
+        if clamp_end == 1:
             points, ends = points[::-1], ends[::-1]
     ys, xs = np.nonzero(line)
     touches = bool(xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1)
@@ -559,9 +603,13 @@ def extract_centreline(
     # the end bands' centroids lie about a quarter band inside the line's ends (measured on
     # synthetic lines of known length)
     trimmed = ((s_along[i0] + band / 4) * scale, (s_along[-1] - s_along[i1] + band / 4) * scale)
-    if fe is not None:
-        # the line starts at the given fixed end, also where the clamp cut removed a piece of it
-        gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+    if fe is not None or clamp_face is not None:
+        # the line starts at the given fixed end (or, guessed, at the face of the clamp that was cut
+        # off), also where the clamp cut removed a piece of it
+        if fe is not None:
+            gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+        else:
+            gap_fixed = _face_distance(image_bgr, gpts, best.half_width) * scale
         if gap_fixed < 0.15 * s_along[-1] * scale:
             trimmed = (max(trimmed[0], gap_fixed), trimmed[1])
     centre = gpts * scale + (scale - 1) / 2

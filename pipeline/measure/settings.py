@@ -269,24 +269,6 @@ def merge_calibration(folder_value: Any, row_value: Any) -> Any:
     return {**base, "board": row}
 
 
-def board_names(value: Any) -> list[str]:
-    """The board photo names in a raw ``calibration`` value (for job inputs; [] when unreadable).
-
-    Examples
-    --------
-    >>> board_names("{board: [a.jpg, b.jpg], square_mm: 20}"), board_names("c.jpg"), board_names(None)
-    (['a.jpg', 'b.jpg'], ['c.jpg'], [])
-    """
-    value = _yaml_value(value)
-    if isinstance(value, Mapping):
-        value = value.get("board")
-    if isinstance(value, str):
-        value = [value]
-    if not isinstance(value, (list, tuple)):
-        return []
-    return [v.strip() for v in value if isinstance(v, str) and v.strip()]
-
-
 def _calibration(
     raw: Mapping[str, Any], folder: Any, problems: list[SettingProblem], cache: CalibrationCache | None
 ) -> Calibration | None:

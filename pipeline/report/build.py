@@ -29,6 +29,7 @@ from pipeline import __version__
 from pipeline.fileio import atomic_write_bytes
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
 from pipeline.report.extra import extra_pages
+from pipeline.report.model_page import add_comparison_note, model_provenance_page
 from pipeline.report.pages import (
     comparison_page,
     material_page,
@@ -115,7 +116,9 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     figures = text_pages(data.inputs.title, lines)
     figures.append(overview_page(data))
     figures += [material_page(data, m) for m in data.materials]
-    figures.append(comparison_page(data))
+    comparison = comparison_page(data)
+    add_comparison_note(comparison, data)  # self-checks named; which l0, what was fitted: next page
+    figures += [comparison] + [f for f in [model_provenance_page(data)] if f is not None]
     return figures + bench.figures + force.figures, warnings
 
 

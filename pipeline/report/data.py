@@ -197,9 +197,10 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
     rms = pd.concat(
         [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms], ignore_index=True
     ) if inputs.rms else pd.DataFrame(columns=["material"])
-    if rms["material"].duplicated().any():
-        dup = rms.loc[rms["material"].duplicated(), "material"].iloc[0]
-        raise UserInputError(f"--rms: material {dup!r} appears twice; pass one rms.csv row per material")
+    key = "curve" if "curve" in rms.columns else "material"  # one row per material and l0
+    if rms[key].duplicated().any():
+        dup = rms.loc[rms[key].duplicated(), key].iloc[0]
+        raise UserInputError(f"--rms: {key} {dup!r} appears twice; pass one rms.csv row per {key}")
     curves = pd.concat(
         [_read_csv(p, "model curve CSV from 'model curve'", ("material", "psi_deg", "pressure_kpa"))
          for p in inputs.model_curves], ignore_index=True
@@ -235,14 +236,18 @@ def model_readings_note(config_path: Path) -> str:
         raise UserInputError(f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config") from None
     readings = ((cfg.get("model") or {}) if isinstance(cfg, dict) else {}).get("readings") or {}
     if not readings:
-        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md; Eq. 12's l0 "
-                "prefactor is a number fitted to the paper's own model results)")
+        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md: derived, no "
+                "constant fitted to the paper's numbers; l0 is the one parameter its two model results fix)")
     given = ", ".join(f"{k}={v}" for k, v in sorted(readings.items()))
     return f"model: the paper's Eqs. 1-13 with readings set in the config: {given} (others default; docs/model.md)"
 
 
 def rms_row(data: ReportData, material: str) -> dict[str, float]:
-    """rms.csv row of a material as a dict (empty when absent)."""
+    """rms.csv row of a material as a dict (empty when absent).
+
+    With several rows (datasets of different l0) this is the first, the model's default l0
+    (``compare`` writes it first); the model provenance page lists them all.
+    """
     sel = data.rms[data.rms["material"].astype(str) == material]
     if sel.empty:
         return {}

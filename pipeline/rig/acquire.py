@@ -10,6 +10,10 @@ the first missing step is reached along the same pressure history (see
 Whatever ends the run early -- Ctrl-C/SIGTERM, ``EVT ESTOP``, a lost port, a camera failure, any
 exception -- the host vents to 0 kPa if the port still answers, keeps every row written, prints
 what happened and how to resume, and returns a non-zero :data:`EXIT_CODES` value.
+
+Firmware that speaks only the base protocol (no ``CFG``, ``WDOG`` or load cell) runs a bending
+ramp too: the session says at the start and in its final message what it could not use
+(:func:`unused_features`); blocked mode, which needs the load cell, stops before pressurising.
 """
 
 from __future__ import annotations
@@ -102,6 +106,7 @@ class SessionResult:
     vented: bool | None = None
     last_step: session.StepPlan | None = None
     garbage_lines: int = 0
+    unused: list[str] = field(default_factory=list)
 
     @property
     def exit_code(self) -> int:
@@ -189,6 +194,33 @@ def describe_plan(cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = 
     return "\n".join(lines)
 
 
+def unused_features(driver: PicoDriver, cfg: SessionConfig) -> list[str]:
+    """What this run would use but the firmware does not speak (one sentence each; empty for ours).
+
+    Parameters
+    ----------
+    driver : PicoDriver
+        Connected driver (its extensions were probed at connect).
+    cfg : SessionConfig
+        The run.
+
+    Returns
+    -------
+    list of str
+    """
+    name = f"{driver.info.name} {driver.info.version}" if driver.info else "the device"
+    out = []
+    if not driver.supports("CFG"):
+        out.append(f"firmware {name} has no CFG: its own pressure limit is unknown, so only the host limit "
+                   f"--max-kpa {driver.max_kpa:g} kPa guards the setpoints")
+    if cfg.watchdog_s > 0 and not driver.supports("WDOG"):
+        out.append(f"firmware {name} has no WDOG: the device cannot vent by itself if the host stops talking "
+                   "(pulled cable, crashed host); keep the emergency stop at hand")
+    if cfg.mode == "blocked" and not driver.supports("LOAD"):
+        out.append(f"firmware {name} has no load-cell commands (LOAD/TARE/SCALE), which --mode blocked needs")
+    return out
+
+
 def run_session(
     driver: PicoDriver,
     camera: Camera,
@@ -222,7 +254,15 @@ def run_session(
         ``status`` is one of :data:`EXIT_CODES`; every row written stays written.
     """
     stream = stream or sys.stderr
-    result = SessionResult()
+    result = SessionResult(unused=unused_features(driver, cfg))
+    for note in result.unused:
+        print(f"acquire: not used: {note}", file=stream)
+    if cfg.mode == "blocked" and not driver.supports("LOAD"):
+        result.status, result.message = "error", (
+            "blocked mode needs the load cell, which this firmware does not speak; nothing was done "
+            "(flash the firmware of pipeline/rig/firmware or use --mode bending)")
+        print(f"acquire: {result.message}", file=stream)
+        return result
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
     raw_settings = {**cfg.settings, **camera.photoset_settings()}
     if session.check_settings(cfg.out_dir, raw_settings):
@@ -249,14 +289,15 @@ def run_session(
     interrupts = _Interrupts()
     try:
         with interrupts:
+            watchdog = cfg.watchdog_s > 0 and driver.supports("WDOG")
             driver.vent()
-            if cfg.watchdog_s > 0:
+            if watchdog:
                 driver.set_watchdog(cfg.watchdog_s)
             driver.sleep(cfg.settle_s)
             for trial, seq, recorded in plans:
                 _run_trial(driver, camera, cfg, trial, seq, recorded, up, stop_up, settings, bar, interrupts, result)
             driver.vent()
-            if cfg.watchdog_s > 0:
+            if watchdog:
                 driver.set_watchdog(0.0)
     except KeyboardInterrupt:
         result.status, result.message = "interrupted", "interrupted (Ctrl-C / SIGTERM)"
@@ -384,6 +425,7 @@ def _final_message(cfg: SessionConfig, result: SessionResult) -> str:
         with open(cfg.out_dir / MANIFEST) as fh:
             n_rows = max(sum(1 for _ in fh) - 1, 0)
     garbage = f"; ignored {result.garbage_lines} garbage line(s) from the device" if result.garbage_lines else ""
+    garbage += "".join(f"\nacquire: not used: {note}" for note in result.unused)
     if result.status == "done":
         return (f"acquire: done: {result.photos_taken} photo(s) taken, {result.steps_skipped} already recorded; "
                 f"{n_rows} row(s) in {cfg.out_dir / MANIFEST}{garbage}")
@@ -432,6 +474,6 @@ def summarise(result: SessionResult) -> dict[str, Any]:
 
 __all__ = [
     "EXIT_CODES", "SessionConfig", "SessionResult", "describe_plan", "psi0_stop_criterion", "run_session",
-    "summarise", "trial_plans",
+    "summarise", "trial_plans", "unused_features",
 ]
 

@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, stop_up: Any, settings: dict[str, Any]) -> int:
     from pipeline.rig.cameras import CameraError, open_camera
-    from pipeline.rig.driver import PicoDriver, RigError
+    from pipeline.rig.driver import PicoDriver, RigError, UnsupportedError
 
     try:
         camera = open_camera(args.camera, material=args.material, l0_mm=settings["l0_mm"], seed=args.seed,
@@ -149,6 +149,8 @@ def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, sto
     try:
         try:
             driver = PicoDriver.open(args.port, max_kpa=args.max_kpa, calibration=calibration, timeout_s=args.timeout_s)
+        except UnsupportedError:
+            raise  # an option this firmware cannot honour: bad input (exit 2), not a lost port
         except RigError as exc:
             print(f"acquire: {exc}", file=sys.stderr)
             return EXIT_CODES["port_lost"]
