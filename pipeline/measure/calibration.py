@@ -16,11 +16,11 @@ residuals, the ramp check) keeps its pixel meaning while psi, the curvature and 
 are those of the physical plane (psi = mean curvature in 1/mm times ``l0_mm``).
 
 Measured (``python -m pipeline.measure.calibration_bench``, 8 rendered poses with the camera
-3-8 deg off nadir and |k1| <= 0.1, 82 lab photos at 1280x960, one board photo each): |psi error|
-against the physical angle, ok rows, median 0.036 deg and p95 0.115 deg calibrated, against
-2.2 deg and 10.5 deg for the same photos measured in the image with ``mm_per_px``; the fitted k1
-is within 0.003 of the rendered one, the reprojection error 0.03-0.04 px.  Mapping a centre
-line of ~225 points costs 0.05 ms.
+3-8 deg off nadir and |k1| <= 0.1, 106 lab photos at 1280x960, one board photo each): |psi
+error| against the physical angle, ok rows, median 0.042 deg and p95 0.18 deg calibrated,
+against 2.0 deg and 10.4 deg for the same photos measured in the image with ``mm_per_px``; the
+fitted k1 is within 0.003 of the rendered one, the reprojection error 0.03-0.05 px.  Mapping a
+centre line of ~210 points costs 0.06 ms.
 
 Examples
 --------
