@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from pipeline.aggregate import status_counts
+from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import ReportData, fmt, rms_row
 from pipeline.report.strip import Strip, build_strip
 from pipeline.report.style import LANDSCAPE_SIZE_IN, PAGE_SIZE_IN, lighter, material_colors
@@ -66,6 +67,7 @@ def summary_lines(data: ReportData, version: str, config_digest: str | None, war
     tot = counts[["images", "ok", "flagged", "failed"]].sum()
     body(f"total: {int(tot['images'])} images, {int(tot['ok'])} ok, {int(tot['flagged'])} flagged, "
          f"{int(tot['failed'])} failed (flagged and failed are left out of the curves and fits)")
+    lines += calibration_lines(data.angles, [d.name for d in data.inputs.datasets])  # issue 17
     lines.append(("h", "Other inputs"))
     for path, digest in data.digests.items():
         if path not in {str(d.angles_csv) for d in data.inputs.datasets}:
