@@ -68,6 +68,9 @@ class BodyExtraction:
         on past a gap (a faint or hidden stretch), so its end, and psi, may be wrong.
     start_gap_px : float
         How far the body's centre line starts from the given fixed end (original px; 0 without).
+    end_short_px : float
+        How much of the body's ridge, at the free end, the centre line does not cover (original
+        px): where the outline was too uneven to find the middle between two edges.
     """
 
     line: LineExtraction
@@ -76,6 +79,7 @@ class BodyExtraction:
     selected_fraction: float
     continues: bool = False
     start_gap_px: float = 0.0
+    end_short_px: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -89,6 +93,8 @@ def _design(xs: np.ndarray, ys: np.ndarray, w: int, h: int) -> np.ndarray:
     return np.c_[np.ones_like(u), u, v, u * u, u * v, v * v]
 
 
+#: the backdrop fits use about this many pixels of the photo, its colour groups this many
+FIT_PIXELS, KMEANS_PIXELS = 8000, 3000
 #: a colour seen on this fraction of the region's border (or more) is backdrop too ...
 BACKDROP_CLASS_FRACTION = 0.15
 #: ... and so is a colour covering this fraction of the whole region (the actuator never does)
@@ -154,44 +160,48 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     h, w = allowed.shape
     lab = _lab(image_bgr)
     ring = _ring(allowed)
-    step = max(1, int(np.sqrt(max(h * w, 1) / 40000.0)))  # fit on about 40k pixels at most
+    step = max(1, int(np.sqrt(max(h * w, 1) / FIT_PIXELS)))  # the fits use a sparse grid of pixels
     grid = np.zeros((h, w), bool)
     grid[::step, ::step] = True
-    ring_px = lab[ring & grid] if (ring & grid).sum() >= 12 else lab[(allowed > 0) & grid]
-    labels, centres = kmeans3(ring_px)
-    k = 3
-    share = np.bincount(labels.ravel(), minlength=k) / max(len(labels), 1)
-    order = [int(i) for i in np.argsort(-share) if share[i] >= BACKDROP_CLASS_FRACTION]
-    main = order[0]
-    # smooth field of the main backdrop colour
     sample = ring & grid
-    near_main = np.zeros((h, w), bool)
-    near_main[sample] = labels.ravel()[: int(sample.sum())] == main if (ring & grid).sum() >= 12 else False
-    if near_main.sum() < 12:
-        near_main = sample
-    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
-    full = _design(xx.ravel(), yy.ravel(), w, h)
-    diff = np.zeros((h, w), np.float32)
-    fit = near_main
+    if sample.sum() < 12:
+        sample = (allowed > 0) & grid
+    ring_px = lab[sample]
+    labels, centres = kmeans3(ring_px[:: max(1, len(ring_px) // KMEANS_PIXELS)])
+    d_ring = ((ring_px[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    labels = np.argmin(d_ring, axis=1)
+    share = np.bincount(labels, minlength=3) / max(len(labels), 1)
+    order = [int(i) for i in np.argsort(-share) if share[i] >= BACKDROP_CLASS_FRACTION]
+    # smooth field of the main backdrop colour, fitted on the grid, evaluated on a coarse one
+    ry, rx = np.nonzero(sample)
+    main = labels == order[0]
+    a_ring = _design(rx[main].astype(np.float32), ry[main].astype(np.float32), w, h)
+    gy, gx = np.nonzero((allowed > 0) & grid)
+    a_grid = _design(gx.astype(np.float32), gy.astype(np.float32), w, h)
+    lab_grid = lab[gy, gx]
+    fit_a, fit_v = a_ring, ring_px[main]
+    coef = np.zeros((6, 3))
     for _ in range(3):
-        ys, xs = np.nonzero(fit)
-        coef, *_ = np.linalg.lstsq(_design(xs.astype(np.float32), ys.astype(np.float32), w, h), lab[ys, xs], rcond=None)
-        model = (full @ coef).reshape(h, w, 3)
-        diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
-        vals = diff[near_main]
-        med = float(np.median(vals))
-        spread = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
-        fit = (allowed > 0) & grid & (diff < med + 3.0 * spread + 2.0)
-        if fit.sum() < 12:
+        if len(fit_v) < 12:
             break
+        coef, *_ = np.linalg.lstsq(fit_a, fit_v, rcond=None)
+        on_ring = np.sqrt(((ring_px[main] - a_ring @ coef) ** 2).sum(axis=1))
+        med = float(np.median(on_ring))
+        spread = max(1.4826 * float(np.median(np.abs(on_ring - med))), 0.5)
+        like = np.sqrt(((lab_grid - a_grid @ coef) ** 2).sum(axis=1)) < med + 3.0 * spread + 2.0
+        fit_a, fit_v = a_grid[like], lab_grid[like]  # every allowed pixel that looks like it (uneven light)
+    cy, cx = np.mgrid[0 : h + 7 : 8, 0 : w + 7 : 8].astype(np.float32)
+    coarse = (_design(cx.ravel(), cy.ravel(), w, h) @ coef).reshape(cy.shape[0], cy.shape[1], 3).astype(np.float32)
+    model = cv2.resize(coarse, (cx.shape[1] * 8, cy.shape[0] * 8), interpolation=cv2.INTER_LINEAR)[:h, :w]
+    diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
     others = [centres[c] for c in order[1:]]
-    region_px = lab[(allowed > 0) & grid].astype(np.float32)
+    region_px = lab_grid[:: max(1, len(lab_grid) // KMEANS_PIXELS)]
     if len(region_px) >= 3:
         glabels, gcentres = kmeans3(region_px)
-        gshare = np.bincount(glabels.ravel(), minlength=3) / len(glabels)
+        gshare = np.bincount(glabels, minlength=3) / len(glabels)
         others += [gcentres[c] for c in range(3) if gshare[c] >= DOMINANT_FRACTION]
     for centre in others:
-        diff = np.minimum(diff, np.sqrt(((lab - centre) ** 2).sum(axis=2)).astype(np.float32))
+        diff = np.minimum(diff, np.sqrt(((lab - centre.astype(np.float32)) ** 2).sum(axis=2)))
     vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
     med = float(np.median(vals))
     sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
@@ -428,6 +438,13 @@ MARCH_HALF_WIDTHS = 2.0
 MARCH_STEP_PX = 2.0
 
 
+def _uncovered(ridge: np.ndarray, end: np.ndarray) -> float:
+    """Length of the ridge path beyond the point nearest ``end`` (px)."""
+    seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ridge, axis=0).T))))
+    i = int(np.argmin(np.hypot(*(ridge - end).T)))
+    return float(seg[-1] - seg[i])
+
+
 def _continues(others: np.ndarray, pts: np.ndarray, half: float) -> bool:
     """Whether other selected pixels lie just ahead of the centre line's free end, on its course."""
     if not others.any() or len(pts) < 8:
@@ -621,6 +638,7 @@ def extract_body(
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
+    ridge = path  # the whole ridge, end to end: what the centre line should cover
     path, _ = _trim_by_thickness(path, dt, half)
     soft = _soft_body(comp, strength)
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
@@ -668,4 +686,5 @@ def extract_body(
     return BodyExtraction(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
+        end_short_px=_uncovered(ridge, pts[-1]) * scale,
     )

@@ -250,6 +250,7 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         selected_fraction=body.selected_fraction,
         continues=body.continues,
         start_gap_px=body.start_gap_px,
+        end_short_px=body.end_short_px,
     )
     mm = settings.mm_per_px
     return AngleResult(

@@ -461,17 +461,22 @@ def turning_quick(
 TANGENT_WINDOW_FRACTION = 0.15
 
 
+#: tangents: polynomial degree of the tangent angle against arc length in each end window
+TANGENT_DEGREE = 1
+
+
 def _end_angle(s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool) -> tuple[float, float]:
-    """Tangent angle at arc length ``at`` from a line fit over the first/last ``window``; and its RMS."""
+    """Tangent angle at arc length ``at`` from a fit over the first/last ``window``; and its RMS."""
     sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
     if sel.sum() < 3:
         sel = np.zeros_like(sel)
         sel[:3] = True if from_start else False
         if not from_start:
             sel[-3:] = True
-    slope, icpt = np.polyfit(s_mid[sel], theta[sel], 1)
-    resid = theta[sel] - (slope * s_mid[sel] + icpt)
-    return float(slope * at + icpt), float(np.sqrt(np.mean(resid**2)))
+    deg = min(TANGENT_DEGREE, int(sel.sum()) - 2)
+    coef = np.polyfit(s_mid[sel], theta[sel], deg)
+    resid = theta[sel] - np.polyval(coef, s_mid[sel])
+    return float(np.polyval(coef, at)), float(np.sqrt(np.mean(resid**2)))
 
 
 def end_tangents(
