@@ -199,18 +199,13 @@ def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Fram
                     return
         failures = 0
         while end is None or k < end:
-            if failures >= MAX_CONSECUTIVE_FAILURES:
-                yield Frame(k, math.nan, None, reason)
-                k += 1
-                continue
-            ok, data = cap.read()
+            ok, data = (False, None) if failures >= MAX_CONSECUTIVE_FAILURES else cap.read()
             if not ok or data is None or data.size == 0:
                 if end is None:
                     return
                 failures += 1
-                reason = (f"frame {k} could not be read from {name}: the video is truncated or corrupt here "
-                          f"(the container announces {info.frame_count} frames)")
-                yield Frame(k, math.nan, None, reason)
+                yield Frame(k, math.nan, None, f"frame {k} could not be read from {name}: the video is truncated or "
+                                              f"corrupt here (the container announces {info.frame_count} frames)")
                 k += 1
                 continue
             failures = 0

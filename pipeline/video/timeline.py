@@ -17,8 +17,8 @@ For each frame this module gives (:func:`frame_conditions`):
     the rising leg, as the peak photo of a stepped ramp does.  Before any change: ``up``.
 ``step``, ``since_step_s``
     Steps are jumps of ``pressure_kpa`` of at least :data:`STEP_MIN_KPA` between consecutive
-    log rows followed by a hold (within :data:`HOLD_TOLERANCE_KPA`) of at least
-    :data:`STEP_HOLD_MIN_S`; ``step`` counts the steps up to the frame (0 before the first) and
+    log rows, between two holds (within :data:`HOLD_TOLERANCE_KPA`) of at least
+    :data:`STEP_HOLD_MIN_S` each (so the end of a fast ramp is no step); ``step`` counts the steps up to the frame (0 before the first) and
     ``since_step_s`` is the time since the last one (NaN before the first).  A continuous ramp
     has no steps.
 
@@ -192,7 +192,10 @@ def step_times(log: PressureLog) -> np.ndarray:
         k = j
         while k + 1 < len(p) and abs(p[k + 1] - p[j]) <= HOLD_TOLERANCE_KPA:
             k += 1
-        if t[k] - t[j] >= STEP_HOLD_MIN_S:
+        i = j - 1
+        while i > 0 and abs(p[i - 1] - p[j - 1]) <= HOLD_TOLERANCE_KPA:
+            i -= 1
+        if t[k] - t[j] >= STEP_HOLD_MIN_S and t[j - 1] - t[i] >= STEP_HOLD_MIN_S:
             out.append(t[j])
     return np.array(out, dtype=float)
 

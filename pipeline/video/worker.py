@@ -71,7 +71,7 @@ def measure_frame(frame: Frame, settings: MeasureSettings, method: str, packets:
     if packets:
         img, f = decode_for_work(frame.data, grey=grey)
         if img is None:
-            return failed(method, f"frame {frame.index}: its JPEG packet cannot be decoded (corrupt frame)"), None, 1
+            return failed(method, f"frame {frame.index}: its JPEG packet cannot be decoded (the video is truncated or corrupt here)"), None, 1
         return measure_decoded(frame.data, img, f, settings, method=method), img, f
     full = cv2.cvtColor(frame.data, cv2.COLOR_BGR2GRAY) if grey else frame.data
     f = reduction_for(full.shape[1])
