@@ -23,22 +23,7 @@ from pipeline.video.reader import probe_video, read_frames
 from pipeline.video.timeline import PressureLog, frame_conditions, read_pressure_log, step_times, turning_points
 
 SCENE = {"width": 320, "height": 240, "tilt_deg": 0.0}
-STEPS = PressureProfile("steps", max_kpa=80, step_kpa=40, hold_s=1.5)  # 0 40 80 40 0 kPa: 7.5 s
 MEASURED = ["psi_deg", "status", "reason", "frame", "time_s", "pressure_kpa", "direction", "step"]
-
-
-@pytest.fixture(scope="module")
-def video_set(tmp_path_factory) -> Path:
-    """An SS40 video (320x240, 10 fps, 85 frames, MJPEG) of a staircase of pressure steps."""
-    folder = tmp_path_factory.mktemp("video") / "steps"
-    render_video(folder, "SS40", profile=STEPS, fps=10, rest_s=0.5, clock_offset_s=0.7, scene="lab",
-                 scene_overrides=SCENE, seed=3)
-    return folder
-
-
-@pytest.fixture(scope="module")
-def measured(video_set) -> pd.DataFrame:
-    return measure_photoset(video_set, jobs=2)
 
 
 def _copy(video_set: Path, tmp_path: Path) -> Path:
@@ -53,19 +38,19 @@ def _video(folder: Path) -> Path:
 
 def test_every_frame_is_a_row_with_its_time_pressure_and_direction(video_set, measured):
     truth = pd.read_csv(video_set / "truth.csv")
-    assert len(measured) == len(truth) == 85
+    assert len(measured) == len(truth) == 135
     assert {"frame", "time_s", "pressure_kpa", "measured_pressure_kpa", "direction", "step", "since_step_s"} <= set(measured.columns)
     m = measured.merge(truth, on=["image", "frame"], suffixes=("", "_true"), validate="one_to_one")
     assert np.allclose(m["time_s"], m["time_s_true"], atol=1e-6)  # frame k at 0.7 + k / 10 s on the log clock
     ok = m[m["status"] == "ok"]
-    assert len(ok) >= 80
+    assert len(ok) >= 130
     err = (ok["psi_deg"] - ok["psi_image_deg"]).abs()
     assert err.median() < 0.1 and err.max() < 2.0
     # the setpoint is interpolated from the log; the measured pressure follows the true one
     assert np.allclose(m["pressure_kpa"], m["setpoint_kpa"], atol=1e-6)
     assert (m["measured_pressure_kpa"] - m["pressure_true_kpa"]).abs().median() < 0.5
     # up until the top step is left (its hold included), then down; 4 steps
-    top_left = 0.7 + 0.5 + 3 * 1.5
+    top_left = 0.7 + 0.5 + 3 * 2.5
     assert (m.loc[m["time_s"] < top_left - 1e-6, "direction"] == "up").all()
     assert (m.loc[m["time_s"] > top_left + 1e-6, "direction"] == "down").all()
     assert sorted(m["step"].unique()) == [0, 1, 2, 3, 4]
@@ -85,17 +70,17 @@ def test_truncated_video_keeps_the_frames_it_could_read_and_fails_the_rest(video
     data = path.read_bytes()
     path.write_bytes(data[: int(len(data) * 0.6)])
     out = measure_photoset(folder, jobs=2)
-    assert len(out) == 85  # the container still announces 85 frames: none disappears
+    assert len(out) == 135  # the container still announces 135 frames: none disappears
     failed = out[out["status"] == "failed"]
     read = out[out["status"] != "failed"]
-    assert 30 < len(read) < 70 and read["frame"].max() < failed["frame"].min()
+    assert 50 < len(read) < 110 and read["frame"].max() < failed["frame"].min()
     assert failed["reason"].str.contains("truncated or corrupt").all()
     assert failed["time_s"].notna().all() and failed["pressure_kpa"].notna().all()
     # frames read after the unusable index (packets skipped from the start) are the same frames
     intact = measure_photoset(video_set, jobs=1).set_index("frame")
     assert np.allclose(read.set_index("frame")["psi_deg"], intact.loc[read["frame"], "psi_deg"])
     text = "\n".join(map(str, photoset.validate_photoset(folder)))
-    assert f"only frames 0-{len(read) - 1} of the 85 of video {path.name} can be read" in text
+    assert f"only frames 0-{len(read) - 1} of the 135 of video {path.name} can be read" in text
 
 
 def test_unreadable_video_is_one_failed_row_or_one_per_listed_frame(video_set, tmp_path):
@@ -120,7 +105,7 @@ def test_a_log_not_covering_the_video_is_refused_naming_both_spans(video_set, tm
     log[log["time_s"] <= 5.0].to_csv(log_path, index=False)
     problems = [p for p in photoset.validate_photoset(folder) if not p.warning]
     assert len(problems) == 1 and problems[0].line == 2
-    assert "spans 0.70-9.10 s on the log clock" in problems[0].message
+    assert "spans 0.70-14.10 s on the log clock" in problems[0].message
     assert "covers 0.00-5.00 s" in problems[0].message
     cli = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(folder)], capture_output=True, text=True)
     assert cli.returncode == 1 and "covers 0.00-5.00 s" in cli.stderr
@@ -133,9 +118,9 @@ def test_a_log_not_covering_the_video_is_refused_naming_both_spans(video_set, tm
 
 def test_frame_times_file_replaces_the_container_times(video_set, tmp_path):
     folder = _copy(video_set, tmp_path)
-    jitter = np.random.default_rng(0).uniform(-0.02, 0.02, 85)
-    times = np.arange(85) / 10 + jitter
-    pd.DataFrame({"frame": range(85), "time_s": times}).to_csv(folder / "frames.csv", index=False)
+    jitter = np.random.default_rng(0).uniform(-0.02, 0.02, 135)
+    times = np.arange(135) / 10 + jitter
+    pd.DataFrame({"frame": range(135), "time_s": times}).to_csv(folder / "frames.csv", index=False)
     m = pd.read_csv(folder / "manifest.csv")
     m["frame_times"] = "frames.csv"
     m.to_csv(folder / "manifest.csv", index=False)
@@ -155,9 +140,9 @@ def test_manifest_rows_of_videos_name_their_problems(video_set, tmp_path):
     assert "line 3: material SS40, actuator A1, trial 1 is also line 2" in text
     assert "line 4: video name is empty" in text
     out = measure_photoset(folder)
-    assert len(out) == 85 + 85 + 1  # line 4 names no video: one row says why
-    assert (out.iloc[:85]["status"] != "failed").all() and (out.iloc[85:]["status"] == "failed").all()
-    assert out.iloc[90]["reason"].startswith("manifest line 3: video 'SS40_A1_t1_steps.avi' is listed twice")
+    assert len(out) == 135 + 135 + 1  # line 4 names no video: one row says why
+    assert (out.iloc[:135]["status"] != "failed").all() and (out.iloc[135:]["status"] == "failed").all()
+    assert out.iloc[140]["reason"].startswith("manifest line 3: video 'SS40_A1_t1_steps.avi' is listed twice")
     with pytest.raises(UserInputError, match="missing column"):
         pd.DataFrame({"video": ["a.avi"], "material": ["SS40"]}).to_csv(folder / "manifest.csv", index=False)
         photoset.read_manifest(folder)
@@ -241,7 +226,7 @@ def test_truncated_avi_cannot_seek_and_is_read_by_skipping(video_set, tmp_path):
     data = _video(video_set).read_bytes()
     path.write_bytes(data[: int(len(data) * 0.8)])
     info = probe_video(path)
-    assert info.frame_count == 85 and not info.seekable
+    assert info.frame_count == 135 and not info.seekable
     whole = {f.index: f.data for f in read_frames(probe_video(_video(video_set)), 40, 5)}
     part = list(read_frames(info, 40, 5))
     assert [f.index for f in part] == list(range(40, 45))
@@ -252,5 +237,5 @@ def test_truncated_avi_cannot_seek_and_is_read_by_skipping(video_set, tmp_path):
 
 def test_clips_know_their_span_and_the_log(video_set):
     clip = resolve_clips(photoset.load_photoset(video_set))[0]
-    assert clip.n_frames == 85 and clip.clock_offset_s == 0.7 and clip.problems == ()
-    assert np.allclose(clip.span_s(), (0.7, 9.1)) and clip.log is not None and clip.log.span_s[0] == 0.0
+    assert clip.n_frames == 135 and clip.clock_offset_s == 0.7 and clip.problems == ()
+    assert np.allclose(clip.span_s(), (0.7, 14.1)) and clip.log is not None and clip.log.span_s[0] == 0.0
