@@ -18,6 +18,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="pressure bin of the loops (kPa, default 5); the measured pressure when logged")
     parser.add_argument("--include-flagged", action="store_true",
                         help="also use frames whose status is 'flagged' (default: only 'ok')")
+    parser.add_argument("--overlays", type=Path, default=None, metavar="DIR",
+                        help="the 'measure --overlays' folder: also write strip.jpg, frames across the recording")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -28,6 +30,10 @@ def run(args: argparse.Namespace) -> int:
     angles = read_table(args.angles, "an angles.csv of a video photo set, written by 'measure'",
                         dtype={"actuator": str, "trial": str, "image": str, "reason": str})
     tables = write_continuous(angles, args.out_dir, bin_kpa=args.bin_kpa or BIN_KPA, include_flagged=args.include_flagged)
+    if args.overlays is not None:
+        from pipeline.video.pages import write_strip
+
+        write_strip(angles, args.overlays, args.out_dir)
     steps, cycles = tables["steps.csv"], tables["cycles.csv"]
     settled = int(steps["settling_time_s"].notna().sum()) if len(steps) else 0
     print(f"continuous: {int(angles['frame'].notna().sum())} frames -> {len(cycles)} cycle(s), {len(steps)} step(s) "
