@@ -442,7 +442,7 @@ def write_manifest(folder: str | os.PathLike[str], rows: pd.DataFrame) -> None:
 
 
 def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
-    """Append rows to ``manifest.csv`` atomically; rows whose image is already listed are replaced.
+    """Append rows to ``manifest.csv`` atomically; rows whose image (video) is already listed are replaced.
 
     Returns
     -------
@@ -453,7 +453,8 @@ def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[
     new = pd.DataFrame(list(rows))
     if path.is_file():
         old = pd.read_csv(path, dtype=str)
-        old = old[~old["image"].isin(new["image"].astype(str))]
+        key = "video" if is_video_manifest(old) else "image"
+        old = old[~old[key].isin(new[key].astype(str))]
         df = pd.concat([old, new.astype(str)], ignore_index=True)
     else:
         df = new

@@ -41,7 +41,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 import pandas as pd
 from scipy.signal import lfilter
@@ -65,9 +64,8 @@ from pipeline.synth.photoset_writer import choose_layout, default_l0_mm, materia
 from pipeline.synth.presets import SceneParams, scene_from
 from pipeline.synth.scene import child_seed, render_actuator, world_extent_mm
 from pipeline.video.profile import PressureProfile
+from pipeline.video.writer import CODECS, open_writer
 
-#: codec name -> (four-character code, file suffix)
-CODECS: dict[str, tuple[str, str]] = {"mjpg": ("MJPG", ".avi"), "mp4v": ("mp4v", ".avi"), "h264": ("avc1", ".mp4")}
 #: seed streams (after the material key)
 _ACTUATOR, _TRIAL, _TABLE, _FRAME, _LOG = 11, 12, 13, 14, 15
 #: the rig counts as vented (the hysteresis peak restarts) below this pressure (kPa)
@@ -158,27 +156,7 @@ def simulate(profile: PressureProfile, trial: TrialActuator, dynamics: Dynamics,
                          "loading": loading})
 
 
-def open_writer(path: Path, codec: str, fps: float, size: tuple[int, int]) -> cv2.VideoWriter:
-    """An open ``VideoWriter`` for ``codec`` (a key of :data:`CODECS`), or a clear refusal.
-
-    Raises
-    ------
-    UserInputError
-        Unknown codec, or one this OpenCV build cannot encode (named with those it can).
-    """
-    if codec not in CODECS:
-        raise UserInputError(f"codec {codec!r} is unknown; use one of {sorted(CODECS)}")
-    fourcc, _ = CODECS[codec]
-    writer = cv2.VideoWriter(str(path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*fourcc), float(fps), size)
-    if not writer.isOpened():
-        writer.release()
-        Path(path).unlink(missing_ok=True)
-        raise UserInputError(f"this OpenCV build cannot encode {codec} (FourCC {fourcc}); use codec mjpg (what USB lab "
-                             "cameras record) or mp4v")
-    return writer
-
-
-def _scene_for(scene: SceneParams, l0_mm: float, psi_range: tuple[float, float]) -> tuple[SceneParams, float]:
+def fit_scene(scene: SceneParams, l0_mm: float, psi_range: tuple[float, float]) -> tuple[SceneParams, float]:
     """Zoom out (as the experimenter would) until every shape of the recording fits; the clamp direction."""
     curves = [world_extent_mm(centreline_mm(float(p), l0_mm, n=241), scene.body_width_mm)
               for p in np.linspace(psi_range[0], psi_range[1], 17)]
@@ -230,7 +208,7 @@ def render_video(
     seed : int
         Seeds everything (same seed, same bytes).
     codec : str
-        A key of :data:`CODECS`.
+        A key of :data:`pipeline.video.writer.CODECS`.
     log_hz : float
         Rate of the pressure log (rows per second).
     dynamics : Dynamics, optional
@@ -272,7 +250,7 @@ def render_video(
     frame_t = clock_offset_s + np.arange(n_frames) / fps
     psi = np.interp(frame_t, sim["time_s"], sim["psi_deg"])
     sc = scene_from(scene, **dict(scene_overrides or {}))
-    sc, rotation = _scene_for(sc, l0, (float(psi.min()), float(psi.max())))
+    sc, rotation = fit_scene(sc, l0, (float(psi.min()), float(psi.max())))
     extent = np.vstack([centreline_mm(float(p), l0, n=241) for p in np.linspace(psi.min(), psi.max(), 9)])
     camera = make_camera(sc, rotation_deg=rotation, extent_mm=extent)
     backdrop = make_backdrop(sc, camera, seed=child_seed(seed, mk, _TABLE), keepout_mm=[extent])
@@ -314,3 +292,40 @@ def render_video(
               mm_per_px=sc.mm_per_px, width=sc.width, height=sc.height, seed=seed)
     atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth
+
+
+class LiveActuator:
+    """The same physics as :func:`simulate`, advanced in real time from observed pressures.
+
+    Used by the synthetic video camera of the rig (``acquire --record video --camera synthetic``):
+    each :meth:`psi_deg` call takes the time and the pressure the rig reports and returns the
+    lagged angle with the hysteresis of :func:`static_psi_deg` (the peak restarts when vented).
+
+    Examples
+    --------
+    >>> live = LiveActuator(toy_actuator(), tau_psi_s=0.0)
+    >>> live.psi_deg(0.0, 0.0), live.psi_deg(1.0, 50.0), live.psi_deg(2.0, 25.0) < 210 - 2 * 25
+    (210.0, 110.0, True)
+    """
+
+    def __init__(self, trial: TrialActuator, *, tau_psi_s: float = Dynamics().tau_psi_s) -> None:
+        self.trial, self.tau_psi_s = trial, tau_psi_s
+        self._peak = 0.0
+        self._t: float | None = None
+        self._psi = float(trial.psi_loading_deg(0.0))
+
+    def psi_deg(self, t_s: float, pressure_kpa: float) -> float:
+        """The angle (deg) at time ``t_s`` (s) when the actuator sees ``pressure_kpa``."""
+        p = max(float(pressure_kpa), 0.0)
+        self._peak = p if p < VENTED_KPA else max(self._peak, p)
+        h = self.trial.behaviour.hysteresis
+        equivalent = p + 4.0 * h * p * (self._peak - p) / self._peak if self._peak > 0 else p
+        static = float(self.trial.psi_loading_deg(equivalent))
+        if not math.isfinite(static):
+            static = self._psi
+        if self._t is None or self.tau_psi_s <= 0:
+            self._psi = static
+        else:
+            self._psi = static + (self._psi - static) * math.exp(-max(t_s - self._t, 0.0) / self.tau_psi_s)
+        self._t = t_s
+        return self._psi

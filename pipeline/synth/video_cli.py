@@ -11,7 +11,7 @@ from pipeline.errors import UserInputError
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``synth-video`` (units in every help text)."""
     from pipeline.synth.presets import SCENE_PRESETS
-    from pipeline.synth.video import CODECS
+    from pipeline.video.writer import CODECS
     from pipeline.video.profile import PROFILES
 
     parser.add_argument("out_dir", metavar="OUT_DIR", help="video photo-set folder to write (created; its files are replaced)")
