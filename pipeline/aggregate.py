@@ -6,8 +6,10 @@ x pressure level, as in the paper's Fig. 6.  A pressure level is the nominal set
 configurable width of the measured pressure (``measured_pressure_kpa`` when present).
 
 Frames of a video (rows with a ``frame``) have no setpoint levels: without a bin width they are
-binned by :data:`CONTINUOUS_BIN_KPA` of their measured pressure (:mod:`pipeline.video.continuous`
-has the per-cycle loops, settling curves and step responses).
+binned by :data:`CONTINUOUS_BIN_KPA` of their measured pressure, and the frames of one trial in one
+bin and direction are first averaged, so a video trial counts once per level as a photo ramp does
+(``n`` counts trials there, not frames; :mod:`pipeline.video.continuous` has the per-cycle loops,
+settling curves and step responses).
 
 Rows whose ``status`` is not ``ok`` (``flagged`` or ``failed``) or whose psi is not finite are
 excluded by default and counted in ``n_excluded``; a level whose rows are all excluded is still
@@ -199,7 +201,27 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
     allowed = {"ok", "flagged"} if include_flagged else {"ok"}
     df["_included"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
     df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
+    if "frame" in df.columns and df["frame"].notna().any():
+        df = _collapse_frames(df)
     return df
+
+
+def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:
+    """One row per video trial, direction and pressure bin: the mean of its included frames.
+
+    A video trial then counts once per level, as a photo ramp does (its frames are not
+    independent trials); the bin counts as excluded when none of its frames is included.
+    """
+    frames = df[df["frame"].notna()]
+    keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
+    inc = frames[frames["_included"]]
+    mean = inc.groupby(keys, sort=False)[["psi_deg", "_pressure"]].mean()
+    rows = frames.groupby(keys, sort=False).size().rename("_frames").to_frame().join(mean).reset_index()
+    rows["_included"] = rows["psi_deg"].notna()
+    rows["status"] = np.where(rows["_included"], "ok", "failed")
+    rows["_pressure"] = rows["_pressure"].where(rows["_included"], np.nan)
+    rows = rows.drop(columns="_frames")
+    return pd.concat([df[df["frame"].isna()], rows], ignore_index=True)
 
 
 def _summarise(df: pd.DataFrame, keys: list[str]) -> pd.DataFrame:

@@ -89,7 +89,7 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
                 messages.append(f"{key}.path: required for source {source!r}; set it to the photo-set folder")
             if source == "folder" and ds.get("path") and not (workdir / ds["path"]).is_dir():
                 messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
-            if source in ("synthetic", "rig"):
+            if source in ("synthetic", "synthetic_video", "rig"):
                 mat = ds.get("material")
                 if not mat:
                     messages.append(f"{key}.material: required for source {source!r}; use one of {sorted(materials)}")

@@ -10,6 +10,7 @@ rule report:
         curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS),
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
         force=FORCE_OUTPUTS,
+        video=VIDEO_CONTINUOUS,
     output:
         f"{RESULTS}/report.pdf",
     params:
@@ -18,6 +19,7 @@ rule report:
         names=list(DATASETS),
         bench=lambda wc, input: f"--bench-dir {input.bench}" if input.bench else "",
         force=f"--force-dir {RESULTS}/force" if FORCE_OUTPUTS else "",
+        video=lambda wc, input: f"--video-dirs {' '.join(input.video)}" if input.video else "",
         title=config["report"]["title"],
     log:
         f"{LOGS}/report.log",
@@ -32,7 +34,7 @@ rule report:
     shell:
         "python -m pipeline report --datasets {params.names} --angles {input.angles}"
         " --hysteresis {input.hysteresis} --rms {input.rms} --model-curves {input.curves}"
-        " --photosets {params.photosets} --overlays {params.overlays} {params.bench} {params.force}"
+        " --photosets {params.photosets} --overlays {params.overlays} {params.bench} {params.force} {params.video}"
         " --config {input.config} --title {params.title:q} --out {output} > {log} 2>&1"
 
 

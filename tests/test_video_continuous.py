@@ -84,10 +84,17 @@ def test_loops_and_cycles_of_the_video(measured):
         loops(measured, bin_kpa=0)
 
 
-def test_hysteresis_of_frames_is_binned_without_being_asked(measured):
+def test_hysteresis_of_frames_is_binned_and_a_video_trial_counts_once_per_level(measured):
     h = aggregate_hysteresis(measured)
     assert len(h) < 40 and np.allclose(h["pressure_kpa"] % continuous.BIN_KPA, 0)
-    assert h["n"].sum() == (measured["status"] == "ok").sum()
+    assert (h["n"] == 1).all() and (h["n_trials"] == 1).all()  # one trial: one value per bin, sd undefined
+    two = pd.concat([measured, measured.assign(trial="2", psi_deg=measured["psi_deg"] + 1.0)], ignore_index=True)
+    h2 = aggregate_hysteresis(two)
+    assert (h2["n"] == 2).all() and np.allclose(h2["psi_sd_deg"], np.sqrt(0.5))  # values x and x + 1
+    level = h[(h["direction"] == "up") & (h["pressure_kpa"] == 40)]
+    frames = measured[(measured["direction"] == "up") & ((measured["measured_pressure_kpa"] / 5).round() == 8)
+                      & (measured["status"] == "ok")]
+    assert np.isclose(level["psi_mean_deg"].iloc[0], frames["psi_deg"].mean())
 
 
 def test_cli_writes_every_table_and_refuses_photos(measured, tmp_path):

@@ -18,9 +18,9 @@ and the ramp keys), using only ``ok`` frames (``flagged`` too with ``include_fla
     rise time (10 % to 90 % of the change, from the step), overshoot (% of the change beyond its
     final value, 0 within the noise), settling time (from the step until psi stays within
     :data:`SETTLING_BAND` of the change, or 3 noise sd, of its final value); the final value is the
-    mean of the last :data:`FINAL_FRACTION` of the hold, and a hold whose end still drifts (the
-    window before differs from it by more than the band) gives no figures ("did not settle within
-    the hold": its final value, and so its 90 % level, are not known).  The
+    mean of the last :data:`FINAL_FRACTION` of the hold, and a hold whose end still drifts (a
+    straight line through that last part moves by more than the band) gives no figures ("did
+    not settle within the hold": its final value, and so its 90 % level, are not known).  The
     noise sd is the ramp's frame-to-frame noise (second differences, robust).  The same rise and
     settling times for the measured pressure when logged.
 ``settling``
@@ -225,9 +225,9 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     t90 = _crossing(t, y, before_deg + 0.9 * change, rising)
     three_sd = 3.0 * (sd if math.isfinite(sd) else 0.0)
     band = max(SETTLING_BAND * abs(change), three_sd)
-    # settled: the window before the final one agrees with it (a hold cut short still drifts)
-    previous = y[max(0, t.size - 2 * tail): t.size - tail]
-    drift = abs(float(np.mean(previous)) - final) if previous.size else math.inf
+    # settled: the final window itself no longer drifts (its straight-line fit moves less than the band)
+    slope = float(np.polyfit(t[-tail:], y[-tail:], 1)[0])
+    drift = abs(slope) * float(t[-1] - t[-tail])
     beyond = float(np.max((y - final) * np.sign(change)))
     outside = np.flatnonzero(np.abs(y - final) > band)
     if drift > band or (outside.size and outside[-1] >= t.size - tail):
