@@ -1,35 +1,10 @@
 # Video datasets (pipeline.video): synthetic videos are rendered, rig videos recorded, and every
 # video dataset gets its continuous aggregation (loops, settling curves, step responses) for its
 # report page.  A folder dataset is a video dataset when its manifest lists videos.
-from pipeline.photoset import is_video_manifest
-
-
-def is_video_dataset(ds):
-    """Whether a dataset's photo set lists videos (rendered, recorded or in a folder)."""
-    if ds["source"] == "synthetic_video":
-        return True
-    if ds["source"] == "rig":
-        return ds["record"] == "video"
-    try:
-        return is_video_manifest(read_manifest(ds["path"]))
-    except UserInputError:
-        return False
-
-
-def names_pattern(names):
-    """A wildcard constraint matching exactly these dataset names (nothing when empty)."""
-    return "|".join(re.escape(n) for n in names) or "(?!)"
-
+from pipeline.video.workflow import is_video_dataset, names_pattern, profile_options
 
 VIDEO_DATASETS = [name for name, ds in DATASETS.items() if is_video_dataset(ds)]
 VIDEO_CONTINUOUS = [f"{RESULTS}/continuous/{name}" for name in VIDEO_DATASETS]
-
-
-def video_profile_options(ds):
-    """The pressure-profile options shared by synth-video and acquire --record video."""
-    return (f"--profile {ds['profile']} --max-kpa {ds['max_kpa']} --rate-kpa-s {ds['rate_kpa_s']}"
-            f" --step-kpa {ds['step_kpa']} --hold-s {ds['hold_s']} --cycles {ds['cycles']} --fps {ds['fps']}"
-            f" --rest-s {ds['rest_s']}")
 
 
 ruleorder: synth_video > synth_photoset
@@ -43,7 +18,7 @@ rule synth_video:
         video_dataset=names_pattern([n for n in VIDEO_DATASETS if DATASETS[n]["source"] == "synthetic_video"]),
     params:
         ds=lambda wc: DATASETS[wc.video_dataset],
-        profile=lambda wc: video_profile_options(DATASETS[wc.video_dataset]),
+        profile=lambda wc: profile_options(DATASETS[wc.video_dataset]),
         overrides=lambda wc: scene_overrides(DATASETS[wc.video_dataset]),
     log:
         f"{LOGS}/synth_video/{{video_dataset}}.log",
@@ -67,7 +42,7 @@ rule acquire_rig_video:
         video_dataset=names_pattern([n for n in VIDEO_DATASETS if DATASETS[n]["source"] == "rig"]),
     params:
         ds=lambda wc: DATASETS[wc.video_dataset],
-        profile=lambda wc: video_profile_options(DATASETS[wc.video_dataset]),
+        profile=lambda wc: profile_options(DATASETS[wc.video_dataset]),
         camera=lambda wc: DATASETS[wc.video_dataset]["camera"],
     log:
         f"{LOGS}/acquire/{{video_dataset}}.log",
