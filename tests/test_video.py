@@ -239,3 +239,14 @@ def test_clips_know_their_span_and_the_log(video_set):
     clip = resolve_clips(photoset.load_photoset(video_set))[0]
     assert clip.n_frames == 135 and clip.clock_offset_s == 0.7 and clip.problems == ()
     assert np.allclose(clip.span_s(), (0.7, 14.1)) and clip.log is not None and clip.log.span_s[0] == 0.0
+
+
+def test_the_ramp_check_runs_over_time(measured):
+    from pipeline.ramp_check import check_ramps
+
+    bad = measured.copy()
+    bad.loc[60, "psi_deg"] += 40.0  # one frame read wrongly
+    shuffled = bad.sample(frac=1.0, random_state=1)  # row order must not matter: frames are ordered by time
+    out = check_ramps(shuffled).loc[bad.index]
+    assert out.loc[60, "status"] == "flagged" and out.loc[60, "reason"].startswith("breaks its ramp")
+    assert (out.drop(index=60)["status"] == measured.drop(index=60)["status"]).all()
