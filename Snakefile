@@ -20,6 +20,7 @@ include: "rules/model.smk"
 include: "rules/compare.smk"
 include: "rules/bench.smk"
 include: "rules/force.smk"
+include: "rules/video.smk"
 include: "rules/report.smk"
 
 

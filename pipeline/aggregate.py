@@ -5,6 +5,12 @@ x pressure level, as in the paper's Fig. 6.  A pressure level is the nominal set
 (``pressure_kpa``) by default, or, when measured pressures scatter around the setpoints, a bin of
 configurable width of the measured pressure (``measured_pressure_kpa`` when present).
 
+Frames of a video (rows with a ``frame``) have no setpoint levels: without a bin width they are
+binned by :data:`CONTINUOUS_BIN_KPA` of their measured pressure, and the frames of one trial in one
+bin and direction are first averaged, so a video trial counts once per level as a photo ramp does
+(``n`` counts trials there, not frames; :mod:`pipeline.video.continuous` has the per-cycle loops,
+settling curves and step responses).
+
 Rows whose ``status`` is not ``ok`` (``flagged`` or ``failed``) or whose psi is not finite are
 excluded by default and counted in ``n_excluded``; a level whose rows are all excluded is still
 written (with ``n = 0`` and a NaN mean) so nothing disappears silently.
@@ -55,6 +61,8 @@ PER_ACTUATOR_COLUMNS: tuple[str, ...] = (
     "n", "n_trials", "n_excluded", "pressure_mean_kpa",
 )
 DIRECTION_ORDER: tuple[str, ...] = ("up", "down")
+#: bin width (kPa) of the frames of a video when no bin width is asked for
+CONTINUOUS_BIN_KPA = 5.0
 STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 
 
@@ -121,10 +129,11 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
             raise UserInputError(
                 f"{where} line {i + 2}: column '{column}' must be a number, got {angles[column].iloc[i]!r}"
             )
-    bad_p = pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna().to_numpy()
+    # a failed row may have no pressure (a bad manifest pressure, a frame outside its pressure log)
+    bad_p = (pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna() & (angles["status"] != "failed")).to_numpy()
     if bad_p.any():
         i = int(np.flatnonzero(bad_p)[0])
-        raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every row needs its setpoint (kPa)")
+        raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint (kPa)")
     for column, allowed in (("direction", DIRECTION_ORDER), ("status", STATUSES)):
         bad = ~angles[column].isin(allowed).to_numpy()
         if bad.any():
@@ -142,7 +151,8 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
     angles : pandas.DataFrame
         Rows with ``pressure_kpa`` and optionally ``measured_pressure_kpa``.
     bin_kpa : float, optional
-        Bin width (kPa).  ``None``: the nominal setpoint ``pressure_kpa``.  Otherwise the
+        Bin width (kPa).  ``None``: the nominal setpoint ``pressure_kpa`` (for the frames of a
+        video, which have no setpoint levels: bins of :data:`CONTINUOUS_BIN_KPA`).  Otherwise the
         measured pressure (``measured_pressure_kpa`` where present and finite, else the
         setpoint) rounded to the nearest multiple of ``bin_kpa`` (bin centres 0, W, 2W, ...).
 
@@ -159,7 +169,10 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
     """
     nominal = pd.to_numeric(angles["pressure_kpa"], errors="coerce").astype(float)
     if bin_kpa is None:
-        return nominal
+        if "frame" not in angles.columns or angles["frame"].isna().all():
+            return nominal
+        frames = angles["frame"].notna()
+        return nominal.where(~frames, pressure_levels(angles, CONTINUOUS_BIN_KPA))
     if not (math.isfinite(bin_kpa) and bin_kpa > 0):
         raise UserInputError(f"--bin-kpa must be a positive number of kPa, got {bin_kpa}")
     measured = nominal
@@ -178,14 +191,37 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["_level"] = pressure_levels(df, bin_kpa)
     pressure_used = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
-    if bin_kpa is not None and "measured_pressure_kpa" in df.columns:
+    binned = pd.Series(bin_kpa is not None, index=df.index)
+    if "frame" in df.columns:
+        binned |= df["frame"].notna()
+    if "measured_pressure_kpa" in df.columns:
         m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
-        pressure_used = m.where(np.isfinite(m), pressure_used)
+        pressure_used = m.where(np.isfinite(m) & binned, pressure_used)
     df["_pressure"] = pressure_used
     allowed = {"ok", "flagged"} if include_flagged else {"ok"}
     df["_included"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
     df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
+    if "frame" in df.columns and df["frame"].notna().any():
+        df = _collapse_frames(df)
     return df
+
+
+def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:
+    """One row per video trial, direction and pressure bin: the mean of its included frames.
+
+    A video trial then counts once per level, as a photo ramp does (its frames are not
+    independent trials); the bin counts as excluded when none of its frames is included.
+    """
+    frames = df[df["frame"].notna()]
+    keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
+    inc = frames[frames["_included"]]
+    mean = inc.groupby(keys, sort=False)[["psi_deg", "_pressure"]].mean()
+    rows = frames.groupby(keys, sort=False).size().rename("_frames").to_frame().join(mean).reset_index()
+    rows["_included"] = rows["psi_deg"].notna()
+    rows["status"] = np.where(rows["_included"], "ok", "failed")
+    rows["_pressure"] = rows["_pressure"].where(rows["_included"], np.nan)
+    rows = rows.drop(columns="_frames")
+    return pd.concat([df[df["frame"].isna()], rows], ignore_index=True)
 
 
 def _summarise(df: pd.DataFrame, keys: list[str]) -> pd.DataFrame:

@@ -130,7 +130,7 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
             source = ds.get("source")
             if source == "folder" and not (workdir / ds["path"]).is_dir():
                 messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
-            if source in ("synthetic", "rig") and ds["material"] not in materials:
+            if source in ("synthetic", "synthetic_video", "rig") and ds["material"] not in materials:
                 messages.append(f"{key}.material: unknown material {ds['material']!r}; use one of {sorted(materials)} or add it to a materials file (model.materials_file)")
             if source == "rig" and not ds["port"]:
                 messages.append(f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. /dev/ttyACM0)")

@@ -12,7 +12,7 @@ from pipeline.measure.estimators import METHODS
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of the ``measure`` subcommand."""
-    parser.add_argument("photoset", metavar="PHOTOSET_DIR", help="photo-set folder (manifest.csv + photoset.yaml + images)")
+    parser.add_argument("photoset", metavar="PHOTOSET_DIR", help="photo-set folder (manifest.csv + photoset.yaml + images, or videos with their pressure logs: one row per frame)")
     parser.add_argument("--out", required=True, help="angles.csv to write: psi_deg (deg), kappa_per_mm (1/mm), length_mm (mm), status per photo")
     parser.add_argument(
         "--method", default=DEFAULT_METHOD, choices=sorted(METHODS),

@@ -10,6 +10,11 @@ prevent it, so one bad row is one ``failed`` measurement and the rest of the set
 Only a set that cannot be read at all (no folder, bad YAML, no manifest, missing columns) is
 refused.  :func:`validate_photoset` (``photoset check``) lists every problem, strictly.
 
+A *video* photo set has the same two files, but ``manifest.csv`` lists videos instead of images
+(columns :data:`VIDEO_REQUIRED_COLUMNS`, optionally :data:`VIDEO_OPTIONAL_COLUMNS` and any
+setting): each row is a video file, its pressure log and the offset between their clocks, and
+every frame of the video is measured with that row's settings (:mod:`pipeline.video`).
+
 This module knows nothing about where a photo set came from (rig, renderer, a copied folder).
 
 Examples
@@ -45,11 +50,16 @@ TRUTH = "truth.csv"
 
 REQUIRED_COLUMNS: tuple[str, ...] = ("image", "pressure_kpa", "direction", "material", "actuator", "trial")
 OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa")
+#: manifest columns of a video photo set (one row per video; see :mod:`pipeline.video`)
+VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", "actuator", "trial")
+#: ``clock_offset_s``: log time of video time 0 (s, default 0); ``frame_times``: a ``frame, time_s``
+#: CSV of the frames' timestamps on the video's clock (default: the container's presentation times)
+VIDEO_OPTIONAL_COLUMNS: tuple[str, ...] = ("clock_offset_s", "frame_times")
 #: folder-wide settings written by default (the other keys are optional, see KEYS)
 SETTING_DEFAULTS: dict[str, Any] = {"l0_mm": None, "mm_per_px": None, "fixed_end": "auto", "positive_turn": "ccw"}
 #: manifest columns read as text
 _TEXT_COLUMNS = ("image", "material", "actuator", "direction", "trial", "line_color", "positive_turn", "target",
-                 "background", "roi", "exclude", "method", "calibration")
+                 "background", "roi", "exclude", "method", "calibration", "video", "pressure_log", "frame_times")
 
 IMAGE_SUFFIXES: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp")
 
@@ -109,8 +119,13 @@ class PhotoSet:
     rows: tuple[MeasureSettings | None, ...]
     problems: tuple[Problem, ...] = ()
 
+    @property
+    def is_video(self) -> bool:
+        """The manifest lists videos (one row per video) rather than images."""
+        return is_video_manifest(self.manifest)
+
     def image_path(self, image: str) -> Path:
-        """Absolute path of an image named in the manifest."""
+        """Absolute path of an image (or video, or log) named in the manifest."""
         return self.folder / image
 
     def row_reason(self, position: int) -> str:
@@ -160,8 +175,16 @@ def write_settings(folder: str | os.PathLike[str], settings: Mapping[str, Any]) 
     atomic_write_bytes(Path(folder) / SETTINGS, text.encode())
 
 
+def is_video_manifest(manifest: pd.DataFrame) -> bool:
+    """Whether a manifest lists videos (a ``video`` column and no ``image`` column)."""
+    return "video" in manifest.columns and "image" not in manifest.columns
+
+
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """Read ``manifest.csv`` as written (text columns kept as text), adding ``manifest_line``.
+
+    A manifest with a ``video`` column and no ``image`` column is a video manifest and needs
+    :data:`VIDEO_REQUIRED_COLUMNS` instead of :data:`REQUIRED_COLUMNS`.
 
     Raises
     ------
@@ -175,9 +198,12 @@ def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
         df = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise UserInputError(f"{path}: cannot be parsed as CSV ({exc}); fix the file") from exc
-    missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
+    required = VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS
+    missing = [c for c in required if c not in df.columns]
     if missing:
-        raise UserInputError(f"{path}: missing column(s) {missing}; the header must contain {list(REQUIRED_COLUMNS)}")
+        raise UserInputError(f"{path}: missing column(s) {missing}; the header must contain {list(required)}"
+                             + ("" if "video" in df.columns else " (or, for videos, "
+                                f"{list(VIDEO_REQUIRED_COLUMNS)})"))
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
     return df
 
@@ -209,6 +235,37 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
         dup = df[df["step"].notna() & df.duplicated(["material", "actuator", "trial", "step"], keep="first")]
         for _, row in dup.iterrows():
             out.append(Problem(mpath, int(row["manifest_line"]), f"step {row['step']} repeats for material {row['material']}, actuator {row['actuator']}, trial {row['trial']}", "renumber the steps or remove the duplicate row"))
+    return out
+
+
+def _video_row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
+    """Problems of the rows of a video manifest themselves (not of their files or settings)."""
+    out: list[Problem] = []
+    first: dict[str, int] = {}
+    ramps: dict[tuple[str, str, str], int] = {}
+    offsets = df["clock_offset_s"] if "clock_offset_s" in df.columns else pd.Series([None] * len(df), index=df.index)
+    for i, (line, video, log, offset) in enumerate(zip(df["manifest_line"], df["video"], df["pressure_log"], offsets)):
+        line = int(line)
+        if is_missing(video):
+            out.append(Problem(mpath, line, "video name is empty", "put the video file name in the 'video' column"))
+        elif video in first:
+            out.append(Problem(mpath, line, f"video {video!r} is listed twice (also line {first[video]})", "remove the duplicate row"))
+        else:
+            first[video] = line
+        if is_missing(log):
+            out.append(Problem(mpath, line, "pressure_log is empty", "name the CSV (time_s, pressure_kpa[, measured_kpa]) logged with this video"))
+        if not is_missing(offset):
+            value = pd.to_numeric(pd.Series([offset]), errors="coerce").iloc[0]
+            if not np.isfinite(value):
+                out.append(Problem(mpath, line, f"clock_offset_s {offset!r} is not a number", "give the log time (s) of the video's first instant, e.g. 1.25, or leave it empty for 0"))
+        for key in ("material", "actuator", "trial"):
+            if is_missing(df[key].iloc[i]):
+                out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
+        key3 = tuple(str(df[k].iloc[i]) for k in ("material", "actuator", "trial"))
+        if key3 in ramps:
+            out.append(Problem(mpath, line, f"material {key3[0]}, actuator {key3[1]}, trial {key3[2]} is also line {ramps[key3]}", "give each video its own trial number"))
+        else:
+            ramps[key3] = line
     return out
 
 
@@ -268,8 +325,11 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
         _refuse(folder, [Problem(str(folder / MANIFEST), None, "has no rows", "add one row per image")])
     if all(r is None for r in rows) and any("l0_mm is missing" in p.message for p in row_problems):
         _refuse(folder, [Problem(str(folder / SETTINGS), None, "l0_mm is missing", "add 'l0_mm: <length of the marked layer in mm>' (or an l0_mm manifest column)")])
-    df["pressure_kpa"] = pd.to_numeric(df["pressure_kpa"], errors="coerce")
-    problems = _row_problems(df, str(folder / MANIFEST)) + row_problems
+    if is_video_manifest(df):
+        problems = _video_row_problems(df, str(folder / MANIFEST)) + row_problems
+    else:
+        df["pressure_kpa"] = pd.to_numeric(df["pressure_kpa"], errors="coerce")
+        problems = _row_problems(df, str(folder / MANIFEST)) + row_problems
     bad_lines = {p.line for p in problems}
     rows = tuple(None if line in bad_lines else r for line, r in zip(df["manifest_line"], rows))
     problems.sort(key=lambda p: p.line or 0)
@@ -317,8 +377,13 @@ def validate_photoset(
         return problems + [Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")]
     problems += list(ps.problems)
     mpath = str(folder / MANIFEST)
+    if ps.is_video:
+        from pipeline.video.clips import clip_problems
+
+        problems += clip_problems(ps, decode=decode_images, require_files=require_images)
     sizes: dict[str, tuple[int, int] | None] = {}
-    for (line, image), settings_row in zip(zip(ps.manifest["manifest_line"], ps.manifest["image"]), ps.rows):
+    images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
+    for (line, image), settings_row in zip(images, ps.rows):
         if is_missing(image):
             continue
         path = folder / str(image)
@@ -410,13 +475,13 @@ def _image_size(path: Path) -> tuple[int, int] | None:
 def write_manifest(folder: str | os.PathLike[str], rows: pd.DataFrame) -> None:
     """Write ``manifest.csv`` atomically (required columns first, ``manifest_line`` dropped)."""
     df = rows.drop(columns=["manifest_line"], errors="ignore")
-    first = [c for c in REQUIRED_COLUMNS if c in df.columns]
+    first = [c for c in (VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS) if c in df.columns]
     df = df[first + [c for c in df.columns if c not in first]]
     atomic_write_bytes(Path(folder) / MANIFEST, df.to_csv(index=False, lineterminator="\n").encode())
 
 
 def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
-    """Append rows to ``manifest.csv`` atomically; rows whose image is already listed are replaced.
+    """Append rows to ``manifest.csv`` atomically; rows whose image (video) is already listed are replaced.
 
     Returns
     -------
@@ -427,7 +492,8 @@ def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[
     new = pd.DataFrame(list(rows))
     if path.is_file():
         old = pd.read_csv(path, dtype=str)
-        old = old[~old["image"].isin(new["image"].astype(str))]
+        key = "video" if is_video_manifest(old) else "image"
+        old = old[~old[key].isin(new[key].astype(str))]
         df = pd.concat([old, new.astype(str)], ignore_index=True)
     else:
         df = new

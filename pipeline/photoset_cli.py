@@ -171,7 +171,9 @@ def _pick(args: argparse.Namespace) -> int:
 def _check(args: argparse.Namespace) -> int:
     problems = photoset.validate_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
     errors = [p for p in problems if not p.warning]
-    if not errors and not args.no_decode:
+    manifest = photoset.read_manifest(args.folder) if (Path(args.folder) / photoset.MANIFEST).is_file() else None
+    video = manifest is not None and photoset.is_video_manifest(manifest)
+    if not errors and not args.no_decode and not video:  # previews read photos, not videos
         from pipeline.preview import empty_first_photos
 
         for r in empty_first_photos(args.folder).itertuples():
@@ -188,5 +190,5 @@ def _check(args: argparse.Namespace) -> int:
         return 1
     n = len(photoset.read_manifest(args.folder))
     warn = len(problems) - len(errors)
-    print(f"{args.folder}: OK ({n} photos{f', {warn} warning(s)' if warn else ''})")
+    print(f"{args.folder}: OK ({n} {'videos' if video else 'photos'}{f', {warn} warning(s)' if warn else ''})")
     return 0

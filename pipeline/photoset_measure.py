@@ -80,7 +80,8 @@ def measure_photoset(
         (pressure_kpa, direction, material, actuator, trial, step, and any others such as
         measured_pressure_kpa, timestamp or force columns) and ``l0_mm``, the marked length
         each photo was measured with (the row's or the folder's setting).  One row per manifest
-        row, same order.
+        row, same order; for a video photo set one row per frame, with ``frame`` and ``time_s``
+        after :data:`RESULT_COLUMNS` (see :func:`pipeline.video.measure.measure_video_set`).
 
     Raises
     ------
@@ -93,10 +94,27 @@ def measure_photoset(
     if jobs < 1:
         raise UserInputError(f"--jobs {jobs} must be at least 1")
     ps = load_photoset(folder)
-    manifest = ps.manifest
     odir = None if overlays_dir is None else Path(overlays_dir)
     if odir is not None:
         odir.mkdir(parents=True, exist_ok=True)
+    if ps.is_video:  # one row per frame (pipeline.video.measure)
+        from pipeline.video.measure import measure_video_set
+
+        out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
+    else:
+        out = _measure_photos(ps, method, jobs, odir)
+    if ramp_check:
+        out = check_ramps(out)
+    if "calibration_px" in out.columns:
+        out = flag_doubtful_calibration(out)
+    if odir is not None:
+        write_contact_sheets(out, odir)
+    return out
+
+
+def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> pd.DataFrame:
+    """The angles.csv table of a photo set of images (one row per manifest row)."""
+    manifest = ps.manifest
     rows = map_photos(run_task, _tasks(ps, method, odir), jobs=jobs, preload=["pipeline.measure.worker"])
     result = pd.DataFrame(rows, index=manifest.index)
     result["degree"] = result["degree"].astype("Int64")
@@ -108,13 +126,7 @@ def measure_photoset(
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
-    out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
-    if ramp_check:
-        out = check_ramps(out)
-    out = flag_doubtful_calibration(out)
-    if odir is not None:
-        write_contact_sheets(out, odir)
-    return out
+    return pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
 
 
 def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
@@ -133,12 +145,21 @@ def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
 
 
 def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]:
-    """One ``contact_<material>_<actuator>_<trial>.jpg`` per ramp, photos in manifest order."""
+    """One ``contact_<material>_<actuator>_<trial>.jpg`` per ramp, photos in manifest order
+    (for a video: the frames that have an overlay, in time order)."""
     from pipeline.measure.overlay import contact_sheet  # cv2 drawing only when overlays are asked for
 
     written = []
     for (material, actuator, trial), g in angles.groupby(["material", "actuator", "trial"], sort=False):
-        paths = [overlays_dir / f"{Path(str(i)).stem}.jpg" for i in g["image"]]
+        if "frame" in g.columns:
+            from pipeline.video.measure import frame_overlay_name
+
+            paths = [overlays_dir / frame_overlay_name(str(i), int(k)) for i, k in zip(g["image"], g["frame"]) if pd.notna(k)]
+            paths = [p for p in paths if p.is_file()]
+            if not paths:
+                continue
+        else:
+            paths = [overlays_dir / f"{Path(str(i)).stem}.jpg" for i in g["image"]]
         sheet = contact_sheet(paths)
         ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 85])
         if ok:
@@ -157,7 +178,8 @@ def summary(angles: pd.DataFrame) -> str:
     """One-line summary of a measured set."""
     counts = angles["status"].value_counts()
     sec = float(np.nansum(angles["seconds"]))
+    unit = "frames" if "frame" in angles.columns else "photos"
     return (
-        f"measured {len(angles)} photos: {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} flagged, "
+        f"measured {len(angles)} {unit}: {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} flagged, "
         f"{counts.get('failed', 0)} failed ({sec:.1f} s of work)"
     )

@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
 from pipeline.measure.core import AngleResult, decode_for_work, measure_decoded
@@ -144,6 +145,9 @@ def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
 def write_preview(folder: str | os.PathLike[str], out: str | os.PathLike[str], *, method: str = "auto", every: bool = False) -> tuple[Path, int]:
     """Write the preview contact sheet of a photo set (JPEG); return its path and the tile count."""
     ps = load_photoset(folder)
+    if ps.is_video:
+        raise UserInputError(f"{folder}: lists videos; preview reads photos. Measure the set with --overlays DIR: it "
+                             "draws 24 frames of each video and a contact sheet")
     tiles = []
     for i in preview_rows(ps, every):
         row = ps.manifest.iloc[i]

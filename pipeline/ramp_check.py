@@ -91,7 +91,8 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
     if out.empty or not set(RAMP_KEYS) <= set(out.columns):
         return out
     status, reason = out["status"].astype(str).to_numpy(copy=True), out["reason"].fillna("").astype(str).to_numpy(copy=True)
-    order = out.sort_values("step", kind="stable").index if "step" in out.columns else out.index
+    keys = [c for c in ("step", "time_s") if c in out.columns]  # frames of a video: over time
+    order = out.sort_values(keys, kind="stable").index if keys else out.index
     position = {ix: k for k, ix in enumerate(out.index)}
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
         measured = ramp[ramp["status"] != "failed"]

@@ -88,13 +88,13 @@ FORCE_FOLDER_DIGESTS = {
 def photoset_dir(name):
     """Folder of a dataset's photo set (synthetic sets are rendered under results/)."""
     ds = DATASETS[name]
-    return f"{RESULTS}/photosets/{name}" if ds["source"] == "synthetic" else ds["path"]
+    return f"{RESULTS}/photosets/{name}" if ds["source"] in ("synthetic", "synthetic_video") else ds["path"]
 
 
 def photoset_input(wildcards):
     """What the measure job of a dataset waits for (and re-runs on when it changes)."""
     ds = DATASETS[wildcards.dataset]
-    if ds["source"] == "synthetic":
+    if ds["source"] in ("synthetic", "synthetic_video"):
         return f"{RESULTS}/photosets/{wildcards.dataset}"
     if ds["source"] == "rig":
         return f"{RESULTS}/acquired/{wildcards.dataset}.done"

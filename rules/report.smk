@@ -11,6 +11,7 @@ rule report:
         + [f"{RESULTS}/compare_curves.csv"],
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
         force=FORCE_OUTPUTS,
+        video=VIDEO_CONTINUOUS,
     output:
         f"{RESULTS}/report.pdf",
     params:
@@ -19,6 +20,7 @@ rule report:
         names=list(DATASETS),
         bench=lambda wc, input: ["--bench-dir", input.bench] if input.bench else [],
         force=["--force-dir", f"{RESULTS}/force"] if FORCE_OUTPUTS else [],
+        video=lambda wc, input: ["--video-dirs", *input.video] if input.video else [],
         title=config["report"]["title"],
     log:
         log_file("report"),
@@ -34,7 +36,7 @@ rule report:
             "python -m pipeline report --datasets {params.names:q} --angles {input.angles:q}"
             " --hysteresis {input.hysteresis:q} --rms {input.rms:q} --model-curves {input.curves:q}"
             " --photosets {params.photosets:q} --overlays {params.overlays:q}"
-            " {params.bench:q} {params.force:q} --config {input.config:q} --title {params.title:q}"
+            " {params.bench:q} {params.force:q} {params.video:q} --config {input.config:q} --title {params.title:q}"
             " --out {output:q}"
         )
 

@@ -25,3 +25,26 @@ def photo_folder(tmp_path: Path) -> Path:
         for step, kpa in enumerate([0, 10, 20, 10, 0][: 3 if trial == 2 else 5]):
             cv2.imwrite(str(tmp_path / f"DS30_A2_t{trial}_s{step:02d}_{kpa}kPa.jpg"), img)
     return tmp_path
+
+
+@pytest.fixture(scope="session")
+def video_set(tmp_path_factory) -> Path:
+    """A video photo set: SS40 through pressure steps 0-40-80-40-0 kPa held 2.5 s each from 1.2 s
+    (320x240, 10 fps, 135 frames, MJPEG; the video starts 0.7 s after its pressure log, at rest for
+    0.5 s before and after the steps).  Read-only: copy it to change it."""
+    from pipeline.synth.video import render_video
+    from pipeline.video.profile import PressureProfile
+
+    folder = tmp_path_factory.mktemp("video") / "steps"
+    render_video(folder, "SS40", profile=PressureProfile("steps", max_kpa=80, step_kpa=40, hold_s=2.5), fps=10,
+                 rest_s=0.5, clock_offset_s=0.7, scene="lab", scene_overrides={"width": 320, "height": 240, "tilt_deg": 0.0},
+                 seed=3)
+    return folder
+
+
+@pytest.fixture(scope="session")
+def measured(video_set):
+    """``measure_photoset(video_set, jobs=2)``: the angles table of every frame."""
+    from pipeline.photoset_measure import measure_photoset
+
+    return measure_photoset(video_set, jobs=2)

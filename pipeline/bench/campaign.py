@@ -41,7 +41,8 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
     0.5
     """
     seen = "psi_image_deg" if "psi_image_deg" in truth.columns else "psi_deg"
-    m = angles.merge(truth[["image", "psi_deg"] + ([seen] if seen != "psi_deg" else [])], on="image", suffixes=("", "_true"))
+    keys = ["image", "frame"] if "frame" in truth.columns and "frame" in angles.columns else ["image"]  # a video: per frame
+    m = angles.merge(truth[keys + ["psi_deg"] + ([seen] if seen != "psi_deg" else [])], on=keys, suffixes=("", "_true"))
     ok = m[m["status"] == "ok"]
     err = (ok["psi_deg"] - ok[seen if seen != "psi_deg" else "psi_deg_true"]).abs()
     err_phys = (ok["psi_deg"] - ok["psi_deg_true"]).abs()
@@ -74,8 +75,8 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     workdir = results_dir.parents[depth - 1] if relative else Path(".")
     rows = []
     for ds in config["datasets"]:
-        folder = (results_dir / "photosets" / ds["name"] if ds["source"] == "synthetic"
-                  else workdir / ds.get("path", ""))
+        synthetic = ds["source"] in ("synthetic", "synthetic_video")
+        folder = results_dir / "photosets" / ds["name"] if synthetic else workdir / ds.get("path", "")
         angles = results_dir / "datasets" / ds["name"] / "angles.csv"
         if (folder / "truth.csv").is_file() and angles.is_file():
             stats = campaign_errors(pd.read_csv(angles), pd.read_csv(folder / "truth.csv"))

@@ -427,11 +427,14 @@ def measure_file(
 
 
 def measure_decoded(
-    data: np.ndarray, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD
+    data: np.ndarray | None, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD,
+    full: np.ndarray | None = None,
 ) -> AngleResult:
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
 
-    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``.  A grey image at
+    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``; or, for a frame
+    already decoded at full size (a video that is not MJPEG), ``full`` is that frame (grey or
+    BGR as ``img``), ``data`` is unused and finer images are reduced from ``full``.  A grey image at
     least ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line
     refined on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While
     the line is narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the
@@ -447,7 +450,11 @@ def measure_decoded(
     res = measure_work_image(img, settings, scale=float(factor), method=method)
     while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
         factor //= 2
-        finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)
+        if full is not None:
+            finer = _reduce(full, factor)
+        else:
+            assert data is not None
+            finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)
         if finer is None:
             break
         res = measure_work_image(finer, settings, scale=float(factor), method=method)

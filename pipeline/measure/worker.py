@@ -55,13 +55,23 @@ def run_task(task: Task) -> dict[str, Any]:
         res = failed(task.method, f"internal error on this photo: {type(exc).__name__}: {exc}")
     seconds = time.perf_counter() - t0
     if task.overlay_path is not None:
-        from pipeline.measure.overlay import draw_overlay
+        write_overlay(task.overlay_path, img, f, res, task.title)
+    return result_fields(res, seconds)
 
-        base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
-        if base.ndim == 2:
-            base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
-        out = draw_overlay(base, res, scale=float(f) if img is not None else 1.0, title=task.title)
-        cv2.imwrite(task.overlay_path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
+
+def write_overlay(path: str, img: np.ndarray | None, factor: int, res: AngleResult, title: str) -> None:
+    """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR) and write a JPEG."""
+    from pipeline.measure.overlay import draw_overlay
+
+    base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
+    if base.ndim == 2:
+        base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
+    out = draw_overlay(base, res, scale=float(factor) if img is not None else 1.0, title=title)
+    cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
+
+
+def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
+    """The angles.csv measurement fields of one result (without image and manifest columns)."""
     return {
         "psi_deg": res.psi_deg,
         "kappa_per_mm": res.kappa_per_mm,

@@ -99,7 +99,8 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     """Every page in order, and the warnings printed on the summary page."""
     bench = extra_pages("pipeline.bench.pages", data.inputs.bench_dir)
     force = extra_pages("pipeline.force.pages", data.inputs.force_dir)
-    warnings = bench.warnings + force.warnings
+    videos = [extra_pages("pipeline.video.pages", d) for d in data.inputs.video_dirs]  # one page per video dataset
+    warnings = bench.warnings + force.warnings + [w for v in videos for w in v.warnings]
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
@@ -112,14 +113,14 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
     config_digest = data.digests.get(str(data.inputs.config)) if data.inputs.config is not None else None
-    lines = summary_lines(data, __version__, config_digest, warnings, bench.infos + force.infos)
+    lines = summary_lines(data, __version__, config_digest, warnings, bench.infos + force.infos + [i for v in videos for i in v.infos])
     figures = text_pages(data.inputs.title, lines)
     figures.append(overview_page(data))
     figures += [material_page(data, m) for m in data.materials]
     comparison = comparison_page(data)
     add_comparison_note(comparison, data)  # self-checks named; which l0, what was fitted: next page
     figures += [comparison] + [f for f in [model_provenance_page(data)] if f is not None]
-    return figures + bench.figures + force.figures, warnings
+    return figures + [f for v in videos for f in v.figures] + bench.figures + force.figures, warnings
 
 
 def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportResult:

@@ -44,6 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="bench output folder; adds pipeline.bench.pages.figures(DIR) pages")
     parser.add_argument("--force-dir", type=Path, default=None, metavar="DIR",
                         help="force output folder; adds pipeline.force.pages.figures(DIR) pages")
+    parser.add_argument("--video-dirs", nargs="+", type=Path, default=(), metavar="DIR",
+                        help="'continuous --out-dir' folder of each video dataset (named as the dataset); adds its page")
     parser.add_argument("--config", type=Path, default=None, metavar="FILE",
                         help="workflow config file; its sha256 is printed on the summary page")
     parser.add_argument("--title", default="Circular actuator characterisation",
@@ -93,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
         model_curves=tuple(args.model_curves or ()),
         bench_dir=args.bench_dir,
         force_dir=args.force_dir,
+        video_dirs=tuple(args.video_dirs),
         config=args.config,
         title=args.title,
     )

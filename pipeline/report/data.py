@@ -59,6 +59,7 @@ class ReportInputs:
     model_curves: tuple[Path, ...] = ()
     bench_dir: Path | None = None
     force_dir: Path | None = None
+    video_dirs: tuple[Path, ...] = ()
     config: Path | None = None
     title: str = "Circular actuator characterisation"
 

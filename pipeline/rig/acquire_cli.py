@@ -61,6 +61,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--timeout-s", type=float, default=2.0, help="longest wait for one reply from the Pico before the port counts as lost (s, default 2)")
     parser.add_argument("--camera-timeout-s", type=float, default=30.0, help="longest wait for a photo (s, default 30)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the synthetic camera's noise (default 0)")
+    video = parser.add_argument_group("continuous recording (--record video)")
+    video.add_argument("--record", choices=("photos", "video"), default="photos",
+                       help="photos: a stepped ramp, one photo per settled step (default); video: a continuous ramp or "
+                            "steps filmed as a video with frame timestamps while the pressure is logged (a video photo set)")
+    video.add_argument("--profile", choices=("ramp", "steps"), default="ramp",
+                       help="video: ramp 0 -> --max-kpa -> 0 at --rate-kpa-s, or steps of --step-kpa held --hold-s (default ramp)")
+    video.add_argument("--rate-kpa-s", type=float, default=5.0, help="video: ramp rate (kPa/s, default 5)")
+    video.add_argument("--hold-s", type=float, default=4.0, help="video: hold per step level (s, default 4)")
+    video.add_argument("--cycles", type=int, default=1, help="video: repetitions of the profile per trial (default 1)")
+    video.add_argument("--log-hz", type=float, default=20.0, help="video: GET (pressure log) rate (rows per second, default 20)")
+    video.add_argument("--fps", type=float, default=30.0, help="video: camera frame rate (frames per second, default 30)")
+    video.add_argument("--rest-s", type=float, default=1.0, help="video: recorded at 0 kPa before and after the profile (s, default 1)")
+    video.add_argument("--video-size", default="480x360", help="video, synthetic camera: frame size WIDTHxHEIGHT (px, default 480x360)")
     parser.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                         help="show the progress bar (default: only on a terminal)")
 
@@ -112,6 +125,8 @@ def run(args: argparse.Namespace) -> int:
                         mode=args.mode, force_samples=args.force_samples, force_interval_s=args.force_interval_s,
                         tare=not args.no_tare,
                         watchdog_s=args.watchdog_s if args.watchdog_s is not None else 3 * args.settle_s + args.camera_timeout_s + 10)
+    if args.record == "video":
+        return _acquire_video(args, settings)
     synthetic = args.camera.strip().startswith("synthetic")
     wants_stop = args.stop_at_psi0 if args.stop_at_psi0 is not None else (synthetic and args.mode == "bending")
     stop_at_psi0 = bool(wants_stop)
@@ -162,4 +177,53 @@ def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, sto
         camera.close()
     if result.status == "done":
         print(f"acquired {result.photos_taken} photo(s) ({result.steps_skipped} already recorded) into {args.out}")
+    return result.exit_code
+
+
+def _acquire_video(args: argparse.Namespace, settings: dict[str, Any]) -> int:
+    """``--record video``: record each trial as a video with its pressure log (pipeline.rig.record_video)."""
+    from pipeline.rig.record_video import VideoSessionConfig, describe_video_plan, run_video_session
+    from pipeline.video.profile import PressureProfile
+
+    for name in ("log_hz", "fps"):
+        if not getattr(args, name) > 0:
+            raise UserInputError(f"--{name.replace('_', '-')} must be positive")
+    if args.rest_s < 0:
+        raise UserInputError("--rest-s must be >= 0 (s)")
+    profile = PressureProfile(args.profile, args.max_kpa, rate_kpa_s=args.rate_kpa_s, step_kpa=args.step_kpa,
+                              hold_s=args.hold_s, cycles=args.cycles)
+    cfg = VideoSessionConfig(out_dir=args.out, material=args.material, actuator=args.actuator, trials=args.trials,
+                             profile=profile, log_hz=args.log_hz, fps=args.fps, rest_s=args.rest_s, settings=settings,
+                             watchdog_s=args.watchdog_s if args.watchdog_s is not None else 3 * args.rest_s + 10)
+    if args.dry_run:
+        print(describe_video_plan(cfg, camera_spec=args.camera, port=args.port or ""))
+        return 0
+    if not args.port:
+        raise UserInputError("--port is required (the Pico's serial port, or the pty printed by 'python -m pipeline rig emulate')")
+    from pipeline.rig.calibration import read_calibration
+    from pipeline.rig.cameras import CameraError
+    from pipeline.rig.driver import PicoDriver, RigError
+    from pipeline.rig.video_cameras import open_recorder, parse_size
+
+    calibration = read_calibration(args.calibration) if args.calibration else None
+    try:
+        recorder = open_recorder(args.camera, material=args.material, l0_mm=settings["l0_mm"], fps=args.fps,
+                                 max_kpa=args.max_kpa, seed=args.seed, size=parse_size(args.video_size))
+    except CameraError as exc:
+        print(f"acquire: camera failed: {exc}", file=sys.stderr)
+        return EXIT_CODES["camera"]
+    try:
+        try:
+            driver = PicoDriver.open(args.port, max_kpa=args.max_kpa, calibration=calibration, timeout_s=args.timeout_s)
+        except RigError as exc:
+            print(f"acquire: {exc}", file=sys.stderr)
+            return EXIT_CODES["port_lost"]
+        try:
+            result = run_video_session(driver, recorder, cfg)
+        finally:
+            driver.close()
+    finally:
+        recorder.close()
+    if result.status == "done":
+        print(f"acquired {result.photos_taken} frame(s) ({result.steps_skipped} trial(s) already recorded) into {args.out}")
     return result.exit_code

@@ -1,0 +1,215 @@
+"""Open a video with OpenCV and stream its frames, never holding more than one in memory.
+
+MJPEG videos (what most lab USB cameras record, and what the synthetic rig writes) are read as
+their JPEG packets (``CAP_PROP_FORMAT = -1``): the measurement then decodes each packet exactly as
+it decodes a photo, directly at reduced size and in grey for a black line
+(:func:`pipeline.measure.core.decode_for_work`), which is several times cheaper than a full colour
+decode.  Any other codec OpenCV's FFmpeg can read (MPEG-4, H.264 where the build has a decoder)
+is read as decoded frames.
+
+Seeking: a chunk of frames starts with a seek, checked against the frame's presentation time
+(``k / fps``); where the container cannot seek (a truncated AVI has lost its index and OpenCV
+then returns frame 0 whatever is asked) the reader skips packets from the start instead, so a
+frame index always means the same frame.
+
+Examples
+--------
+>>> import tempfile, os, cv2, numpy as np
+>>> path = os.path.join(tempfile.mkdtemp(), "clip.avi")
+>>> w = cv2.VideoWriter(path, cv2.VideoWriter_fourcc(*"MJPG"), 10, (64, 48))
+>>> for i in range(5):
+...     _ = w.write(np.full((48, 64, 3), 40 * i, np.uint8))
+>>> w.release()
+>>> info = probe_video(path)
+>>> info.frame_count, info.fps, info.packets, info.seekable
+(5, 10.0, True, True)
+>>> [(f.index, round(f.pts_s, 2)) for f in read_frames(info, 3, 2)]
+[(3, 0.3), (4, 0.4)]
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+#: four-character codes whose packets are plain JPEG images
+JPEG_FOURCCS: frozenset[str] = frozenset({"MJPG", "mjpg", "MJPA", "AVRn", "JPEG", "jpeg"})
+#: consecutive unreadable frames after which the rest of a chunk is given up
+MAX_CONSECUTIVE_FAILURES = 2
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """What a video file is, as far as OpenCV can tell without decoding it.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    opened : bool
+        OpenCV could open it.
+    frame_count : int
+        Frames the container announces (0 when unknown or unopened); a truncated file may
+        hold fewer.
+    fps : float
+        Nominal frame rate (NaN when unknown).
+    width, height : int
+        Frame size (px).
+    fourcc : str
+        Codec four-character code ('' when unknown).
+    packets : bool
+        Frames can be read as JPEG packets (MJPEG whose first packet decodes as a JPEG).
+    seekable : bool
+        A seek lands on the frame asked for (checked in the middle of the video).
+    problem : str
+        Why the video cannot be read ('' when it can).
+    """
+
+    path: str
+    opened: bool
+    frame_count: int = 0
+    fps: float = math.nan
+    width: int = 0
+    height: int = 0
+    fourcc: str = ""
+    packets: bool = False
+    seekable: bool = False
+    problem: str = ""
+
+    @property
+    def frame_period_s(self) -> float:
+        """1 / fps (s); NaN when the rate is unknown."""
+        return 1.0 / self.fps if self.fps and math.isfinite(self.fps) and self.fps > 0 else math.nan
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One frame as read: ``data`` is a JPEG packet (1-D uint8) or a decoded BGR image, or None.
+
+    ``pts_s`` is the presentation time in the video (s, NaN when unread); ``reason`` says why
+    ``data`` is None.
+    """
+
+    index: int
+    pts_s: float
+    data: np.ndarray | None
+    reason: str = ""
+
+
+def _fourcc(cap: cv2.VideoCapture) -> str:
+    code = int(cap.get(cv2.CAP_PROP_FOURCC))
+    if code <= 0:
+        return ""
+    return "".join(chr((code >> (8 * i)) & 0xFF) for i in range(4)).strip("\x00")
+
+
+def _open(path: str, packets: bool) -> cv2.VideoCapture:
+    cap = cv2.VideoCapture(path, cv2.CAP_FFMPEG)
+    if packets and cap.isOpened():
+        cap.set(cv2.CAP_PROP_FORMAT, -1)
+    return cap
+
+
+def _pts_s(cap: cv2.VideoCapture) -> float:
+    return float(cap.get(cv2.CAP_PROP_POS_MSEC)) / 1000.0
+
+
+def _lands_on(cap: cv2.VideoCapture, index: int, fps: float) -> bool:
+    """Seek to ``index`` and check with the presentation time that it got there (cap is left after it)."""
+    if not cap.set(cv2.CAP_PROP_POS_FRAMES, float(index)):
+        return False
+    ok = cap.grab()
+    return bool(ok) and abs(_pts_s(cap) - index / fps) <= 0.5 / fps
+
+
+def probe_video(path: str | Path) -> VideoInfo:
+    """Open ``path`` and describe it (frame count, rate, size, codec, packet reading, seeking).
+
+    Never raises: a file OpenCV cannot open gives ``opened=False`` and the reason.
+    """
+    path = str(path)
+    if not Path(path).is_file():
+        return VideoInfo(path, False, problem=f"video {Path(path).name} does not exist")
+    cap = _open(path, packets=False)
+    if not cap.isOpened():
+        return VideoInfo(path, False, problem=f"video {Path(path).name} cannot be opened by OpenCV (not a video, "
+                                              "an unsupported codec, or truncated before its header was complete)")
+    try:
+        count = int(round(cap.get(cv2.CAP_PROP_FRAME_COUNT)))
+        fps = float(cap.get(cv2.CAP_PROP_FPS))
+        fps = fps if math.isfinite(fps) and fps > 0 else math.nan
+        width, height = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        fourcc = _fourcc(cap)
+    finally:
+        cap.release()
+    packets = False
+    if fourcc in JPEG_FOURCCS:
+        cap = _open(path, packets=True)
+        ok, data = cap.read()
+        cap.release()
+        packets = bool(ok) and data is not None and data.size > 4 and bytes(data.ravel()[:2]) == b"\xff\xd8" and (
+            cv2.imdecode(data.ravel(), cv2.IMREAD_REDUCED_GRAYSCALE_8) is not None)
+    if count <= 0:  # the container does not say: count by reading (slow for long non-MJPEG videos)
+        count = sum(1 for f in read_frames(VideoInfo(path, True, 0, fps, width, height, fourcc, packets), 0, None)
+                    if f.data is not None)
+    seekable = False
+    if count > 2 and math.isfinite(fps):
+        cap = _open(path, packets)
+        seekable = _lands_on(cap, count // 2, fps)
+        cap.release()
+    return VideoInfo(path, True, max(count, 0), fps, width, height, fourcc, packets, seekable)
+
+
+def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Frame]:
+    """Frames ``first .. first + count - 1`` of a probed video, in order, one at a time.
+
+    Yields exactly ``count`` frames (all frames to the end when ``count`` is None); a frame that
+    cannot be read has ``data=None`` and the reason.  After
+    :data:`MAX_CONSECUTIVE_FAILURES` unreadable frames the rest are not attempted.
+    """
+    name = Path(info.path).name
+    end = None if count is None else first + count
+    if not info.opened:
+        for k in range(first, end if end is not None else first):
+            yield Frame(k, math.nan, None, info.problem)
+        return
+    cap = _open(info.path, info.packets)
+    try:
+        k = first
+        if first > 0:
+            landed = info.seekable and _lands_on(cap, first, info.fps)
+            if landed:
+                cap.set(cv2.CAP_PROP_POS_FRAMES, float(first))
+            else:  # no usable index: skip packets from the start
+                cap.release()
+                cap = _open(info.path, info.packets)
+                skipped = 0
+                while skipped < first and cap.grab():
+                    skipped += 1
+                if skipped < first:
+                    reason = (f"frame could not be read from {name}: the video ends or is corrupt after frame "
+                              f"{skipped - 1} (the container announces {info.frame_count} frames)")
+                    for j in range(first, end if end is not None else first):
+                        yield Frame(j, math.nan, None, reason)
+                    return
+        failures = 0
+        while end is None or k < end:
+            ok, data = (False, None) if failures >= MAX_CONSECUTIVE_FAILURES else cap.read()
+            if not ok or data is None or data.size == 0:
+                if end is None:
+                    return
+                failures += 1
+                yield Frame(k, math.nan, None, f"frame {k} could not be read from {name}: the video is truncated or "
+                                              f"corrupt here (the container announces {info.frame_count} frames)")
+                k += 1
+                continue
+            failures = 0
+            yield Frame(k, _pts_s(cap), data.ravel() if info.packets else data)
+            k += 1
+    finally:
+        cap.release()

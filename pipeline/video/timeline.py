@@ -1,0 +1,239 @@
+"""The pressure log of a video and what each frame's time means on it.
+
+A pressure log is a CSV with ``time_s`` (s, strictly increasing), ``pressure_kpa`` (the pressure
+asked for: the regulator's setpoint, or the only pressure logged) and optionally ``measured_kpa``
+(the pressure the regulator's monitor or a gauge read).  A frame recorded at video time ``t``
+(its presentation time, or its entry in a frame-times file) happened at ``t + clock_offset_s`` on
+the log's clock.
+
+For each frame this module gives (:func:`frame_conditions`):
+
+``pressure_kpa``, ``measured_pressure_kpa``
+    The log linearly interpolated at the frame's time (NaN outside the log's span).
+``direction``
+    ``up`` / ``down`` from the trend of ``pressure_kpa``: turning points are the extremes the
+    pressure leaves by more than :data:`TREND_DEADBAND_KPA` (so logging noise never flips it),
+    placed at the last sample of the extreme, so a hold at the top of a ramp still belongs to
+    the rising leg, as the peak photo of a stepped ramp does.  Before any change: ``up``.
+``step``, ``since_step_s``
+    Steps are jumps of ``pressure_kpa`` of at least :data:`STEP_MIN_KPA` between consecutive
+    log rows, between two holds (within :data:`HOLD_TOLERANCE_KPA`) of at least
+    :data:`STEP_HOLD_MIN_S` each (so the end of a fast ramp is no step); ``step`` counts the steps up to the frame (0 before the first) and
+    ``since_step_s`` is the time since the last one (NaN before the first).  A continuous ramp
+    has no steps.
+
+Examples
+--------
+>>> import numpy as np
+>>> log = PressureLog("log.csv", np.array([0.0, 1, 2, 3, 4]), np.array([0.0, 10, 20, 10, 0]))
+>>> c = frame_conditions(log, np.array([0.5, 2.0, 2.5, 5.0]))
+>>> c["pressure_kpa"].tolist()[:3], c["direction"].tolist()
+([5.0, 20.0, 15.0], ['up', 'up', 'down', 'down'])
+>>> bool(np.isnan(c["pressure_kpa"].iloc[3]))
+True
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline.constants import VACUUM_KPA
+
+LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
+OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
+FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
+#: a reversal of the pressure trend counts once the pressure left its extreme by this much (kPa)
+TREND_DEADBAND_KPA = 1.0
+#: a jump of the logged pressure of at least this between two log rows may be a step (kPa)
+STEP_MIN_KPA = 2.0
+#: ... when the pressure then holds (within HOLD_TOLERANCE_KPA) for at least this long (s)
+STEP_HOLD_MIN_S = 0.5
+HOLD_TOLERANCE_KPA = 0.5
+
+
+@dataclass(frozen=True)
+class PressureLog:
+    """A validated pressure log (arrays of equal length, time strictly increasing)."""
+
+    path: str
+    time_s: np.ndarray
+    pressure_kpa: np.ndarray
+    measured_kpa: np.ndarray | None = None
+
+    @property
+    def span_s(self) -> tuple[float, float]:
+        """First and last logged time (s)."""
+        return float(self.time_s[0]), float(self.time_s[-1])
+
+
+def _numbers(df: pd.DataFrame, column: str, name: str, problems: list[str]) -> np.ndarray:
+    values = pd.to_numeric(df[column], errors="coerce").to_numpy(float)
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        i = int(bad[0])
+        problems.append(f"{name} line {i + 2}: {column} {df[column].iloc[i]!r} is not a number"
+                        + (f" ({bad.size} such rows)" if bad.size > 1 else ""))
+    return values
+
+
+def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None, list[str]]:
+    """Read and check a pressure log; return it (None if unusable) and every problem in words.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
+    >>> _ = p.write_text("time_s,pressure_kpa\\n0,0\\n1,5\\n1,6\\n")
+    >>> read_pressure_log(p)[1]
+    ['log.csv line 4: time_s 1 does not increase (previous row 1); sort the log by time or drop the repeated row']
+    """
+    path = Path(path)
+    name = path.name
+    if not path.is_file():
+        return None, [f"pressure log {name} does not exist"]
+    try:
+        df = pd.read_csv(path)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
+    missing = [c for c in LOG_COLUMNS if c not in df.columns]
+    if missing:
+        return None, [f"pressure log {name} lacks column(s) {missing}; it needs time_s (s) and pressure_kpa (kPa), "
+                      "optionally measured_kpa"]
+    if len(df) < 2:
+        return None, [f"pressure log {name} has {len(df)} row(s); at least 2 are needed to interpolate"]
+    problems: list[str] = []
+    t = _numbers(df, "time_s", name, problems)
+    p = _numbers(df, "pressure_kpa", name, problems)
+    m = _numbers(df, "measured_kpa", name, problems) if "measured_kpa" in df.columns else None
+    if not problems:
+        back = np.flatnonzero(np.diff(t) <= 0)
+        if back.size:
+            i = int(back[0]) + 1
+            problems.append(f"{name} line {i + 2}: time_s {t[i]:g} does not increase (previous row "
+                            f"{t[i - 1]:g}); sort the log by time or drop the repeated row")
+        for column, values in (("pressure_kpa", p), ("measured_kpa", m)):
+            if values is not None and (values < VACUUM_KPA).any():
+                i = int(np.flatnonzero(values < VACUUM_KPA)[0])
+                problems.append(f"{name} line {i + 2}: {column} {values[i]:g} is below absolute vacuum "
+                                f"({VACUUM_KPA:g} kPa gauge); log gauge pressures in kPa")
+    if problems:
+        return None, problems
+    return PressureLog(str(path), t, p, m), []
+
+
+def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, list[str]]:
+    """Frame timestamps (s, on the video's clock) from a ``frame, time_s`` CSV, frame 0 first.
+
+    Returns the times (None if unusable) and every problem in words.
+    """
+    path = Path(path)
+    name = path.name
+    if not path.is_file():
+        return None, [f"frame-times file {name} does not exist"]
+    try:
+        df = pd.read_csv(path)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        return None, [f"frame-times file {name} cannot be parsed as CSV ({exc})"]
+    if any(c not in df.columns for c in FRAME_TIME_COLUMNS):
+        return None, [f"frame-times file {name} needs columns {list(FRAME_TIME_COLUMNS)}"]
+    problems: list[str] = []
+    frame = _numbers(df, "frame", name, problems)
+    t = _numbers(df, "time_s", name, problems)
+    if problems:
+        return None, problems
+    if not np.array_equal(frame, np.arange(len(frame))):
+        return None, [f"frame-times file {name}: frames must be 0, 1, 2, ... in order, one row each"]
+    if (np.diff(t) <= 0).any():
+        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        return None, [f"frame-times file {name} line {i + 2}: time_s does not increase"]
+    return t, []
+
+
+def turning_points(pressure_kpa: np.ndarray, deadband_kpa: float = TREND_DEADBAND_KPA) -> np.ndarray:
+    """Indices of the confirmed extremes of a pressure series (the last sample of each extreme).
+
+    Examples
+    --------
+    >>> turning_points(np.array([0.0, 5, 10, 10, 9.5, 10, 5, 0, 0.3, 4]))
+    array([5, 7])
+    """
+    p = np.asarray(pressure_kpa, float)
+    out: list[int] = []
+    rising = True
+    ext = 0
+    for i in range(1, len(p)):
+        if rising:
+            if p[i] >= p[ext]:
+                ext = i
+            elif p[ext] - p[i] > deadband_kpa:
+                out.append(ext)
+                rising, ext = False, i
+        else:
+            if p[i] <= p[ext]:
+                ext = i
+            elif p[i] - p[ext] > deadband_kpa:
+                out.append(ext)
+                rising, ext = True, i
+    return np.array(out, dtype=int)
+
+
+def step_times(log: PressureLog) -> np.ndarray:
+    """Times (s, log clock) at which ``pressure_kpa`` steps (see the module docstring)."""
+    t, p = log.time_s, log.pressure_kpa
+    jumps = np.flatnonzero(np.abs(np.diff(p)) >= STEP_MIN_KPA) + 1
+    out = []
+    for j in jumps:
+        k = j
+        while k + 1 < len(p) and abs(p[k + 1] - p[j]) <= HOLD_TOLERANCE_KPA:
+            k += 1
+        i = j - 1
+        while i > 0 and abs(p[i - 1] - p[j - 1]) <= HOLD_TOLERANCE_KPA:
+            i -= 1
+        if t[k] - t[j] >= STEP_HOLD_MIN_S and t[j - 1] - t[i] >= STEP_HOLD_MIN_S:
+            out.append(t[j])
+    return np.array(out, dtype=float)
+
+
+def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
+    """Pressure, direction and step of frames at ``time_s`` (log clock), one row per frame.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``pressure_kpa``, ``measured_pressure_kpa`` (only when the log has ``measured_kpa``),
+        ``direction``, ``step``, ``since_step_s``, ``in_log`` (the time lies in the log's span).
+    """
+    t = np.asarray(time_s, float)
+    lo, hi = log.span_s
+    inside = np.isfinite(t) & (t >= lo) & (t <= hi)
+    out = pd.DataFrame({"pressure_kpa": np.where(inside, np.interp(t, log.time_s, log.pressure_kpa), np.nan)})
+    if log.measured_kpa is not None:
+        out["measured_pressure_kpa"] = np.where(inside, np.interp(t, log.time_s, log.measured_kpa), np.nan)
+    tp = turning_points(log.pressure_kpa)
+    # direction of each log interval: up until the first turning point, then alternating
+    edges = log.time_s[tp]
+    n_turns = np.searchsorted(edges, t, side="left")  # a frame at a peak's own time is still rising
+    out["direction"] = np.where(n_turns % 2 == 0, "up", "down")
+    steps = step_times(log)
+    k = np.searchsorted(steps, t, side="right")
+    out["step"] = k.astype(int)
+    out["since_step_s"] = np.where(k > 0, t - steps[np.maximum(k - 1, 0)] if steps.size else np.nan, np.nan)
+    out["in_log"] = inside
+    return out
+
+
+def span_text(span: tuple[float, float]) -> str:
+    """A time span for messages: ``'0.00-120.00 s'``."""
+    return f"{span[0]:.2f}-{span[1]:.2f} s"
+
+
+def covers(log_span: tuple[float, float], video_span: tuple[float, float], slack_s: float = 0.0) -> bool:
+    """Whether the log's span holds the video's (within ``slack_s`` at each end)."""
+    return log_span[0] <= video_span[0] + slack_s and video_span[1] - slack_s <= log_span[1] and not math.isnan(
+        video_span[0])

@@ -1,0 +1,252 @@
+"""Video photo sets: every frame measured against a synthetic video's truth, timing, bad input."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline import photoset
+from pipeline.errors import UserInputError
+from pipeline.photoset_measure import measure_photoset
+from pipeline.synth.video import Dynamics, render_video, simulate, toy_actuator
+from pipeline.video import measure as video_measure
+from pipeline.video.clips import resolve_clips
+from pipeline.video.profile import PressureProfile
+from pipeline.video.reader import probe_video, read_frames
+from pipeline.video.timeline import PressureLog, frame_conditions, read_pressure_log, step_times, turning_points
+
+SCENE = {"width": 320, "height": 240, "tilt_deg": 0.0}
+MEASURED = ["psi_deg", "status", "reason", "frame", "time_s", "pressure_kpa", "direction", "step"]
+
+
+def _copy(video_set: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "copy"
+    shutil.copytree(video_set, out)
+    return out
+
+
+def _video(folder: Path) -> Path:
+    return folder / pd.read_csv(folder / "manifest.csv")["video"].iloc[0]
+
+
+def test_every_frame_is_a_row_with_its_time_pressure_and_direction(video_set, measured):
+    truth = pd.read_csv(video_set / "truth.csv")
+    assert len(measured) == len(truth) == 135
+    assert {"frame", "time_s", "pressure_kpa", "measured_pressure_kpa", "direction", "step", "since_step_s"} <= set(measured.columns)
+    m = measured.merge(truth, on=["image", "frame"], suffixes=("", "_true"), validate="one_to_one")
+    assert np.allclose(m["time_s"], m["time_s_true"], atol=1e-6)  # frame k at 0.7 + k / 10 s on the log clock
+    ok = m[m["status"] == "ok"]
+    assert len(ok) >= 130
+    err = (ok["psi_deg"] - ok["psi_image_deg"]).abs()
+    assert err.median() < 0.1 and err.max() < 2.0
+    # the setpoint is interpolated from the log; the measured pressure follows the true one
+    assert np.allclose(m["pressure_kpa"], m["setpoint_kpa"], atol=1e-6)
+    assert (m["measured_pressure_kpa"] - m["pressure_true_kpa"]).abs().median() < 0.5
+    # up until the top step is left (its hold included), then down; 4 steps
+    top_left = 0.7 + 0.5 + 3 * 2.5
+    assert (m.loc[m["time_s"] < top_left - 1e-6, "direction"] == "up").all()
+    assert (m.loc[m["time_s"] > top_left + 1e-6, "direction"] == "down").all()
+    assert sorted(m["step"].unique()) == [0, 1, 2, 3, 4]
+    first = m[m["step"] == 1]
+    assert np.isclose(first["since_step_s"].min(), 0.0, atol=0.05)
+
+
+def test_chunks_in_workers_give_the_same_rows_as_one_pass(video_set, measured, monkeypatch):
+    monkeypatch.setattr(video_measure, "chunk_ranges", lambda n, seekable, jobs: [(a, min(16, n - a)) for a in range(0, n, 16)])
+    serial = measure_photoset(video_set, jobs=1)
+    pd.testing.assert_frame_equal(serial[MEASURED], measured[MEASURED])
+
+
+def test_truncated_video_keeps_the_frames_it_could_read_and_fails_the_rest(video_set, tmp_path):
+    folder = _copy(video_set, tmp_path)
+    path = _video(folder)
+    data = path.read_bytes()
+    path.write_bytes(data[: int(len(data) * 0.6)])
+    out = measure_photoset(folder, jobs=2)
+    assert len(out) == 135  # the container still announces 135 frames: none disappears
+    failed = out[out["status"] == "failed"]
+    read = out[out["status"] != "failed"]
+    assert 50 < len(read) < 110 and read["frame"].max() < failed["frame"].min()
+    assert failed["reason"].str.contains("truncated or corrupt").all()
+    assert failed["time_s"].notna().all() and failed["pressure_kpa"].notna().all()
+    # frames read after the unusable index (packets skipped from the start) are the same frames
+    intact = measure_photoset(video_set, jobs=1).set_index("frame")
+    assert np.allclose(read.set_index("frame")["psi_deg"], intact.loc[read["frame"], "psi_deg"])
+    text = "\n".join(map(str, photoset.validate_photoset(folder)))
+    assert f"only frames 0-{len(read) - 1} of the 135 of video {path.name} can be read" in text
+
+
+def test_unreadable_video_is_one_failed_row_or_one_per_listed_frame(video_set, tmp_path):
+    folder = _copy(video_set, tmp_path)
+    _video(folder).write_bytes(b"\x00" * 5000)
+    out = measure_photoset(folder)
+    assert len(out) == 1 and out["status"].iloc[0] == "failed" and pd.isna(out["frame"].iloc[0])
+    assert "cannot be opened" in out["reason"].iloc[0]
+    pd.DataFrame({"frame": range(12), "time_s": np.arange(12) / 10}).to_csv(folder / "frames.csv", index=False)
+    m = pd.read_csv(folder / "manifest.csv")
+    m["frame_times"] = "frames.csv"
+    m.to_csv(folder / "manifest.csv", index=False)
+    out = measure_photoset(folder)
+    assert list(out["frame"]) == list(range(12)) and (out["status"] == "failed").all()
+    assert np.allclose(out["time_s"], 0.7 + np.arange(12) / 10)
+
+
+def test_a_log_not_covering_the_video_is_refused_naming_both_spans(video_set, tmp_path):
+    folder = _copy(video_set, tmp_path)
+    log_path = folder / pd.read_csv(folder / "manifest.csv")["pressure_log"].iloc[0]
+    log = pd.read_csv(log_path)
+    log[log["time_s"] <= 5.0].to_csv(log_path, index=False)
+    problems = [p for p in photoset.validate_photoset(folder) if not p.warning]
+    assert len(problems) == 1 and problems[0].line == 2
+    assert "spans 0.70-14.10 s on the log clock" in problems[0].message
+    assert "covers 0.00-5.00 s" in problems[0].message
+    cli = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(folder)], capture_output=True, text=True)
+    assert cli.returncode == 1 and "covers 0.00-5.00 s" in cli.stderr
+    out = measure_photoset(folder)
+    outside = out["time_s"] > 5.0
+    assert (out.loc[outside, "status"] == "failed").all() and out.loc[outside, "psi_deg"].isna().all()
+    assert out.loc[outside, "reason"].str.contains("outside the pressure log").all()
+    assert (out.loc[~outside, "status"] != "failed").all()
+
+
+def test_frame_times_file_replaces_the_container_times(video_set, tmp_path):
+    folder = _copy(video_set, tmp_path)
+    jitter = np.random.default_rng(0).uniform(-0.02, 0.02, 135)
+    times = np.arange(135) / 10 + jitter
+    pd.DataFrame({"frame": range(135), "time_s": times}).to_csv(folder / "frames.csv", index=False)
+    m = pd.read_csv(folder / "manifest.csv")
+    m["frame_times"] = "frames.csv"
+    m.to_csv(folder / "manifest.csv", index=False)
+    out = measure_photoset(folder)
+    assert np.allclose(out["time_s"], times + 0.7, atol=1e-9)
+
+
+def test_manifest_rows_of_videos_name_their_problems(video_set, tmp_path):
+    folder = _copy(video_set, tmp_path)
+    m = pd.read_csv(folder / "manifest.csv", dtype=str)
+    bad = pd.concat([m, m.assign(clock_offset_s="soon", pressure_log=""), m.assign(video="", trial="2")], ignore_index=True)
+    bad.to_csv(folder / "manifest.csv", index=False)
+    text = "\n".join(str(p) for p in photoset.load_photoset(folder).problems)
+    assert "line 3: video 'SS40_A1_t1_steps.avi' is listed twice (also line 2)" in text
+    assert "line 3: pressure_log is empty" in text
+    assert "line 3: clock_offset_s 'soon' is not a number" in text
+    assert "line 3: material SS40, actuator A1, trial 1 is also line 2" in text
+    assert "line 4: video name is empty" in text
+    out = measure_photoset(folder)
+    assert len(out) == 135 + 135 + 1  # line 4 names no video: one row says why
+    assert (out.iloc[:135]["status"] != "failed").all() and (out.iloc[135:]["status"] == "failed").all()
+    assert out.iloc[140]["reason"].startswith("manifest line 3: video 'SS40_A1_t1_steps.avi' is listed twice")
+    with pytest.raises(UserInputError, match="missing column"):
+        pd.DataFrame({"video": ["a.avi"], "material": ["SS40"]}).to_csv(folder / "manifest.csv", index=False)
+        photoset.read_manifest(folder)
+
+
+def test_mpeg4_frames_are_read_decoded_and_measured_the_same_way(tmp_path):
+    folder = tmp_path / "mp4v"
+    truth = render_video(folder, "SS40", profile=PressureProfile("ramp", max_kpa=60, rate_kpa_s=60), fps=10, rest_s=0.2,
+                         scene="lab", scene_overrides=SCENE, seed=4, codec="mp4v")
+    info = probe_video(_video(folder))
+    assert info.fourcc in ("FMP4", "mp4v") and not info.packets and info.seekable
+    out = measure_photoset(folder, jobs=2)
+    m = out.merge(truth, on=["image", "frame"], suffixes=("", "_true"))
+    ok = m[m["status"] == "ok"]
+    assert len(ok) >= len(m) - 1 and (ok["psi_deg"] - ok["psi_image_deg"]).abs().median() < 0.2
+
+
+def test_h264_is_written_when_the_build_can_and_refused_by_name_when_not(tmp_path):
+    profile = PressureProfile("ramp", max_kpa=20, rate_kpa_s=40)
+    try:
+        render_video(tmp_path / "h264", "SS40", profile=profile, fps=5, rest_s=0.1, scene="clean",
+                     scene_overrides=SCENE, codec="h264")
+    except UserInputError as exc:
+        assert "cannot encode h264" in str(exc) and "mjpg" in str(exc)
+        assert not list((tmp_path / "h264").glob("*.mp4"))
+    else:
+        assert probe_video(_video(tmp_path / "h264")).frame_count == 6
+
+
+def test_rendering_is_deterministic(tmp_path):
+    kw = dict(profile=PressureProfile("ramp", max_kpa=30, rate_kpa_s=60), fps=5, rest_s=0.2, scene="lab",
+              scene_overrides=SCENE, seed=9)
+    render_video(tmp_path / "a", "SS40", **kw)
+    render_video(tmp_path / "b", "SS40", **kw)
+    for name in ("manifest.csv", "truth.csv", "SS40_A1_t1_ramp.avi", "SS40_A1_t1_ramp_pressure.csv"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+
+
+# --- the pieces -----------------------------------------------------------------------------
+
+
+def test_direction_turns_at_confirmed_extremes_only():
+    rng = np.random.default_rng(1)
+    p = np.concatenate([np.linspace(0, 100, 101), np.full(20, 100.0), np.linspace(100, 0, 101)]) + rng.normal(0, 0.2, 222)
+    tp = turning_points(p)
+    assert len(tp) == 1 and 100 <= tp[0] <= 121  # at the top hold, not at a noise wiggle
+    log = PressureLog("log.csv", np.arange(222) * 0.1, p)
+    d = frame_conditions(log, log.time_s)["direction"]
+    assert (d[:100] == "up").all() and (d[125:] == "down").all()
+
+
+def test_steps_are_jumps_followed_by_a_hold_not_a_fast_ramp():
+    t = np.arange(0, 20, 0.05)
+    steps = PressureProfile("steps", max_kpa=40, step_kpa=20, hold_s=4)
+    log = PressureLog("s.csv", t, steps.setpoint_kpa(t))
+    assert np.allclose(step_times(log), steps.step_times_s(), atol=0.051)
+    ramp = PressureProfile("ramp", max_kpa=200, rate_kpa_s=60)  # 3 kPa per log row: fast, but no hold
+    assert step_times(PressureLog("r.csv", t, ramp.setpoint_kpa(t))).size == 0
+
+
+def test_pressure_log_problems_name_the_line(tmp_path):
+    path = tmp_path / "log.csv"
+    path.write_text("time_s,pressure_kpa\n0,0\n1,x\n")
+    assert read_pressure_log(path)[1] == ["log.csv line 3: pressure_kpa 'x' is not a number"]
+    path.write_text("time_s,kpa\n0,0\n")
+    assert "lacks column(s) ['pressure_kpa']" in read_pressure_log(path)[1][0]
+    path.write_text("time_s,pressure_kpa,measured_kpa\n0,0,0\n1,10,-200\n")
+    assert "below absolute vacuum" in read_pressure_log(path)[1][0]
+
+
+def test_first_order_lags_reach_63_percent_after_tau():
+    dyn = Dynamics(tau_pressure_s=0.0, tau_psi_s=0.5)
+    sim = simulate(PressureProfile("steps", max_kpa=50, step_kpa=50, hold_s=5), toy_actuator(), dyn, start_s=0.0, end_s=10.0)
+    psi = np.interp([5.0, 5.5, 9.9], sim["time_s"], sim["psi_deg"])  # the step to 50 kPa at 5 s: 210 -> 110 deg
+    assert np.isclose(psi[0], 210, atol=0.2) and np.isclose(psi[1], 210 - 100 * (1 - np.exp(-1)), atol=0.3)
+    assert np.isclose(psi[2], 110, atol=0.1)
+
+
+def test_truncated_avi_cannot_seek_and_is_read_by_skipping(video_set, tmp_path):
+    path = tmp_path / "t.avi"
+    data = _video(video_set).read_bytes()
+    path.write_bytes(data[: int(len(data) * 0.8)])
+    info = probe_video(path)
+    assert info.frame_count == 135 and not info.seekable
+    whole = {f.index: f.data for f in read_frames(probe_video(_video(video_set)), 40, 5)}
+    part = list(read_frames(info, 40, 5))
+    assert [f.index for f in part] == list(range(40, 45))
+    assert all(np.array_equal(f.data, whole[f.index]) for f in part)
+    assert [round(f.pts_s, 3) for f in part] == [4.0, 4.1, 4.2, 4.3, 4.4]
+    assert cv2.imdecode(part[0].data, cv2.IMREAD_GRAYSCALE).shape == (240, 320)
+
+
+def test_clips_know_their_span_and_the_log(video_set):
+    clip = resolve_clips(photoset.load_photoset(video_set))[0]
+    assert clip.n_frames == 135 and clip.clock_offset_s == 0.7 and clip.problems == ()
+    assert np.allclose(clip.span_s(), (0.7, 14.1)) and clip.log is not None and clip.log.span_s[0] == 0.0
+
+
+def test_the_ramp_check_runs_over_time(measured):
+    from pipeline.ramp_check import check_ramps
+
+    bad = measured.copy()
+    bad.loc[60, "psi_deg"] += 40.0  # one frame read wrongly
+    shuffled = bad.sample(frac=1.0, random_state=1)  # row order must not matter: frames are ordered by time
+    out = check_ramps(shuffled).loc[bad.index]
+    assert out.loc[60, "status"] == "flagged" and out.loc[60, "reason"].startswith("breaks its ramp")
+    assert (out.drop(index=60)["status"] == measured.drop(index=60)["status"]).all()

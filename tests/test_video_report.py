@@ -1,0 +1,42 @@
+"""The report page of a video dataset: one page per dataset, its figures and tables named."""
+
+from __future__ import annotations
+
+import numpy as np
+import pypdfium2 as pdfium
+
+from pipeline.report import Dataset, ReportInputs, build_report
+from pipeline.video.continuous import write_continuous
+from pipeline.video.pages import figures, write_strip
+
+
+def _text(pdf_path) -> list[str]:
+    doc = pdfium.PdfDocument(str(pdf_path))
+    return [doc[i].get_textpage().get_text_range() for i in range(len(doc))]
+
+
+def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
+    angles = tmp_path / "angles.csv"
+    measured.to_csv(angles, index=False)
+    for name in ("steps_a", "steps_b"):
+        write_continuous(measured, tmp_path / "continuous" / name)
+    base = ReportInputs(datasets=(Dataset("steps", angles),), title="t")
+    plain = build_report(base, tmp_path / "plain.pdf")
+    with_video = build_report(
+        ReportInputs(datasets=base.datasets, title="t",
+                     video_dirs=(tmp_path / "continuous" / "steps_a", tmp_path / "continuous" / "steps_b")),
+        tmp_path / "video.pdf")
+    assert with_video.pages == plain.pages + 2
+    pages = _text(tmp_path / "video.pdf")
+    video_pages = [p for p in pages if "Video dataset" in p]
+    assert len(video_pages) == 2 and "Video dataset steps_a" in video_pages[0]
+    for text in video_pages:
+        assert "Step responses" in text and "40 -> 80" in text and "loop width" in text
+    assert not any("pipeline.video.pages" in w for w in with_video.warnings)
+
+
+def test_a_folder_without_tables_gives_no_page_and_a_strip_needs_overlays(measured, tmp_path):
+    assert figures(tmp_path / "empty") == []
+    assert write_strip(measured, tmp_path / "no-overlays", tmp_path) is None
+    write_continuous(measured.assign(psi_deg=np.nan, status="failed"), tmp_path / "all_failed")
+    assert len(figures(tmp_path / "all_failed")) == 1  # every frame failed: the page still says so
