@@ -21,6 +21,8 @@ Never a silent wrong number: whatever the estimator returns, a row is ``flagged`
 
 ``failed`` rows (no psi) come from :class:`pipeline.measure.extract.NoLineFound` or an image
 that cannot be decoded; their reason is set by the caller.
+
+A body (``target: body``) is judged by :func:`assess_body` instead: see its docstring.
 """
 
 from __future__ import annotations
