@@ -26,17 +26,30 @@ from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from pipeline import __version__
+from pipeline.bench import pages as bench_pages
+from pipeline.force import pages as force_pages
 from pipeline.photoset import atomic_write_bytes
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
-from pipeline.report.extra import extra_pages
-from pipeline.report.pages import (
-    comparison_page,
-    material_page,
-    overview_page,
-    summary_lines,
-    text_pages,
-)
-from pipeline.report.style import report_style
+from pipeline.report.pages import comparison_page, material_page, overview_page
+from pipeline.report.provenance import provenance_page
+from pipeline.report.style import FOOTER_PT, material_colors, report_style
+from pipeline.report.summary import summary_page
+from pipeline.report.textcheck import FOOTER_GID
+
+#: what each page is, for the contents list on page 1 (by figure label; first page of a run of pages)
+CONTENTS: dict[str, str] = {
+    "overview": "All materials (as Fig. 6)",
+    "material": "One page per material: curves, table, photos",
+    "comparison": "Model versus measurements, beside the paper",
+    "speed-accuracy": "Angle methods: speed against accuracy",
+    "stability": "Angle methods: stability, where each breaks",
+    "bench-tables": "Angle methods: breakdown, repeatability tables",
+    "model-cost": "Model: accuracy against cost",
+    "force": "Blocked force and eccentricity (Fig. 7A)",
+    "eccentricity": "Eccentricity at the highest pressure (Fig. 7B)",
+    "grasp": "Grasping: heaviest mass held (Fig. 8B)",
+    "provenance": "Provenance: software, config, sha256 of inputs",
+}
 
 
 @dataclass(frozen=True)
@@ -78,15 +91,14 @@ def pdf_float_decimals(decimals: int = PDF_FLOAT_DECIMALS) -> Iterator[None]:
 
 
 def render_pdf(figures: list[Figure], title: str) -> bytes:
-    """Save figures as pages of one PDF; no timestamps, so the bytes depend on the figures only."""
+    """Save figures as pages of one PDF with a footer; no timestamps, so the bytes depend on the figures only."""
     buf = io.BytesIO()
     metadata = {"Title": title, "Creator": f"pipeline {__version__}", "CreationDate": None}
     saved_epoch = os.environ.pop("SOURCE_DATE_EPOCH", None)  # would re-introduce a date
     try:
         with pdf_float_decimals(), PdfPages(buf, metadata=metadata) as pdf:
             for i, fig in enumerate(figures, start=1):
-                fig.text(0.99, 0.004, f"{title} | page {i} of {len(figures)}", ha="right", va="bottom",
-                         fontsize=6.5, color="0.4")
+                add_footer(fig, f"{title} | page {i} of {len(figures)}")
                 pdf.savefig(fig)
     finally:
         if saved_epoch is not None:
@@ -94,11 +106,41 @@ def render_pdf(figures: list[Figure], title: str) -> bytes:
     return buf.getvalue()
 
 
+def add_footer(fig: Figure, text: str) -> None:
+    """The page line, bottom right, inside the footer band (nothing else is drawn there)."""
+    fig.text(1.0 - 30.0 / (72.0 * fig.get_figwidth()), 0.45 * FOOTER_PT / (72.0 * fig.get_figheight()), text,
+             ha="right", va="center", fontsize=7.0, color="0.4", gid=FOOTER_GID)
+
+
+def contents(figures: list[Figure]) -> list[tuple[str, int]]:
+    """(what, first page) of each part, from the page labels (page 1 is the summary)."""
+    out: list[tuple[str, int]] = []
+    seen: set[str] = set()
+    for number, fig in enumerate(figures, start=2):
+        kind = fig.get_label().split(" ")[0]
+        if kind in CONTENTS and kind not in seen:
+            seen.add(kind)
+            out.append((CONTENTS[kind], number))
+    return out
+
+
 def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     """Every page in order, and the warnings printed on the summary page."""
-    bench = extra_pages("pipeline.bench.pages", data.inputs.bench_dir)
-    force = extra_pages("pipeline.force.pages", data.inputs.force_dir)
-    warnings = bench.warnings + force.warnings
+    warnings: list[str] = []
+    infos: list[str] = []
+    extra: list[Figure] = []
+    colors = material_colors(data.materials)
+    for name, folder, build in (("--bench-dir", data.inputs.bench_dir, bench_pages.figures),
+                                ("--force-dir", data.inputs.force_dir,
+                                 lambda d: force_pages.figures(d, colors=colors))):
+        if folder is None:
+            continue
+        if not folder.is_dir():
+            warnings.append(f"{name} {folder} does not exist; its pages are missing")
+            continue
+        figs = build(folder)
+        extra += figs
+        infos.append(f"{len(figs)} page(s) from {name} {folder}")
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
@@ -110,13 +152,9 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
-    config_digest = data.digests.get(str(data.inputs.config)) if data.inputs.config is not None else None
-    lines = summary_lines(data, __version__, config_digest, warnings, bench.infos + force.infos)
-    figures = text_pages(data.inputs.title, lines)
-    figures.append(overview_page(data))
-    figures += [material_page(data, m) for m in data.materials]
-    figures.append(comparison_page(data))
-    return figures + bench.figures + force.figures, warnings
+    body = [overview_page(data)] + [material_page(data, m) for m in data.materials] + [comparison_page(data)]
+    body += extra + [provenance_page(data, __version__, infos)]
+    return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
 
 
 def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportResult:

@@ -1,0 +1,48 @@
+"""The last page: what the report was made from (software, configuration, every input's sha256)."""
+
+from __future__ import annotations
+
+import platform
+from collections.abc import Sequence
+from importlib import metadata
+
+from matplotlib.figure import Figure
+
+from pipeline.report.data import ReportData
+from pipeline.report.style import text_page
+from pipeline.report.typeset import MONO, Column, Flow, Table
+
+#: libraries whose versions can change a number or a pixel of the report
+LIBRARIES: tuple[str, ...] = ("numpy", "pandas", "scipy", "opencv-python-headless", "opencv-python", "matplotlib")
+
+
+def library_versions() -> list[str]:
+    """``name version`` of each installed library of :data:`LIBRARIES`."""
+    out = []
+    for name in LIBRARIES:
+        try:
+            out.append(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:
+            continue
+    return out
+
+
+def provenance_page(data: ReportData, version: str, infos: Sequence[str]) -> Figure:
+    """Software, configuration and the sha256 of every input file (portrait A4)."""
+    fig = text_page(label="provenance")
+    flow = Flow(fig, top_pt=36.0)
+    flow.text("Provenance", size=14.0, weight="bold")
+    flow.space(2.0)
+    flow.text(f"pipeline {version}, Python {platform.python_version()}; " + ", ".join(library_versions()) + ".",
+              size=8.0)
+    flow.text("The same inputs give the same PDF, byte for byte: nothing on any page comes from the clock or the "
+              "machine.  Photos are covered by the sha256 of their photo set's manifest.csv and photoset.yaml.",
+              size=8.0, color="0.25")
+    for line in list(data.notes) + list(infos):
+        flow.text(line, size=8.0, color="0.25")
+    flow.space(4.0)
+    rows = tuple((f.role, f.path, f.sha256) for f in data.files)
+    flow.table(Table(columns=(Column("Input", "left"), Column("File", "left", wrap_pt=150.0),
+                              Column("sha256", "left", family=MONO)),
+                     rows=rows, title="Input files", size=7.0))
+    return fig
