@@ -157,8 +157,8 @@ def speed_accuracy_figure(table: pd.DataFrame) -> Figure:
                 ax.scatter([fn(np.array([value]))[0]], [y[m]], s=190, facecolors="none", edgecolors="black",
                            linewidths=1.1, zorder=5)
             label = f"{value:.1f} ms" if key == "median_ms_per_image" else f"{value:.3g}°"
-            ax.annotate(label, (fn(np.array([value]))[0], y[m]), textcoords="offset points", xytext=(0, 7.5),
-                        ha="center", va="bottom", fontsize=7.5, zorder=6)
+            ax.text(fn(np.array([value]))[0], y[m], label, ha="center", va="bottom", fontsize=7.5, zorder=6,
+                    transform=transforms.offset_copy(ax.transData, fig=fig, y=7.5, units="points"))
         ax.grid(True, axis="x", which="major", alpha=0.4)
         ax.grid(False, axis="y")
     ax_t.set_xlim(left=0.0, right=1.12 * float(np.nanmax(table["median_ms_per_image"].astype(float))))

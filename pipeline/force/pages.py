@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.transforms import offset_copy
 
 from pipeline.report.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
 from pipeline.report.typeset import Column, Flow, Table, fmt, table_height_pt
@@ -242,8 +243,8 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
                 ax.plot(m.loc[~ok, "pressure_kpa"], np.zeros(int((~ok).sum())), "x", color="#b00000", ms=8, mew=2,
                         clip_on=False, zorder=5)
                 for p in m.loc[~ok, "pressure_kpa"]:
-                    ax.annotate(f"{material} not held", (p, 0.0), textcoords="offset points", xytext=(0, 8),
-                                ha="center", fontsize=7.0, color="#b00000")
+                    ax.text(p, 0.0, f"{material} not held", ha="center", fontsize=7.0, color="#b00000",
+                            transform=offset_copy(ax.transData, fig=fig, y=8.0, units="points"))
         ax.set_title(f"{side} an object of {diameter:g} mm diameter")
         ax.set_xlim(-0.04 * p_max - 1.0, 1.08 * p_max + 1.0)
         ax.set_ylim(0.0, 1.15 * m_max)

@@ -16,11 +16,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
 import numpy as np
-
-matplotlib.use("Agg", force=False)
-import matplotlib.pyplot as plt
 from matplotlib.backends import backend_pdf
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
@@ -173,11 +169,7 @@ def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportRes
     data = load_report_data(inputs)
     with report_style():
         figures, warnings = report_figures(data)
-        try:
-            pdf = render_pdf(figures, inputs.title)
-        finally:
-            for fig in figures:
-                plt.close(fig)
+        pdf = render_pdf(figures, inputs.title)
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(path, pdf)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import matplotlib as mpl
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
 from matplotlib.figure import Figure
 from matplotlib.text import Text
@@ -53,8 +54,12 @@ class _RecordingRenderer(RendererAgg):
         return super().draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
 
 
-def drawn_texts(fig: Figure, dpi: float = 72.0) -> list[DrawnText]:
+def drawn_texts(fig: Figure, dpi: float = 100.0) -> list[DrawnText]:
     """Draw ``fig`` once and return every text it drew, in drawing order.
+
+    The drawing uses unhinted glyphs, as the PDF does (hinting at screen resolution widens small
+    text by up to a tenth).  The figure keeps the layout of this drawing (constrained layout
+    starts from the current axes positions), so save a freshly made figure for byte-exact output.
 
     Parameters
     ----------
@@ -66,23 +71,25 @@ def drawn_texts(fig: Figure, dpi: float = 72.0) -> list[DrawnText]:
     -------
     list of DrawnText
     """
-    saved_dpi = fig.dpi
-    canvas = FigureCanvasAgg(fig)
+    saved_dpi, saved_canvas = fig.dpi, fig.canvas
+    FigureCanvasAgg(fig)
     fig.dpi = dpi
     try:
-        w, h = fig.get_size_inches() * dpi
-        renderer = _RecordingRenderer(int(w), int(h), dpi)
-        fig.draw(renderer)
-        out = []
-        scale = 72.0 / dpi
-        for t in renderer.drawn.values():
-            b = t.get_window_extent(renderer)
-            out.append(DrawnText(t.get_text(), float(t.get_fontsize()),
-                                 Bbox.from_extents(b.x0 * scale, b.y0 * scale, b.x1 * scale, b.y1 * scale), t.get_gid()))
-        return out
+        with mpl.rc_context({"text.hinting": "no_hinting"}):
+            w, h = fig.get_size_inches() * dpi
+            renderer = _RecordingRenderer(int(w), int(h), dpi)
+            fig.draw(renderer)
+            scale = 72.0 / dpi
+            out = []
+            for t in renderer.drawn.values():
+                b = t.get_window_extent(renderer)
+                out.append(DrawnText(t.get_text(), float(t.get_fontsize()),
+                                     Bbox.from_extents(b.x0 * scale, b.y0 * scale, b.x1 * scale, b.y1 * scale),
+                                     t.get_gid()))
+            return out
     finally:
         fig.dpi = saved_dpi
-        del canvas
+        fig.set_canvas(saved_canvas)
 
 
 def overlapping_texts(texts: list[DrawnText], tolerance_pt: float = 0.5) -> list[tuple[str, str]]:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties, findfont, get_font
-from matplotlib.ft2font import LOAD_NO_HINTING
+from matplotlib import ft2font
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.transforms import Affine2D, Transform
@@ -65,6 +65,8 @@ def fmt(value: object, digits: int = 0, unit: str = "") -> str:
     return text + unit
 
 
+#: unhinted glyph outlines, as in the PDF (``LoadFlags`` from matplotlib 3.10 on)
+_NO_HINTING = ft2font.LoadFlags.NO_HINTING if hasattr(ft2font, "LoadFlags") else ft2font.LOAD_NO_HINTING
 #: size (pt) at which widths are measured; advance widths of unhinted outlines scale linearly with size
 _REFERENCE_PT = 10.0
 
@@ -73,7 +75,7 @@ _REFERENCE_PT = 10.0
 def _reference_width(text: str, weight: str, family: str) -> float:
     font = get_font(findfont(FontProperties(family=family, weight=weight)))
     font.set_size(_REFERENCE_PT, 72.0)
-    font.set_text(text, 0.0, flags=LOAD_NO_HINTING)
+    font.set_text(text, 0.0, flags=_NO_HINTING)
     return font.get_width_height()[0] / 64.0
 
 
