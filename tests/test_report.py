@@ -220,7 +220,7 @@ def default(tmp_path_factory):
     with report_style():  # the same pages, drawn once to see what they draw (before any saving)
         figures, _ = report_figures(load_report_data(inputs))
         texts = [(f.get_label(), drawn_texts(f)) for f in figures]
-    return inputs, pdf, texts, rms
+    return inputs, pdf, texts, rms, figures
 
 
 @pytest.fixture(scope="module")
@@ -238,7 +238,7 @@ def pdf_text(pdf: Path, page: int) -> str:
 
 
 def test_every_page_is_a4_and_in_order(default):
-    _inputs, pdf, pages, _rms = default
+    _inputs, pdf, pages, _rms, _figs = default
     doc = pdfium.PdfDocument(str(pdf))
     try:
         sizes = [tuple(sorted(doc[i].get_size())) for i in range(len(doc))]
@@ -279,7 +279,7 @@ def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
 
 
 def test_page_one_figures_read_back_match_rms_csv(default):
-    _inputs, pdf, _pages, rms = default
+    _inputs, pdf, _pages, rms, _figs = default
     text = pdf_text(pdf, 0)
     all_lines = text.split("\r\n")
     table = pd.read_csv(rms)
@@ -300,7 +300,7 @@ def test_page_one_figures_read_back_match_rms_csv(default):
 
 
 def test_page_one_quality_reasons_in_words_sources_and_dates(default):
-    inputs, pdf, _pages, _rms = default
+    inputs, pdf, _pages, _rms, _figs = default
     text = " ".join(pdf_text(pdf, 0).split())
     assert "Photos taken: 2026-03-02 to 2026-03-03 (from the timestamps; no date for DS20, DS30, SS40, SS50)" in text
     assert "no marker line found" in text and "line touches the image border" in text
@@ -378,7 +378,7 @@ def test_bench_pages_say_where_each_method_breaks(pages, default):
 
 
 def test_identical_inputs_identical_bytes_across_processes(default, tmp_path):
-    inputs, pdf, _pages, rms = default
+    inputs, pdf, _pages, rms, _figs = default
     d = inputs.datasets
     args = ["report", "--datasets", *[x.name for x in d], "--angles", *[str(x.angles_csv) for x in d],
             "--photosets", *[str(x.photoset_dir) for x in d], "--overlays", *[str(x.overlays_dir) for x in d],
@@ -461,3 +461,23 @@ def test_bad_inputs_exit_2(default, tmp_path):
     assert main(["report", "--angles", angles, "--photosets", "a", "b", "--out", out]) == 2
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2
     assert main(["report", "--angles", angles, "--rms", angles, "--model-curves", angles, "--out", out]) == 2
+
+
+def test_each_material_has_one_colour_on_every_page(default):
+    from matplotlib.colors import to_rgb
+
+    from pipeline.force import pages as force_pages
+    from pipeline.report.style import material_colors
+
+    inputs, figures = default[0], default[4]
+    colors = material_colors(["DS20", "DS30", "SS40", "SS50"])
+    with report_style():
+        standalone = force_pages.figures(inputs.force_dir)  # the force CLI's pages, without the report
+    seen = 0
+    for fig in figures + standalone:
+        for ax in fig.axes:
+            for line in ax.get_lines():
+                if line.get_label() in colors:
+                    assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), fig.get_label()
+                    seen += 1
+    assert seen >= 4 * 5  # summary plot, force, eccentricity, grasp (x2) name every material

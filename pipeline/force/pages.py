@@ -186,14 +186,18 @@ def _draw_photo(ax: Axes, r: pd.Series, base: Path | None, color: Color) -> None
 
 
 def grasp_table(summary: pd.DataFrame) -> Table:
-    """Every grasp-log summary row, typeset."""
-    rows = tuple((str(r.material), str(r.side), fmt(r.diameter_mm, 0), fmt(r.pressure_kpa, 0),
-                  "not held" if not np.isfinite(r.max_mass_held_g) else fmt(r.max_mass_held_g, 0),
-                  str(int(r.n_held)), str(int(r.n_attempts))) for r in summary.itertuples())
+    """The grasp-log summary, one row per material, side and object: mass held at each pressure."""
+    rows = []
+    for (material, side, diameter), g in summary.groupby(["material", "side", "diameter_mm"], sort=True):
+        cells = [f"{fmt(r.pressure_kpa, 0)}: " + ("not held" if not np.isfinite(r.max_mass_held_g)
+                                                  else fmt(r.max_mass_held_g, 0))
+                 for r in g.sort_values("pressure_kpa").itertuples()]
+        rows.append((str(material), str(side), fmt(diameter, 0), ", ".join(cells),
+                     f"{int(g['n_held'].sum())} of {int(g['n_attempts'].sum())}"))
     return Table(columns=(Column("material", "left"), Column("side", "left"), Column("object diameter (mm)"),
-                          Column("pressure (kPa)"), Column("heaviest mass held (g)"), Column("held"),
-                          Column("attempts")),
-                 rows=rows, title="Grasp log summary", size=7.5,
+                          Column("pressure (kPa): heaviest mass held (g)", "left", wrap_pt=260.0),
+                          Column("attempts held")),
+                 rows=tuple(rows), title="Grasp log summary", size=7.5,
                  notes=("not held: no attempt at that pressure held the object (a red x on the zero line above).",))
 
 
@@ -238,7 +242,7 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
             ok = m["max_mass_held_g"].notna()
             # shrinking markers drawn on top of each other: materials with equal values stay visible as rings
             ax.plot(m.loc[ok, "pressure_kpa"], m.loc[ok, "max_mass_held_g"], "o-", color=palette[str(material)],
-                    label=str(material), ms=max(9.0 - 1.8 * j, 3.0), mec="white", mew=0.6, lw=1.2, zorder=2 + j)
+                    label=str(material), ms=max(10.0 - 1.7 * j, 5.0), mec="white", mew=0.6, lw=1.2, zorder=2 + j)
             if (~ok).any():
                 ax.plot(m.loc[~ok, "pressure_kpa"], np.zeros(int((~ok).sum())), "x", color="#b00000", ms=8, mew=2,
                         clip_on=False, zorder=5)
