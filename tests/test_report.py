@@ -481,3 +481,30 @@ def test_each_material_has_one_colour_on_every_page(default):
                     assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), fig.get_label()
                     seen += 1
     assert seen >= 4 * 5  # summary plot, force, eccentricity, grasp (x2) name every material
+
+
+def test_many_datasets_and_inputs_stay_on_their_pages(tmp_path):
+    """Forty photo sets: page 1 folds the quiet ones into one row, provenance continues on a new page."""
+    from pipeline.report.data import InputFile
+    from pipeline.report.provenance import provenance_pages
+    from pipeline.report.summary import summary_page
+
+    sets = [make_dataset(tmp_path, "SS40", name=f"set{k:02d}", actuators=1, trials=1, step=50.0, photos=False,
+                         overlays=False, seed=k) for k in range(40)]
+    data = load_report_data(ReportInputs(datasets=tuple(sets)))
+    data = dataclasses.replace(data, files=data.files + tuple(InputFile("extra", f"x/{k}.csv", "0" * 64)
+                                                               for k in range(60)))
+    with report_style():
+        page1 = summary_page(data, "0", [f"warning {k}" for k in range(12)], [("Provenance", 6)])
+        texts = drawn_texts(page1)
+        prov = provenance_pages(data, "0", [], [f"warning {k}" for k in range(12)])
+        prov_texts = [drawn_texts(p) for p in prov]
+    words_on_1 = [t.text for t in texts]
+    assert any(w.endswith(" more") for w in words_on_1) and "all" in words_on_1
+    assert "... and 4 more warning(s), listed on the provenance page" in " ".join(words_on_1)
+    assert len(prov) >= 2
+    for page in [texts, *prov_texts]:
+        assert overlapping_texts(page) == []
+        assert all(t.box.y0 >= FOOTER_PT for t in page)
+    listed = [t.text for page in prov_texts for t in page]
+    assert all(f"x/{k}.csv" in listed for k in range(60))

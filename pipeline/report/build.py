@@ -27,7 +27,7 @@ from pipeline.force import pages as force_pages
 from pipeline.photoset import atomic_write_bytes
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
 from pipeline.report.pages import comparison_page, material_page, overview_page
-from pipeline.report.provenance import provenance_page
+from pipeline.report.provenance import provenance_pages
 from pipeline.report.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.summary import summary_page
 from pipeline.report.textcheck import FOOTER_GID
@@ -149,7 +149,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
     body = [overview_page(data)] + [material_page(data, m) for m in data.materials] + [comparison_page(data)]
-    body += extra + [provenance_page(data, __version__, infos)]
+    body += extra + provenance_pages(data, __version__, infos, warnings)
     return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
 
 

@@ -1,7 +1,8 @@
-"""The last page: what the report was made from (software, configuration, every input's sha256)."""
+"""The last page(s): what the report was made from (software, configuration, every input's sha256)."""
 
 from __future__ import annotations
 
+import dataclasses
 import platform
 from collections.abc import Sequence
 from importlib import metadata
@@ -10,7 +11,7 @@ from matplotlib.figure import Figure
 
 from pipeline.report.data import ReportData
 from pipeline.report.style import text_page
-from pipeline.report.typeset import MONO, Column, Flow, Table
+from pipeline.report.typeset import MONO, Column, Flow, Table, rows_that_fit
 
 #: libraries whose versions can change a number or a pixel of the report
 LIBRARIES: tuple[str, ...] = ("numpy", "pandas", "scipy", "opencv-python-headless", "opencv-python", "matplotlib")
@@ -27,8 +28,8 @@ def library_versions() -> list[str]:
     return out
 
 
-def provenance_page(data: ReportData, version: str, infos: Sequence[str]) -> Figure:
-    """Software, configuration and the sha256 of every input file (portrait A4)."""
+def provenance_pages(data: ReportData, version: str, infos: Sequence[str], warnings: Sequence[str] = ()) -> list[Figure]:
+    """Software, configuration and the sha256 of every input file (portrait A4, as many pages as needed)."""
     fig = text_page(label="provenance")
     flow = Flow(fig, top_pt=36.0)
     flow.text("Provenance", size=14.0, weight="bold")
@@ -40,9 +41,20 @@ def provenance_page(data: ReportData, version: str, infos: Sequence[str]) -> Fig
               size=8.0, color="0.25")
     for line in list(data.notes) + list(infos):
         flow.text(line, size=8.0, color="0.25")
+    for line in warnings:
+        flow.text(f"WARNING: {line}", size=8.0, color="#b00000")
     flow.space(4.0)
     rows = tuple((f.role, f.path, f.sha256) for f in data.files)
-    flow.table(Table(columns=(Column("Input", "left"), Column("File", "left", wrap_pt=150.0),
-                              Column("sha256", "left", family=MONO)),
-                     rows=rows, title="Input files", size=7.0))
-    return fig
+    pages = [fig]
+    while True:
+        table = Table(columns=(Column("Input", "left"), Column("File", "left", wrap_pt=150.0),
+                               Column("sha256", "left", family=MONO)),
+                      rows=rows, title="Input files" + ("" if len(pages) == 1 else " (continued)"), size=7.0)
+        k = rows_that_fit(table, flow.width, flow.remaining_pt)
+        flow.table(dataclasses.replace(table, rows=rows[:k]))
+        rows = rows[k:]
+        if not rows:
+            return pages
+        fig = text_page(label="provenance (continued)")
+        flow = Flow(fig, top_pt=36.0)
+        pages.append(fig)

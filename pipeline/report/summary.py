@@ -17,12 +17,14 @@ from matplotlib.figure import Figure
 from pipeline.report.data import ReportData, rms_row
 from pipeline.report.reasons import top_reasons
 from pipeline.report.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt
+from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
 #: least height (pt) worth giving the overview plot on page 1
 MIN_PLOT_PT = 170.0
 #: the plot never takes more than this (pt), so page 1 stays a summary
 MAX_PLOT_PT = 250.0
+#: warnings printed on page 1 (all of them are on the provenance page)
+MAX_WARNINGS = 8
 
 
 def material_sources(data: ReportData) -> dict[str, str]:
@@ -102,35 +104,53 @@ def missing_notes(data: ReportData) -> list[str]:
     return out
 
 
-def quality_table(data: ReportData) -> Table:
-    """Per dataset: real or synthetic, dates, photo counts by status and the top reasons in words."""
+def quality_table(data: ReportData, *, width_pt: float = 511.0, height_pt: float | None = None) -> Table:
+    """Per dataset: real or synthetic, dates, photo counts by status and the top reasons in words.
+
+    When the rows do not fit in ``height_pt``, the datasets with the most flagged and failed photos
+    keep their rows and the others are summed into one.
+    """
     reasons = top_reasons(data.angles)
-    rows = []
-    totals = np.zeros(4, dtype=int)
+    rows, counts = [], []
     for info in data.datasets:
         a = data.angles[data.angles["dataset"] == info.name]
         status = a["status"].astype(str)
-        counts = np.array([len(a), (status == "ok").sum(), (status == "flagged").sum(), (status == "failed").sum()])
-        totals += counts
+        c = np.array([len(a), (status == "ok").sum(), (status == "flagged").sum(), (status == "failed").sum()])
+        counts.append(c)
         materials = ", ".join(sorted(a["material"].astype(str).unique()))
         dates = NA if not info.first_date else (info.first_date if info.first_date == info.last_date
                                                 else f"{info.first_date} to {info.last_date}")
         why = "; ".join(f"{w} ({n})" for w, n in reasons.get(info.name, [])) or "none"
-        rows.append((info.name, info.source, materials, dates, *(str(int(c)) for c in counts), why))
-    rows.append(("all", "", "", "", *(str(int(c)) for c in totals), ""))
-    columns = (Column("Dataset", "left"), Column("Data", "left"), Column("Material", "left"),
-               Column("Photos taken", "left"), Column("photos"), Column("ok"), Column("flagged"),
-               Column("failed"), Column("Top reasons (photos)", "left", wrap_pt=150.0))
-    if not any(d.first_date for d in data.datasets):  # the date line above says so once
-        columns = columns[:3] + columns[4:]
-        rows = [r[:3] + r[4:] for r in rows]
-    return Table(
-        columns=columns,
-        rows=tuple(rows), title="Data quality: every photo is ok, flagged or failed",
-        notes=("Flagged and failed photos are left out of the curves and fits; the reasons are counted once "
-               "per photo.  Data: synthetic = the photo set holds the renderer's truth.csv.",),
-        size=8.0,
-    )
+        rows.append((info.name, info.source, materials, dates, *(str(int(v)) for v in c), why))
+    dated = any(d.first_date for d in data.datasets)
+
+    def table(kept: list[int]) -> Table:
+        body = [rows[i] for i in kept]
+        rest = [i for i in range(len(rows)) if i not in kept]
+        if rest:
+            other = sum((counts[i] for i in rest), np.zeros(4, dtype=int))
+            body.append((f"{len(rest)} more", "", "", "", *(str(int(v)) for v in other), "fewest flagged/failed"))
+        total = sum(counts, np.zeros(4, dtype=int))
+        body.append(("all", "", "", "", *(str(int(v)) for v in total), ""))
+        columns = (Column("Dataset", "left"), Column("Data", "left"), Column("Material", "left"),
+                   Column("Photos taken", "left"), Column("photos"), Column("ok"), Column("flagged"),
+                   Column("failed"), Column("Top reasons (photos)", "left", wrap_pt=200.0))
+        if not dated:  # the date line above says so once
+            columns = columns[:3] + columns[4:]
+            body = [r[:3] + r[4:] for r in body]
+        return Table(
+            columns=columns, rows=tuple(body), title="Data quality: every photo is ok, flagged or failed",
+            notes=("Flagged and failed photos are left out of the curves and fits; the reasons are counted once "
+                   "per photo.  Data: synthetic = the photo set holds the renderer's truth.csv.",),
+            size=8.0,
+        )
+
+    worst = sorted(range(len(rows)), key=lambda i: (-(counts[i][2] + counts[i][3]), i))
+    for keep in range(len(rows), 0, -1):
+        candidate = table(sorted(worst[:keep]))
+        if height_pt is None or table_height_pt(candidate, width_pt) <= height_pt:
+            return candidate
+    return candidate
 
 
 def summary_page(data: ReportData, version: str, warnings: Sequence[str],
@@ -157,13 +177,18 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     flow.space(4.0)
     flow.table(results_table(data))
     flow.space(4.0)
-    flow.table(quality_table(data))
-    if warnings:
-        flow.heading("Warnings", size=9.5)
-        flow.bullets(list(warnings), color="#b00000")
     notes = list(data.notes)
+    shown = list(warnings[:MAX_WARNINGS])
+    if len(warnings) > MAX_WARNINGS:
+        shown.append(f"... and {len(warnings) - MAX_WARNINGS} more warning(s), listed on the provenance page")
     contents_h = 9.0 * 1.32 * (1 + int(np.ceil(len(contents) / 2))) + 14.0
     notes_h = sum(8.0 * 1.32 * (1 + len(n) // 110) for n in notes) + 16.0
+    warnings_h = sum(8.0 * 1.32 * (1 + len(w) // 100) for w in shown) + (16.0 if shown else 0.0)
+    flow.table(quality_table(data, width_pt=flow.width,
+                             height_pt=flow.remaining_pt - contents_h - notes_h - warnings_h - 8.0))
+    if shown:
+        flow.heading("Warnings", size=9.5)
+        flow.bullets(shown, color="#b00000")
     plot_h = min(MAX_PLOT_PT, flow.remaining_pt - contents_h - notes_h - 8.0)
     if plot_h >= MIN_PLOT_PT and len(data.hysteresis):
         flow.space(6.0)

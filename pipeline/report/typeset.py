@@ -20,6 +20,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import re
@@ -329,6 +330,18 @@ def table_height_pt(table: Table, width_pt: float) -> float:
     for note in table.notes:
         height += len(wrap(note, width_pt, note_size)) * note_size * LINE_SPACING
     return height
+
+
+def rows_that_fit(table: Table, width_pt: float, height_pt: float) -> int:
+    """How many of the table's rows (from the top) fit in ``height_pt`` (at least one)."""
+    lo, hi = 1, len(table.rows)
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if table_height_pt(dataclasses.replace(table, rows=table.rows[:mid]), width_pt) <= height_pt:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
 
 
 def _layout(table: Table, width_pt: float) -> tuple[float, list[float], list[list[list[str]]], list[list[str]]]:
