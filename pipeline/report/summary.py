@@ -223,5 +223,5 @@ def overview_axes(ax, data: ReportData) -> None:  # type: ignore[no-untyped-def]
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
     ax.set_title("Mean bending angle of every material (solid: rising, dashed: falling pressure)", fontsize=9.0)
-    ax.legend(loc="upper right", frameon=False, ncols=2)
+    ax.legend(loc="best", frameon=False, ncols=2)
 
