@@ -10,6 +10,9 @@ synthetic, dates from the inputs, n/a for missing values, identical bytes for id
 from __future__ import annotations
 
 import dataclasses
+import fcntl
+import os
+import pickle
 import subprocess
 import sys
 from pathlib import Path
@@ -203,10 +206,23 @@ def write_force(folder: Path) -> Path:
     return folder
 
 
-@pytest.fixture(scope="module")
-def default(tmp_path_factory):
-    """Inputs shaped like the default run: 4 materials, a second DS20 set, bench and force folders."""
-    tmp = tmp_path_factory.mktemp("default")
+def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: ignore[no-untyped-def]
+    """``make(folder)`` computed once per test run, however many xdist workers ask (lock, then pickle)."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return make(tmp_path_factory.mktemp(name))
+    root = tmp_path_factory.getbasetemp().parent  # one folder per run, shared by its workers
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        done = root / f"{name}.pickle"
+        if not done.is_file():
+            (root / name).mkdir()
+            done.write_bytes(pickle.dumps(make(root / name)))
+        return pickle.loads(done.read_bytes())
+
+
+def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
+    """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders) and
+    the report built from them."""
     datasets = [make_dataset(tmp, "DS20", name="sample", actuators=1, seed=9, timestamps="2026-03-02 09:00")]
     datasets += [make_dataset(tmp, m, seed=i, synthetic=True) for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))]
     hyst, rms = pipeline_tables(tmp, datasets)
@@ -217,16 +233,24 @@ def default(tmp_path_factory):
                           force_dir=write_force(tmp / "force"), config=config)
     pdf = tmp / "report.pdf"
     build_report(inputs, pdf)
-    with report_style():  # the same pages, drawn once to see what they draw (before any saving)
-        figures, _ = report_figures(load_report_data(inputs))
-        texts = [(f.get_label(), drawn_texts(f)) for f in figures]
-    return inputs, pdf, texts, rms, figures
+    return inputs, pdf, rms
 
 
 @pytest.fixture(scope="module")
-def pages(default):
-    """(label, texts drawn) of every page of the default report."""
-    return default[2]
+def default(tmp_path_factory):
+    """(inputs, report.pdf, rms.csv) of a report shaped like the default run's."""
+    return shared(tmp_path_factory, "report-default", make_default)
+
+
+@pytest.fixture(scope="module")
+def pages(default, tmp_path_factory):
+    """(label, texts drawn) of every page of the default report, each page drawn once (not saved)."""
+    def make(_folder: Path) -> list:
+        with report_style():
+            made, _ = report_figures(load_report_data(default[0]))
+            return [(f.get_label(), drawn_texts(f)) for f in made]
+
+    return shared(tmp_path_factory, "report-pages", make)
 
 
 def pdf_text(pdf: Path, page: int) -> str:
@@ -237,19 +261,14 @@ def pdf_text(pdf: Path, page: int) -> str:
         doc.close()
 
 
-def test_every_page_is_a4_and_in_order(default):
-    _inputs, pdf, pages, _rms, _figs = default
+def test_every_page_is_a4(default):
+    _inputs, pdf, _rms = default
     doc = pdfium.PdfDocument(str(pdf))
     try:
         sizes = [tuple(sorted(doc[i].get_size())) for i in range(len(doc))]
     finally:
         doc.close()
-    labels = [label for label, _ in pages]
-    assert len(sizes) == len(labels)
-    assert labels[:14] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
-                           "comparison", "speed-accuracy", "stability", "bench-tables", "model-cost", "force",
-                           "eccentricity", "grasp"]
-    assert labels[14] == "provenance" and all(x == "provenance (continued)" for x in labels[15:])  # long tmp paths
+    assert len(sizes) >= 15
     for i, (w, h) in enumerate(sizes, start=1):
         assert w == pytest.approx(A4_PT[0], abs=0.5) and h == pytest.approx(A4_PT[1], abs=0.5), f"page {i}: {w} x {h}"
     assert "Provenance" in pdf_text(pdf, 14)
@@ -257,8 +276,10 @@ def test_every_page_is_a4_and_in_order(default):
 
 def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
     labels = [label for label, _ in pages]
-    for needed in ("summary", "speed-accuracy", "stability"):
-        assert needed in labels
+    assert labels[:14] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
+                           "comparison", "speed-accuracy", "stability", "bench-tables", "model-cost", "force",
+                           "eccentricity", "grasp"]
+    assert labels[14] == "provenance" and all(x == "provenance (continued)" for x in labels[15:])  # long tmp paths
     for label, texts in pages:
         assert len(texts) > 10, label
         assert overlapping_texts(texts) == [], label
@@ -284,7 +305,7 @@ def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
 
 
 def test_page_one_figures_read_back_match_rms_csv(default):
-    _inputs, pdf, _pages, rms, _figs = default
+    _inputs, pdf, rms = default
     text = pdf_text(pdf, 0)
     all_lines = text.split("\r\n")
     table = pd.read_csv(rms)
@@ -305,7 +326,7 @@ def test_page_one_figures_read_back_match_rms_csv(default):
 
 
 def test_page_one_quality_reasons_in_words_sources_and_dates(default):
-    inputs, pdf, _pages, _rms, _figs = default
+    inputs, pdf, _rms = default
     text = " ".join(pdf_text(pdf, 0).split())
     assert "Photos taken: 2026-03-02 to 2026-03-03 (from the timestamps; no date for DS20, DS30, SS40, SS50)" in text
     assert "no marker line found" in text and "line touches the image border" in text
@@ -365,7 +386,7 @@ def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default
     assert "actuator DS20/A1, trial 1" in text
 
 
-def test_bench_pages_say_where_each_method_breaks(pages, default):
+def test_bench_pages_say_where_each_method_breaks(pages):
     stability = " ".join(t.text for t in dict(pages)["stability"])
     assert ("paper_corrected, pratt, taubin, hyper: break at true bending angle psi -360 deg (fine at -30), "
             "camera tilt 12 deg (fine at 5), non-constant curvature 0.2 (fine at 0)") in stability
@@ -383,7 +404,7 @@ def test_bench_pages_say_where_each_method_breaks(pages, default):
 
 
 def test_identical_inputs_identical_bytes_across_processes(default, tmp_path):
-    inputs, pdf, _pages, rms, _figs = default
+    inputs, pdf, rms = default
     d = inputs.datasets
     args = ["report", "--datasets", *[x.name for x in d], "--angles", *[str(x.angles_csv) for x in d],
             "--photosets", *[str(x.photoset_dir) for x in d], "--overlays", *[str(x.overlays_dir) for x in d],
@@ -456,9 +477,8 @@ def test_bench_and_force_folders_missing_or_broken(tmp_path):
         build_report(ReportInputs(datasets=(d,), bench_dir=bench), out)
 
 
-def test_bad_inputs_exit_2(default, tmp_path):
-    inputs = default[0]
-    angles = str(inputs.datasets[0].angles_csv)
+def test_bad_inputs_exit_2(tmp_path):
+    angles = str(make_dataset(tmp_path, "DS30", actuators=1, trials=1, photos=False, overlays=False).angles_csv)
     out = str(tmp_path / "r.pdf")
     assert main(["report", "--angles", angles, "--photosets", "a", "b", "--out", out]) == 2
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2
@@ -469,44 +489,24 @@ def test_each_material_has_one_colour_on_every_page(default):
     from matplotlib.colors import to_rgb
 
     from pipeline.force import pages as force_pages
+    from pipeline.report.pages import overview_page
     from pipeline.report.style import material_colors
+    from pipeline.report.summary import summary_page
 
-    inputs, figures = default[0], default[4]
-    colors = material_colors(["DS20", "DS30", "SS40", "SS50"])
+    data = load_report_data(default[0])
+    colors = material_colors(data.materials)
     with report_style():
-        standalone = force_pages.figures(inputs.force_dir)  # the force CLI's pages, without the report
+        figures = [summary_page(data, "0", [], []), overview_page(data)]
+        figures += force_pages.figures(data.inputs.force_dir, colors=colors)
+        figures += force_pages.figures(data.inputs.force_dir)  # the force CLI's pages, without the report
     seen = 0
-    for fig in figures + standalone:
+    for fig in figures:
         for ax in fig.axes:
             for line in ax.get_lines():
                 if line.get_label() in colors:
                     assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), fig.get_label()
                     seen += 1
-    assert seen >= 4 * 5  # summary plot, force, eccentricity, grasp (x2) name every material
-
-
-def test_many_datasets_and_inputs_stay_on_their_pages(tmp_path):
-    """Forty photo sets: page 1 folds the quiet ones into one row, provenance continues on a new page."""
-    from pipeline.report.data import InputFile
-    from pipeline.report.provenance import provenance_pages
-    from pipeline.report.summary import summary_page
-
-    sets = [make_dataset(tmp_path, "SS40", name=f"set{k:02d}", actuators=1, trials=1, step=50.0, photos=False,
-                         overlays=False, seed=k) for k in range(40)]
-    data = load_report_data(ReportInputs(datasets=tuple(sets)))
-    data = dataclasses.replace(data, files=data.files + tuple(InputFile("extra", f"x/{k}.csv", "0" * 64)
-                                                               for k in range(60)))
-    with report_style():
-        page1 = summary_page(data, "0", [f"warning {k}" for k in range(12)], [("Provenance", 6)])
-        texts = drawn_texts(page1)
-        prov = provenance_pages(data, "0", [], [f"warning {k}" for k in range(12)])
-        prov_texts = [drawn_texts(p) for p in prov]
-    words_on_1 = [t.text for t in texts]
-    assert any(w.endswith(" more") for w in words_on_1) and "all" in words_on_1
-    assert "... and 4 more warning(s), listed on the provenance page" in " ".join(words_on_1)
-    assert len(prov) >= 2
-    for page in [texts, *prov_texts]:
-        assert overlapping_texts(page) == []
-        assert all(t.box.y0 >= FOOTER_PT for t in page)
-    listed = [t.text for page in prov_texts for t in page]
-    assert all(f"x/{k}.csv" in listed for k in range(60))
+            if ax.get_title() in colors:
+                assert to_rgb(ax.title.get_color()) == pytest.approx(colors[ax.get_title()])  # overview panels
+                seen += 1
+    assert seen >= 4 + 4 + 2 * (4 + 7)  # summary plot, overview titles; force and grasp lines (report and CLI)
