@@ -12,6 +12,7 @@ configfile: "config.yaml"
 
 
 include: "rules/common.smk"
+include: "rules/cluster.smk"
 include: "rules/acquire.smk"
 include: "rules/measure.smk"
 include: "rules/aggregate.smk"

@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 #: columns angles.csv must have for aggregation
 REQUIRED_ANGLE_COLUMNS: tuple[str, ...] = (

@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline.aggregate import aggregate_hysteresis, aggregate_per_actuator, read_angles
-from pipeline.photoset import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 from collections.abc import Sequence
+from types import FrameType
 
 from pipeline import __version__
 from pipeline.errors import UserInputError
@@ -28,7 +31,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "synth": ("pipeline.synth.cli", "render a synthetic pressure-ramp photo set with exact ground truth"),
     "acquire": ("pipeline.rig.acquire_cli", "run the pressure ramp on a rig (real or emulated) and photograph it"),
     "rig": ("pipeline.rig.cli", "rig utilities: emulate the Pico over a pseudo-terminal, calibrate the regulator"),
-    "measure": ("pipeline.measure.cli", "measure the bending angle psi (deg) of every photo of a photo set"),
+    "measure": ("pipeline.measure_cli", "measure the bending angle psi (deg) of every photo of a photo set"),
     "aggregate": ("pipeline.aggregate_cli", "aggregate angles.csv into mean/sd hysteresis curves per pressure (kPa)"),
     "model": ("pipeline.model.cli", "analytical model of the paper: P(psi) curves, inverse, k_P calibration"),
     "compare": ("pipeline.compare_cli", "compare measured hysteresis with the model: RMS (deg), crossings (kPa), k_P"),
@@ -69,8 +72,17 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+def _terminated(signum: int, frame: FrameType | None) -> None:
+    raise SystemExit(128 + signum)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the process exit code."""
+    """Run the command line; return the process exit code.
+
+    SIGTERM (how Snakemake and cluster schedulers cancel a job) unwinds the command like Ctrl-C
+    does, so half-written outputs are removed on the way out (exit status 143); Ctrl-C exits
+    with 130 and one line instead of a traceback.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(command if command in SUBCOMMANDS else None)
@@ -78,8 +90,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     if getattr(args, "_run", None) is None:
         parser.print_help()
         return 0 if not argv else 2
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminated) if in_main else None
     try:
         return int(args._run(args) or 0)
     except UserInputError as exc:  # bad input: one clear message, no traceback
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"{command}: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)

@@ -3,14 +3,28 @@
 Everything here is a pure function of DataFrames (hysteresis.csv, angles.csv) and of two
 callables standing for the model, so the module is testable without :mod:`pipeline.model`:
 
-- ``model_psi(material, pressure_kpa) -> psi_deg`` (the loading branch, used for both
+- ``model_psi(material, pressure_kpa, l0_mm) -> psi_deg`` (the loading branch, used for both
   directions as the paper's single model curve), and
-- ``fit_k_p(material, pressure_kpa, psi_deg) -> (k_p, anything)``.
+- ``fit_k_p(material, pressure_kpa, psi_deg, l0_mm) -> (k_p, anything)``.
 
 :func:`model_callables` builds both from :mod:`pipeline.model`.
 
-Definitions (per material, on the mean curves of hysteresis.csv)
------------------------------------------------------------------
+Each dataset's own actuator
+---------------------------
+angles.csv carries the ``l0_mm`` of every photo (from its photo set).  Datasets of one material
+are pooled only when they share l0; each (material, l0) is one comparison (one rms.csv row,
+``curve`` names it) against the model evaluated at that l0.  A dataset without l0_mm uses the
+model's default l0 (the materials file's, or ``--l0-mm``), and ``l0_source`` says which; a
+dataset holding one material at several l0 cannot be split from its hysteresis.csv, so its row
+keeps the data figures and leaves the model columns empty, with the reason in ``note``.
+
+What the RMS is (``rms_kind``): ``self-check`` when every dataset of the row is synthetic (its
+photos were rendered from this package's model, so the RMS checks the measurement chain, not the
+model), ``prediction`` when none is (no model parameter is fitted to these data: k_P is the
+paper's; ``k_p_fit`` is the one number fitted to them), ``mixed`` or ``unknown`` otherwise.
+
+Definitions (per row, on the mean curves of hysteresis.csv)
+-----------------------------------------------------------
 RMS
     sqrt(mean((psi_mean - psi_model(P))**2)) over the pressure levels of both directions
     together (the paper's figure), and of each direction; levels where the model or the mean is
@@ -34,7 +48,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,8 +58,8 @@ import pandas as pd
 from pipeline.aggregate import actuator_keys, pool_hysteresis
 from pipeline.errors import UserInputError
 
-ModelPsi = Callable[[str, np.ndarray], np.ndarray]
-FitKp = Callable[[str, np.ndarray, np.ndarray], tuple[float, Any]]
+ModelPsi = Callable[[str, np.ndarray, "float | None"], np.ndarray]
+FitKp = Callable[[str, np.ndarray, np.ndarray, "float | None"], tuple[float, Any]]
 
 HYSTERESIS_REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n")
 
@@ -85,7 +99,8 @@ PAPER_VALUES: dict[str, PaperValues] = {
 
 #: rms.csv columns, in order
 RMS_COLUMNS: tuple[str, ...] = (
-    "material", "rms_deg", "rms_up_deg", "rms_down_deg", "n_levels", "n_model_nan",
+    "material", "curve", "datasets", "l0_mm", "l0_source", "data_source", "rms_kind", "model_fit",
+    "note", "rms_deg", "rms_up_deg", "rms_down_deg", "n_levels", "n_model_nan",
     "p_zero_up_kpa", "p_zero_down_kpa", "p_minus_psi0_up_kpa", "p_minus_psi0_down_kpa", "psi0_deg",
     "range_deg", "psi_max_deg", "psi_min_deg", "range_kpa",
     "hysteresis_width_deg", "hysteresis_width_at_kpa",
@@ -273,8 +288,8 @@ def compare_material(
     hyst_material: pd.DataFrame,
     rows: pd.DataFrame | None,
     *,
-    model_psi: ModelPsi | None,
-    fit_k_p: FitKp | None,
+    model_psi: Callable[[str, np.ndarray], np.ndarray] | None,
+    fit_k_p: Callable[[str, np.ndarray, np.ndarray], tuple[float, Any]] | None,
     psi0_deg: float,
     n_boot: int = 200,
     seed: int = 0,
@@ -290,7 +305,8 @@ def compare_material(
     rows : pandas.DataFrame or None
         This material's included angles rows (for k_P); ``None`` skips the fit.
     model_psi, fit_k_p : callable or None
-        Model callables (see module docstring); ``None`` leaves model columns NaN.
+        ``model_psi(material, pressure_kpa)`` and ``fit_k_p(material, pressure_kpa, psi_deg)`` at
+        this row's l0 (:func:`compare` binds it); ``None`` leaves model columns NaN.
     psi0_deg : float
         Rest angle psi0 (deg) for the psi = -psi0 crossing.
     n_boot, seed : int
@@ -359,6 +375,117 @@ def included_rows(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Dat
     return df[ok].reset_index(drop=True)
 
 
+@dataclass(frozen=True)
+class Group:
+    """One comparison: the datasets of one material that share one l0 (one rms.csv row).
+
+    Attributes
+    ----------
+    material : str
+    l0_mm : float or None
+        l0 of the model curve; ``None``: not known here, the model's own default is used.
+    l0_source : str
+        ``"photo set"`` (angles.csv's l0_mm), or where the model default came from.
+    datasets : tuple of str
+    mixed : bool
+        The one dataset of this group holds the material at several l0: no model curve fits.
+    note : str
+        Why the model columns are empty, or an empty string.
+    """
+
+    material: str
+    l0_mm: float | None
+    l0_source: str
+    datasets: tuple[str, ...]
+    mixed: bool = False
+    note: str = ""
+
+    @property
+    def curve(self) -> str:
+        """Label of the row and of its model curve, e.g. ``"SS50, l0 220 mm"``."""
+        if self.mixed:
+            return f"{self.material}, {' + '.join(self.datasets)} (several l0)"
+        return self.material if self.l0_mm is None else f"{self.material}, l0 {self.l0_mm:g} mm"
+
+
+def comparison_groups(
+    hyst: pd.DataFrame,
+    angles: pd.DataFrame | None,
+    default_l0_mm: Mapping[str, float] | None = None,
+    default_l0_source: str = "materials file",
+) -> list[Group]:
+    """Split the (dataset, material) pairs of ``hyst`` into comparisons of one material and one l0.
+
+    Parameters
+    ----------
+    hyst : pandas.DataFrame
+        hysteresis.csv rows with a ``dataset`` column.
+    angles : pandas.DataFrame or None
+        angles.csv rows with ``dataset`` and (from ``measure``) ``l0_mm``.
+    default_l0_mm : mapping of str to float, optional
+        The model's l0 per material, for datasets without their own; a material not listed
+        gets ``l0_mm=None`` (the model's own default, source ``"model default"``).
+    default_l0_source : str
+        Where ``default_l0_mm`` comes from (shown in ``l0_source``).
+
+    Returns
+    -------
+    list of Group
+        Sorted by material, the default l0 first, then by l0; a dataset holding one material
+        at several l0 is a group of its own (``mixed``) with the reason in ``note``.
+    """
+    defaults = dict(default_l0_mm or {})
+    pairs = hyst[["dataset", "material"]].astype(str).drop_duplicates()
+    have_l0 = angles is not None and "l0_mm" in angles.columns
+    found: dict[tuple[Any, ...], Group] = {}
+    for dataset, material in pairs.itertuples(index=False):
+        l0s: list[float] = []
+        if have_l0:
+            sel = angles[(angles["dataset"].astype(str) == dataset) & (angles["material"].astype(str) == material)]
+            values = pd.to_numeric(sel["l0_mm"], errors="coerce").to_numpy(float)
+            l0s = sorted({float(v) for v in values[np.isfinite(values)]})
+        if len(l0s) > 1:
+            note = (
+                f"dataset {dataset!r} holds {material} actuators of several l0 "
+                f"({', '.join(f'{v:g}' for v in l0s)} mm) pooled in one hysteresis.csv: no single model "
+                "curve fits them; split the photo set into one dataset per l0 to compare with the model"
+            )
+            found[(material, "several", dataset)] = Group(
+                material, None, "several l0 in one dataset", (dataset,), mixed=True, note=note
+            )
+            continue
+        if l0s:
+            l0, source = l0s[0], "photo set"
+        elif material in defaults:
+            l0, source = float(defaults[material]), default_l0_source
+        else:
+            l0, source = None, "model default"
+        key = (material, l0)
+        prev = found.get(key)
+        if prev is None:
+            found[key] = Group(material, l0, source, (dataset,))
+        else:
+            sources = prev.l0_source.split(" + ")
+            merged = " + ".join(sources + ([source] if source not in sources else []))
+            found[key] = Group(material, l0, merged, prev.datasets + (dataset,))
+
+    def order(g: Group) -> tuple[str, int, float]:
+        l0 = math.inf if g.l0_mm is None else g.l0_mm
+        return g.material, 0 if (g.l0_mm is None or g.l0_mm == defaults.get(g.material)) else 1, l0
+
+    return sorted(found.values(), key=order)
+
+
+def rms_kind(sources: Sequence[str]) -> str:
+    """``self-check`` (all synthetic), ``prediction`` (none synthetic), ``mixed`` or ``unknown``."""
+    known = [s for s in sources if s in ("synthetic", "measured")]
+    if len(known) < len(sources) or not known:
+        return "unknown"
+    if all(s == "synthetic" for s in known):
+        return "self-check"
+    return "prediction" if all(s == "measured" for s in known) else "mixed"
+
+
 def compare(
     hyst: pd.DataFrame,
     angles: pd.DataFrame | None = None,
@@ -366,51 +493,88 @@ def compare(
     model_psi: ModelPsi | None,
     fit_k_p: FitKp | None,
     psi0_deg: Mapping[str, float] | None = None,
+    default_l0_mm: Mapping[str, float] | None = None,
+    default_l0_source: str = "materials file",
+    data_sources: Mapping[str, str] | None = None,
+    model_fit: str = "",
     n_boot: int = 200,
     seed: int = 0,
     include_flagged: bool = False,
 ) -> pd.DataFrame:
-    """rms.csv: one row per material of ``hyst`` (see :func:`compare_material`).
+    """rms.csv: one row per material and l0 (see the module docstring and :func:`compare_material`).
 
     Parameters
     ----------
     hyst : pandas.DataFrame
-        hysteresis.csv rows (any number of materials); rows of the same material x direction x
-        level (several datasets of one material) are pooled first (:func:`pool_hysteresis`).
+        hysteresis.csv rows (any number of materials and datasets; a ``dataset`` column names
+        them, one dataset when absent); rows of one comparison (same material and l0) are pooled
+        first (:func:`pool_hysteresis`).
     angles : pandas.DataFrame, optional
-        angles.csv rows for the k_P fit and its bootstrap; ``None`` skips the fit.
+        angles.csv rows (with the same ``dataset`` names) for each dataset's ``l0_mm`` and for the
+        k_P fit and its bootstrap; ``None``: default l0, no fit.
     model_psi, fit_k_p : callable or None
-        Model callables; a material the model does not know (callable raises
-        :class:`UserInputError`) gets NaN model columns and a warning.
+        Model callables taking the l0 (mm, or None for the model's default) last; a material
+        the model does not know, or an l0 it refuses (the callable raises
+        :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
         Rest angle per material (deg); 210 deg (the paper's) for materials not listed.
+    default_l0_mm : mapping, optional
+        The model's l0 per material for datasets without their own (materials not listed: the
+        callables get ``l0_mm=None``, the model's own default).
+    default_l0_source : str
+        Where that default comes from, for ``l0_source``.
+    data_sources : mapping, optional
+        ``"synthetic"`` or ``"measured"`` per dataset name, for ``data_source`` and ``rms_kind``.
+    model_fit : str
+        What in the model is fitted to the paper's numbers (``model_fit`` column).
     n_boot, seed, include_flagged
         Bootstrap resamples, its seed, and whether flagged rows enter the k_P fit.
 
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`RMS_COLUMNS`, materials in sorted order.
+        Columns :data:`RMS_COLUMNS`, ordered by material, the default l0 first.
     """
     check_hysteresis(hyst)
-    hyst = pool_hysteresis(hyst)
+    hyst = hyst.copy()
+    if "dataset" not in hyst.columns:
+        hyst["dataset"] = ""
+    hyst["dataset"] = hyst["dataset"].astype(str)
+    if angles is not None:
+        angles = angles.copy()
+        if "dataset" not in angles.columns:
+            angles["dataset"] = ""
+        angles["dataset"] = angles["dataset"].astype(str)
     rows_all = None if angles is None else included_rows(angles, include_flagged)
     psi0 = dict(psi0_deg or {})
+    sources = dict(data_sources or {})
     records = []
-    for material in sorted(hyst["material"].astype(str).unique()):
-        hm = hyst[hyst["material"].astype(str) == material]
-        rows = None if rows_all is None else rows_all[rows_all["material"].astype(str) == material]
+    for group in comparison_groups(hyst, angles, dict(default_l0_mm or {}), default_l0_source):
+        material, l0 = group.material, group.l0_mm
+        in_group = hyst["dataset"].isin(group.datasets) & (hyst["material"].astype(str) == material)
+        hm = pool_hysteresis(hyst[in_group].drop(columns="dataset"))
+        rows = None
+        if rows_all is not None:
+            rows = rows_all[rows_all["dataset"].isin(group.datasets) & (rows_all["material"].astype(str) == material)]
+        usable = not group.mixed
+        psi_fn = (lambda m, p, l0=l0: model_psi(m, p, l0)) if model_psi is not None and usable else None
+        fit_fn = (lambda m, p, s, l0=l0: fit_k_p(m, p, s, l0)) if fit_k_p is not None and usable else None
+        kwargs = dict(psi0_deg=float(psi0.get(material, 210.0)), n_boot=n_boot, seed=seed)
+        note = group.note
         try:
-            rec = compare_material(
-                material, hm, rows, model_psi=model_psi, fit_k_p=fit_k_p,
-                psi0_deg=float(psi0.get(material, 210.0)), n_boot=n_boot, seed=seed,
-            )
+            rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)
         except UserInputError as exc:
-            warnings.warn(f"{material}: model unavailable ({exc}); model columns left empty", stacklevel=2)
-            rec = compare_material(
-                material, hm, rows, model_psi=None, fit_k_p=None,
-                psi0_deg=float(psi0.get(material, 210.0)), n_boot=n_boot, seed=seed,
-            )
+            warnings.warn(f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2)
+            note = f"model unavailable: {exc}"
+            rec = compare_material(material, hm, rows, model_psi=None, fit_k_p=None, **kwargs)
+        if note and group.note:
+            warnings.warn(f"{group.curve}: {note}", stacklevel=2)
+        data = [sources.get(d, "unknown") for d in group.datasets]
+        rec.update(
+            curve=group.curve, datasets=" + ".join(group.datasets), l0_mm=math.nan if l0 is None else l0,
+            l0_source=group.l0_source,
+            data_source=" + ".join(sorted(set(data))), rms_kind=rms_kind(data), model_fit=model_fit, note=note,
+        )
         records.append(rec)
     return pd.DataFrame(records, columns=list(RMS_COLUMNS))
 
@@ -426,12 +590,13 @@ def model_callables(
         Materials YAML (the packaged one when ``None``).
     **options
         Model readings (:class:`pipeline.model.ModelOptions`), applied to both callables;
-        validated here, so a bad one fails before any data is read.
+        validated here, so a bad one fails before any data is read.  ``l0_mm`` here is only the
+        default: the callables take the l0 of each comparison.
 
     Returns
     -------
     model_psi, fit_k_p : callable
-        Loading-branch psi(P) and the k_P fit, taking a material *name*.
+        Loading-branch psi(P) and the k_P fit, taking a material *name* and the l0 (mm) last.
     psi0_deg : dict of str to float
         Rest angle of every material in the file.
     """
@@ -439,6 +604,8 @@ def model_callables(
 
     table = model.load_materials(materials_path)
     model.make_options(**options)  # unknown names or values: a clear error now
+    readings = {k: v for k, v in options.items() if k != "l0_mm"}
+    default_l0 = options.get("l0_mm")
 
     def _material(name: str) -> Any:
         if name not in table:
@@ -448,12 +615,15 @@ def model_callables(
             )
         return table[name]
 
-    def model_psi(name: str, pressure_kpa: np.ndarray) -> np.ndarray:
+    def model_psi(name: str, pressure_kpa: np.ndarray, l0_mm: float | None) -> np.ndarray:
         return np.asarray(
-            model.psi_deg(_material(name), np.asarray(pressure_kpa, float), branch="loading", **options)
+            model.psi_deg(_material(name), np.asarray(pressure_kpa, float), branch="loading",
+                          l0_mm=default_l0 if l0_mm is None else l0_mm,
+                          **readings)
         )
 
-    def fit(name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray) -> tuple[float, Any]:
-        return model.fit_k_p(_material(name), pressure_kpa, psi_deg, **options)
+    def fit(name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray, l0_mm: float | None) -> tuple[float, Any]:
+        l0 = default_l0 if l0_mm is None else l0_mm
+        return model.fit_k_p(_material(name), pressure_kpa, psi_deg, l0_mm=l0, **readings)
 
     return model_psi, fit, {n: float(m.psi0_deg) for n, m in table.items()}

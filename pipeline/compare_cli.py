@@ -7,14 +7,15 @@ import io
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, model_callables
 from pipeline.errors import UserInputError
 from pipeline.model.cli import add_reading_arguments, reading_options
-from pipeline.photoset import atomic_write_bytes
-from pipeline.tables import read_table
+from pipeline.fileio import atomic_write_bytes, read_table
+from pipeline.photoset import TRUTH
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,13 +45,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--datasets", nargs="+", default=None, metavar="NAME",
-        help="dataset names, one per HYSTERESIS.csv in the same order (used in messages only)",
+        help="dataset names, one per HYSTERESIS.csv in the same order (default: each file's folder name); "
+        "with as many ANGLES.csv, the i-th angles file belongs to the i-th dataset",
+    )
+    parser.add_argument(
+        "--photosets", nargs="+", default=None, metavar="DIR",
+        help="photo-set folder of each dataset, same order ('-' for unknown): a set holding truth.csv was "
+        "rendered by 'synth' from this model, so its RMS is a self-check, not a validation",
+    )
+    parser.add_argument(
+        "--curves", type=Path, default=None, metavar="FILE",
+        help="also write the model curve of every rms.csv row (curve, material, l0_mm in mm, psi_deg, "
+        "pressure_kpa in kPa, reason): the curve each RMS was computed against",
     )
     parser.add_argument(
         "--include-flagged", action="store_true",
         help="also fit k_P on rows with status 'flagged' (default: only 'ok')",
     )
-    model_group = parser.add_argument_group("model readings (as in 'python -m pipeline model'; default: the calibrated reading)")
+    model_group = parser.add_argument_group(
+        "model readings (as in 'python -m pipeline model'; default: the derived reading of docs/model.md). "
+        "--l0-mm is the model's l0 for datasets whose angles.csv has no l0_mm; a dataset's own l0_mm wins"
+    )
     add_reading_arguments(model_group)
 
 
@@ -64,30 +79,108 @@ def read_hysteresis(paths: list[Path]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def dataset_names(paths: list[Path], given: list[str] | None) -> list[str]:
+    """``given``, or each file's folder name made unique with a numeric suffix."""
+    if given is not None:
+        if len(given) != len(paths):
+            raise UserInputError(
+                f"--datasets names {len(given)} dataset(s) but {len(paths)} HYSTERESIS.csv "
+                "file(s) were given; pass one name per file, in the same order"
+            )
+        return [str(g) for g in given]
+    names: list[str] = []
+    for p in paths:
+        base = p.resolve().parent.name or p.stem
+        name, k = base, 2
+        while name in names:
+            name, k = f"{base}-{k}", k + 1
+        names.append(name)
+    return names
+
+
+def data_source(folder: str) -> str:
+    """``synthetic`` if the photo set was rendered by ``synth`` (it holds truth.csv), else ``measured``.
+
+    Only the file's presence is checked (truth.csv itself is for tests and benchmarks);
+    ``"-"`` or a missing folder give ``unknown``.
+    """
+    if folder == "-" or not Path(folder).is_dir():
+        return "unknown"
+    return "synthetic" if (Path(folder) / TRUTH).is_file() else "measured"
+
+
+def model_fit_text(options: dict[str, object]) -> str:
+    """What in the model is fitted to the paper's numbers, for rms.csv's ``model_fit``."""
+    from pipeline.model import make_options
+
+    opts = make_options(**options)
+    if opts.l0_factor == "fitted_scale":
+        how = f"given as {opts.eq12_scale:g}" if opts.eq12_scale is not None else "fitted for these readings"
+        return f"eq12_scale fitted to the paper's two model results (l0_factor=fitted_scale, {how})"
+    return "none (derived reading; k_P and k_t are the paper's)"
+
+
+def write_csv(table: pd.DataFrame, path: Path) -> None:
+    """Write ``table`` atomically with 6 significant digits."""
+    buf = io.StringIO()
+    table.to_csv(buf, index=False, float_format="%.6g", lineterminator="\n")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(path, buf.getvalue().encode("utf-8"))
+
+
 def run(args: argparse.Namespace) -> int:
-    """Compare and write rms.csv; print a one-line summary."""
-    if args.datasets is not None and len(args.datasets) != len(args.hysteresis):
-        raise UserInputError(
-            f"--datasets names {len(args.datasets)} dataset(s) but {len(args.hysteresis)} HYSTERESIS.csv "
-            "file(s) were given; pass one name per file, in the same order"
-        )
+    """Compare and write rms.csv (and the model curves); print a one-line summary per row."""
+    from pipeline import model
+
+    names = dataset_names(args.hysteresis, args.datasets)
     if args.n_boot < 0:
         raise UserInputError(f"--bootstrap must be >= 0 resamples, got {args.n_boot}")
-    hyst = read_hysteresis(args.hysteresis)
-    angles = read_angles(args.angles) if args.angles else None
-    model_psi, fit_k_p, psi0 = model_callables(args.materials, **reading_options(args))
+    if args.photosets is not None and len(args.photosets) != len(names):
+        raise UserInputError(
+            f"--photosets has {len(args.photosets)} folder(s) but {len(names)} HYSTERESIS.csv file(s) were "
+            "given; pass one per dataset in the same order ('-' for unknown)"
+        )
+    frames = []
+    for name, path in zip(names, args.hysteresis, strict=True):
+        frames.append(read_hysteresis([path]).assign(dataset=name))
+    hyst = pd.concat(frames, ignore_index=True)
+    angles = None
+    if args.angles:
+        if len(args.angles) == len(names):  # the i-th angles.csv belongs to the i-th dataset
+            angles = pd.concat([read_angles([a]).assign(dataset=n) for a, n in zip(args.angles, names, strict=True)],
+                               ignore_index=True)
+        else:  # cannot tell which angles belong to which hysteresis: one pool
+            angles = read_angles(args.angles)
+            hyst["dataset"] = "all"
+            angles["dataset"] = "all"
+    options = reading_options(args)
+    model_psi, fit_k_p, psi0 = model_callables(args.materials, **options)
+    table_m = model.load_materials(args.materials)
+    given_l0 = options.get("l0_mm")
+    default_l0 = {n: float(given_l0) if given_l0 is not None else m.l0_mm for n, m in table_m.items()}
+    sources = dict(zip(names, [data_source(f) for f in args.photosets], strict=True)) if args.photosets else {}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         table = compare(
-            hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0,
-            n_boot=args.n_boot, seed=args.seed, include_flagged=args.include_flagged,
+            hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, default_l0_mm=default_l0,
+            default_l0_source="--l0-mm" if given_l0 is not None else "materials file", data_sources=sources,
+            model_fit=model_fit_text(options), n_boot=args.n_boot, seed=args.seed,
+            include_flagged=args.include_flagged,
         )
     for w in caught:
         print(f"warning: {w.message}")
-    buf = io.StringIO()
-    table.to_csv(buf, index=False, float_format="%.6g", lineterminator="\n")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(args.out, buf.getvalue().encode("utf-8"))
-    parts = [f"{r.material} RMS {r.rms_deg:.1f} deg" for r in table.itertuples()]
-    print(f"compare: {len(table)} material(s): {'; '.join(parts) or 'none'} -> {args.out}")
+    write_csv(table, args.out)
+    if args.curves is not None:
+        readings = {k: v for k, v in options.items() if k != "l0_mm"}
+        curves = [
+            model.model_curve(table_m[r.material], l0_mm=r.l0_mm, **readings).assign(curve=r.curve)
+            for r in table.itertuples()
+            if r.material in table_m and np.isfinite(r.l0_mm)
+        ]
+        columns = ["curve", "material", "l0_mm", "psi_deg", "pressure_kpa", "reason"]
+        out = pd.concat(curves, ignore_index=True)[columns] if curves else pd.DataFrame(columns=columns)
+        write_csv(out, args.curves)
+    for r in table.itertuples():
+        print(f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; {r.rms_kind}]: RMS {r.rms_deg:.1f} deg")
+    print(f"compare: {len(table)} comparison(s) -> {args.out}" + (f", curves -> {args.curves}" if args.curves else ""))
     return 0

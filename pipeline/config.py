@@ -1,9 +1,11 @@
 """Workflow configuration: defaults, JSON-schema validation and checks that need the file system.
 
-The schema (``rules/config.schema.yaml``) is the single source of the keys, their defaults and
-their descriptions.  :func:`validate_config` fills defaults and refuses a bad config with one
-message per problem, naming the key path (``datasets[2].material``) and the fix, before any
-Snakemake job runs.
+The schema (``config.schema.yaml``, shipped inside this package so the package validates a config
+without the workflow around it) is the single source of the keys, their defaults and their
+descriptions; the enums of ``model.readings`` are taken from :data:`pipeline.model.CHOICES` when
+it is loaded.  :func:`validate_config` fills defaults and refuses a bad config with one message
+per problem, naming the key path (``datasets[2].material``) and the fix, before any Snakemake job
+runs.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ import copy
 import hashlib
 import json
 from collections.abc import Mapping
+from dataclasses import fields
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -19,27 +23,60 @@ import jsonschema
 import yaml
 
 from pipeline.errors import UserInputError
+from pipeline.model import CHOICES, ModelOptions, load_materials
 
-SCHEMA_PATH = Path(__file__).resolve().parent.parent / "rules" / "config.schema.yaml"
-BUILTIN_MATERIALS = ("DS20", "DS30", "SS40", "SS50")
+#: the schema, as shipped in the package (named so in messages)
+SCHEMA_NAME = "pipeline/config.schema.yaml"
 
 
-def load_schema(path: str | Path = SCHEMA_PATH) -> dict[str, Any]:
-    """Read the configuration JSON-schema (YAML)."""
-    return yaml.safe_load(Path(path).read_text())
+def load_schema() -> dict[str, Any]:
+    """Read the configuration JSON-schema (YAML) and complete it from the model's options.
+
+    Each categorical key of ``model.readings`` gets ``type: string``, ``enum`` = the model's
+    :data:`~pipeline.model.CHOICES` and ``default`` = :class:`~pipeline.model.ModelOptions`'s
+    value; the numeric ones get their default from ``ModelOptions`` too.
+
+    Returns
+    -------
+    dict
+
+    Examples
+    --------
+    >>> readings = load_schema()["properties"]["model"]["properties"]["readings"]["properties"]
+    >>> readings["l0_factor"]["enum"], readings["l0_factor"]["default"]
+    (['metres', 'none', 'fitted_scale'], 'metres')
+    """
+    text = resources.files("pipeline").joinpath("config.schema.yaml").read_text(encoding="utf-8")
+    schema = yaml.safe_load(text)
+    readings = schema["properties"]["model"]["properties"]["readings"]["properties"]
+    defaults = ModelOptions()
+    options = {f.name for f in fields(ModelOptions)}
+    for key, sub in readings.items():
+        if key in CHOICES:
+            sub.update(type="string", enum=list(CHOICES[key]))
+        if key in options:
+            sub["default"] = getattr(defaults, key)
+    return schema
 
 
 def fill_defaults(config: Any, schema: Mapping[str, Any]) -> Any:
     """Return a copy of ``config`` with every missing key set to its schema ``default``.
 
-    Recurses into ``properties`` of objects and ``items`` of arrays.
+    Recurses into ``properties`` of objects and ``items`` of arrays, but not into an object
+    marked ``overrides: true`` (a mapping whose absent keys mean "the default", such as
+    ``model.readings``: only what the user gave is passed on).
 
     Examples
     --------
     >>> fill_defaults({}, {"type": "object", "properties": {"a": {"default": 1}}})
     {'a': 1}
+    >>> fill_defaults({}, {"properties": {"o": {"default": {}, "overrides": True,
+    ...                                         "properties": {"b": {"default": 2}}}}})
+    {'o': {}}
     """
     config = copy.deepcopy(config)
+    if schema.get("overrides"):
+        return config
     if isinstance(config, dict) and "properties" in schema:
         for key, sub in schema["properties"].items():
             if key not in config and "default" in sub:
@@ -64,14 +101,20 @@ def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list
     for err in sorted(validator.iter_errors(config), key=lambda e: list(map(str, e.absolute_path))):
         key = _key_path(err.absolute_path)
         hint = err.schema.get("description", "") if isinstance(err.schema, Mapping) else ""
-        if err.validator == "additionalProperties":
+        if err.validator == "required":
+            # a conditional requirement (an if/then block) says why in its description
+            why = err.schema.get("description") if set(err.schema) <= {"required", "description"} else None
+            name = str(err.message).split("'")[1]  # "'port' is a required property"
+            where = f"{key}.{name}" if err.absolute_path else name
+            messages.append(f"{where}: required" + (f" {why}" if why else ""))
+        elif err.validator == "additionalProperties":
             allowed = sorted(err.schema.get("properties", {}))
             messages.append(f"{key}: {err.message}; allowed keys here: {allowed}")
         elif err.validator == "enum":
             messages.append(f"{key}: {err.instance!r} is not one of {err.validator_value}")
         else:
             messages.append(f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else ""))
-    return messages
+    return list(dict.fromkeys(messages))
 
 
 def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[str]) -> list[str]:
@@ -85,24 +128,14 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
                 messages.append(f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give each dataset a unique name")
             names.setdefault(name, i)
             source = ds.get("source")
-            if source in ("folder", "rig") and not ds.get("path"):
-                messages.append(f"{key}.path: required for source {source!r}; set it to the photo-set folder")
-            if source == "folder" and ds.get("path") and not (workdir / ds["path"]).is_dir():
+            if source == "folder" and not (workdir / ds["path"]).is_dir():
                 messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
-            if source in ("synthetic", "rig"):
-                mat = ds.get("material")
-                if not mat:
-                    messages.append(f"{key}.material: required for source {source!r}; use one of {sorted(materials)}")
-                elif mat not in materials:
-                    messages.append(f"{key}.material: unknown material {mat!r}; use one of {sorted(materials)} or add it to a materials file (model.materials_file)")
-            if source == "rig":
-                for req in ("port", "l0_mm"):
-                    if ds.get(req) in (None, ""):
-                        messages.append(f"{key}.{req}: required for source 'rig'")
+            if source in ("synthetic", "rig") and ds["material"] not in materials:
+                messages.append(f"{key}.material: unknown material {ds['material']!r}; use one of {sorted(materials)} or add it to a materials file (model.materials_file)")
+            if source == "rig" and not ds["port"]:
+                messages.append(f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. /dev/ttyACM0)")
     for i, ds in enumerate(config.get("force", {}).get("datasets", [])):
-        if not isinstance(ds, Mapping) or "name" not in ds or "source" not in ds:
-            messages.append(f"force.datasets[{i}]: needs at least 'name' and 'source' (folder or synthetic)")
-        elif ds.get("source") == "folder" and not (workdir / str(ds.get("path", ""))).is_dir():
+        if ds.get("source") == "folder" and not (workdir / ds["path"]).is_dir():
             messages.append(f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist")
         elif ds.get("source") == "synthetic" and ds.get("material") not in materials:
             messages.append(f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; use one of {sorted(materials)}")
@@ -117,10 +150,6 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
 
 def known_materials(materials_file: str | Path | None = None) -> set[str]:
     """Names of the materials the model knows (built-in table, or ``materials_file``)."""
-    try:
-        from pipeline.model import load_materials
-    except ImportError:  # the model package is optional for config checks
-        return set(BUILTIN_MATERIALS)
     return set(load_materials(materials_file) if materials_file else load_materials())
 
 
@@ -129,7 +158,6 @@ def validate_config(
     *,
     workdir: str | Path = ".",
     source: str = "config.yaml",
-    schema_path: str | Path = SCHEMA_PATH,
 ) -> dict[str, Any]:
     """Fill defaults and validate a workflow configuration.
 
@@ -141,8 +169,6 @@ def validate_config(
         Folder relative to which paths in the config are resolved.
     source : str
         Name of the config file, used in error messages.
-    schema_path : path
-        The JSON-schema (YAML); the workflow passes its own ``rules/config.schema.yaml``.
 
     Returns
     -------
@@ -154,7 +180,7 @@ def validate_config(
     UserInputError
         Listing every problem, each naming the key path and the fix.
     """
-    schema = load_schema(schema_path)
+    schema = load_schema()
     filled = fill_defaults(dict(config), schema)
     problems = _schema_errors(filled, schema)
     if not problems:
@@ -166,7 +192,7 @@ def validate_config(
         raise UserInputError(
             f"{source} is not valid ({len(problems)} problem(s)); nothing was run:\n  - "
             + "\n  - ".join(problems)
-            + f"\n  Every key, its default and its meaning: {schema_path}"
+            + f"\n  Every key, its default and its meaning: {SCHEMA_NAME}"
         )
     return filled
 

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from pipeline import photoset
+from pipeline import photoset, photoset_init
+from pipeline.errors import UserInputError
+from pipeline.measure.settings import POSITIVE_TURNS
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define ``photoset init`` and ``photoset check``."""
-    sub = parser.add_subparsers(dest="photoset_command", metavar="{init,check}", required=True)
+    sub = parser.add_subparsers(dest="photoset_command", metavar="{init,check,preview,pick-color}", required=True)
     init = sub.add_parser(
         "init",
         help="write a starter manifest.csv and photoset.yaml from the image file names",
@@ -27,9 +30,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument("--actuator", help="actuator label when the pattern has no {actuator} (default A1)")
     init.add_argument("--trial", help="trial label when the pattern has no {trial} (default 1)")
     init.add_argument("--l0-mm", type=float, help="length of the marked inextensible layer, mm (written to photoset.yaml)")
-    init.add_argument("--mm-per-px", type=float, help="image scale, mm per pixel (optional)")
-    init.add_argument("--line-color", default="black", help="marker colour: black, blue, red, green or 'h,s,v-h,s,v' (default black)")
-    init.add_argument("--positive-turn", choices=photoset.POSITIVE_TURNS, default="ccw", help="turning direction on screen, fixed end to free end, that counts as positive psi (default ccw)")
+    init.add_argument("--mm-per-px", type=float, help="image scale, mm per pixel (recommended: without it psi relies on the measured line length)")
+    init.add_argument("--fixed-end", metavar="X,Y", help="pixel near the clamped end, e.g. 812,455 (recommended; default: guessed per photo)")
+    init.add_argument("--target", choices=("line", "body"), default="line", help="measure a drawn line (default) or the actuator's body")
+    init.add_argument("--line-color", default=None, help="colour of the line or body: a name (black, white, grey, red, orange, yellow, green, cyan, blue, purple, magenta), 'h,s,v-h,s,v', or several joined by ';' (default: black for a line, none for a body)")
+    init.add_argument("--positive-turn", choices=POSITIVE_TURNS, default="ccw", help="turning direction on screen, fixed end to free end, that counts as positive psi (default ccw)")
     init.add_argument("--overwrite", action="store_true", help="replace an existing manifest.csv")
     check = sub.add_parser(
         "check",
@@ -38,30 +43,102 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     check.add_argument("folder", metavar="DIR", help="photo-set folder")
     check.add_argument("--no-decode", action="store_true", help="only check that images exist (faster)")
+    preview = sub.add_parser(
+        "preview",
+        help="write one contact sheet showing what the settings select and measure, first and last photo of every ramp",
+        description="For the first and last photo of every ramp: the photo with the selection tinted, roi/exclude, "
+        "candidates, the chosen line or body centre line, the fixed end and psi, beside the selection mask.",
+    )
+    preview.add_argument("folder", metavar="DIR", help="photo-set folder")
+    preview.add_argument("--out", help="JPEG to write (default: <DIR name>_preview.jpg in the current folder)")
+    preview.add_argument("--all", action="store_true", help="every photo, not only the first and last of each ramp")
+    pick = sub.add_parser(
+        "pick-color",
+        help="print an HSV range (ready for photoset.yaml) for the colour around a pixel",
+        description="Sample the colour around X,Y and print a line_color value that selects it (red's hue wrap handled).",
+    )
+    pick.add_argument("image", metavar="IMAGE", help="a photo")
+    pick.add_argument("--at", required=True, metavar="X,Y", help="pixel (x right, y down) on the line or body")
+    pick.add_argument("--radius", type=float, default=4.0, help="radius of the sampled disc, px (default 4)")
+
+
+def _xy(text: str, option: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise UserInputError(f"{option} {text!r}: write two pixel numbers as X,Y, e.g. 812,455") from None
+    return x, y
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``photoset init`` or ``photoset check``."""
+    """Run ``photoset init``, ``check``, ``preview`` or ``pick-color``."""
     if args.photoset_command == "init":
-        defaults = {k: getattr(args, k) for k in ("material", "actuator", "trial") if getattr(args, k)}
-        settings = {
-            "l0_mm": args.l0_mm,
-            "mm_per_px": args.mm_per_px,
-            "line_color": args.line_color,
-            "positive_turn": args.positive_turn,
-        }
-        df = photoset.init_photoset(args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite)
-        n_up = int((df["direction"] == "up").sum())
-        print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} down)")
-        if args.l0_mm is None:
-            print(f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline photoset check {args.folder}'")
+        return _init(args)
+    if args.photoset_command == "preview":
+        from pipeline.preview import write_preview
+
+        out = args.out or f"{Path(args.folder).resolve().name}_preview.jpg"
+        path, n = write_preview(args.folder, out, every=args.all)
+        print(f"wrote {path}: {n} photo(s); green = ok, orange = flagged, tinted = what the settings select")
         return 0
-    problems = photoset.validate_photoset(args.folder, decode_images=not args.no_decode)
-    if problems:
-        print(f"{args.folder}: {len(problems)} problem(s)", file=sys.stderr)
-        for p in problems:
-            print(f"  {p}", file=sys.stderr)
+    if args.photoset_command == "pick-color":
+        return _pick(args)
+    return _check(args)
+
+
+def _init(args: argparse.Namespace) -> int:
+    defaults = {k: getattr(args, k) for k in ("material", "actuator", "trial") if getattr(args, k)}
+    settings: dict[str, object] = {"l0_mm": args.l0_mm, "mm_per_px": args.mm_per_px, "positive_turn": args.positive_turn}
+    if args.target != "line":
+        settings["target"] = args.target
+    if args.line_color is not None or args.target == "line":
+        settings["line_color"] = args.line_color or "black"
+    if args.fixed_end:
+        settings["fixed_end"] = list(_xy(args.fixed_end, "--fixed-end"))
+    df = photoset_init.init_photoset(args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite)
+    n_up = int((df["direction"] == "up").sum())
+    print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} down)")
+    if args.l0_mm is None:
+        print(f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline photoset check {args.folder}'")
+    return 0
+
+
+def _pick(args: argparse.Namespace) -> int:
+    import cv2
+
+    from pipeline.measure.colors import color_mask, pick_color
+
+    img = cv2.imread(args.image, cv2.IMREAD_COLOR)
+    if img is None:
+        raise UserInputError(f"{args.image}: cannot be read as an image")
+    x, y = _xy(args.at, "--at")
+    spec = pick_color(img, x, y, args.radius)
+    share = float(color_mask(img, spec).mean())
+    print(f'line_color: "{spec.text}"')
+    print(f"# {spec.describe()}; selects {100 * share:.1f}% of {Path(args.image).name}"
+          + ("; that is a lot: pick on a purer spot or add an roi" if share > 0.3 else ""))
+    return 0
+
+
+def _check(args: argparse.Namespace) -> int:
+    problems = photoset.validate_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
+    errors = [p for p in problems if not p.warning]
+    if not errors and not args.no_decode:
+        from pipeline.preview import empty_first_photos
+
+        for r in empty_first_photos(args.folder).itertuples():
+            problems.append(photoset.Problem(
+                str(Path(args.folder) / photoset.MANIFEST), r.manifest_line,
+                f"the first photo of its ramp ({r.image}) shows nothing that {r.what}",
+                f"check line_color / background / roi with 'python -m pipeline photoset preview {args.folder}'",
+                warning=True,
+            ))
+    for p in problems:
+        print(f"  {p}", file=sys.stderr)
+    if errors:
+        print(f"{args.folder}: {len(errors)} problem(s)", file=sys.stderr)
         return 1
     n = len(photoset.read_manifest(args.folder))
-    print(f"{args.folder}: OK ({n} photos)")
+    warn = len(problems) - len(errors)
+    print(f"{args.folder}: OK ({n} photos{f', {warn} warning(s)' if warn else ''})")
     return 0

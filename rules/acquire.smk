@@ -9,20 +9,22 @@ rule synth_photoset:
         ds=lambda wc: DATASETS[wc.dataset],
         overrides=lambda wc: scene_overrides(DATASETS[wc.dataset]),
     log:
-        f"{LOGS}/synth/{{dataset}}.log",
+        log_file("synth/{dataset}"),
     benchmark:
-        f"{BENCHMARKS}/synth/{{dataset}}.tsv"
+        benchmark_file("synth/{dataset}")
     threads: 2
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=2000,
-        runtime=30,
     shell:
-        "python -m pipeline synth {output} --material {params.ds[material]}"
-        " --actuators {params.ds[actuators]} --trials {params.ds[trials]} --seed {params.ds[seed]}"
-        " --scene {params.ds[scene]} --step-kpa {params.ds[step_kpa]} --max-kpa {params.ds[max_kpa]}"
-        " {params.overrides} --jobs {threads} > {log} 2>&1"
+        logged(
+            "python -m pipeline synth {output:q} --material {params.ds[material]:q}"
+            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q}"
+            " --seed {params.ds[seed]:q} --scene {params.ds[scene]:q}"
+            " --step-kpa {params.ds[step_kpa]:q} --max-kpa {params.ds[max_kpa]:q}"
+            " {params.overrides:q} --jobs {threads}"
+        )
 
 
 rule acquire_rig:
@@ -30,19 +32,21 @@ rule acquire_rig:
         touch(f"{RESULTS}/acquired/{{dataset}}.done"),
     params:
         ds=lambda wc: DATASETS[wc.dataset],
-        camera=lambda wc: DATASETS[wc.dataset]["camera"],
     log:
-        f"{LOGS}/acquire/{{dataset}}.log",
+        log_file("acquire/{dataset}"),
     benchmark:
-        f"{BENCHMARKS}/acquire/{{dataset}}.tsv"
+        benchmark_file("acquire/{dataset}")
     threads: 1
-    conda:
-        CONDA_ENV
     resources:
         mem_mb=1000,
         runtime=240,
+    conda:
+        CONDA_ENV
     shell:
-        "python -m pipeline acquire --port {params.ds[port]} --camera {params.camera:q}"
-        " --material {params.ds[material]} --actuator {params.ds[actuator]}"
-        " --trials {params.ds[trials]} --step-kpa {params.ds[step_kpa]} --max-kpa {params.ds[max_kpa]}"
-        " --settle-s {params.ds[settle_s]} --l0-mm {params.ds[l0_mm]} --out {params.ds[path]} > {log} 2>&1"
+        logged(
+            "python -m pipeline acquire --port {params.ds[port]:q} --camera {params.ds[camera]:q}"
+            " --material {params.ds[material]:q} --actuator {params.ds[actuator]:q}"
+            " --trials {params.ds[trials]:q} --step-kpa {params.ds[step_kpa]:q}"
+            " --max-kpa {params.ds[max_kpa]:q} --settle-s {params.ds[settle_s]:q}"
+            " --l0-mm {params.ds[l0_mm]:q} --out {params.ds[path]:q}"
+        )

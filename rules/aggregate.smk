@@ -8,18 +8,19 @@ rule aggregate:
         hysteresis=f"{RESULTS}/datasets/{{dataset}}/hysteresis.csv",
         per_actuator=f"{RESULTS}/datasets/{{dataset}}/hysteresis_per_actuator.csv",
     params:
-        bin=lambda wc: f"--bin-kpa {config['aggregate']['bin_kpa']}" if config["aggregate"]["bin_kpa"] else "",
-        flagged="--include-flagged" if config["aggregate"]["include_flagged"] else "",
+        bin=["--bin-kpa", config["aggregate"]["bin_kpa"]] if config["aggregate"]["bin_kpa"] else [],
+        flagged=["--include-flagged"] if config["aggregate"]["include_flagged"] else [],
     log:
-        f"{LOGS}/aggregate/{{dataset}}.log",
+        log_file("aggregate/{dataset}"),
     benchmark:
-        f"{BENCHMARKS}/aggregate/{{dataset}}.tsv"
+        benchmark_file("aggregate/{dataset}")
     threads: 1
+    resources:
+        **TABLE_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=1000,
-        runtime=10,
     shell:
-        "python -m pipeline aggregate {input.angles} --out {output.hysteresis}"
-        " --per-actuator-out {output.per_actuator} {params.bin} {params.flagged} > {log} 2>&1"
+        logged(
+            "python -m pipeline aggregate {input.angles:q} --out {output.hysteresis:q}"
+            " --per-actuator-out {output.per_actuator:q} {params.bin:q} {params.flagged:q}"
+        )

@@ -6,34 +6,33 @@ rule bench_default:
     output:
         directory(f"{RESULTS}/bench/default"),
     log:
-        f"{LOGS}/bench/default.log",
+        log_file("bench/default"),
     benchmark:
-        f"{BENCHMARKS}/bench/default.tsv"
+        benchmark_file("bench/default")
     threads: 2
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=2000,
-        runtime=30,
     shell:
-        "python -m pipeline bench --grid default --jobs {threads} --out {output} > {log} 2>&1"
+        logged("python -m pipeline bench --grid default --jobs {threads} --out {output:q}")
 
 
 rule bench_full:
     output:
         directory(f"{RESULTS}/bench/full"),
     log:
-        f"{LOGS}/bench/full.log",
+        log_file("bench/full"),
     benchmark:
-        f"{BENCHMARKS}/bench/full.tsv"
+        benchmark_file("bench/full")
     threads: 2
-    conda:
-        CONDA_ENV
     resources:
         mem_mb=4000,
         runtime=120,
+    conda:
+        CONDA_ENV
     shell:
-        "python -m pipeline bench --grid full --jobs {threads} --out {output} > {log} 2>&1"
+        logged("python -m pipeline bench --grid full --jobs {threads} --out {output:q}")
 
 
 rule bench:

@@ -1,4 +1,11 @@
-# Helpers shared by the rules: config validation, dataset lookup, result paths.
+# Helpers shared by the rules: config validation, dataset lookup, result paths, the parts every
+# rule repeats (log, benchmark, job size, logged shell command) and shell arguments from the config.
+#
+# The config schema ships inside the package (pipeline/config.schema.yaml, so `pipeline.config`
+# validates a config without the workflow around it); it is applied here, before any job runs.
+#
+# Every value that reaches a shell command from the config is quoted: placeholders carry `:q`, and
+# the option helpers below return lists of arguments, which `{params.x:q}` quotes one by one.
 import re
 from pathlib import Path
 
@@ -6,11 +13,11 @@ from snakemake.exceptions import WorkflowError
 
 from pipeline.config import validate_config
 from pipeline.errors import UserInputError
+from pipeline.folders import update_folder_digest
 from pipeline.photoset import read_manifest
 
 try:
-    _schema = Path(workflow.basedir) / "rules" / "config.schema.yaml"
-    _validated = validate_config(config, workdir=Path.cwd(), source="config", schema_path=_schema)
+    _validated = validate_config(config, workdir=Path.cwd(), source="config")
 except UserInputError as exc:
     raise WorkflowError(str(exc)) from None
 config.clear()
@@ -20,14 +27,62 @@ RESULTS = config["results_dir"]
 DATASETS = {ds["name"]: ds for ds in config["datasets"]}
 FORCE_DATASETS = {ds["name"]: ds for ds in config["force"]["datasets"]}
 LOGS = f"{RESULTS}/logs"
-CONDA_ENV = "envs/pipeline.yaml"
 BENCHMARKS = f"{RESULTS}/benchmarks"
+CONDA_ENV = "envs/pipeline.yaml"
+
+# Job sizes for a cluster (memory in MB, wall time in minutes); threads are set by each rule.
+SMALL_JOB = {"mem_mb": 500, "runtime": 5}  # a model curve, a small table
+TABLE_JOB = {"mem_mb": 1000, "runtime": 10}  # tables of a whole campaign
+PHOTO_JOB = {"mem_mb": 2000, "runtime": 30}  # a photo set: render, measure, report
+
+#: log lines a failed job shows on the console
+LOG_TAIL_LINES = 25
 
 
 wildcard_constraints:
     dataset="|".join(re.escape(n) for n in DATASETS) or "no-dataset",
     force_dataset="|".join(re.escape(n) for n in FORCE_DATASETS) or "no-dataset",
     material=r"[A-Za-z0-9_.-]+",
+
+
+def log_file(job):
+    """Log of one job, e.g. `log_file("measure/{dataset}")`."""
+    return f"{LOGS}/{job}.log"
+
+
+def benchmark_file(job):
+    """Run-time and memory record of one job."""
+    return f"{BENCHMARKS}/{job}.tsv"
+
+
+def logged(command):
+    """`command` with its output in the job's log; when it fails, the log's last lines are printed.
+
+    Snakemake itself only reports the exit status; the message that names the file, the row and
+    the fix is at the end of the log.
+    """
+    return (
+        f"{{{{ {command}; }}}} > {{log:q}} 2>&1 || {{{{ status=$?;"
+        f' echo "--- exit status $status; last {LOG_TAIL_LINES} lines of" {{log:q}}: >&2;'
+        f" tail -n {LOG_TAIL_LINES} {{log:q}} >&2; exit $status; }}}}"
+    )
+
+
+def _digest(kind, name, folder):
+    """Digest file of a photo-set folder, rewritten (at DAG build) only when a file changed."""
+    return str(update_folder_digest(folder, f"{RESULTS}/digests/{kind}/{name}.sha256"))
+
+
+# A folder's measure job depends on the bytes of every file in it (a photo replaced, added or
+# removed, or manifest.csv/photoset.yaml edited), through a digest kept under results/digests/.
+FOLDER_DIGESTS = {
+    n: _digest("datasets", n, ds["path"]) for n, ds in DATASETS.items() if ds["source"] == "folder"
+}
+FORCE_FOLDER_DIGESTS = {
+    n: _digest("force", n, ds["path"])
+    for n, ds in FORCE_DATASETS.items()
+    if ds["source"] == "folder"
+}
 
 
 def photoset_dir(name):
@@ -43,7 +98,7 @@ def photoset_input(wildcards):
         return f"{RESULTS}/photosets/{wildcards.dataset}"
     if ds["source"] == "rig":
         return f"{RESULTS}/acquired/{wildcards.dataset}.done"
-    return [f"{ds['path']}/manifest.csv", f"{ds['path']}/photoset.yaml"]
+    return FOLDER_DIGESTS[wildcards.dataset]
 
 
 def dataset_materials(ds):
@@ -69,29 +124,35 @@ def per_dataset(pattern):
 def materials_option():
     """`--materials FILE` when the config names a materials file."""
     path = config["model"]["materials_file"]
-    return f"--materials {path}" if path else ""
+    return ["--materials", path] if path else []
 
 
 def model_readings_option():
-    """`--<reading> VALUE` flags for `model` and `compare` from config key model.readings."""
+    """`--<reading> VALUE` for `model` and `compare`: the readings model.readings gives."""
     readings = config["model"]["readings"]
-    return " ".join(f"--{key.replace('_', '-')} {value}" for key, value in sorted(readings.items()))
+    return [
+        arg
+        for key, value in sorted(readings.items())
+        if value is not None
+        for arg in (f"--{key.replace('_', '-')}", str(value))
+    ]
 
 
 def measure_method_option():
     """`--method NAME` unless the config asks for the package default."""
     method = config["measure"]["method"]
-    return "" if method == "default" else f"--method {method}"
+    return [] if method == "default" else ["--method", method]
 
 
 def overlays_option(folder):
     """`--overlays DIR` when overlays are enabled."""
-    return f"--overlays {folder}" if config["measure"]["overlays"] else ""
+    return ["--overlays", folder] if config["measure"]["overlays"] else []
 
 
 def scene_overrides(ds):
     """`--set KEY=VALUE` options of a synthetic dataset's scene overrides."""
-    return " ".join(f"--set {k}={v}" for k, v in sorted(ds.get("scene_set", {}).items()))
+    pairs = sorted(ds.get("scene_set", {}).items())
+    return [arg for k, v in pairs for arg in ("--set", f"{k}={v}")]
 
 
 def force_photoset_dir(name):
@@ -101,14 +162,13 @@ def force_photoset_dir(name):
 
 
 def force_photoset_input(wildcards):
-    """What a force measure job waits for."""
+    """What a force measure job waits for (and re-runs on when it changes)."""
     ds = FORCE_DATASETS[wildcards.force_dataset]
     if ds["source"] == "synthetic":
         return f"{RESULTS}/force_photosets/{wildcards.force_dataset}"
-    return [f"{ds['path']}/manifest.csv", f"{ds['path']}/photoset.yaml"]
+    return FORCE_FOLDER_DIGESTS[wildcards.force_dataset]
 
 
 FORCE_OUTPUTS = (
     [f"{RESULTS}/force/force_summary.csv"] if FORCE_DATASETS else []
 ) + ([f"{RESULTS}/force/grasp_summary.csv"] if config["force"]["grasp_log"] else [])
-

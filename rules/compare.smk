@@ -1,4 +1,5 @@
-# Model versus data: RMS, crossings, range of motion, fitted k_P, for every dataset and material.
+# Model versus data: RMS, crossings, range of motion, fitted k_P, per material and l0 (each
+# dataset's own actuator), with the model curve every RMS was computed against.
 
 
 rule compare:
@@ -6,23 +7,27 @@ rule compare:
         hysteresis=per_dataset("{results}/datasets/{dataset}/hysteresis.csv"),
         angles=per_dataset("{results}/datasets/{dataset}/angles.csv"),
     output:
-        f"{RESULTS}/rms.csv",
+        rms=f"{RESULTS}/rms.csv",
+        curves=f"{RESULTS}/compare_curves.csv",
     params:
         names=list(DATASETS),
+        photosets=[photoset_dir(n) for n in DATASETS],
         materials=materials_option(),
         readings=model_readings_option(),
         bootstrap=config["compare"]["bootstrap"],
         seed=config["compare"]["seed"],
     log:
-        f"{LOGS}/compare.log",
+        log_file("compare"),
     benchmark:
-        f"{BENCHMARKS}/compare.tsv"
+        benchmark_file("compare")
     threads: 1
+    resources:
+        **TABLE_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=1000,
-        runtime=10,
     shell:
-        "python -m pipeline compare {input.hysteresis} --angles {input.angles} --datasets {params.names}"
-        " --bootstrap {params.bootstrap} --seed {params.seed} {params.materials} {params.readings} --out {output} > {log} 2>&1"
+        logged(
+            "python -m pipeline compare {input.hysteresis:q} --angles {input.angles:q}"
+            " --datasets {params.names:q} --photosets {params.photosets:q} --bootstrap {params.bootstrap:q}"
+            " --seed {params.seed:q} {params.materials:q} {params.readings:q} --out {output.rms:q} --curves {output.curves:q}"
+        )

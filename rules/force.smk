@@ -8,19 +8,21 @@ rule force_synth_photoset:
     params:
         ds=lambda wc: FORCE_DATASETS[wc.force_dataset],
     log:
-        f"{LOGS}/force_synth/{{force_dataset}}.log",
+        log_file("force_synth/{force_dataset}"),
     benchmark:
-        f"{BENCHMARKS}/force_synth/{{force_dataset}}.tsv"
+        benchmark_file("force_synth/{force_dataset}")
     threads: 1
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=1000,
-        runtime=20,
     shell:
-        "python -m pipeline force synth {output} --material {params.ds[material]}"
-        " --actuators {params.ds[actuators]} --trials {params.ds[trials]} --seed {params.ds[seed]}"
-        " --scene {params.ds[scene]} --step-kpa {params.ds[step_kpa]} > {log} 2>&1"
+        logged(
+            "python -m pipeline force synth {output:q} --material {params.ds[material]:q}"
+            " --actuators {params.ds[actuators]:q} --trials {params.ds[trials]:q}"
+            " --seed {params.ds[seed]:q} --scene {params.ds[scene]:q}"
+            " --step-kpa {params.ds[step_kpa]:q}"
+        )
 
 
 rule force_measure:
@@ -31,17 +33,18 @@ rule force_measure:
     params:
         folder=lambda wc: force_photoset_dir(wc.force_dataset),
     log:
-        f"{LOGS}/force_measure/{{force_dataset}}.log",
+        log_file("force_measure/{force_dataset}"),
     benchmark:
-        f"{BENCHMARKS}/force_measure/{{force_dataset}}.tsv"
+        benchmark_file("force_measure/{force_dataset}")
     threads: 2
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=2000,
-        runtime=20,
     shell:
-        "python -m pipeline force measure {params.folder} --out {output} --jobs {threads} > {log} 2>&1"
+        logged(
+            "python -m pipeline force measure {params.folder:q} --out {output:q} --jobs {threads}"
+        )
 
 
 rule force_aggregate:
@@ -51,18 +54,19 @@ rule force_aggregate:
         force=f"{RESULTS}/force/force_summary.csv",
         eccentricity=f"{RESULTS}/force/eccentricity_summary.csv",
     log:
-        f"{LOGS}/force_aggregate.log",
+        log_file("force_aggregate"),
     benchmark:
-        f"{BENCHMARKS}/force_aggregate.tsv"
+        benchmark_file("force_aggregate")
     threads: 1
+    resources:
+        **TABLE_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=1000,
-        runtime=10,
     shell:
-        "python -m pipeline force aggregate {input} --out {output.force}"
-        " --eccentricity-out {output.eccentricity} > {log} 2>&1"
+        logged(
+            "python -m pipeline force aggregate {input:q} --out {output.force:q}"
+            " --eccentricity-out {output.eccentricity:q}"
+        )
 
 
 rule force_grasp:
@@ -71,14 +75,13 @@ rule force_grasp:
     output:
         f"{RESULTS}/force/grasp_summary.csv",
     log:
-        f"{LOGS}/force_grasp.log",
+        log_file("force_grasp"),
     benchmark:
-        f"{BENCHMARKS}/force_grasp.tsv"
+        benchmark_file("force_grasp")
     threads: 1
+    resources:
+        **SMALL_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=500,
-        runtime=5,
     shell:
-        "python -m pipeline force grasp {input} --out {output} > {log} 2>&1"
+        logged("python -m pipeline force grasp {input:q} --out {output:q}")

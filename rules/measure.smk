@@ -12,15 +12,16 @@ rule measure:
         method=measure_method_option(),
         overlays=lambda wc, output: overlays_option(output.overlays),
     log:
-        f"{LOGS}/measure/{{dataset}}.log",
+        log_file("measure/{dataset}"),
     benchmark:
-        f"{BENCHMARKS}/measure/{{dataset}}.tsv"
+        benchmark_file("measure/{dataset}")
     threads: config["measure"]["jobs"]
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=2000,
-        runtime=30,
     shell:
-        "mkdir -p {output.overlays} && python -m pipeline measure {params.folder} --out {output.angles}"
-        " {params.method} {params.overlays} --jobs {threads} > {log} 2>&1"
+        logged(
+            "mkdir -p {output.overlays:q} && python -m pipeline measure {params.folder:q}"
+            " --out {output.angles:q} {params.method:q} {params.overlays:q} --jobs {threads}"
+        )

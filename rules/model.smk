@@ -8,16 +8,16 @@ rule model_curve:
         materials=materials_option(),
         readings=model_readings_option(),
     log:
-        f"{LOGS}/model/{{material}}.log",
+        log_file("model/{material}"),
     benchmark:
-        f"{BENCHMARKS}/model/{{material}}.tsv"
+        benchmark_file("model/{material}")
     threads: 1
+    resources:
+        **SMALL_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=500,
-        runtime=5,
     shell:
-        "python -m pipeline model curve --material {wildcards.material} {params.materials}"
-        " {params.readings}"
-        " --out {output} > {log} 2>&1"
+        logged(
+            "python -m pipeline model curve --material {wildcards.material:q} {params.materials:q}"
+            " {params.readings:q} --out {output:q}"
+        )

@@ -7,7 +7,8 @@ rule report:
         hysteresis=per_dataset("{results}/datasets/{dataset}/hysteresis.csv"),
         rms=f"{RESULTS}/rms.csv",
         config=f"{RESULTS}/config.resolved.yaml",
-        curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS),
+        curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS)
+        + [f"{RESULTS}/compare_curves.csv"],
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
         force=FORCE_OUTPUTS,
     output:
@@ -16,24 +17,26 @@ rule report:
         photosets=[photoset_dir(n) for n in DATASETS],
         overlays=per_dataset("{results}/datasets/{dataset}/overlays"),
         names=list(DATASETS),
-        bench=lambda wc, input: f"--bench-dir {input.bench}" if input.bench else "",
-        force=f"--force-dir {RESULTS}/force" if FORCE_OUTPUTS else "",
+        bench=lambda wc, input: ["--bench-dir", input.bench] if input.bench else [],
+        force=["--force-dir", f"{RESULTS}/force"] if FORCE_OUTPUTS else [],
         title=config["report"]["title"],
     log:
-        f"{LOGS}/report.log",
+        log_file("report"),
     benchmark:
-        f"{BENCHMARKS}/report.tsv"
+        benchmark_file("report")
     threads: 1
+    resources:
+        **PHOTO_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=2000,
-        runtime=10,
     shell:
-        "python -m pipeline report --datasets {params.names} --angles {input.angles}"
-        " --hysteresis {input.hysteresis} --rms {input.rms} --model-curves {input.curves}"
-        " --photosets {params.photosets} --overlays {params.overlays} {params.bench} {params.force}"
-        " --config {input.config} --title {params.title:q} --out {output} > {log} 2>&1"
+        logged(
+            "python -m pipeline report --datasets {params.names:q} --angles {input.angles:q}"
+            " --hysteresis {input.hysteresis:q} --rms {input.rms:q} --model-curves {input.curves:q}"
+            " --photosets {params.photosets:q} --overlays {params.overlays:q}"
+            " {params.bench:q} {params.force:q} --config {input.config:q} --title {params.title:q}"
+            " --out {output:q}"
+        )
 
 
 rule resolved_config:
@@ -42,15 +45,14 @@ rule resolved_config:
     params:
         config=config,
     log:
-        f"{LOGS}/resolved_config.log",
+        log_file("resolved_config"),
     benchmark:
-        f"{BENCHMARKS}/resolved_config.tsv"
+        benchmark_file("resolved_config")
     threads: 1
+    resources:
+        **SMALL_JOB,
     conda:
         CONDA_ENV
-    resources:
-        mem_mb=200,
-        runtime=1,
     run:
         from pipeline.config import write_resolved_config
 

@@ -29,7 +29,7 @@ def _hyst() -> pd.DataFrame:
                          for d, p, s in rows])
 
 
-def linear_model(material: str, pressure_kpa: np.ndarray) -> np.ndarray:
+def linear_model(material: str, pressure_kpa: np.ndarray, l0_mm=None) -> np.ndarray:
     return 200.0 - 10.0 * np.asarray(pressure_kpa, float)
 
 
@@ -45,7 +45,7 @@ def test_rms_hand_computed():
 
 
 def test_rms_skips_model_nan():
-    def partial(material, p):
+    def partial(material, p, l0_mm):
         p = np.asarray(p, float)
         return np.where(p > 15, np.nan, linear_model(material, p))
 
@@ -85,7 +85,7 @@ def _g(psi):
     return (200.0 - np.asarray(psi, float)) / 10.0
 
 
-def ls_fit(material, p, psi):
+def ls_fit(material, p, psi, l0_mm=None):
     """k minimising sum (P - k g(psi))^2, a stand-in for the model's fit."""
     g = _g(psi)
     return float(g @ p / (g @ g)), None
@@ -128,7 +128,7 @@ def test_compare_fits_k_p_from_angles_rows():
 
 
 def test_unknown_material_keeps_data_metrics():
-    def model(material, p):
+    def model(material, p, l0_mm):
         raise UserInputError(f"no material {material!r}")
 
     h = _hyst().assign(material="EcoFlex")
@@ -153,7 +153,7 @@ def test_two_datasets_of_one_material_are_pooled():
 
 def test_cli_with_the_real_model(tmp_path, capsys):
     """Angles drawn from the model itself (SS40, k_P 2.2) + 2 deg noise: small RMS, k_P ~ 2.2."""
-    model = pytest.importorskip("pipeline.model")
+    from pipeline import model
     from pipeline.cli import main
 
     rng = np.random.default_rng(7)
@@ -173,7 +173,7 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     hyst, rms = tmp_path / "h.csv", tmp_path / "rms.csv"
     assert main(["aggregate", str(angles), "--out", str(hyst)]) == 0
     assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(rms), "--seed", "3"]) == 0
-    assert "SS40 RMS" in capsys.readouterr().out
+    assert "compare: SS40, l0 255 mm [" in capsys.readouterr().out
     out = pd.read_csv(rms).iloc[0]
     finite = np.isfinite(truth)
     assert out["n_model_nan"] == 2 * int((~finite).sum())
@@ -182,11 +182,178 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     assert abs(out["k_p_fit"] - 2.2) < 0.1
     assert out["p_zero_up_kpa"] == pytest.approx(crossing_kpa(p, truth, 0.0), abs=3.0)
     assert main(["compare", str(tmp_path / "missing.csv"), "--out", str(rms)]) == 2
-    # another reading of the model reaches the comparison: the printed l0 factor (l0 in metres)
-    # is 16 % softer, so data drawn from the calibrated model need a larger k_P
-    other = tmp_path / "rms_metres.csv"
+    # another reading of the model reaches the comparison: the printed Jacobian (jacobian=none)
+    # is about 15 % softer, so data drawn from the default model need a larger k_P
+    other = tmp_path / "rms_printed.csv"
     assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(other), "--seed", "3",
-                 "--l0-factor", "metres"]) == 0
-    metres = pd.read_csv(other).iloc[0]
-    assert metres["k_p_fit"] > out["k_p_fit"] * 1.1 and metres["rms_deg"] > out["rms_deg"]
+                 "--jacobian", "none"]) == 0
+    printed = pd.read_csv(other).iloc[0]
+    assert printed["k_p_fit"] > out["k_p_fit"] * 1.1 and printed["rms_deg"] > out["rms_deg"]
     assert main(["compare", str(hyst), "--out", str(other), "--eq12-scale", "-1"]) == 2
+    # no l0_mm in this angles.csv: the model's default l0, and rms.csv says where it came from
+    assert out["l0_mm"] == model.load_materials()["SS40"].l0_mm and out["l0_source"] == "materials file"
+    assert out["rms_kind"] == "unknown" and out["model_fit"].startswith("none")
+
+
+def _angles(dataset: str, material: str, l0_mm, psi_offset: float = 0.0) -> pd.DataFrame:
+    p = np.array([0.0, 10.0, 20.0])
+    rows = [{"dataset": dataset, "image": f"{dataset}_{a}_{d}_{pk:g}.jpg", "status": "ok", "material": material,
+             "actuator": a, "trial": "1", "direction": d, "pressure_kpa": pk, "l0_mm": l0_mm,
+             "psi_deg": 200.0 - 10.0 * pk + psi_offset}
+            for a in ("A1", "A2") for d in ("up", "down") for pk in p]
+    return pd.DataFrame(rows)
+
+
+def _hyst_of(angles: pd.DataFrame) -> pd.DataFrame:
+    from pipeline.aggregate import aggregate_hysteresis
+
+    return pd.concat([aggregate_hysteresis(g).assign(dataset=d) for d, g in angles.groupby("dataset")],
+                     ignore_index=True)
+
+
+def test_each_dataset_is_compared_at_its_own_l0():
+    """Datasets of one material pool only when they share l0; each row says which l0 and why."""
+    angles = pd.concat([_angles("a", "SS50", 255.0), _angles("b", "SS50", 220.0, psi_offset=5.0),
+                        _angles("c", "SS50", 255.0), _angles("d", "SS50", np.nan)], ignore_index=True)
+    calls = []
+
+    def model(material, p, l0_mm):
+        calls.append(l0_mm)
+        return 200.0 - 10.0 * np.asarray(p, float) + (5.0 if l0_mm == 220.0 else 0.0)
+
+    out = compare(_hyst_of(angles), angles, model_psi=model, fit_k_p=None, default_l0_mm={"SS50": 250.0},
+                  data_sources={"a": "synthetic", "b": "measured", "c": "synthetic", "d": "measured"})
+    assert list(out["curve"]) == ["SS50, l0 250 mm", "SS50, l0 220 mm", "SS50, l0 255 mm"]
+    rows = out.set_index("curve")
+    assert rows.loc["SS50, l0 255 mm", "datasets"] == "a + c"
+    assert rows.loc["SS50, l0 255 mm", "l0_source"] == "photo set"
+    assert rows.loc["SS50, l0 255 mm", "rms_kind"] == "self-check"
+    assert rows.loc["SS50, l0 220 mm", "rms_kind"] == "prediction"
+    assert rows.loc["SS50, l0 250 mm", "datasets"] == "d"  # no l0 in its angles: the default
+    assert rows.loc["SS50, l0 250 mm", "l0_source"] == "materials file"
+    assert sorted(set(calls)) == [220.0, 250.0, 255.0]
+    # every comparison meets its own model exactly (b's data are 5 deg up, so is its 220 mm model)
+    np.testing.assert_allclose(out["rms_deg"], 0.0, atol=1e-12)
+    assert (out["n_actuators"] == [2, 2, 4]).all()
+    mixed = compare(_hyst_of(angles), angles, model_psi=model, fit_k_p=None,
+                    data_sources={"a": "synthetic", "b": "measured"})
+    assert "unknown" in set(mixed["rms_kind"])  # c and d have no stated source
+
+
+def test_a_dataset_mixing_l0_keeps_its_data_figures_and_says_why_no_model():
+    one = pd.concat([_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
+                    ignore_index=True)
+    with pytest.warns(UserWarning, match="several l0 .200, 220 mm"):
+        out = compare(_hyst_of(one), one, model_psi=linear_model, fit_k_p=ls_fit).iloc[0]
+    assert out["curve"] == "DS20, x (several l0)" and math.isnan(out["l0_mm"])
+    assert math.isnan(out["rms_deg"]) and math.isnan(out["k_p_fit"]) and out["range_deg"] == 200.0
+    assert "split the photo set into one dataset per l0" in out["note"]
+
+
+def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
+    """compare --curves writes, per rms.csv row, the model curve at that row's l0 (real model)."""
+    from pipeline import model
+    from pipeline.cli import main
+
+    folders = []
+    for name, l0 in (("short", 220.0), ("long", None)):
+        p = np.arange(0.0, 241.0, 40.0)
+        psi = model.psi_deg("SS50", p, l0_mm=l0)
+        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
+                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1, "l0_mm": l0}
+                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        folder = tmp_path / name
+        folder.mkdir()
+        frame = pd.DataFrame(rows)
+        if l0 is None:
+            frame = frame.drop(columns="l0_mm")
+        frame.to_csv(folder / "angles.csv", index=False)
+        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        folders.append(folder)
+    (folders[0] / "truth.csv").write_text("image,psi_deg\n")  # 'short' was rendered by synth
+    rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
+    assert main(["compare", *(str(f / "hysteresis.csv") for f in folders),
+                 "--angles", *(str(f / "angles.csv") for f in folders),
+                 "--photosets", *(str(f) for f in folders), "--bootstrap", "0",
+                 "--out", str(rms), "--curves", str(curves)]) == 0
+    text = capsys.readouterr().out
+    assert "compare: SS50, l0 220 mm [short; l0 from photo set; self-check]" in text
+    out = pd.read_csv(rms).set_index("datasets")
+    default = model.load_materials()["SS50"].l0_mm
+    assert out.loc["short", "l0_mm"] == 220.0 and out.loc["long", "l0_mm"] == default
+    assert out.loc["long", "l0_source"] == "materials file" and out.loc["long", "rms_kind"] == "prediction"
+    assert (out["rms_deg"] < 1e-3).all()  # each set was drawn from the model at its own l0
+    c = pd.read_csv(curves)
+    assert set(c["curve"]) == set(out["curve"])
+    short = c[c["curve"] == "SS50, l0 220 mm"]
+    assert (short["l0_mm"] == 220.0).all() and len(short) == 400
+    expected = model.model_curve("SS50", l0_mm=220.0)
+    np.testing.assert_allclose(short["pressure_kpa"], expected["pressure_kpa"], rtol=1e-5, atol=1e-9)
+    assert not np.allclose(expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3)
+    assert main(["compare", str(folders[0] / "hysteresis.csv"), "--photosets", "a", "b",
+                 "--out", str(rms)]) == 2
+
+
+@pytest.mark.slow
+def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
+    """End to end (real snakemake, tiny config in a temporary folder): two SS50 photo sets, one of
+    an actuator with l0 = 220 mm; its model curve and its RMS use 220 mm, the other's the default,
+    and the report says which l0 each curve used and that synthetic RMS is a self-check."""
+    import subprocess
+    import sys
+
+    import pypdfium2 as pdfium
+    import yaml
+
+    from pipeline import model
+    from pipeline.cli import main
+
+    short = tmp_path / "short"  # a folder photo set of a shorter actuator (rendered by synth)
+    assert main(["synth", str(short), "--material", "SS50", "--actuators", "1", "--trials", "1",
+                 "--step-kpa", "80", "--max-kpa", "240", "--scene", "clean", "--set", "width=400",
+                 "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
+    config = {
+        "datasets": [
+            {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
+             "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
+            {"name": "short", "source": "folder", "path": str(short)},
+        ],
+        "compare": {"bootstrap": 5},
+        "bench": {"in_report": False},
+    }
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    run = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
+                          str(tmp_path), "--cores", "2"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-5000:]
+    res = tmp_path / "results"
+    angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
+    assert (angles["l0_mm"] == 220.0).all()  # measure carries each photo's l0
+    default = model.load_materials()["SS50"].l0_mm
+    assert default != 220.0
+    rms = pd.read_csv(res / "rms.csv").set_index("datasets")
+    assert rms.loc["short", "curve"] == "SS50, l0 220 mm" and rms.loc["short", "l0_mm"] == 220.0
+    assert rms.loc["short", "l0_source"] == "photo set"
+    assert rms.loc["std", "l0_mm"] == default
+    assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
+    # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
+    hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
+    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
+    at_220 = rms_deg(psi, model.psi_deg("SS50", p, l0_mm=220.0))[0]
+    at_default = rms_deg(psi, model.psi_deg("SS50", p))[0]
+    assert rms.loc["short", "rms_deg"] == pytest.approx(at_220, rel=1e-4)
+    assert abs(at_220 - at_default) > 1e-3
+    curves = pd.read_csv(res / "compare_curves.csv")
+    c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
+    assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
+    np.testing.assert_allclose(c220["pressure_kpa"], model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
+                               rtol=1e-5, atol=1e-9)
+    doc = pdfium.PdfDocument(str(res / "report.pdf"))
+    pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
+    doc.close()
+    comparison = next(t for t in pages if "Model versus measurements, beside" in t)
+    assert "photos rendered from this package's model, so the RMS is a self-check, not a validation" in comparison
+    provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
+    assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
+    assert f"SS50, l0 {default:g} mm" in provenance
+    material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
+    assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 
 from pipeline.cli import main
+from pipeline.measure.settings import resolve_settings
 from pipeline.force.blocked import RESULT_COLUMNS, measure_blocked_image, measure_blocked_photoset
 from pipeline.force.ellipse import fit_ellipse
 from pipeline.force.pages import figures
@@ -81,11 +82,14 @@ def test_ramp_table_is_seeded() -> None:
 
 # ----------------------------------------------------------------------------- one photo
 
+SCALED = resolve_settings(l0_mm=270.0, mm_per_px=0.3)
+UNSCALED = resolve_settings(l0_mm=270.0)
+
 
 @pytest.mark.parametrize("e", [0.3, 0.55, 0.8])
 @pytest.mark.parametrize("gap_deg", [0.0, 90.0])
 def test_drawn_photo_eccentricity_within_target(e: float, gap_deg: float) -> None:
-    r = measure_blocked_image(drawn_arc_image(e, gap_deg=gap_deg), l0_mm=270.0, mm_per_px=0.3)
+    r = measure_blocked_image(drawn_arc_image(e, gap_deg=gap_deg), SCALED)
     assert r.status == "ok", r.reason
     assert abs(r.eccentricity - e) <= 0.02
     assert r.length_px == pytest.approx(900.0, rel=0.03)
@@ -93,14 +97,14 @@ def test_drawn_photo_eccentricity_within_target(e: float, gap_deg: float) -> Non
 
 
 def test_unreadable_and_empty_photos_fail() -> None:
-    assert measure_blocked_image(None).status == "failed"
+    assert measure_blocked_image(None, UNSCALED).status == "failed"
     blank = np.full((200, 300, 3), 200, np.uint8)
-    r = measure_blocked_image(blank)
+    r = measure_blocked_image(blank, UNSCALED)
     assert r.status == "failed" and "no line" in r.reason and np.isnan(r.eccentricity)
 
 
 def test_line_leaving_the_photo_is_flagged() -> None:
-    r = measure_blocked_image(drawn_arc_image(0.5, offset_px=(560, 0)), l0_mm=270.0, mm_per_px=0.3)
+    r = measure_blocked_image(drawn_arc_image(0.5, offset_px=(560, 0)), SCALED)
     assert r.status == "flagged"
     assert "border" in r.reason
 
@@ -119,7 +123,7 @@ def test_clamp_blob_is_painted_over() -> None:
     cv2.rectangle(img, (x - 62, y - 27), (x - 8, y + 27), (120, 120, 120), 3)
     cv2.circle(img, (x - 35, y - 12), 7, (170, 170, 170), 2)
     cv2.circle(img, (x - 35, y + 12), 7, (170, 170, 170), 2)
-    good = measure_blocked_image(img, l0_mm=270.0, mm_per_px=0.3)
+    good = measure_blocked_image(img, SCALED)
     assert abs(good.eccentricity - e) <= 0.02
     assert good.status == "ok", good.reason
 

@@ -11,40 +11,43 @@ import pandas as pd
 import pytest
 
 from pipeline import photoset as ps
+from pipeline import photoset_init
+from pipeline.fileio import atomic_write_bytes
+from pipeline.measure.colors import ColorError, parse_color
 from pipeline.errors import UserInputError
 
 PATTERN = "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg"
 
 
 def test_init_reads_fields_and_infers_direction(photo_folder):
-    df = ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    df = photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
     df = df.sort_values(["trial", "step"]).reset_index(drop=True)
     assert list(df["pressure_kpa"]) == [0, 10, 20, 10, 0, 0, 10, 20]
     assert list(df["direction"]) == ["up", "up", "up", "down", "down", "up", "up", "up"]
     assert set(df["material"]) == {"DS30"} and set(df["actuator"]) == {"A2"}
     loaded = ps.load_photoset(photo_folder)
     assert len(loaded.manifest) == 8
-    assert (loaded.manifest["l0_mm"] == 210.0).all()
+    assert all(r.l0_mm == 210.0 for r in loaded.rows)
     assert ps.validate_photoset(photo_folder) == []
 
 
 def test_init_refuses_to_overwrite_and_unknown_field(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN)
+    photoset_init.init_photoset(photo_folder, PATTERN)
     with pytest.raises(UserInputError, match="already exists"):
-        ps.init_photoset(photo_folder, PATTERN)
+        photoset_init.init_photoset(photo_folder, PATTERN)
     with pytest.raises(UserInputError, match="unknown"):
-        ps.pattern_to_regex("{pressure}_{pressure_kpa}.jpg")
+        photoset_init.pattern_to_regex("{pressure}_{pressure_kpa}.jpg")
     with pytest.raises(UserInputError, match="no image .* matches"):
-        ps.init_photoset(photo_folder, "{pressure_kpa}psi.png", overwrite=True)
+        photoset_init.init_photoset(photo_folder, "{pressure_kpa}psi.png", overwrite=True)
 
 
 def test_pressure_with_p_as_decimal_point():
-    m = ps.pattern_to_regex("P{pressure_kpa}_{direction}.png").match("P12p5_dec.png")
+    m = photoset_init.pattern_to_regex("P{pressure_kpa}_{direction}.png").match("P12p5_dec.png")
     assert m and m["pressure_kpa"] == "12p5" and m["direction"] == "dec"
 
 
 def test_check_names_every_bad_row_and_its_fix(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
     m = pd.read_csv(photo_folder / "manifest.csv")
     m.loc[1, "direction"] = "sideways"
     m.loc[2, "pressure_kpa"] = np.nan
@@ -66,7 +69,7 @@ def test_check_names_every_bad_row_and_its_fix(photo_folder):
 
 
 def test_missing_l0_is_reported_unless_every_row_has_it(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN)
+    photoset_init.init_photoset(photo_folder, PATTERN)
     assert any("l0_mm is missing" in str(p) for p in ps.validate_photoset(photo_folder))
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["l0_mm"] = 180.0
@@ -75,32 +78,32 @@ def test_missing_l0_is_reported_unless_every_row_has_it(photo_folder):
 
 
 def test_row_overrides_win_over_folder_settings(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": "black", "fixed_end": [5, 6]})
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": "black", "fixed_end": [5, 6]})
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["l0_mm"] = [np.nan] * (len(m) - 1) + [150.0]
     m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
     m.to_csv(photo_folder / "manifest.csv", index=False)
-    rows = ps.load_photoset(photo_folder).manifest
-    assert list(rows["l0_mm"])[-1] == 150.0 and (rows["l0_mm"].iloc[:-1] == 210.0).all()
-    assert rows["line_color"].iloc[0] == "blue" and (rows["line_color"].iloc[1:] == "black").all()
-    assert (rows["fixed_end_x"] == 5).all() and (rows["fixed_end_y"] == 6).all()
+    rows = ps.load_photoset(photo_folder).rows
+    assert rows[-1].l0_mm == 150.0 and all(r.l0_mm == 210.0 for r in rows[:-1])
+    assert rows[0].color == parse_color("blue") and all(r.color == parse_color("black") for r in rows[1:])
+    assert all(r.fixed_end_px == (5.0, 6.0) for r in rows)
 
 
 def test_bad_settings_values_are_named(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN)
-    (photo_folder / "photoset.yaml").write_text("l0_mm: -3\npositive_turn: left\nline_color: purple\n")
+    photoset_init.init_photoset(photo_folder, PATTERN)
+    (photo_folder / "photoset.yaml").write_text("l0_mm: -3\npositive_turn: left\nline_color: chartreuse\n")
     text = "\n".join(map(str, ps.validate_photoset(photo_folder)))
-    assert "l0_mm = -3" in text and "positive_turn = 'left'" in text and "purple" in text
+    assert "l0_mm = -3" in text and "positive_turn = 'left'" in text and "chartreuse" in text
 
 
 @pytest.mark.parametrize("value, expected", [("red", 2), ("0,0,0-179,255,60", 1), ({"lower": [1, 2, 3], "upper": [4, 5, 6]}, 1)])
 def test_line_color_ranges(value, expected):
-    assert len(ps.line_color_ranges(value)) == expected
+    assert len(parse_color(value).ranges) == expected
 
 
 def test_line_color_rejects_bad_range():
-    with pytest.raises(UserInputError):
-        ps.line_color_ranges("10,0,0-5,255,255")
+    with pytest.raises(ColorError):
+        parse_color("10,0,0-5,255,255")
 
 
 def test_append_rows_is_idempotent(tmp_path):
@@ -115,17 +118,17 @@ def test_append_rows_is_idempotent(tmp_path):
 def test_atomic_write_gives_normal_permissions(tmp_path):
     old = os.umask(0o022)
     try:
-        ps.atomic_write_bytes(tmp_path / "report.pdf", b"%PDF")
+        atomic_write_bytes(tmp_path / "report.pdf", b"%PDF")
     finally:
         os.umask(old)
     assert (tmp_path / "report.pdf").stat().st_mode & 0o777 == 0o644
 
 
 def test_folder_hsv_range_fills_rows_without_their_own_colour(photo_folder):
-    ps.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": {"lower": [0, 0, 0], "upper": [179, 255, 60]}})
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": {"lower": [0, 0, 0], "upper": [179, 255, 60]}})
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
     m.to_csv(photo_folder / "manifest.csv", index=False)
-    rows = ps.load_photoset(photo_folder).manifest
-    assert rows["line_color"].iloc[0] == "blue"
-    assert all(v == {"lower": [0, 0, 0], "upper": [179, 255, 60]} for v in rows["line_color"].iloc[1:])
+    rows = ps.load_photoset(photo_folder).rows
+    assert rows[0].color == parse_color("blue")
+    assert all(r.color.ranges == (((0, 0, 0), (179, 255, 60)),) and not r.color.dark_line for r in rows[1:])

@@ -118,10 +118,12 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         out = d.angles_csv.parent / "hysteresis.csv"
         assert main(["aggregate", str(d.angles_csv), "--out", str(out)]) == 0
         hyst.append(out)
-    h = pd.concat([pd.read_csv(p) for p in hyst])
-    table = compare(h, read_angles([d.angles_csv for d in datasets]),
-                    model_psi=lambda m, p: fake_psi(m, p, "up") + 10.0,
-                    fit_k_p=lambda m, p, s: (1.0 + 0.01 * len(p), None), n_boot=20)
+    h = pd.concat([pd.read_csv(p).assign(dataset=str(d.angles_csv)) for p, d in zip(hyst, datasets, strict=True)])
+    sources = {str(d.angles_csv): "synthetic" if (d.photoset_dir and (d.photoset_dir / "truth.csv").is_file())
+               else "measured" for d in datasets}
+    table = compare(h, read_angles([d.angles_csv for d in datasets]), data_sources=sources,
+                    model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0,
+                    fit_k_p=lambda m, p, s, l0_mm: (1.0 + 0.01 * len(p), None), n_boot=20)
     rms = tmp / "rms.csv"
     table.to_csv(rms, index=False)
     return hyst, rms
@@ -268,18 +270,18 @@ def test_every_page_is_a4(default):
         sizes = [tuple(sorted(doc[i].get_size())) for i in range(len(doc))]
     finally:
         doc.close()
-    assert len(sizes) >= 15
+    assert len(sizes) >= 16
     for i, (w, h) in enumerate(sizes, start=1):
         assert w == pytest.approx(A4_PT[0], abs=0.5) and h == pytest.approx(A4_PT[1], abs=0.5), f"page {i}: {w} x {h}"
-    assert "Provenance" in pdf_text(pdf, 14)
+    assert "Provenance" in pdf_text(pdf, 15)
 
 
 def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
     labels = [label for label, _ in pages]
-    assert labels[:14] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
-                           "comparison", "speed-accuracy", "stability", "bench-tables", "model-cost", "force",
-                           "eccentricity", "grasp"]
-    assert labels[14] == "provenance" and all(x == "provenance (continued)" for x in labels[15:])  # long tmp paths
+    assert labels[:15] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
+                           "comparison", "model-curves", "speed-accuracy", "stability", "bench-tables", "model-cost",
+                           "force", "eccentricity", "grasp"]
+    assert labels[15] == "provenance" and all(x == "provenance (continued)" for x in labels[16:])  # long tmp paths
     for label, texts in pages:
         assert len(texts) > 10, label
         assert overlapping_texts(texts) == [], label
@@ -446,7 +448,7 @@ def test_one_material_without_optional_tables(tmp_path):
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert res.materials == ("SS40",)
-    assert res.pages == 5  # summary, overview, SS40, comparison, provenance
+    assert res.pages == 5  # summary, overview, SS40, comparison, provenance (no rms.csv: no model-curve page)
     text = " ".join(pdf_text(out, 0).split())
     assert "SS40 unknown" in text  # no photo-set folder: neither real nor synthetic can be told
     assert "SS40: no row in --rms" in text
@@ -457,7 +459,7 @@ def test_increasing_only_photoset(tmp_path):
     hyst, rms = pipeline_tables(tmp_path, [d])
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)), out)
-    assert res.pages == 5
+    assert res.pages == 6  # summary, overview, DS20, comparison, model curves, provenance
     table = pd.read_csv(rms)
     assert np.isnan(table["rms_down_deg"].iloc[0]) and np.isfinite(table["rms_up_deg"].iloc[0])
     line = next(x for x in pdf_text(out, 0).split("\r\n") if x.startswith("DS20 "))
@@ -510,3 +512,22 @@ def test_each_material_has_one_colour_on_every_page(default):
                 assert to_rgb(ax.title.get_color()) == pytest.approx(colors[ax.get_title()])  # overview panels
                 seen += 1
     assert seen >= 4 + 4 + 2 * (4 + 7)  # summary plot, overview titles; force and grasp lines (report and CLI)
+
+
+def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_path):
+    """angles.csv records seconds per photo; two runs on the same photos (a workstation and a
+    cluster) differ only there, and the report (which prints the table's digest) must not.
+    The pages are pure functions of ReportData, so equal data means equal bytes (the SLURM test
+    compares whole PDFs)."""
+    from pipeline.report.data import sha256_file, sha256_measurements
+
+    d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
+    first = load_report_data(ReportInputs(datasets=(d,))).files
+    angles = pd.read_csv(d.angles_csv)
+    angles.assign(seconds=angles["seconds"] * 3.7 + 0.011).to_csv(d.angles_csv, index=False)
+    assert load_report_data(ReportInputs(datasets=(d,))).files == first
+    digest = sha256_measurements(d.angles_csv)
+    angles.assign(psi_deg=angles["psi_deg"] + 0.001).to_csv(d.angles_csv, index=False)
+    assert sha256_measurements(d.angles_csv) != digest
+    angles.drop(columns="seconds").to_csv(d.angles_csv, index=False)
+    assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)

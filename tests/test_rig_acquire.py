@@ -21,6 +21,7 @@ import pandas as pd
 import pytest
 
 from pipeline.photoset import load_photoset, validate_photoset
+from pipeline.rig.acquire import EXIT_CODES
 from pipeline.rig.emulator import Emulator, Faults, PlantParams
 
 REPO = Path(__file__).resolve().parents[1]
@@ -121,7 +122,7 @@ def test_estop_mid_ramp_vents_keeps_data_then_resumes(tmp_path, photo):
 def test_dropped_connection_then_rerun_resumes_without_duplicates(tmp_path, photo):
     out = tmp_path / "set"
     link = tmp_path / "ttyPICO"
-    with Emulator(faults=Faults(drop_after=14), link=link) as emu:
+    with Emulator(faults=Faults(drop_after=16), link=link) as emu:
         first = run(acquire_cmd(str(link), out, photo, "--watchdog-s", "2"))
         assert first.returncode == 4, first.stderr
         assert "lost" in first.stderr and "COULD NOT VENT" in first.stderr
@@ -179,6 +180,31 @@ def test_limit_refused_before_anything_is_sent(tmp_path, photo, capsys):
     assert "above the driver limit 100 kPa" in err
 
 
+def test_base_protocol_firmware_ramp_completes_and_vents(tmp_path, photo, capsys):
+    """Firmware with only ID/SET/GET/VENT/EVT ESTOP: the ramp runs to --max-kpa, vents, and says what it lacked."""
+    out = tmp_path / "set"
+    with Emulator(protocol="base", seed=2) as emu:
+        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--watchdog-s", "5", trials=1), capsys)
+        assert code == 0, err
+        assert emu.setpoint_kpa == 0.0 and emu.pressure_kpa == 0.0
+        received = list(emu.stats.received)
+    df = assert_consistent(out)
+    assert list(df["pressure_kpa"]) == FULL_RAMP
+    assert received[-1] == "VENT"
+    sets = [float(c.split()[1]) for c in received if c.startswith("SET")]
+    assert max(sets) == 120.0  # the limit came from the command line
+    extension_commands = [c for c in received if c.split()[0] not in ("ID", "SET", "GET", "VENT")]
+    assert extension_commands == ["CFG", "WDOG 0.0000", "SCALE"]  # probed once at connect, never used
+    assert "not used: firmware circact-pico 1.1 has no CFG" in err and "--max-kpa 120 kPa" in err
+    assert "has no WDOG" in err and "acquire: done" in err
+    out_blocked = tmp_path / "blocked"
+    with Emulator(protocol="base") as emu:
+        code, _, err = main_inprocess(acquire_cmd(emu.port, out_blocked, photo, "--mode", "blocked", trials=1), capsys)
+        assert not [c for c in emu.stats.received if c.startswith("SET")]  # nothing pressurised
+    assert code == EXIT_CODES["error"] and "blocked mode needs the load cell" in err
+    assert not (out_blocked / "manifest.csv").exists()
+
+
 def test_garbage_from_device_is_ignored(tmp_path, photo, capsys):
     out = tmp_path / "set"
     with Emulator(faults=Faults(garbage_every=2), seed=3) as emu:
@@ -216,7 +242,7 @@ def test_dry_run_prints_plan_and_resume_point(tmp_path, photo, capsys):
     assert code == 0
     assert "up 0 50 100 120" in text and "trial 2: 7 steps, 0 recorded, start at step 0" in text
     assert not out.exists()
-    with Emulator(faults=Faults(drop_after=14)) as emu:
+    with Emulator(faults=Faults(drop_after=16)) as emu:
         assert run(acquire_cmd(emu.port, out, photo)).returncode == 4
     n = len(manifest(out))
     code, text, _ = main_inprocess(acquire_cmd("", out, photo, "--dry-run"), capsys)
@@ -269,13 +295,6 @@ def test_watched_folder_camera(tmp_path, photo, capsys):
     assert photo.read_bytes() not in images
 
 
-def _need(module: str, name: str):
-    mod = pytest.importorskip(module)
-    if not hasattr(mod, name):
-        pytest.skip(f"{module}.{name} not available yet")
-    return getattr(mod, name)
-
-
 def synthetic_cmd(port: str, out: Path, *extra: str, step: int = 40, top: int = 120) -> list[str]:
     return [sys.executable, "-m", "pipeline", "acquire", "--port", port, "--camera", "synthetic:clean",
             "--material", "DS20", "--actuator", "A1", "--trials", "1", "--step-kpa", str(step), "--max-kpa", str(top),
@@ -283,7 +302,6 @@ def synthetic_cmd(port: str, out: Path, *extra: str, step: int = 40, top: int = 
 
 
 def test_synthetic_camera_virtual_rig(tmp_path):
-    _need("pipeline.synth", "render_actuator")
     out = tmp_path / "set"
     with Emulator(seed=2) as emu:
         done = run(synthetic_cmd(emu.port, out, "--no-stop-at-psi0"), timeout=120)
@@ -296,7 +314,7 @@ def test_synthetic_camera_virtual_rig(tmp_path):
     assert first is not None and top is not None and first.shape == top.shape
     assert np.mean(np.abs(first.astype(int) - top.astype(int))) > 1  # the actuator moved
     # the virtual camera frames the whole line at every step (it zooms out for a long actuator)
-    from pipeline.measure import measure_photoset
+    from pipeline.photoset_measure import measure_photoset
 
     angles = measure_photoset(out)
     assert (angles["status"] == "ok").all(), angles[["image", "status", "reason"]]
@@ -304,15 +322,14 @@ def test_synthetic_camera_virtual_rig(tmp_path):
 
 def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     """Live measurement ends the up leg once psi <= -psi0; the down leg mirrors it; resume keeps it."""
-    measure_image = _need("pipeline.measure", "measure_image")
-    _need("pipeline.synth", "render_actuator")
+    from pipeline.measure import measure_image
     from pipeline.model import load_materials, psi_deg
 
     psi0 = load_materials()["DS20"].psi0_deg
     out = tmp_path / "set"
-    # ID, CFG, VENT, WDOG, VENT, then SET+GET per step: the port drops right after the 6th photo
-    # (100 kPa), the one that reaches -psi0, before any down step: the re-run must find the peak from it
-    with Emulator(seed=2, faults=Faults(drop_after=17)) as emu:
+    # ID, CFG, WDOG 0, SCALE, VENT, WDOG, VENT, then SET+GET per step: the port drops right after the
+    # 6th photo (100 kPa), the one that reaches -psi0, before any down step: the re-run must find the peak
+    with Emulator(seed=2, faults=Faults(drop_after=19)) as emu:
         first = run(synthetic_cmd(emu.port, out, "--stop-at-psi0", step=20, top=260), timeout=120)
     assert first.returncode == 4
     kept = manifest(out)
@@ -329,16 +346,13 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     assert list(down["pressure_kpa"]) == sorted(up["pressure_kpa"][:-1], reverse=True)
     assert df["step"].tolist() == list(range(len(df)))
     # the stop is where the measured psi first reaches -psi0 (and not before)
-    fe = tuple(ps.settings["fixed_end"])
-    psis = [measure_image(cv2.imread(str(out / name)), l0_mm=ps.settings["l0_mm"], mm_per_px=ps.settings["mm_per_px"],
-                          fixed_end_px=fe, positive_turn="ccw").psi_deg for name in up["image"]]
+    psis = [measure_image(cv2.imread(str(out / name)), settings).psi_deg for name, settings in zip(df["image"], ps.rows)
+            if name in set(up["image"])]
     assert psis[-1] <= -psi0 and all(p > -psi0 for p in psis[:-1])
     assert float(psi_deg("DS20", np.array([peak]))[0]) < -psi0 + 30
 
 
 def test_synthetic_blocked_rig(tmp_path, capsys):
-    _need("pipeline.synth", "render_curve")
-    _need("pipeline.force.synth_blocked", "blocked_arc_mm")
     out = tmp_path / "set"
     with Emulator(seed=3) as emu:
         code, _, err = main_inprocess(synthetic_cmd(emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100), capsys)

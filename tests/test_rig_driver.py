@@ -13,7 +13,14 @@ import pytest
 from pipeline.errors import UserInputError
 from pipeline.rig.calibration import fit_calibration, read_calibration, write_calibration
 from pipeline.rig.cli import run_calibration
-from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, WatchdogError
+from pipeline.rig.driver import (
+    EStopError,
+    LimitError,
+    PicoDriver,
+    PortLostError,
+    UnsupportedError,
+    WatchdogError,
+)
 from pipeline.rig.emulator import Emulator, Faults, PlantParams, parse_faults
 from pipeline.rig.firmware import rigcore
 
@@ -33,6 +40,32 @@ def test_set_get_through_pty_follows_the_plant():
             assert reading.measured_kpa == pytest.approx(expected, abs=0.2)  # one ADC step
             assert not reading.estop
     assert emu.setpoint_kpa == 0.0  # leaving the context vents
+
+
+def test_base_protocol_firmware_connects_and_extensions_are_optional(tmp_path):
+    """Firmware that speaks only ID, SET, GET, VENT: set/get/vent work, extensions raise without being sent."""
+    with Emulator(protocol="base", seed=1) as emu, PicoDriver.open(emu.port, max_kpa=150) as rig:
+        assert rig.info is not None and rig.info.extensions == frozenset()
+        assert rig.info.missing == ("CFG", "WDOG", "LOAD") and rig.info.max_kpa is None
+        probes = list(emu.stats.received)
+        assert probes == ["ID", "CFG", "WDOG 0.0000", "SCALE"]  # each probed once, no retry on ERR PARSE
+        assert rig.set_kpa(100).pressure_kpa == 100
+        assert rig.get().setpoint_kpa == 100
+        with pytest.raises(LimitError) as info:  # the host limit from the caller still applies
+            rig.set_kpa(151)
+        assert info.value.sent is False
+        for call in (lambda: rig.set_watchdog(5), rig.tare, rig.load_n, rig.get_scale):
+            with pytest.raises(UnsupportedError, match="does not speak"):
+                call()
+        assert emu.stats.received[len(probes):] == ["SET 100.0000", "GET"]  # nothing else was sent
+    assert emu.setpoint_kpa == 0.0  # leaving the context vents
+    cal = fit_calibration([0, 4095], [0.0, 500.0])
+    with Emulator(protocol="base") as emu:
+        with pytest.raises(UnsupportedError, match="no CFG"):
+            PicoDriver.open(emu.port, max_kpa=150, calibration=cal)
+        assert not [c for c in emu.stats.received if c.startswith("SET")]
+    with Emulator() as emu, PicoDriver.open(emu.port, max_kpa=150) as rig:  # our firmware: everything found
+        assert rig.info is not None and rig.info.missing == () and rig.info.max_kpa == 300.0
 
 
 def test_host_limit_refuses_before_sending():
@@ -75,8 +108,8 @@ def test_slow_replies_ok_within_timeout_and_lost_beyond():
 
 
 def test_dropped_connection_raises_port_lost():
-    with Emulator(faults=Faults(drop_after=4)) as emu:
-        rig = PicoDriver.open(emu.port, max_kpa=260)  # ID, CFG
+    with Emulator(faults=Faults(drop_after=6)) as emu:
+        rig = PicoDriver.open(emu.port, max_kpa=260)  # ID, CFG, WDOG 0, SCALE
         rig.set_kpa(10)
         rig.get()
         with pytest.raises(PortLostError):
@@ -88,7 +121,7 @@ def test_dropped_connection_raises_port_lost():
 
 def test_dropped_connection_with_link_reconnects(tmp_path):
     link = tmp_path / "ttyPICO"
-    with Emulator(faults=Faults(drop_after=3), link=link):
+    with Emulator(faults=Faults(drop_after=5), link=link):
         rig = PicoDriver.open(str(link), max_kpa=260)
         rig.set_kpa(50)
         with pytest.raises(PortLostError):

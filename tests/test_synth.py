@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import cv2
@@ -12,7 +17,8 @@ import pytest
 from scipy.ndimage import map_coordinates
 
 from pipeline.errors import UserInputError
-from pipeline.photoset import line_color_ranges, load_photoset, validate_photoset
+from pipeline.measure.colors import parse_color
+from pipeline.photoset import load_photoset, validate_photoset
 from pipeline.synth import SCENE_PRESETS, centreline_mm, render_actuator, render_curve, scene_from
 from pipeline.synth.actuator import (
     BEHAVIOURS,
@@ -135,7 +141,7 @@ def test_line_colour_is_inside_the_photoset_hsv_range(colour, preset):
     r = render_actuator(120.0, 195.0, scene_from(preset, line_color=colour, line_width_px=5.0, **SMALL), seed=4)
     hsv = cv2.cvtColor(r.image, cv2.COLOR_BGR2HSV)
     mask = np.zeros(hsv.shape[:2], np.uint8)
-    for lo, hi in line_color_ranges(colour):
+    for lo, hi in parse_color(colour).ranges:
         mask |= cv2.inRange(hsv, np.array(lo), np.array(hi))
     pts = np.round(r.centreline_px[::200]).astype(int)
     assert mask[pts[:, 1], pts[:, 0]].mean() / 255 > 0.95
@@ -262,9 +268,8 @@ def test_same_seed_same_bytes_whatever_the_jobs(tmp_path):
 
 
 def test_default_loading_curve_is_the_model():
-    model = pytest.importorskip("pipeline.model")
-    if not hasattr(model, "psi_deg"):
-        pytest.skip("pipeline.model.psi_deg not available yet")
+    from pipeline import model
+
     curve = loading_curve("DS20", max_kpa=150)
     p = np.array([0.0, 30.0, 60.0])
     assert np.allclose(curve(p), model.psi_deg("DS20", p), atol=0.5)
@@ -280,6 +285,29 @@ def test_cli_writes_a_photoset_and_rejects_bad_keys(tmp_path, capsys):
     assert validate_photoset(out) == []
     assert main(["synth", str(out), "--material", "SS50", "--set", "colour=red"]) == 2
     assert main(["synth", str(out), "--material", "SS50", "--behaviour", "hysteresis=0.9"]) == 2
+
+
+def test_ctrl_c_mid_synth_leaves_no_partial_set_and_keeps_the_previous_one(tmp_path):
+    """SIGINT to the process group (Ctrl-C in a terminal) while `synth` renders with two workers."""
+    out = tmp_path / "set"
+    cmd = [sys.executable, "-m", "pipeline", "synth", str(out), "--material", "SS50", "--actuators", "2",
+           "--trials", "1", "--step-kpa", "20", "--scene", "clean", "--set", "width=320", "--set", "height=240",
+           "--jobs", "2"]
+    render_photoset(out, "SS50", actuators=1, trials=1, step_kpa=130, scene="clean", scene_overrides=SMALL,
+                    psi_fn=toy_psi)  # a previous set in the same place
+    previous = sha(out)
+    proc = subprocess.Popen(cmd, cwd=REPO, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    partial = tmp_path / ".set.partial"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (partial.is_dir() and any(partial.glob("*.jpg"))):
+        time.sleep(0.01)
+    assert proc.poll() is None, "synth finished before it could be interrupted"
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and err.rstrip().endswith("synth: interrupted"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]  # no partial set beside it
+    assert sha(out) == previous  # the previous set is untouched
 
 
 def test_committed_sample_images():

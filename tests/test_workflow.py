@@ -1,11 +1,19 @@
-"""End to end: the real `snakemake` on a tiny config in a temporary folder."""
+"""End to end: the real `snakemake` on tiny configs of the tests' own in temporary folders.
+
+No test reads the user's `config.yaml`: adding a dataset to it (the README's step) changes no
+test result (``test_lint_and_dry_run_plan_every_stage`` runs against such a checkout too).
+"""
 
 from __future__ import annotations
 
+import os
 import re
+import shlex
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -17,12 +25,13 @@ from pipeline.bench.campaign import run_accuracy
 pytestmark = pytest.mark.slow
 
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+PHOTOS = "photos/sample"  # the folder dataset: the first ramp of sample_images/, copied per test
 
 
-def _tiny_config(repo: Path) -> dict:
+def _tiny_config() -> dict:
     return {
         "datasets": [
-            {"name": "sample", "source": "folder", "path": str(repo / "sample_images")},
+            {"name": "sample", "source": "folder", "path": PHOTOS},
             {
                 "name": "tiny",
                 "source": "synthetic",
@@ -48,21 +57,40 @@ def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedPro
     )
 
 
+def _workdir(path: Path, repo: Path, config: dict) -> Path:
+    """A work folder holding the tests' own config and the first ramp of the sample photo set."""
+    photos = path / PHOTOS
+    photos.mkdir(parents=True)
+    shutil.copy(repo / "sample_images" / "photoset.yaml", photos)
+    for table in ("manifest.csv", "truth.csv"):
+        rows = pd.read_csv(repo / "sample_images" / table, dtype=str)
+        rows = rows[rows["trial"] == "1"]
+        rows.to_csv(photos / table, index=False)
+    for image in rows["image"]:
+        shutil.copy2(repo / "sample_images" / image, photos)
+    (path / "config.yaml").write_text(yaml.safe_dump(config))
+    return path
+
+
 def _planned_jobs(stdout: str) -> dict[str, int]:
     table = stdout.split("Job stats:")[-1]
     return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
 
 
+#: tests using the finished run go to one xdist worker (pyproject: --dist loadgroup), which builds it once
+ON_THE_FINISHED_RUN = pytest.mark.xdist_group("finished_run")
+
+
 @pytest.fixture(scope="module")
 def finished_run(tmp_path_factory, request):
     repo = Path(request.config.rootpath)
-    workdir = tmp_path_factory.mktemp("wf")
-    (workdir / "config.yaml").write_text(yaml.safe_dump(_tiny_config(repo)))
+    workdir = _workdir(tmp_path_factory.mktemp("wf"), repo, _tiny_config())
     out = _snakemake(workdir, repo, "--cores", "2")
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-5000:]
     return repo, workdir
 
 
+@ON_THE_FINISHED_RUN
 def test_outputs_exist_and_hold_real_numbers(finished_run):
     repo, workdir = finished_run
     res = workdir / "results"
@@ -85,6 +113,7 @@ def test_outputs_exist_and_hold_real_numbers(finished_run):
         assert any((res / sub).rglob("*")), f"no {sub} written"
 
 
+@ON_THE_FINISHED_RUN
 def test_rerun_does_nothing(finished_run):
     repo, workdir = finished_run
     out = _snakemake(workdir, repo, "-n", "--cores", "2")
@@ -92,9 +121,10 @@ def test_rerun_does_nothing(finished_run):
     assert "Nothing to be done" in out.stdout + out.stderr
 
 
+@ON_THE_FINISHED_RUN
 def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config(repo)
+    cfg = _tiny_config()
     cfg["datasets"].append({"name": "new", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1, "step_kpa": 120, "max_kpa": 240})
     (workdir / "config2.yaml").write_text(yaml.safe_dump(cfg))
     out = _snakemake(workdir, repo, "-n", "--cores", "2", "--configfile", str(workdir / "config2.yaml"))
@@ -107,9 +137,10 @@ def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     assert "results/datasets/tiny/angles.csv" not in re.findall(r"output: (\S+)", out.stdout)
 
 
+@ON_THE_FINISHED_RUN
 def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config(repo)
+    cfg = _tiny_config()
     cfg["model"] = {"readings": {"l0_factor": "metres", "jacobian": "deformed"}}
     (workdir / "config3.yaml").write_text(yaml.safe_dump(cfg))
     out = _snakemake(workdir, repo, "-n", "-p", "--cores", "2", "--configfile", str(workdir / "config3.yaml"))
@@ -124,9 +155,9 @@ def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
 
 
 def test_broken_config_is_refused_before_any_job(tmp_path, repo):
-    cfg = _tiny_config(repo)
+    cfg = _tiny_config()
     cfg["datasets"][1]["material"] = "DS25"
-    (tmp_path / "config.yaml").write_text(yaml.safe_dump(cfg))
+    _workdir(tmp_path, repo, cfg)
     out = _snakemake(tmp_path, repo, "--cores", "1")
     assert out.returncode != 0
     text = out.stdout + out.stderr
@@ -134,26 +165,131 @@ def test_broken_config_is_refused_before_any_job(tmp_path, repo):
     assert not (tmp_path / "results").exists()
 
 
-def test_lint_and_dry_run_on_the_default_config(repo, tmp_path):
-    work = tmp_path / "clone"
-    shutil.copytree(repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__"))
-    out = subprocess.run([*SNAKEMAKE, "--lint"], cwd=work, capture_output=True, text=True)
+def _users_checkout(repo: Path, path: Path) -> Path:
+    """A checkout after the README's "add a dataset" step: a config.yaml with the user's own set.
+
+    Written here, not derived from this checkout's config.yaml, which the tests never read.
+    """
+    ignore = shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__", "tests")
+    shutil.copytree(repo, path, ignore=ignore)
+    shutil.copytree(repo / "sample_images", path / "my_photos")
+    (path / "config.yaml").write_text(
+        "datasets:\n"
+        "  - {name: sample, source: folder, path: sample_images}\n"
+        "  - {name: my_photos, source: folder, path: my_photos}  # the README's step\n"
+    )
+    return path
+
+
+def _every_stage_config(checkout: Path) -> dict:
+    """One of each input: a folder set, synthetic sets, folder and synthetic force sets, a grasp log, the bench.
+
+    The folder's name has a space and a scene override shell syntax: both must reach the commands intact.
+    """
+    photos = "lab photos"  # copied into the work folder
+    return {
+        "datasets": [
+            {"name": "lab", "source": "folder", "path": photos},
+            {"name": "DS20", "source": "synthetic", "material": "DS20", "scene_set": {"noise_sigma": "1 $(touch x)"}},
+            {"name": "SS50", "source": "synthetic", "material": "SS50"},
+        ],
+        "force": {
+            "datasets": [{"name": "force_lab", "source": "folder", "path": photos},
+                         {"name": "force_SS40", "source": "synthetic", "material": "SS40"}],
+            "grasp_log": str(checkout / "pipeline" / "force" / "data" / "grasp_example.csv"),
+        },
+    }
+
+
+@pytest.mark.parametrize("checkout", ["as shipped", "after the README's add-a-dataset step"])
+def test_lint_and_dry_run_plan_every_stage(checkout, repo, tmp_path):
+    src = repo if checkout == "as shipped" else _users_checkout(repo, tmp_path / "user")
+    work = tmp_path / "work"
+    shutil.copytree(repo / "sample_images", work / "lab photos")
+    (work / "config.yaml").write_text(yaml.safe_dump(_every_stage_config(src)))
+    out = _snakemake(work, src, "--lint")
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
-    out = subprocess.run([*SNAKEMAKE, "-n", "--cores", "2"], cwd=work, capture_output=True, text=True)
+    out = _snakemake(work, src, "-n", "-p", "--cores", "2")
     assert out.returncode == 0, out.stderr[-3000:]
-    jobs = _planned_jobs(out.stdout)
-    assert jobs["synth_photoset"] == 4 and jobs["measure"] == 5 and jobs["report"] == 1
+    commands = [shlex.split(line) for line in re.findall(r"^Shell command: (.*)$", out.stdout, re.MULTILINE)]
+    measure = next(c for c in commands if "measure" in c and "lab photos" in c)  # one argument, not two
+    assert measure[measure.index("measure") + 1] == "lab photos"
+    synth = next(c for c in commands if "synth" in c and "results/photosets/DS20" in c)
+    assert synth[synth.index("--set") + 1] == "noise_sigma=1 $(touch x)"  # quoted: never run by the shell
+    assert _planned_jobs(out.stdout) == {
+        "all": 1, "synth_photoset": 2, "measure": 3, "aggregate": 3, "model_curve": 2, "compare": 1,
+        "force_synth_photoset": 1, "force_measure": 2, "force_aggregate": 1, "force_grasp": 1, "bench_default": 1,
+        "resolved_config": 1, "report": 1,
+    }
+    # a folder's measure job waits for the digest of the folder's bytes (kept under results/digests/)
+    for line in ("input: results/digests/datasets/lab.sha256", "input: results/digests/force/force_lab.sha256"):
+        assert line in out.stdout
+    assert (work / "results" / "digests" / "force" / "force_lab.sha256").is_file()
 
 
 def test_slurm_profile_plans_the_workflow(repo, tmp_path):
     work = tmp_path / "clone"
     shutil.copytree(repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__"))
+    cfg = _tiny_config()
+    cfg["datasets"][0]["path"] = "sample_images"
+    (work / "config.yaml").write_text(yaml.safe_dump(cfg))  # the test's own config, never the user's
     out = subprocess.run(
         [*SNAKEMAKE, "--executor", "slurm", "--profile", "rules/profiles/slurm", "-n"],
         cwd=work, capture_output=True, text=True,
+        env={**os.environ, "SBATCH_ACCOUNT": "lab", "SBATCH_PARTITION": "debug"},
     )
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
-    assert _planned_jobs(out.stdout)["measure"] == 5
+    assert _planned_jobs(out.stdout)["measure"] == len(cfg["datasets"])
+
+
+@ON_THE_FINISHED_RUN
+def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_finishes(finished_run, tmp_path):
+    """A re-taken photo re-runs its set's jobs only; Ctrl-C mid-measure; a plain re-run completes."""
+    repo, done = finished_run
+    work = tmp_path / "wf"
+    shutil.copytree(done, work)  # photos, results and Snakemake's records, modification times kept
+    angles = work / "results" / "datasets" / "sample" / "angles.csv"
+    before = pd.read_csv(angles).set_index("image")
+    fixed, donor = "DS20_A1_t1_s003_up_30kPa.jpg", "DS20_A1_t1_s008_up_80kPa.jpg"
+    shutil.copyfile(work / PHOTOS / donor, work / PHOTOS / fixed)  # the lab re-took one photo
+    # run, and Ctrl-C it (SIGINT to the process group, as a terminal sends it) while measure runs
+    run = subprocess.Popen([*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(work), "--cores", "2"],
+                           start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    partial = angles.parent / ".overlays.partial"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and run.poll() is None and not (partial.is_dir() and any(partial.iterdir())):
+        time.sleep(0.01)
+    assert run.poll() is None, "the run ended before it could be interrupted"
+    os.killpg(run.pid, signal.SIGINT)
+    interrupted, _ = run.communicate(timeout=120)
+    assert run.returncode != 0
+    only_this_set = {"measure": 1, "aggregate": 1, "compare": 1, "report": 1, "all": 1}
+    assert _planned_jobs(interrupted.split("Terminating")[0]) == only_this_set  # what the photo set off
+    outputs = re.findall(r"output: (\S+)", interrupted)
+    assert "results/datasets/sample/angles.csv," in outputs and not [o for o in outputs if "/tiny/" in o]
+    assert any((work / ".snakemake" / "incomplete").iterdir())  # a job was cut short ...
+    assert not partial.exists()  # ... and its half-written overlays are gone
+    out = _snakemake(work, repo, "--cores", "2")  # ... and a plain re-run finishes it
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert _planned_jobs(out.stderr) == only_this_set
+    after = pd.read_csv(angles).set_index("image")
+    assert after.loc[fixed, "psi_deg"] == pytest.approx(before.loc[donor, "psi_deg"], abs=1e-6)
+    assert before.loc[fixed, "psi_deg"] != pytest.approx(before.loc[donor, "psi_deg"], abs=1.0)
+    others = before.index.drop(fixed)
+    assert (after.loc[others, "psi_deg"] == before.loc[others, "psi_deg"]).all()
+
+
+def test_a_failed_job_shows_the_end_of_its_log_on_the_console(tmp_path, repo):
+    cfg = _tiny_config()
+    cfg["datasets"] = cfg["datasets"][:1]
+    cfg["force"] = {"grasp_log": "grasp.csv"}
+    _workdir(tmp_path, repo, cfg)
+    (tmp_path / "grasp.csv").write_text("material,mass_g\nDS20,10\n")  # columns missing
+    out = _snakemake(tmp_path, repo, "--cores", "1", "results/force/grasp_summary.csv")
+    assert out.returncode != 0
+    message = (tmp_path / "results" / "logs" / "force_grasp.log").read_text().strip().splitlines()[-1]
+    assert "grasp.csv: missing column(s)" in message  # the log names the file and the fix ...
+    assert message in out.stderr  # ... and the console shows it, not only an exit status
 
 
 def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, repo):

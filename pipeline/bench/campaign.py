@@ -61,11 +61,21 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
 
 
 def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataFrame:
-    """One row per dataset of a finished run that has ground truth."""
+    """One row per dataset of a finished run that has ground truth.
+
+    A relative photo-set path in the config is relative to the run's working folder (the one
+    holding ``results_dir``), wherever this is called from.
+    """
     config = yaml.safe_load((config_path or results_dir / "config.resolved.yaml").read_text())
+    results_dir = Path(results_dir)
+    configured = Path(config.get("results_dir", "results"))
+    depth = len(configured.parts)
+    relative = not configured.is_absolute() and len(results_dir.parts) >= depth
+    workdir = results_dir.parents[depth - 1] if relative else Path(".")
     rows = []
     for ds in config["datasets"]:
-        folder = results_dir / "photosets" / ds["name"] if ds["source"] == "synthetic" else Path(ds.get("path", ""))
+        folder = (results_dir / "photosets" / ds["name"] if ds["source"] == "synthetic"
+                  else workdir / ds.get("path", ""))
         angles = results_dir / "datasets" / ds["name"] / "angles.csv"
         if (folder / "truth.csv").is_file() and angles.is_file():
             stats = campaign_errors(pd.read_csv(angles), pd.read_csv(folder / "truth.csv"))

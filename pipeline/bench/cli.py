@@ -23,10 +23,15 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.folders import staged_folder
+
+if TYPE_CHECKING:
+    from pipeline.bench.grids import Grid
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -83,8 +88,7 @@ def summary(sa: pd.DataFrame, bd: pd.DataFrame, rep: pd.DataFrame, choice: pd.Da
 def run(args: argparse.Namespace) -> int:
     """Run the study and write the tables and charts; 0 on success."""
     t_start = time.perf_counter()
-    from pipeline.bench import analysis, charts, grids
-    from pipeline.bench.run import run_grid
+    from pipeline.bench import grids
 
     if args.jobs < 1:
         raise UserInputError(f"--jobs {args.jobs}: give a number of worker processes >= 1")
@@ -97,8 +101,16 @@ def run(args: argparse.Namespace) -> int:
         unknown = [m for m in methods if m not in METHODS]
         if unknown:
             raise UserInputError(f"--methods: unknown method(s) {unknown}; use some of {sorted(METHODS)}")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    with staged_folder(args.out, marker="results.csv") as out:  # appears only when complete
+        return _run_into(out, args, grid, methods, t_start)
+
+
+def _run_into(out: Path, args: argparse.Namespace, grid: Grid, methods: list[str] | None,
+              t_start: float) -> int:
+    """Render, measure and analyse ``grid`` into the folder ``out``."""
+    from pipeline.bench import analysis, charts, grids
+    from pipeline.bench.run import run_grid
+
     cases = grids.cases(grid, base_seed=args.seed)
 
     def progress(done: int, total: int) -> None:
@@ -124,5 +136,5 @@ def run(args: argparse.Namespace) -> int:
     print(summary(sa, bd, rep, choice, cost))
     total = time.perf_counter() - t_start
     print(f"\nbench --grid {grid.name}: {len(cases)} images x {results['method'].nunique()} methods, "
-          f"jobs={args.jobs}: render+measure {t_measured - t_start:.1f} s, total {total:.1f} s -> {out}")
+          f"jobs={args.jobs}: render+measure {t_measured - t_start:.1f} s, total {total:.1f} s -> {args.out}")
     return 0

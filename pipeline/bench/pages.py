@@ -12,7 +12,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from pipeline.bench import charts
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 #: the tables a bench directory holds (written by ``python -m pipeline bench``)
 TABLES: tuple[str, ...] = (

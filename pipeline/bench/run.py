@@ -43,7 +43,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
 
 
 def _init_worker() -> None:
-    from pipeline.measure.worker import init_worker
+    from pipeline.pool import init_worker
 
     init_worker()
 
@@ -79,8 +79,8 @@ def measure_case(case: Case, methods: Sequence[str], workdir: str | Path) -> lis
     list of dict
         Rows with the keys of :data:`RESULT_COLUMNS`, in the order of ``methods``.
     """
-    from pipeline.measure.core import decode_for_work
-    from pipeline.measure.extract import is_value_only, resolve_ranges
+    from pipeline.measure.core import decode_for_work, decodes_grey
+    from pipeline.measure.settings import resolve_settings
     from pipeline.measure.worker import Task, run_task
 
     t0 = time.perf_counter()
@@ -88,17 +88,19 @@ def measure_case(case: Case, methods: Sequence[str], workdir: str | Path) -> lis
     render_s = time.perf_counter() - t0
     path = Path(workdir) / f"case_{case.case_id:06d}.jpg"
     path.write_bytes(rendered.jpeg_bytes)
-    ranges = resolve_ranges(scene.line_color)  # as measure_photoset hands the colour to its workers
-    fixed = tuple(float(v) for v in rendered.fixed_end_px)
+    settings = resolve_settings(  # as measure_photoset hands the settings to its workers
+        l0_mm=case.l0_mm, mm_per_px=scene.mm_per_px, line_color=scene.line_color,
+        fixed_end=[float(v) for v in rendered.fixed_end_px], positive_turn="ccw",
+    )
     t1 = time.perf_counter()
-    decode_for_work(np.frombuffer(rendered.jpeg_bytes, dtype=np.uint8), grey=is_value_only(ranges))
+    decode_for_work(np.frombuffer(rendered.jpeg_bytes, dtype=np.uint8), grey=decodes_grey(settings))
     decode_s = time.perf_counter() - t1
     k = case.case_id % max(len(methods), 1)
     order = list(methods[k:]) + list(methods[:k])
     out: dict[str, dict[str, Any]] = {}
     try:
         for method in order:
-            row = run_task(Task(str(path), case.l0_mm, scene.mm_per_px, ranges, fixed, "ccw", method))
+            row = run_task(Task(str(path), settings, method))
             err = row["psi_deg"] - case.psi_deg
             out[method] = {
                 "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,

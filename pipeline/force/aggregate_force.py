@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "actuator", "trial", "force_n")
 

@@ -63,6 +63,7 @@ def image_sweep(*, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int 
     import cv2
 
     from pipeline.force.blocked import measure_blocked_image
+    from pipeline.measure.settings import resolve_settings
     from pipeline.force.synth_blocked import blocked_arc_mm
     from pipeline.synth import render_curve, scene_from
 
@@ -79,8 +80,9 @@ def image_sweep(*, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int 
                         img = render_curve(shape.points_mm, scene, seed=np.random.SeedSequence(key), rotation_deg=rot)
                         photo = cv2.imdecode(np.frombuffer(img.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
                         t0 = time.perf_counter()
-                        r = measure_blocked_image(photo, l0_mm=270.0, mm_per_px=scene.mm_per_px,
-                                                  line_color=scene.line_color, fixed_end_px=img.fixed_end_px)
+                        settings = resolve_settings(l0_mm=270.0, mm_per_px=scene.mm_per_px, line_color=scene.line_color,
+                                                    fixed_end=list(img.fixed_end_px))
+                        r = measure_blocked_image(photo, settings)
                         rows.append({"scene": scene_name, "e_true": e, "arc_fraction": fraction, "gap_deg": gap,
                                      "seed": seed, "error": r.eccentricity - e, "status": r.status,
                                      "reason": r.reason, "in_frame": img.line_in_frame,

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,6 +32,8 @@ import numpy as np
 import pandas as pd
 
 from pipeline.force.ellipse import EllipseFit, Refine, fit_ellipse
+from pipeline.measure.colors import BLACK, ColorSpec
+from pipeline.measure.settings import MeasureSettings
 
 RESULT_COLUMNS: tuple[str, ...] = (
     "image", "eccentricity", "eccentricity_sd", "semi_major_px", "semi_minor_px", "semi_major_mm", "semi_minor_mm",
@@ -128,7 +129,7 @@ def line_flags(line: Any, length_px: float, expected_length_px: float | None) ->
     return flags
 
 
-def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndarray, int]:
+def blank_thick_blobs(image_bgr: np.ndarray, color: ColorSpec = BLACK) -> tuple[np.ndarray, int]:
     """Paint over blobs of the line colour much thicker than the line (a dark clamp).
 
     The marker line is thin; a clamp of the same dark colour is a thick blob whose lighter
@@ -141,8 +142,8 @@ def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple
     Parameters
     ----------
     image_bgr : ndarray (H, W, 3) uint8
-    line_color : str or mapping
-        Marker colour (see :func:`pipeline.photoset.line_color_ranges`).
+    color : ColorSpec
+        Marker colour.
 
     Returns
     -------
@@ -153,15 +154,15 @@ def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple
     """
     import cv2
 
-    from pipeline.measure.extract import line_mask
+    from pipeline.measure.extract import clamp_radius_px, line_mask
 
-    mask = (line_mask(image_bgr, line_color)[0] > 0).astype(np.uint8)
+    mask = (line_mask(image_bgr, color)[0] > 0).astype(np.uint8)
     if not mask.any():
         return image_bgr, 0
     dt = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
     ridge = (dt > 0) & (dt >= cv2.dilate(dt, np.ones((3, 3), np.uint8)))
     half_width = float(np.median(dt[ridge])) if ridge.any() else 0.5
-    radius = max(2.5 * half_width, half_width + 3.0)
+    radius = clamp_radius_px(half_width)
     # close the blob's lighter details (frame, screw heads) so it reads as one solid thick blob
     k = 2 * int(np.ceil(2.0 * radius)) + 1
     solid = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
@@ -184,11 +185,8 @@ def blank_thick_blobs(image_bgr: np.ndarray, line_color: Any = "black") -> tuple
 
 def measure_blocked_image(
     image_bgr: np.ndarray | None,
+    settings: MeasureSettings,
     *,
-    l0_mm: float | None = None,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
     refine: Refine = "auto",
     blank_clamp: bool = True,
     **fit_options: Any,
@@ -199,14 +197,10 @@ def measure_blocked_image(
     ----------
     image_bgr : ndarray (H, W, 3) uint8 or None
         The photo (None: unreadable, gives ``failed``).
-    l0_mm : float, optional
-        Length of the marked line (mm); with ``mm_per_px`` it lets a partly hidden line be flagged.
-    mm_per_px : float, optional
-        Scale (mm per px) for the mm columns and the length check.
-    line_color : str or mapping
-        Marker colour (see :func:`pipeline.photoset.line_color_ranges`).
-    fixed_end_px : (x, y), optional
-        Near the clamped end; only helps the extraction pick the line's ends.
+    settings : MeasureSettings
+        The photo's settings: ``l0_mm`` with ``mm_per_px`` lets a partly hidden line be
+        flagged, ``mm_per_px`` gives the mm columns, ``color`` the marker, ``fixed_end_px``
+        only helps the extraction pick the line's ends.
     refine : {"auto", "always", "never"}
         Geometric refinement of the ellipse (see :func:`pipeline.force.ellipse.fit_ellipse`).
     blank_clamp : bool
@@ -223,16 +217,18 @@ def measure_blocked_image(
 
     if image_bgr is None:
         return _failed("unreadable image (cannot be decoded)")
+    color = settings.color or BLACK
     if blank_clamp:
-        image_bgr = blank_thick_blobs(image_bgr, line_color)[0]
+        image_bgr = blank_thick_blobs(image_bgr, color)[0]
     try:
-        line = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px)
+        line = extract_centreline(image_bgr, color=color, fixed_end_px=settings.fixed_end_px)
     except NoLineFound as exc:
         return _failed(str(exc))
     pts = line.centreline_px
     length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) if len(pts) > 1 else 0.0
-    scale_ok = mm_per_px is not None and np.isfinite(mm_per_px) and mm_per_px > 0
-    expected = l0_mm / mm_per_px if scale_ok and l0_mm else None
+    mm_per_px = settings.mm_per_px
+    scale_ok = mm_per_px is not None
+    expected = settings.l0_mm / mm_per_px if mm_per_px else None
     fit = fit_ellipse(pts, refine=refine, **fit_options)
     if not fit:
         return EccentricityResult(fit, length, float(mm_per_px) if scale_ok else float("nan"), "failed", fit.reason, pts)
@@ -259,24 +255,24 @@ def _read_image(path: Path) -> np.ndarray | None:
     return cv2.imdecode(data, cv2.IMREAD_COLOR)
 
 
-def _measure_row(args: tuple[str, dict[str, Any], str, dict[str, Any]]) -> dict[str, Any]:
-    path, settings, refine, fit_options = args
+@dataclass(frozen=True)
+class _Task:
+    path: str
+    settings: MeasureSettings | None
+    reason: str
+    refine: str
+    fit_options: dict[str, Any]
+
+
+def _measure_row(task: _Task) -> dict[str, Any]:
     t0 = time.perf_counter()
-    fe = (settings["fixed_end_x"], settings["fixed_end_y"])
-    fe_px = None if not np.all(np.isfinite(np.asarray(fe, dtype=float))) else (float(fe[0]), float(fe[1]))
-    p = Path(path)
-    if not p.is_file():
+    p = Path(task.path)
+    if task.settings is None:
+        result = _failed(task.reason)
+    elif not p.is_file():
         result = _failed(f"image file {p.name} not found")
     else:
-        result = measure_blocked_image(
-            _read_image(p),
-            l0_mm=settings["l0_mm"],
-            mm_per_px=settings["mm_per_px"],
-            line_color=settings["line_color"],
-            fixed_end_px=fe_px,
-            refine=refine,  # type: ignore[arg-type]
-            **fit_options,
-        )
+        result = measure_blocked_image(_read_image(p), task.settings, refine=task.refine, **task.fit_options)  # type: ignore[arg-type]
     row = result.row()
     row["seconds"] = round(time.perf_counter() - t0, 4)
     return row
@@ -313,24 +309,20 @@ def measure_blocked_photoset(
         When the photo set itself is not valid.
     """
     from pipeline.photoset import load_photoset
+    from pipeline.pool import map_photos
 
     ps = load_photoset(folder)
     m = ps.manifest
-    tasks = []
-    for _, r in m.iterrows():
-        settings = {k: r[k] for k in ("l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y")}
-        settings = {k: (None if k in ("l0_mm", "mm_per_px") and pd.isna(v) else v) for k, v in settings.items()}
-        tasks.append((str(ps.image_path(str(r["image"]))), settings, refine, dict(fit_options)))
-    if jobs > 1 and len(tasks) > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            rows = list(pool.map(_measure_row, tasks, chunksize=max(1, len(tasks) // (4 * jobs))))
-    else:
-        rows = [_measure_row(t) for t in tasks]
+    tasks = [
+        _Task(str(ps.image_path(str(image))), ps.rows[i], ps.row_reason(i), refine, dict(fit_options))
+        for i, image in enumerate(m["image"])
+    ]
+    rows = map_photos(_measure_row, tasks, jobs=jobs, preload=["pipeline.force.blocked"])
     out = pd.DataFrame(rows)
     out.insert(0, "image", m["image"].astype(str).to_numpy())
     out = out[list(RESULT_COLUMNS)]
     for c in CARRIED_COLUMNS:
         if c in m.columns:
             out[c] = m[c].to_numpy()
-    out["image_path"] = [str(Path(t[0]).resolve()) for t in tasks]
+    out["image_path"] = [str(Path(t.path).resolve()) for t in tasks]
     return out

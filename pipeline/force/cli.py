@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _write_csv(df: pd.DataFrame, path: Path) -> None:
-    from pipeline.photoset import atomic_write_bytes
+    from pipeline.fileio import atomic_write_bytes
 
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(path, df.to_csv(index=False, lineterminator="\n").encode())

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 #: the example log shipped with the package (values transcribed from the paper's text, Fig. 8B/8C)
 EXAMPLE_LOG = Path(__file__).with_name("data") / "grasp_example.csv"

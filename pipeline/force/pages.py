@@ -29,9 +29,9 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.transforms import offset_copy
 
+from pipeline.fileio import read_table
 from pipeline.report.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
 from pipeline.report.typeset import Column, Flow, Table, fmt, table_height_pt
-from pipeline.tables import read_table
 
 FORCE_SUMMARY = "force_summary.csv"
 ECCENTRICITY_SUMMARY = "eccentricity_summary.csv"

@@ -304,7 +304,8 @@ def render_blocked_photoset(
     Parameters
     ----------
     out_dir : path
-        Folder to write (created).
+        Folder to write; written under a temporary name and renamed when complete, so an
+        interrupted render leaves nothing (:func:`pipeline.folders.staged_folder`).
     material : str
         A key of :data:`BLOCKED_MATERIALS`.
     actuators, trials : int
@@ -329,57 +330,58 @@ def render_blocked_photoset(
     pandas.DataFrame
         The manifest written.
     """
-    from pipeline.photoset import TRUTH, atomic_write_bytes, write_manifest, write_settings
+    from pipeline.fileio import atomic_write_bytes
+    from pipeline.folders import staged_folder
+    from pipeline.photoset import TRUTH, write_manifest, write_settings
     from pipeline.synth import child_seed, render_curve, scene_from
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    sc = scene_from(scene, **dict(scene_overrides or {}))
-    table = blocked_ramp_table(
-        material, actuators=actuators, trials=trials, seed=seed, step_kpa=step_kpa, max_kpa=max_kpa,
-        force_samples=force_samples, arc_fraction=arc_fraction, gap_deg=gap_deg,
-    )
-    truth_rows = []
-    fixed_ends = []
-    for k, row in table.iterrows():
-        shape = blocked_arc_mm(row["eccentricity"], l0_mm, arc_fraction=row["arc_fraction"], gap_deg=row["gap_deg"])
-        image = render_curve(
-            shape.points_mm, sc, seed=child_seed(int(seed), zlib.crc32(material.encode()), int(k)),
-            rotation_deg=row["rotation_deg"],
+    with staged_folder(out_dir, marker=TRUTH) as tmp:  # the set appears complete or not at all
+        sc = scene_from(scene, **dict(scene_overrides or {}))
+        table = blocked_ramp_table(
+            material, actuators=actuators, trials=trials, seed=seed, step_kpa=step_kpa, max_kpa=max_kpa,
+            force_samples=force_samples, arc_fraction=arc_fraction, gap_deg=gap_deg,
         )
-        atomic_write_bytes(out / row["image"], image.jpeg_bytes)
-        fixed_ends.append(tuple(float(v) for v in image.fixed_end_px))
-        truth_rows.append(
+        truth_rows = []
+        fixed_ends = []
+        for k, row in table.iterrows():
+            shape = blocked_arc_mm(row["eccentricity"], l0_mm, arc_fraction=row["arc_fraction"], gap_deg=row["gap_deg"])
+            image = render_curve(
+                shape.points_mm, sc, seed=child_seed(int(seed), zlib.crc32(material.encode()), int(k)),
+                rotation_deg=row["rotation_deg"],
+            )
+            atomic_write_bytes(tmp / row["image"], image.jpeg_bytes)
+            fixed_ends.append(tuple(float(v) for v in image.fixed_end_px))
+            truth_rows.append(
+                {
+                    "image": row["image"],
+                    "eccentricity": shape.eccentricity,
+                    "force_true_n": row["force_true_n"],
+                    "semi_major_mm": shape.semi_major_mm,
+                    "semi_minor_mm": shape.semi_minor_mm,
+                    "arc_fraction": shape.arc_fraction,
+                    "gap_deg": shape.gap_deg,
+                    "rotation_deg": row["rotation_deg"],
+                    "pressure_kpa": row["pressure_kpa"],
+                    "material": material,
+                    "actuator": row["actuator"],
+                    "trial": row["trial"],
+                }
+            )
+        manifest = table[list(MANIFEST_COLUMNS)].copy()
+        manifest["fixed_end_x"] = [round(x, 1) for x, _ in fixed_ends]
+        manifest["fixed_end_y"] = [round(y, 1) for _, y in fixed_ends]
+        write_manifest(tmp, manifest)
+        write_settings(
+            tmp,
             {
-                "image": row["image"],
-                "eccentricity": shape.eccentricity,
-                "force_true_n": row["force_true_n"],
-                "semi_major_mm": shape.semi_major_mm,
-                "semi_minor_mm": shape.semi_minor_mm,
-                "arc_fraction": shape.arc_fraction,
-                "gap_deg": shape.gap_deg,
-                "rotation_deg": row["rotation_deg"],
-                "pressure_kpa": row["pressure_kpa"],
-                "material": material,
-                "actuator": row["actuator"],
-                "trial": row["trial"],
-            }
+                "l0_mm": float(l0_mm),
+                "mm_per_px": float(sc.mm_per_px),
+                "line_color": sc.line_color,
+                "fixed_end": "auto",
+                "positive_turn": "ccw",
+            },
         )
-    manifest = table[list(MANIFEST_COLUMNS)].copy()
-    manifest["fixed_end_x"] = [round(x, 1) for x, _ in fixed_ends]
-    manifest["fixed_end_y"] = [round(y, 1) for _, y in fixed_ends]
-    write_manifest(out, manifest)
-    write_settings(
-        out,
-        {
-            "l0_mm": float(l0_mm),
-            "mm_per_px": float(sc.mm_per_px),
-            "line_color": sc.line_color,
-            "fixed_end": "auto",
-            "positive_turn": "ccw",
-        },
-    )
-    truth = pd.DataFrame(truth_rows, columns=list(TRUTH_COLUMNS))
-    atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n").encode())
+        truth = pd.DataFrame(truth_rows, columns=list(TRUTH_COLUMNS))
+        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n").encode())
     return manifest
 

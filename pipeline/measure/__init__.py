@@ -2,13 +2,11 @@
 
 Public API
 ----------
-``measure_image(image_bgr, *, l0_mm, mm_per_px=None, line_color="black", fixed_end_px=None,
-positive_turn="ccw", method=DEFAULT_METHOD) -> AngleResult``
-    One decoded photo.
-``measure_file(path, **same) -> (AngleResult, seconds)``
+``measure_image(image_bgr, settings, *, method=DEFAULT_METHOD) -> AngleResult``
+    One decoded photo; ``settings`` is a :class:`~pipeline.measure.settings.MeasureSettings`
+    (``resolve_settings(l0_mm=..., line_color=..., ...)`` builds one).
+``measure_file(path, settings, *, method) -> (AngleResult, seconds)``
     One image file, decoded once at reduced size (grey for a black line).
-``measure_photoset(folder, *, method=DEFAULT_METHOD, jobs=1, overlays_dir=None) -> DataFrame``
-    The angles.csv table of a photo set (see :mod:`pipeline.measure.photoset_measure`).
 ``METHODS``
     name -> estimator: ``paper``, ``paper_corrected``, ``pratt``, ``taubin``, ``hyper``,
     ``turning``, ``auto`` (see :mod:`pipeline.measure.estimators`).
@@ -19,7 +17,7 @@ sub-pixel centre line) -> :mod:`~pipeline.measure.estimators` -> :mod:`~pipeline
 ``AngleResult.degree`` (angles.csv column ``degree``, after ``seconds``) is the complexity of the
 curve model used: 1 = circular arc, more = the turning-angle series ``turning`` / ``auto`` chose.
 
-Files (``measure_file``, ``measure_photoset``) with a black line are decoded in grey at reduced
+Files (``measure_file``, :func:`pipeline.photoset_measure.measure_photoset`) with a black line are decoded in grey at reduced
 size; the extraction runs on a further halved copy and the centre line is refined on the decoded
 image (:mod:`~pipeline.measure.refine`: darkness-profile centroids across the line), which
 costs a third of the work and is as precise; a result that is not ``ok`` there is measured again
@@ -69,21 +67,15 @@ is 5x at best.
 
 from pipeline.measure.core import DEFAULT_METHOD, AngleResult, measure_file, measure_image
 from pipeline.measure.estimators import METHODS, CurveEstimate
+from pipeline.measure.settings import MeasureSettings, resolve_settings
 
 __all__ = [
     "DEFAULT_METHOD",
     "METHODS",
     "AngleResult",
     "CurveEstimate",
+    "MeasureSettings",
     "measure_file",
     "measure_image",
-    "measure_photoset",
+    "resolve_settings",
 ]
-
-
-def __getattr__(name: str):  # lazy: keep pandas out of the workers' imports
-    if name == "measure_photoset":
-        from pipeline.measure.photoset_measure import measure_photoset
-
-        return measure_photoset
-    raise AttributeError(name)

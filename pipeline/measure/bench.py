@@ -43,7 +43,9 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.measure.colors import BLACK
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work, measure_decoded, measure_file
+from pipeline.measure.settings import resolve_settings
 from pipeline.measure.estimators import METHODS, algebraic_circle, hyper
 from pipeline.measure.extract import _candidates, _choose, line_mask
 from pipeline.synth import render_actuator, scene_from
@@ -92,8 +94,8 @@ def accuracy(n: int, seed: int) -> pd.DataFrame:
             data = np.frombuffer(r.jpeg_bytes, np.uint8)
             img, f = decode_for_work(data, grey=True)  # as measure_file / the workers do
             for method in METHODS:
-                res = measure_decoded(data, img, f, l0_mm=L0_MM, mm_per_px=scene.mm_per_px,
-                                      fixed_end_px=r.fixed_end_px, method=method)
+                settings = resolve_settings(l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px))
+                res = measure_decoded(data, img, f, settings, method=method)
                 rows.append({"kind": kind, "method": method, "psi_true": psi, "psi_deg": res.psi_deg,
                              "error": res.psi_deg - psi, "status": res.status})
     return pd.DataFrame(rows)
@@ -115,7 +117,7 @@ def _skeleton_psi(path: Path, mm_per_px: float, fixed_end: tuple[float, float]) 
     from skimage.morphology import skeletonize
 
     img = cv2.imread(str(path))
-    mask, _ = line_mask(img)
+    mask, _ = line_mask(img, BLACK)
     skel = skeletonize(mask.astype(bool))  # the whole frame, as a straightforward pipeline does
     cands = _candidates(mask, fixed_end)
     best, _ = _choose(cands, 0.03 * float(np.hypot(*img.shape[:2])))
@@ -206,14 +208,14 @@ def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] =
                 r = render_actuator(psi, L0_MM, scene, seed=seed * 500 + i)
                 path = workdir / f"s{width}_{i}_tilt{tilt:g}.jpg"
                 path.write_bytes(r.jpeg_bytes)
-                kw = {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px, "fixed_end_px": r.fixed_end_px}
-                res, _ = measure_file(path, **kw)
+                settings = resolve_settings(l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px))
+                res, _ = measure_file(path, settings)
                 skel = _skeleton_psi(path, scene.mm_per_px, r.fixed_end_px)
                 if not timing:
                     data = np.frombuffer(r.jpeg_bytes, np.uint8)
                     timing = {  # partial binds this iteration's values (no late-binding lambdas)
                         "imread_s": _median_time(partial(cv2.imread, str(path)), repeats),
-                        "ours_s": _median_time(partial(measure_file, path, **kw), repeats),
+                        "ours_s": _median_time(partial(measure_file, path, settings), repeats),
                         "skeleton_s": _median_time(
                             partial(_skeleton_psi, path, scene.mm_per_px, r.fixed_end_px), repeats),
                         "decode_floor_s": _median_time(
@@ -382,7 +384,7 @@ def scaling(n: int, seed: int, workdir: Path, copies: int = COPIES) -> dict[str,
     Also ``"start-up, jobs=2"``: the same call on a 2-photo set, i.e. what starting the pool
     costs (forkserver preloading OpenCV/numpy/scipy), which small sets cannot amortise.
     """
-    from pipeline.measure.photoset_measure import measure_photoset
+    from pipeline.photoset_measure import measure_photoset
 
     scene = scene_from("lab", width=4000, height=3000)
     renders = [render_actuator(float(psi), L0_MM, scene, seed=seed + i)

@@ -11,18 +11,19 @@ measured line (mean curvature x measured length).
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
 
-from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, turning_quick
-from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, is_value_only
-from pipeline.measure.quality import assess
+from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
+from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
+from pipeline.measure.quality import assess, assess_body
 from pipeline.measure.refine import refine_centreline
+from pipeline.measure.settings import MeasureSettings
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
@@ -63,6 +64,8 @@ class AngleResult:
         Centre line (x right, y down, original px), fixed end first; empty when failed.
     line_width_px : float
         Width of the extracted line (original px); NaN when failed.
+    length_px : float
+        Measured line length (original px); NaN when failed.
     degree : int
         Complexity of the curve model the estimator used: 1 for a circular arc (constant
         curvature, also the ``paper`` averages), higher for the turning-angle series actually
@@ -79,6 +82,7 @@ class AngleResult:
     centreline_px: np.ndarray
     line_width_px: float = float("nan")
     degree: int = 0
+    length_px: float = float("nan")
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -109,13 +113,9 @@ def _psi_from(est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | 
 
 def measure_work_image(
     image_bgr: np.ndarray,
+    settings: MeasureSettings,
     *,
     scale: float,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     fine: np.ndarray | None = None,
     fine_scale: float = 1.0,
@@ -127,14 +127,18 @@ def measure_work_image(
     ``fine_scale`` < ``scale``) the centre line extracted from ``image_bgr`` is refined on it
     before the curvature fit.
     """
+    method = settings.method or method
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; use one of {sorted(METHODS)}")
-    if positive_turn not in ("ccw", "cw"):
-        raise ValueError(f"positive_turn {positive_turn!r}: use 'ccw' or 'cw'")
-    if mm_per_px is not None and not np.isfinite(mm_per_px):
-        mm_per_px = None
+    if settings.target == "body":
+        return measure_body(image_bgr, settings, scale=scale, method=method)
+    l0_mm, mm_per_px = settings.l0_mm, settings.mm_per_px
+    assert settings.color is not None
+    region = None if image_bgr is None else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     try:
-        line: LineExtraction = extract_centreline(image_bgr, line_color=line_color, fixed_end_px=fixed_end_px, scale=scale)
+        line: LineExtraction = extract_centreline(
+            image_bgr, color=settings.color, fixed_end_px=settings.fixed_end_px, scale=scale, region=region
+        )
     except NoLineFound as exc:
         return failed(method, str(exc))
     if fine is not None:
@@ -142,7 +146,7 @@ def measure_work_image(
         line = replace(line, centreline_px=refined)
     pts = line.centreline_px * np.array([1.0, -1.0])  # y-up: on-screen ccw is positive
     rng = np.random.default_rng(SEED)
-    sign = 1.0 if positive_turn == "ccw" else -1.0
+    sign = settings.sign
     try:
         ends = line.trimmed_px
         arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
@@ -184,17 +188,81 @@ def measure_work_image(
         centreline_px=line.centreline_px,
         line_width_px=line.width_px,
         degree=int(est.degree),
+        length_px=float(est.length_px),
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def _background(path: str, shape: tuple[int, int]) -> np.ndarray | None:
+    """The empty-scene photo, resized to the work image (cached per worker: one decode)."""
+    img = cv2.imread(path, cv2.IMREAD_COLOR)
+    if img is None:
+        return None
+    return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+
+
+def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD) -> AngleResult:
+    """psi of the actuator's body (``target: body``): its centre line's total turning.
+
+    ``auto`` is :func:`~pipeline.measure.estimators.tangents` here (the tip angle: a body is
+    rarely an arc); any other method may be asked for.  A known ``fixed_direction_deg`` replaces
+    the measured base tangent.
+    """
+    from pipeline.measure.body import extract_body
+
+    background = None
+    if settings.background_path is not None and image_bgr is not None:
+        background = _background(settings.background_path, image_bgr.shape[:2])
+        if background is None:
+            return failed(method, f"background photo {Path(settings.background_path).name} cannot be decoded")
+    try:
+        body = extract_body(image_bgr, settings, scale=scale, background_bgr=background)
+    except NoLineFound as exc:
+        return failed(method, str(exc))
+    line = body.line
+    pts = line.centreline_px * np.array([1.0, -1.0])
+    rng = np.random.default_rng(SEED)
+    base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    ends = line.trimmed_px  # the tangents are carried to the clamp face and to the tip (not over a cap)
+    try:
+        tip = tangents(pts, rng, ends_px=ends, base_rad=base)
+        free = tangents(pts, rng, ends_px=ends) if base is not None else tip
+        est = tip if method in ("auto", "tangents") or base is not None else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        return failed(method, f"curvature fit failed: {exc}")
+    sign = settings.sign
+    psi = float(np.rad2deg(sign * est.turning_rad))
+    mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
+    quality = assess_body(
+        line,
+        psi_deg=psi,
+        psi_check_deg=float(np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))),
+        widths_px=body.widths_px,
+        expected_length_px=settings.l0_mm / settings.mm_per_px if settings.mm_per_px else None,
+        length_px=est.length_px,
+        base_mismatch_deg=mismatch,
+        selected_fraction=body.selected_fraction,
+    )
+    mm = settings.mm_per_px
+    return AngleResult(
+        psi_deg=psi,
+        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
+        length_mm=float(est.length_px * mm) if mm else float("nan"),
+        method="tangents" if method == "auto" or base is not None else method,
+        residual_px=est.residual_px,
+        status=quality.status,
+        reason=quality.reason,
+        centreline_px=line.centreline_px,
+        line_width_px=line.width_px,
+        degree=int(est.degree),
+        length_px=float(est.length_px),
     )
 
 
 def measure_image(
     image_bgr: np.ndarray,
+    settings: MeasureSettings,
     *,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     work_width_px: int = WORK_WIDTH_PX,
 ) -> AngleResult:
@@ -204,16 +272,9 @@ def measure_image(
     ----------
     image_bgr : ndarray, shape (H, W, 3), uint8
         The photo (OpenCV BGR).
-    l0_mm : float
-        Length of the marked inextensible layer (mm).
-    mm_per_px : float, optional
-        Image scale (mm per px); without it psi is the total turning angle of the measured line.
-    line_color : str or mapping
-        Marker colour name or HSV range (see :func:`pipeline.photoset.line_color_ranges`).
-    fixed_end_px : (x, y), optional
-        Pixel near the clamped end; None or NaN: guessed.
-    positive_turn : {"ccw", "cw"}
-        Turning direction (fixed end -> free end, as seen on screen) that counts positive.
+    settings : MeasureSettings
+        How to measure it (l0, scale, colour, fixed end, sign, ...), see
+        :func:`pipeline.measure.settings.resolve_settings`.
     method : str
         Estimator, a key of :data:`pipeline.measure.METHODS`.
     work_width_px : int
@@ -228,25 +289,23 @@ def measure_image(
     Examples
     --------
     >>> import cv2, numpy as np
+    >>> from pipeline.measure.settings import resolve_settings
     >>> img = np.full((480, 640, 3), 200, np.uint8)
     >>> t = np.linspace(0, np.pi, 200)                      # half circle, radius 150 px
     >>> pts = np.c_[320 + 150 * np.cos(t), 300 - 150 * np.sin(t)]
     >>> _ = cv2.polylines(img, [np.round(pts * 16).astype(np.int32)], False, (20, 20, 20), 5, cv2.LINE_AA, 4)
-    >>> r = measure_image(img, l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end_px=(470, 300))
+    >>> s = resolve_settings(l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end=[470, 300])
+    >>> r = measure_image(img, s)
     >>> print(round(r.psi_deg), r.status)
     180 ok
     """
-    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
-        fixed_end_px = None
-    kw = dict(l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color, fixed_end_px=fixed_end_px,
-              positive_turn=positive_turn, method=method)
     if image_bgr is None or image_bgr.ndim != 3:
-        return measure_work_image(image_bgr, scale=1.0, **kw)
+        return measure_work_image(image_bgr, settings, scale=1.0, method=method)
     f = reduction_for(image_bgr.shape[1], work_width_px)
-    res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+    res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
-        res = measure_work_image(_reduce(image_bgr, f), scale=float(f), **kw)
+        res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
     return res
 
 
@@ -327,14 +386,15 @@ def _reduce(image: np.ndarray, factor: int) -> np.ndarray:
     return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
 
 
+def decodes_grey(settings: MeasureSettings) -> bool:
+    """Whether a grey (luma) decoding is enough: a black drawn line, nothing needing colour."""
+    return settings.target == "line" and settings.color is not None and settings.color.dark_line
+
+
 def measure_file(
     path: str | Path,
+    settings: MeasureSettings,
     *,
-    l0_mm: float,
-    mm_per_px: float | None = None,
-    line_color: Any = "black",
-    fixed_end_px: tuple[float, float] | None = None,
-    positive_turn: str = "ccw",
     method: str = DEFAULT_METHOD,
     work_width_px: int = WORK_WIDTH_PX,
 ) -> tuple[AngleResult, float]:
@@ -351,41 +411,35 @@ def measure_file(
         data = np.fromfile(str(path), dtype=np.uint8)
     except OSError as exc:
         return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
-    grey = is_value_only(line_color)
-    img, f = decode_for_work(data, work_width_px, grey=grey) if data.size else (None, 1)
+    img, f = decode_for_work(data, work_width_px, grey=decodes_grey(settings)) if data.size else (None, 1)
     if img is None:
         return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
-    if fixed_end_px is not None and not np.all(np.isfinite(fixed_end_px)):
-        fixed_end_px = None
-    res = measure_decoded(
-        data, img, f, l0_mm=l0_mm, mm_per_px=mm_per_px, line_color=line_color,
-        fixed_end_px=fixed_end_px, positive_turn=positive_turn, method=method,
-    )
-    return res, time.perf_counter() - t0
+    return measure_decoded(data, img, f, settings, method=method), time.perf_counter() - t0
 
 
-def measure_decoded(data: np.ndarray, img: np.ndarray, factor: int, **kw: Any) -> AngleResult:
+def measure_decoded(
+    data: np.ndarray, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD
+) -> AngleResult:
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
 
-    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``; ``kw`` are the
-    keyword arguments of :func:`measure_work_image` except ``scale``.  A grey image at least
-    ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line refined
-    on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While the line is
-    narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the image was
-    reduced, it is decoded again at twice the resolution: thin lines cost a second decode, the
-    usual photo only one small one.
+    ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``.  A grey image at
+    least ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line
+    refined on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While
+    the line is narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the
+    image was reduced, it is decoded again at twice the resolution: thin lines cost a second
+    decode, the usual photo only one small one.
     """
     if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
         coarse = _reduce(img, 2)
-        res = measure_work_image(coarse, scale=2.0 * factor, fine=img, fine_scale=float(factor), **kw)
+        res = measure_work_image(coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor))
         # anything doubtful (gaps, rivals, border, ...) is measured again at the decoded size
         if res.status == "ok" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
             return res
-    res = measure_work_image(img, scale=float(factor), **kw)
+    res = measure_work_image(img, settings, scale=float(factor), method=method)
     while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
         factor //= 2
         finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)
         if finer is None:
             break
-        res = measure_work_image(finer, scale=float(factor), **kw)
+        res = measure_work_image(finer, settings, scale=float(factor), method=method)
     return res

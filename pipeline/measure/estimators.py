@@ -27,6 +27,13 @@ Methods
     curvature, up to 9 terms) whose integrated curve is fitted to the centre line, the number
     of terms chosen by BIC (constant curvature unless the photo demands more);
     psi = theta(L) - theta(0).  Right when curvature is not constant.
+``tangents``
+    The tip angle: tangent direction at the free end minus that at the fixed end, each from a
+    straight-line fit of the tangent angle against arc length over an end window (15 % of the
+    line), extrapolated to the line's very ends; turns between them are counted along the line.
+    psi is the total turning whatever the shape, without assuming any model between the ends:
+    the default for an actuator's body (``target: body``) and whenever the direction the
+    actuator leaves the clamp is given (``fixed_direction_deg``).
 ``auto``
     ``hyper``, switching to ``turning`` only when the curvature is visibly not constant.
 
@@ -450,6 +457,89 @@ def turning_quick(
     return CurveEstimate(psi / length, psi, length, resid_px, deg)
 
 
+#: tangents: each end's tangent is fitted over this fraction of the line
+TANGENT_WINDOW_FRACTION = 0.15
+
+
+def _end_angle(s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool) -> tuple[float, float]:
+    """Tangent angle at arc length ``at`` from a line fit over the first/last ``window``; and its RMS."""
+    sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
+    if sel.sum() < 3:
+        sel = np.zeros_like(sel)
+        sel[:3] = True if from_start else False
+        if not from_start:
+            sel[-3:] = True
+    slope, icpt = np.polyfit(s_mid[sel], theta[sel], 1)
+    resid = theta[sel] - (slope * s_mid[sel] + icpt)
+    return float(slope * at + icpt), float(np.sqrt(np.mean(resid**2)))
+
+
+def end_tangents(
+    points: np.ndarray, *, ends_px: tuple[float, float] = (0.0, 0.0), window_fraction: float = TANGENT_WINDOW_FRACTION
+) -> tuple[float, float, float]:
+    """Tangent angles (rad, y-up, unwrapped along the line) at both ends of the whole line.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2)
+        Ordered centre line (y up), fixed end first.
+    ends_px : (float, float)
+        Length of the line beyond the first and the last point (px): the tangent is
+        extrapolated to the line's true ends.
+    window_fraction : float
+        Fraction of the line each end's fit uses.
+
+    Returns
+    -------
+    theta_start, theta_end : float
+    rms_rad : float
+        RMS misfit of the chord angles in the two windows (rad).
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, np.deg2rad(300.0), 500)
+    >>> pts = np.c_[np.sin(t), 1 - np.cos(t)] * 100.0
+    >>> a, b, _ = end_tangents(pts)
+    >>> print(round(float(np.rad2deg(b - a)), 2))
+    300.0
+    """
+    means, piece = chunk_means(points)
+    d = np.diff(means, axis=0)
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    s_mid = (np.arange(1, len(means)) * piece).astype(float)  # chords between means: tangent at the chunk boundary
+    total = len(means) * piece
+    window = max(window_fraction * total, 3.0 * piece)
+    a, ra = _end_angle(s_mid, theta, -ends_px[0], window, True)
+    b, rb = _end_angle(s_mid, theta, total + ends_px[1], window, False)
+    return a, b, float(np.hypot(ra, rb) / np.sqrt(2.0))
+
+
+def tangents(
+    points: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    ends_px: tuple[float, float] = (0.0, 0.0),
+    base_rad: float | None = None,
+) -> CurveEstimate:
+    """psi as the free end's tangent minus the fixed end's (or minus ``base_rad`` when known).
+
+    ``base_rad`` is the known direction the line leaves the clamp (y-up, rad); it is taken on the
+    branch nearest the measured start tangent.  ``neighbour_turning_rad`` holds the same estimate
+    with end windows twice as long: a stability check (they differ on a wobbly or hooked end).
+    """
+    if len(points) < 4:
+        raise ValueError("need at least 4 centre-line points")
+    a, b, rms = end_tangents(points, ends_px=ends_px)
+    a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)
+    if base_rad is not None:
+        base = base_rad + 2 * np.pi * np.round((a - base_rad) / (2 * np.pi))
+        a2, a = a2 - a + base, base
+    length = smooth_length(points) + ends_px[0] + ends_px[1]
+    psi, check = b - a, b2 - a2
+    resid_px = float(rms * length * TANGENT_WINDOW_FRACTION / np.sqrt(12.0))  # angle misfit as a sideways offset
+    return CurveEstimate(psi / length, psi, length, resid_px, 1, check)
+
+
 #: auto: switch from the arc to the turning model beyond this turning-vs-arc difference (deg)
 AUTO_SWITCH_DEG = 1.5
 
@@ -489,5 +579,6 @@ METHODS: dict[str, Estimator] = {
     "taubin": taubin,
     "hyper": hyper,
     "turning": turning,
+    "tangents": tangents,
     "auto": auto,
 }

@@ -2,8 +2,9 @@
 
 Steps (all vectorised OpenCV / numpy / scipy, no per-pixel Python loops):
 
-1. colour mask: the HSV range(s) of ``line_color`` (:func:`pipeline.photoset.line_color_ranges`);
-   for ranges that only bound the value (black) the HSV conversion is skipped;
+1. colour mask: for the colour name ``black`` a black-hat filter of the value channel (thin dark
+   strokes, whatever the lighting), otherwise exactly the colour's HSV ranges
+   (:mod:`pipeline.measure.colors`); pixels outside ``roi`` or inside ``exclude`` are dropped;
 2. connected components; each large one is scored by its length (area / width, the width from
    the distance transform), so the clamp (thick), glare (not in the colour range), short
    distractor marks and specks lose to the long thin marker line;
@@ -23,12 +24,13 @@ on a reduced image (``scale`` > 1).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
-
 import cv2
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
+
+from pipeline.measure.colors import ColorSpec, color_mask
+from pipeline.measure.settings import Polygon
 
 #: components shorter than this (work px) are never the marker line
 MIN_LENGTH_PX = 25.0
@@ -93,46 +95,26 @@ class LineExtraction:
 # colour mask
 
 
-def resolve_ranges(line_color: Any) -> tuple[tuple[tuple[int, int, int], tuple[int, int, int]], ...]:
-    """HSV ranges of a colour name or range spec; already-resolved ranges pass through.
-
-    Parallel workers receive resolved ranges, so they never import :mod:`pipeline.photoset`
-    (and pandas).
-    """
-    if isinstance(line_color, tuple) and line_color and all(
-        isinstance(r, tuple) and len(r) == 2 and all(isinstance(v, tuple) and len(v) == 3 for v in r) for r in line_color
-    ):
-        return line_color
-    from pipeline.photoset import line_color_ranges
-
-    return line_color_ranges(line_color)
-
-
-def is_value_only(line_color: Any) -> bool:
-    """True when the colour range bounds only the value (black): a grey decode is enough."""
-    return all(lo[0] == 0 and hi[0] == 179 and lo[1] == 0 and hi[1] == 255 for lo, hi in resolve_ranges(line_color))
-
-
 def _kernel_px(shape: tuple[int, ...]) -> int:
     """Side of the black-hat square: wider than any marker line, narrower than the clamp."""
     return int(max(11, shape[1] // 40) | 1)
 
 
-def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndarray, np.ndarray]:
+def line_mask(image_bgr: np.ndarray, color: ColorSpec) -> tuple[np.ndarray, np.ndarray]:
     """Binary mask of the marker line's pixels and per-pixel weights for sub-pixel centroids.
 
-    For a value-only range (``black``) the mask is a black-hat (closing minus image) of the
-    value channel ``V = max(B, G, R)`` with a square wider than the line, thresholded at 35 % of
-    its strong response: thin dark strokes stand out whatever the lighting gradient, vignetting or
-    faded ink, while large dark things (clamp block, shadows) do not.  For coloured ranges the
-    HSV range itself is the mask.
+    For the colour name ``black`` (``color.dark_line``) the mask is a black-hat (closing minus
+    image) of the value channel ``V = max(B, G, R)`` with a square wider than the line,
+    thresholded at 35 % of its strong response: thin dark strokes stand out whatever the
+    lighting gradient, vignetting or faded ink, while large dark things (clamp block, shadows) do
+    not.  For any other colour the HSV ranges themselves are the mask.
 
     Parameters
     ----------
     image_bgr : ndarray, shape (H, W, 3) or (H, W), uint8
-        Colour photo, or its grey (luma) decoding for value-only ranges.
-    line_color : str or mapping or resolved ranges
-        See :func:`pipeline.photoset.line_color_ranges`.
+        Colour photo, or its grey (luma) decoding for ``black``.
+    color : ColorSpec
+        See :mod:`pipeline.measure.colors`.
 
     Returns
     -------
@@ -140,7 +122,7 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
     weight : ndarray, shape (H, W), uint8
         Line strength (black-hat response, or the mask for colour ranges).
     """
-    if is_value_only(line_color):
+    if color.dark_line:
         v = image_bgr if image_bgr.ndim == 2 else cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
         k = _kernel_px(image_bgr.shape)
         bh = cv2.morphologyEx(v, cv2.MORPH_BLACKHAT, cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)))
@@ -150,15 +132,35 @@ def line_mask(image_bgr: np.ndarray, line_color: Any = "black") -> tuple[np.ndar
         thr = max(20, int(0.35 * peak))
         mask = (bh >= thr).astype(np.uint8)
         return mask, bh
-    hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
-    out = None
-    ranges = resolve_ranges(line_color)
-    for lo, hi in ranges:
-        m = cv2.inRange(hsv, lo, hi)
-        out = m if out is None else cv2.bitwise_or(out, m)
-    assert out is not None
-    mask = (out > 0).astype(np.uint8)
+    mask = color_mask(image_bgr, color)
     return mask, mask
+
+
+def region_mask(shape: tuple[int, ...], roi: Polygon | None, exclude: tuple[Polygon, ...], scale: float = 1.0) -> np.ndarray | None:
+    """0/1 mask of where the actuator may be (inside ``roi``, outside every ``exclude``), or None.
+
+    Polygons are in original pixels; ``scale`` is original px per px of ``shape``.
+
+    Examples
+    --------
+    >>> m = region_mask((10, 10), ((0, 0), (5, 0), (5, 10), (0, 10)), ())
+    >>> int(m.sum()) > 0 and m[5, 8] == 0
+    True
+    """
+    if roi is None and not exclude:
+        return None
+    h, w = shape[:2]
+
+    def px(poly: Polygon) -> np.ndarray:
+        q = (np.asarray(poly, float) - (scale - 1) / 2) / scale
+        return np.round(q * 16).astype(np.int32)
+
+    out = np.ones((h, w), np.uint8) if roi is None else np.zeros((h, w), np.uint8)
+    if roi is not None:
+        cv2.fillPoly(out, [px(roi)], 1, cv2.LINE_8, 4)
+    for poly in exclude:
+        cv2.fillPoly(out, [px(poly)], 0, cv2.LINE_8, 4)
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -173,6 +175,17 @@ class _Candidate:
     half_width: float
     length: float  # half the outer perimeter: the length of a thin line, small for blobs
     dist_fixed: float  # nearest pixel to the fixed end (work px), inf when unknown
+
+
+def clamp_radius_px(half_width_px: float) -> float:
+    """Thickness (px from the edge) above which a blob of the line's colour is a clamp, not line.
+
+    Examples
+    --------
+    >>> clamp_radius_px(1.0), clamp_radius_px(4.0)
+    (4.0, 10.0)
+    """
+    return max(2.5 * half_width_px, half_width_px + 3.0)
 
 
 def _ridge_half_width(sub: np.ndarray) -> float:
@@ -242,7 +255,7 @@ def _cut_thick_parts(sub: np.ndarray, half_width: float) -> tuple[np.ndarray, np
     """Remove blobs much thicker than the line (a clamp); return (line, removed blob or None)."""
     filled = _fill_small_holes(sub)
     dt = cv2.distanceTransform(filled, cv2.DIST_L2, 3)
-    radius = int(np.ceil(max(2.5 * half_width, half_width + 3.0)))
+    radius = int(np.ceil(clamp_radius_px(half_width)))
     if dt.max() <= radius:
         return sub, None
     k = 2 * radius + 1
@@ -373,7 +386,7 @@ def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> t
     roi = image[y0:y1, x0:x1]
     v = cv2.blur(_value(roi), (5, 5))
     dark = (v <= 110).astype(np.uint8)
-    radius = int(np.ceil(max(2.5 * cand.half_width, cand.half_width + 3.0)))
+    radius = int(np.ceil(clamp_radius_px(cand.half_width)))
     k = 2 * radius + 1
     block = cv2.morphologyEx(dark, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
     if not block.any():
@@ -386,6 +399,39 @@ def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> t
         return line, None
     keep = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
     return (labels == keep).astype(np.uint8), block
+
+
+def _face_distance(image: np.ndarray, points: np.ndarray, half_width: float) -> float:
+    """Distance (work px) back from the line's first point, along its start tangent, to the face of
+    the clamp that was cut off (0 when no clear face is seen).
+
+    Beside the line, on both sides, the photo goes from table to clamp at the face: the two side
+    profiles are sampled (sub-pixel) and the face is where their mean crosses halfway between
+    the table's and the clamp's brightness.
+    """
+    k = min(len(points) - 1, max(len(points) // 20, 3))
+    t = points[0] - points[k]
+    t = t / max(float(np.hypot(*t)), 1e-9)  # pointing back, towards the clamp
+    nrm = np.array([-t[1], t[0]])
+    steps = np.arange(0.0, 14.0 * half_width + 14.0, 0.25, dtype=np.float32)
+    side = 2.0 * half_width + 3.0
+    v = _value(image).astype(np.float32)
+    prof = np.zeros_like(steps)
+    for sgn in (-1.0, 1.0):
+        cx = (points[0, 0] + steps * t[0] + sgn * side * nrm[0]).astype(np.float32)[None, :]
+        cy = (points[0, 1] + steps * t[1] + sgn * side * nrm[1]).astype(np.float32)[None, :]
+        prof += 0.5 * cv2.remap(v, cx, cy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0]
+    table = float(np.median(prof[: max(4, len(prof) // 12)]))
+    dark = float(prof.min())
+    if table - dark < 25.0:
+        return 0.0
+    below = np.nonzero(prof <= 0.5 * (table + dark))[0]
+    if not below.size or below[0] == 0:
+        return 0.0
+    j = int(below[0])
+    a, b = prof[j - 1], prof[j]
+    frac = (a - 0.5 * (table + dark)) / max(a - b, 1e-6)
+    return float(steps[j - 1] + frac * (steps[j] - steps[j - 1]))
 
 
 def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> float:
@@ -445,9 +491,10 @@ def _bridge(
 def extract_centreline(
     image_bgr: np.ndarray,
     *,
-    line_color: Any = "black",
+    color: ColorSpec,
     fixed_end_px: tuple[float, float] | None = None,
     scale: float = 1.0,
+    region: np.ndarray | None = None,
 ) -> LineExtraction:
     """Extract the ordered sub-pixel centre line of the marker line.
 
@@ -455,12 +502,14 @@ def extract_centreline(
     ----------
     image_bgr : ndarray, shape (H, W, 3), uint8
         The photo, possibly reduced by ``scale`` from the original.
-    line_color : str or mapping
-        Marker colour (name or HSV range).
+    color : ColorSpec
+        Marker colour.
     fixed_end_px : (x, y) or None
         The clamped end of the line in *original* pixels; None: guess it.
     scale : float
         Original pixels per pixel of ``image_bgr``.
+    region : ndarray of 0/1, optional
+        Where the line may be (:func:`region_mask`, same size as ``image_bgr``).
 
     Returns
     -------
@@ -473,17 +522,21 @@ def extract_centreline(
     """
     if image_bgr is None or not (image_bgr.ndim == 2 or (image_bgr.ndim == 3 and image_bgr.shape[2] == 3)):
         raise NoLineFound("unreadable image (not a colour or grey image)")
-    if image_bgr.ndim == 2 and not is_value_only(line_color):
-        raise NoLineFound(f"a grey image cannot show line_color={line_color!r}; decode it in colour")
+    if image_bgr.ndim == 2 and not color.dark_line:
+        raise NoLineFound(f"a grey image cannot show line_color {color.describe()}; decode it in colour")
     h, w = image_bgr.shape[:2]
     fe = None
     if fixed_end_px is not None and np.all(np.isfinite(fixed_end_px)):
         fe = ((fixed_end_px[0] - (scale - 1) / 2) / scale, (fixed_end_px[1] - (scale - 1) / 2) / scale)
-    mask, weight = line_mask(image_bgr, line_color)
+    mask, weight = line_mask(image_bgr, color)
+    if region is not None:
+        mask &= region
     cands = _candidates(mask, fe)
     if not cands:
+        where = " inside roi / outside exclude" if region is not None else ""
         raise NoLineFound(
-            f"no line found: no long thin component of line_color={line_color!r}; check line_color and lighting"
+            f"no line found: nothing long and thin of line_color {color.describe()}{where}; "
+            "check line_color (python -m pipeline photoset preview shows what it selects)"
         )
     diag = float(np.hypot(h, w))
     best, at_fixed = _choose(cands, near_px=0.03 * diag)
@@ -516,11 +569,22 @@ def extract_centreline(
         raise NoLineFound(f"no line found: the longest candidate is only {len(points)} bands long")
     fixed_auto = fe is None
     clamp_seen = thick is not None
+    clamp_face: np.ndarray | None = None  # (x, y) pixels of the clamp's face, work image
     if fixed_auto:
         ends_g = ends + np.array([x0, y0], float)
-        darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
-        clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
-        if darkness[1] > darkness[0]:  # the clamp (dark block) sits at the fixed end
+        clamp_end = None
+        if thick is not None:
+            # the clamp that was cut off sits at the fixed end: the end nearer to it
+            ty, tx = np.nonzero(thick)
+            face = np.c_[tx + best.x0, ty + best.y0].astype(float)
+            d = [float(np.min(np.hypot(*(face - e).T))) for e in ends_g]
+            if min(d) < 0.5 * max(d):
+                clamp_end, clamp_face = int(np.argmin(d)), face
+        if clamp_end is None:
+            darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
+            clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
+            clamp_end = 1 if darkness[1] > darkness[0] else 0  # the clamp (dark block) sits at the fixed end
+        if clamp_end == 1:
             points, ends = points[::-1], ends[::-1]
     ys, xs = np.nonzero(line)
     touches = bool(xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1)
@@ -539,9 +603,13 @@ def extract_centreline(
     # the end bands' centroids lie about a quarter band inside the line's ends (measured on
     # synthetic lines of known length)
     trimmed = ((s_along[i0] + band / 4) * scale, (s_along[-1] - s_along[i1] + band / 4) * scale)
-    if fe is not None:
-        # the line starts at the given fixed end, also where the clamp cut removed a piece of it
-        gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+    if fe is not None or clamp_face is not None:
+        # the line starts at the given fixed end (or, guessed, at the face of the clamp that was cut
+        # off), also where the clamp cut removed a piece of it
+        if fe is not None:
+            gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+        else:
+            gap_fixed = _face_distance(image_bgr, gpts, best.half_width) * scale
         if gap_fixed < 0.15 * s_along[-1] * scale:
             trimmed = (max(trimmed[0], gap_fixed), trimmed[1])
     centre = gpts * scale + (scale - 1) / 2

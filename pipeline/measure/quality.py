@@ -37,6 +37,9 @@ NONCONSTANT_DEG = 1.5
 DISAGREE_DEG = 3.0
 #: measured / expected length outside [LENGTH_LOW, LENGTH_HIGH] -> flagged
 LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
+#: flags that doubt only how much of the line was seen, not the angle read from it: a photo
+#: flagged for these alone is trusted again when its psi agrees with its ramp (pipeline.ramp_check)
+COSMETIC_FLAGS: tuple[str, ...] = ("line partly hidden", "line touches the image border", "body partly hidden")
 
 
 @dataclass(frozen=True)
@@ -136,3 +139,65 @@ def assess(
         flags.append("fixed end guessed (no clamp seen at either end); set fixed_end")
     status = "flagged" if flags else "ok"
     return Quality(status, "; ".join(flags + notes))
+
+
+#: body: the free end's tangent may move this much (deg) when its fit window doubles
+TIP_UNSTABLE_DEG = 8.0
+#: body: width along the centre line (90th / 10th percentile) above this -> uneven outline
+WIDTH_RATIO = 2.2
+#: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
+BASE_MISMATCH_DEG = 20.0
+
+
+def assess_body(
+    line: LineExtraction,
+    *,
+    psi_deg: float,
+    psi_check_deg: float,
+    widths_px: "np.ndarray",
+    expected_length_px: float | None,
+    length_px: float,
+    base_mismatch_deg: float | None,
+    selected_fraction: float,
+) -> Quality:
+    """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
+
+    Flagged when the body leaves the photo; several bodies compete; the fixed end is not
+    reached or guessed; the outline is uneven (the segmentation leaked into the backdrop, or
+    lost part of the body); the free end's direction depends on how much of the end is fitted
+    (a hooked or ragged tip); the body closes on itself; or it is much shorter than ``l0``
+    (partly hidden).  Notes (status stays ``ok``) say how psi was taken.
+    """
+    import numpy as np
+
+    flags: list[str] = []
+    notes: list[str] = []
+    if line.touches_border:
+        flags.append("body touches the image border")
+    if line.n_candidates > 1:
+        flags.append(f"{line.n_candidates} candidate bodies")
+    if not line.fixed_end_found:
+        flags.append("no body reaches fixed_end; used the largest")
+    elif line.fixed_end_auto:
+        flags.append("fixed end guessed; set fixed_end")
+    w = widths_px[np.isfinite(widths_px) & (widths_px > 0)]
+    if w.size >= 8:
+        core = w[int(0.1 * len(w)) : max(int(0.9 * len(w)), int(0.1 * len(w)) + 1)]
+        lo, hi = np.percentile(core, [10, 90])
+        if lo > 0 and hi / lo > WIDTH_RATIO:
+            flags.append(f"uneven outline (width {lo:.0f}-{hi:.0f} px): check line_color / roi / exclude in photoset preview")
+    if abs(psi_check_deg - psi_deg) > TIP_UNSTABLE_DEG:
+        flags.append(f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)")
+    if line.branched_fraction > 0.05:
+        flags.append("body closes on itself")
+    elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
+        flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
+    if expected_length_px and length_px < 0.8 * expected_length_px:
+        flags.append(f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible")
+    if base_mismatch_deg is not None:
+        notes.append("psi from the free end's tangent against fixed_direction_deg")
+        if abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
+            flags.append(f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg")
+    if selected_fraction > 0.35:
+        notes.append(f"selection covers {100 * selected_fraction:.0f}% of the photo")
+    return Quality("flagged" if flags else "ok", "; ".join(flags + notes))

@@ -13,46 +13,42 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipeline.measure.core import decode_for_work, failed, measure_decoded
-from pipeline.measure.extract import is_value_only
+from pipeline.measure.core import DEFAULT_METHOD, AngleResult, decode_for_work, decodes_grey, failed, measure_decoded
+from pipeline.measure.settings import MeasureSettings
 
 
 @dataclass(frozen=True)
 class Task:
-    """Everything needed to measure one photo (picklable)."""
+    """Everything needed to measure one photo (picklable).
+
+    ``settings`` is None for a manifest row that cannot be measured; ``reason`` then says why.
+    """
 
     path: str
-    l0_mm: float
-    mm_per_px: float | None
-    line_color: Any
-    fixed_end_px: tuple[float, float] | None
-    positive_turn: str
-    method: str
+    settings: MeasureSettings | None
+    method: str = DEFAULT_METHOD
     overlay_path: str | None = None
     title: str = ""
-
-
-def init_worker() -> None:
-    """Pool initialiser: one OpenCV thread per process (the pool is the parallelism)."""
-    cv2.setNumThreads(1)
+    reason: str = ""
 
 
 def run_task(task: Task) -> dict[str, Any]:
     """Measure one photo; return the angles.csv fields (without the manifest columns)."""
     t0 = time.perf_counter()
     img, f = None, 1
+    res: AngleResult
     try:
-        data = np.fromfile(task.path, dtype=np.uint8)
-        if data.size:
-            img, f = decode_for_work(data, grey=is_value_only(task.line_color))
-        res = (
-            failed(task.method, f"unreadable image: {task.path} cannot be decoded")
-            if img is None
-            else measure_decoded(
-                data, img, f, l0_mm=task.l0_mm, mm_per_px=task.mm_per_px, line_color=task.line_color,
-                fixed_end_px=task.fixed_end_px, positive_turn=task.positive_turn, method=task.method,
+        if task.settings is None:
+            res = failed(task.method, task.reason)
+        else:
+            data = np.fromfile(task.path, dtype=np.uint8)
+            if data.size:
+                img, f = decode_for_work(data, grey=decodes_grey(task.settings))
+            res = (
+                failed(task.method, f"unreadable image: {task.path} cannot be decoded")
+                if img is None
+                else measure_decoded(data, img, f, task.settings, method=task.method)
             )
-        )
     except OSError as exc:
         res = failed(task.method, f"unreadable image: {task.path}: {exc.strerror or exc}")
     except Exception as exc:  # one bad photo never stops the set
@@ -70,6 +66,7 @@ def run_task(task: Task) -> dict[str, Any]:
         "psi_deg": res.psi_deg,
         "kappa_per_mm": res.kappa_per_mm,
         "length_mm": res.length_mm,
+        "length_px": res.length_px,
         "method": res.method,
         "residual_px": res.residual_px,
         "status": res.status,

@@ -9,13 +9,23 @@ load_materials(path=None) -> dict[str, Material]
 model_curve(material, psi_deg=None, **options) -> DataFrame   (with the reason for every NaN)
 snap_regions(material, **options) -> DataFrame                 (snap-through jumps)
 anchor_table(**options) -> DataFrame                           (paper anchors: paper, ours, % off)
-fit_eq12_scale(**options) -> float                             (Eq. 12 prefactor fitted to them)
+fit_l0(**options) -> float                                     (the l0 the two model results fix)
+search_readings(keys) -> DataFrame, select_reading(df)         (the selection protocol)
+fit_eq12_scale(**options) -> float                             (the fitted_scale option: a fit)
 
 ``options`` are the readings of the ambiguous equations and the quadrature sizes, see
 :class:`ModelOptions` and ``docs/model.md``.  Material names: "DS20", "DS30", "SS40", "SS50".
 """
 
-from pipeline.model.calibrate import anchor_table, fit_eq12_scale, fit_k_p
+from pipeline.model.calibrate import (
+    PROTOCOL,
+    anchor_table,
+    fit_eq12_scale,
+    fit_k_p,
+    fit_l0,
+    search_readings,
+    select_reading,
+)
 from pipeline.model.forward import model_curve, pressure_kpa
 from pipeline.model.geometry import REASONS
 from pipeline.model.inverse import psi_deg, snap_regions
@@ -26,6 +36,7 @@ MATERIAL_NAMES: tuple[str, ...] = ("DS20", "DS30", "SS40", "SS50")
 
 __all__ = [
     "CHOICES",
+    "PROTOCOL",
     "DEFAULT_MATERIALS_PATH",
     "MATERIAL_NAMES",
     "REASONS",
@@ -34,10 +45,13 @@ __all__ = [
     "anchor_table",
     "fit_eq12_scale",
     "fit_k_p",
+    "fit_l0",
     "load_materials",
     "make_options",
     "model_curve",
     "pressure_kpa",
     "psi_deg",
+    "search_readings",
+    "select_reading",
     "snap_regions",
 ]

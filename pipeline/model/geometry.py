@@ -17,13 +17,19 @@ from pipeline.model.options import ModelOptions
 
 FloatArray = NDArray[np.float64]
 
+#: gauge pressure of absolute vacuum (kPa): no pressure below it exists
+ABSOLUTE_VACUUM_KPA = -101.325
+
 #: reason codes attached to NaN results
-OK, BAD_STRETCH, BAD_THICKNESS, NO_EQ5_ROOT = 0, 1, 2, 3
+OK, BAD_STRETCH, BAD_THICKNESS, NO_EQ5_ROOT, NAN_PSI, INF_PSI, BELOW_VACUUM = range(7)
 REASONS: dict[int, str] = {
     OK: "",
     BAD_STRETCH: "a stretch ratio (Eqs. 1-3) would be <= 0",
     BAD_THICKNESS: "scaled wall thickness t (Eq. 4 with k_t) would be <= 0",
     NO_EQ5_ROOT: "Eq. 5 has no root phi_m for this wall thickness",
+    NAN_PSI: "psi is NaN",
+    INF_PSI: "psi is infinite",
+    BELOW_VACUUM: "the pressure would be below absolute vacuum (-101.3 kPa gauge)",
 }
 
 

@@ -19,7 +19,7 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from pipeline.errors import UserInputError
-from pipeline.model.forward import pressure_core, psi_grid_rad
+from pipeline.model.forward import as_numbers, pressure_core, psi_grid_rad
 from pipeline.model.materials import Material, resolve_material
 from pipeline.model.options import ModelOptions, make_options
 
@@ -254,7 +254,7 @@ def psi_deg(
         raise UserInputError(f"psi_deg: branch={branch!r} is not one of {BRANCHES}")
     mat = resolve_material(material)
     opts = make_options(**options)
-    p = np.asarray(pressure_kpa, dtype=float)
+    p = as_numbers(pressure_kpa, "pressure_kpa")
     out = psi_rad_core(mat, p.ravel(), opts, branch)
     return np.degrees(out).reshape(p.shape)
 

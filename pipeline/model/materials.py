@@ -66,6 +66,38 @@ class Material:
         return math.radians(self.psi0_deg)
 
     @property
+    def height_mm(self) -> float:
+        """Height b + a0 + t0 of the section above the inextensible layer (mm)."""
+        return self.b_mm + self.a0_mm + self.t0_mm
+
+    @property
+    def min_l0_mm(self) -> float:
+        """Shortest l0 the section allows: the top fibre's rest length l0 - h psi0 must be > 0."""
+        return self.height_mm * self.psi0_rad
+
+    def check_l0(self, l0_mm: float, where: str = "l0_mm") -> float:
+        """``l0_mm`` if the section fits on it, else a :class:`UserInputError` with the fix.
+
+        Examples
+        --------
+        >>> from pipeline.model import load_materials
+        >>> load_materials()["SS40"].check_l0(30.0)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        pipeline.errors.UserInputError: l0_mm = 30 mm is shorter ... l0 must exceed 51.3 mm; ...
+        """
+        if not l0_mm > self.min_l0_mm:
+            raise UserInputError(
+                f"{where} = {l0_mm:g} mm is shorter than {self.name}'s own wall allows: at "
+                f"psi0 = {self.psi0_deg:g} deg the top of the section (b + a0 + t0 = "
+                f"{self.height_mm:g} mm above the inextensible layer) would have a rest length "
+                f"l0 - {self.height_mm:g} mm x psi0 <= 0, so l0 must exceed "
+                f"{self.min_l0_mm:.1f} mm; pass the length of the marked layer in mm (the "
+                "paper's actuators: 170-270 mm)"
+            )
+        return float(l0_mm)
+
+    @property
     def area0_mm2(self) -> float:
         """Undeformed area A0 of the semi-circular wall, pi/2 ((a0 + t0)^2 - a0^2), in mm^2."""
         return 0.5 * math.pi * ((self.a0_mm + self.t0_mm) ** 2 - self.a0_mm**2)
@@ -131,7 +163,7 @@ def _parse_material(name: str, raw: Any, geometry: dict[str, Any], where: str) -
     k_p = _number(raw["k_p"], here, "k_p")
     if k_p <= 0:
         raise UserInputError(f"{here}: 'k_p' must be > 0, got {k_p}")
-    return Material(
+    mat = Material(
         name=str(name),
         mu_mpa=mu_t,
         alpha=alpha_t,
@@ -140,6 +172,8 @@ def _parse_material(name: str, raw: Any, geometry: dict[str, Any], where: str) -
         description=str(raw.get("description", "")),
         **geo_f,
     )
+    mat.check_l0(mat.l0_mm, where=f"{here}: l0_mm")
+    return mat
 
 
 @functools.lru_cache(maxsize=16)

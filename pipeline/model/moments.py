@@ -31,11 +31,13 @@ def stress_moment_nmm(
     The base (width 2 (a0 + t0), stretch of Eq. 1, lambda_2 = 1) plus the deformed wall (stretches
     of Eqs. 2-3 on the deformed section, integrated over the undeformed tau in [0, t0] and phi in
     [-pi/2, pi/2] by Gauss-Legendre, using the evenness in phi).  ``opts.jacobian="deformed"``
-    multiplies the wall area element by (2 phi_m/pi)(t/t0); ``opts.l0_factor`` puts in place of
-    the printed l0 prefactor the fitted number ``opts.eq12_scale`` ("calibrated"), l0 in metres
-    ("metres") or nothing ("none"); ``opts.stress="nominal"`` divides the
-    Cauchy stress by lambda_1; ``opts.base_width="one_side"`` drops the factor 2 of the base
-    term; ``opts.wall_coords`` is passed to :func:`pipeline.model.geometry.wall_coordinates`.
+    multiplies the wall area element by (2 phi_m/pi)(t/t0), ``"deformed_angle"`` by (2 phi_m/pi)
+    only (the integral over phi' without dtau'/dtau); ``opts.l0_factor`` keeps the printed l0
+    prefactor with l0 in metres ("metres"), drops it ("none") or puts the FITTED number
+    ``opts.eq12_scale`` in its place ("fitted_scale", resolved by the caller);
+    ``opts.stress="nominal"`` divides the Cauchy stress by lambda_1;
+    ``opts.base_width="one_side"`` drops the factor 2 of the base term; ``opts.wall_coords`` is
+    passed to :func:`pipeline.model.geometry.wall_coordinates`.
 
     Returns
     -------
@@ -68,10 +70,12 @@ def stress_moment_nmm(
     m_wall = 2.0 * np.einsum("nij,i,j->n", integrand, w_tau, w_phi)
     if opts.jacobian == "deformed":
         m_wall = m_wall * (2.0 * sec.phi_m / math.pi) * (sec.t / mat.t0_mm)
+    elif opts.jacobian == "deformed_angle":
+        m_wall = m_wall * (2.0 * sec.phi_m / math.pi)
     moment = m_base + m_wall
     if opts.l0_factor == "metres":
         moment = moment * (l0 / 1000.0)
-    elif opts.l0_factor == "calibrated":
+    elif opts.l0_factor == "fitted_scale":
         moment = moment * opts.eq12_scale
     reason = np.where((sec.reason == OK) & bad, BAD_STRETCH, sec.reason)
     return np.where(reason == OK, moment, np.nan), reason
@@ -89,3 +93,22 @@ def pressure_area_mm3(mat: Material, sec: Section, opts: ModelOptions) -> FloatA
         s, c = np.sin(sec.phi_m), np.cos(sec.phi_m)
         return (mat.b_mm + q) * a**2 * (sec.phi_m - s * c) + (2.0 / 3.0) * a**3 * s**3
     return (4.0 * a**3 + 3.0 * math.pi * a**2 * (mat.b_mm + q)) / 6.0
+
+
+def wall_area_mm2(mat: Material, sec: Section, opts: ModelOptions) -> FloatArray:
+    """Area the Eq. 12 wall element integrates to, per angle (mm^2): a check of each reading.
+
+    The integral of (a + tau') times the ``jacobian`` factor over tau in [0, t0] and phi in
+    [-pi/2, pi/2].  Only ``jacobian="deformed"`` gives A0 (the incompressible wall area of Eq. 6)
+    at every angle; ``"none"`` and ``"deformed_angle"`` do not (``deformed_angle``: A0 t0 / t).
+    """
+    tau, w_tau = gauss_nodes(opts.n_tau, 0.0, mat.t0_mm)
+    phi, w_phi = gauss_nodes(opts.n_phi, 0.0, 0.5 * math.pi)
+    r_def, _, _ = wall_coordinates(mat, sec, tau, phi, opts)
+    r_def = np.broadcast_to(r_def, (sec.a.size, tau.size, phi.size))
+    area = 2.0 * np.einsum("nij,i,j->n", r_def, w_tau, w_phi)
+    if opts.jacobian == "deformed":
+        area = area * (2.0 * sec.phi_m / math.pi) * (sec.t / mat.t0_mm)
+    elif opts.jacobian == "deformed_angle":
+        area = area * (2.0 * sec.phi_m / math.pi)
+    return area

@@ -24,9 +24,10 @@ from matplotlib.figure import Figure
 
 from pipeline import __version__
 from pipeline.bench import pages as bench_pages
+from pipeline.fileio import atomic_write_bytes
 from pipeline.force import pages as force_pages
-from pipeline.photoset import atomic_write_bytes
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
+from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
 from pipeline.report.provenance import provenance_pages
 from pipeline.report.style import FOOTER_PT, material_colors, report_style
@@ -38,6 +39,7 @@ CONTENTS: dict[str, str] = {
     "overview": "All materials (as Fig. 6)",
     "material": "One page per material: curves, table, photos",
     "comparison": "Model versus measurements, beside the paper",
+    "model-curves": "Which model curve and l0; fitted or predicted",
     "speed-accuracy": "Angle methods: speed against accuracy",
     "stability": "Angle methods: stability, where each breaks",
     "bench-tables": "Angle methods: breakdown, repeatability tables",
@@ -153,6 +155,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
     body = [overview_page(data)] + [material_page(data, m) for m in data.materials] + [comparison_page(data)]
+    body += [f for f in [model_provenance_page(data)] if f is not None]  # which l0, what was fitted
     body += extra + provenance_pages(data, __version__, infos, warnings)
     return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
 

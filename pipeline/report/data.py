@@ -7,7 +7,9 @@ photos were taken, read from the inputs (:func:`dataset_dates`).
 
 from __future__ import annotations
 
+import csv
 import hashlib
+import io
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -25,9 +27,9 @@ from pipeline.aggregate import (
 from pipeline.compare import check_hysteresis
 from pipeline.bench.pages import TABLES as BENCH_TABLES
 from pipeline.errors import UserInputError
+from pipeline.fileio import read_table
 from pipeline.force.pages import FILES as FORCE_FILES
 from pipeline.photoset import MANIFEST, SETTINGS, TRUTH
-from pipeline.tables import read_table
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
 EXIF_IFD, EXIF_DATETIME_ORIGINAL, EXIF_DATETIME = 0x8769, 36867, 306
@@ -120,7 +122,8 @@ class ReportData:
     model_curves : pandas.DataFrame
         ``material``, ``psi_deg``, ``pressure_kpa`` (may be empty).
     files : tuple of InputFile
-        Every input file with its sha256, in a fixed order.
+        Every input file with its sha256, in a fixed order; angles tables without their timing
+        column (:func:`sha256_measurements`).
     datasets : tuple of DatasetInfo
         Source and dates of each dataset, in input order.
     notes : list of str
@@ -159,6 +162,37 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
     except OSError as exc:
         raise UserInputError(f"{path}: cannot read ({exc.strerror}); check the path") from None
     return h.hexdigest()
+
+
+TIMING_COLUMNS: tuple[str, ...] = ("seconds",)
+
+
+def sha256_measurements(path: str | os.PathLike[str], timing: Sequence[str] = TIMING_COLUMNS) -> str:
+    """Hex sha256 of a CSV table without its run-time columns (``seconds``).
+
+    A measure job records how long each photo took; two runs on the same photos (on a
+    workstation or on a cluster) differ only there. The rest of the table, re-written with
+    ``\\n`` line ends, identifies the measurements. A table without such a column gets the
+    digest of its bytes, as :func:`sha256_file`.
+
+    Raises
+    ------
+    UserInputError
+        If the file cannot be read.
+    """
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserInputError(f"{path}: cannot read ({exc}); check the path") from None
+    rows = list(csv.reader(io.StringIO(text)))
+    drop = {i for i, name in enumerate(rows[0] if rows else []) if name in timing}
+    if not drop:
+        return sha256_file(path)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerows([v for i, v in enumerate(row) if i not in drop] for row in rows)
+    return hashlib.sha256(out.getvalue().encode("utf-8")).hexdigest()
 
 
 def _read_csv(path: Path, what: str, required: Sequence[str]) -> pd.DataFrame:
@@ -207,9 +241,10 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
     rms = pd.concat(
         [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms], ignore_index=True
     ) if inputs.rms else pd.DataFrame(columns=["material"])
-    if rms["material"].duplicated().any():
-        dup = rms.loc[rms["material"].duplicated(), "material"].iloc[0]
-        raise UserInputError(f"--rms: material {dup!r} appears twice; pass one rms.csv row per material")
+    key = "curve" if "curve" in rms.columns else "material"  # one row per material and l0
+    if rms[key].duplicated().any():
+        dup = rms.loc[rms[key].duplicated(), key].iloc[0]
+        raise UserInputError(f"--rms: {key} {dup!r} appears twice; pass one rms.csv row per {key}")
     curves = pd.concat(
         [_read_csv(p, "model curve CSV from 'model curve'", ("material", "psi_deg", "pressure_kpa"))
          for p in inputs.model_curves], ignore_index=True
@@ -226,7 +261,8 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
 
 
 def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
-    """Every file the report reads, with its sha256 (photos are covered by their manifests)."""
+    """Every file the report reads, with its sha256 (photos are covered by their manifests; angles
+    tables are hashed without their run-time column, :func:`sha256_measurements`)."""
     files: list[tuple[str, Path]] = []
     for d in inputs.datasets:
         files.append((f"{d.name}: angles", d.angles_csv))
@@ -241,7 +277,8 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
             files += [(role, folder / n) for n in names if (folder / n).is_file()]
     if inputs.config is not None:
         files.append(("config", inputs.config))
-    return tuple(InputFile(role, str(p), sha256_file(p)) for role, p in files)
+    return tuple(InputFile(role, str(p), sha256_measurements(p) if role.endswith(": angles") else sha256_file(p))
+                 for role, p in files)
 
 
 def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
@@ -303,14 +340,18 @@ def model_readings_note(config_path: Path) -> str:
         raise UserInputError(f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config") from None
     readings = ((cfg.get("model") or {}) if isinstance(cfg, dict) else {}).get("readings") or {}
     if not readings:
-        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md; Eq. 12's l0 "
-                "prefactor is a number fitted to the paper's own model results)")
+        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md: derived, no "
+                "constant fitted to the paper's numbers; l0 is the one parameter its two model results fix)")
     given = ", ".join(f"{k}={v}" for k, v in sorted(readings.items()))
     return f"model: the paper's Eqs. 1-13 with readings set in the config: {given} (others default; docs/model.md)"
 
 
 def rms_row(data: ReportData, material: str) -> dict[str, float]:
-    """rms.csv row of a material as a dict (empty when absent)."""
+    """rms.csv row of a material as a dict (empty when absent).
+
+    With several rows (datasets of different l0) this is the first, the model's default l0
+    (``compare`` writes it first); the model provenance page lists them all.
+    """
     sel = data.rms[data.rms["material"].astype(str) == material]
     if sel.empty:
         return {}

@@ -16,6 +16,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from pipeline.report.data import ReportData, rms_row
+from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
 from pipeline.report.style import (
     A4_PORTRAIT_IN,
@@ -41,16 +42,31 @@ STRIP_BAND_PT = 118.0
 # hysteresis plots
 
 
-def model_xy(data: ReportData, material: str, p_max_kpa: float) -> tuple[np.ndarray, np.ndarray]:
-    """Model curve of ``material`` in psi order, NaN-broken beyond ``p_max_kpa`` (not drawn there)."""
+#: line styles of successive model curves of one material (one per l0)
+CURVE_STYLES: tuple[object, ...] = ("--", ":", "-.", (0, (5, 1, 1, 1)))
+
+
+def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple[str, np.ndarray, np.ndarray, object]]:
+    """Model curves of ``material`` to draw: ``(label, pressure, psi, linestyle)``, psi order.
+
+    The curves ``compare`` used (``curve`` column: one per l0, labelled with it) when present,
+    else the plain model curve.  Pressures outside [0, ``p_max_kpa``] are NaN (not drawn).
+    """
     c = data.model_curves[data.model_curves["material"].astype(str) == material]
-    if c.empty:
-        return np.array([]), np.array([])
-    c = c.sort_values("psi_deg", ascending=False, kind="stable")
-    p = pd.to_numeric(c["pressure_kpa"], errors="coerce").to_numpy(float)
-    s = pd.to_numeric(c["psi_deg"], errors="coerce").to_numpy(float)
-    p = np.where((p >= 0) & (p <= p_max_kpa), p, np.nan)
-    return p, s
+    if "curve" in c.columns and c["curve"].notna().any():
+        groups = [(g, f"model, l0 {float(g['l0_mm'].iloc[0]):g} mm")
+                  for _, g in c[c["curve"].notna()].groupby("curve", sort=False)]
+    else:
+        groups = [(c, "analytical model")] if len(c) else []
+    out = []
+    for i, (g, label) in enumerate(groups):
+        g = g.sort_values("psi_deg", ascending=False, kind="stable")
+        p = pd.to_numeric(g["pressure_kpa"], errors="coerce").to_numpy(float)
+        s = pd.to_numeric(g["psi_deg"], errors="coerce").to_numpy(float)
+        p = np.where((p >= 0) & (p <= p_max_kpa), p, np.nan)
+        if np.isfinite(p).any():
+            out.append((label, p, s, CURVE_STYLES[i % len(CURVE_STYLES)]))
+    return out
 
 
 def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, legend: bool = True,
@@ -69,9 +85,8 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, 
         sd = np.nan_to_num(b["psi_sd_deg"].to_numpy(float))
         ax.fill_between(p, m - sd, m + sd, color=col, alpha=alpha, linewidth=0, label=f"± 1 sd, {label}")
         ax.plot(p, m, color=col, marker="o", markersize=2.5, label=f"mean, {label}")
-    mp, ms = model_xy(data, material, p_max * 1.02)
-    if np.isfinite(mp).any():
-        ax.plot(mp, ms, linestyle="--", color="0.15", linewidth=1.2, label="analytical model")
+    for label, mp, ms, style in model_lines(data, material, p_max * 1.02):
+        ax.plot(mp, ms, linestyle=style, color="0.15", linewidth=1.2, label=label)
     ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=0)
     ax.set_xlim(left=0.0, right=max(p_max, 1.0) * 1.03)
     ax.set_xlabel(P_LABEL)
@@ -217,13 +232,15 @@ def material_page(data: ReportData, material: str) -> Figure:
 
 
 def comparison_notes(data: ReportData) -> list[str]:
-    """Sentences under the comparison table (what each figure is; what is fitted)."""
-    return [
+    """Sentences under the comparison table (what each figure is; what is fitted; self-checks named)."""
+    notes = [
         "RMS: the model's loading branch at the measured pressure levels against the mean curve.  Crossings: "
         "interpolated linearly along each ramp.  n/a: not reached by the mean curve, or not reported by the paper.",
         "k_P is fitted to this run's photos (bootstrap interval over actuators): a fitted value, so its closeness "
         "to the paper's k_P is not evidence for the model.",
     ]
+    note = comparison_note(data)
+    return notes + ([note] if note else [])
 
 
 def comparison_table(data: ReportData) -> Table:

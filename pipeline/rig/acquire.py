@@ -10,6 +10,10 @@ the first missing step is reached along the same pressure history (see
 Whatever ends the run early -- Ctrl-C/SIGTERM, ``EVT ESTOP``, a lost port, a camera failure, any
 exception -- the host vents to 0 kPa if the port still answers, keeps every row written, prints
 what happened and how to resume, and returns a non-zero :data:`EXIT_CODES` value.
+
+Firmware that speaks only the base protocol (no ``CFG``, ``WDOG`` or load cell) runs a bending
+ramp too: the session says at the start and in its final message what it could not use
+(:func:`unused_features`); blocked mode, which needs the load cell, stops before pressurising.
 """
 
 from __future__ import annotations
@@ -28,13 +32,9 @@ from typing import Any, TextIO
 import numpy as np
 from tqdm import tqdm
 
-from pipeline.photoset import (
-    MANIFEST,
-    append_manifest_rows,
-    atomic_write_bytes,
-    write_manifest,
-    write_settings,
-)
+from pipeline.fileio import atomic_write_bytes
+from pipeline.measure.settings import MeasureSettings, SettingsError, resolve_settings
+from pipeline.photoset import MANIFEST, append_manifest_rows, write_manifest, write_settings
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
 from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
@@ -46,7 +46,7 @@ EXIT_CODES: dict[str, int] = {
     "done": 0, "error": 1, "estop": 3, "port_lost": 4, "camera": 5, "limit": 6, "interrupted": 130,
 }
 
-StopCriterion = Callable[[bytes, dict[str, Any]], bool]
+StopCriterion = Callable[[bytes, MeasureSettings], bool]
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,7 @@ class SessionResult:
     vented: bool | None = None
     last_step: session.StepPlan | None = None
     garbage_lines: int = 0
+    unused: list[str] = field(default_factory=list)
 
     @property
     def exit_code(self) -> int:
@@ -193,6 +194,33 @@ def describe_plan(cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = 
     return "\n".join(lines)
 
 
+def unused_features(driver: PicoDriver, cfg: SessionConfig) -> list[str]:
+    """What this run would use but the firmware does not speak (one sentence each; empty for ours).
+
+    Parameters
+    ----------
+    driver : PicoDriver
+        Connected driver (its extensions were probed at connect).
+    cfg : SessionConfig
+        The run.
+
+    Returns
+    -------
+    list of str
+    """
+    name = f"{driver.info.name} {driver.info.version}" if driver.info else "the device"
+    out = []
+    if not driver.supports("CFG"):
+        out.append(f"firmware {name} has no CFG: its own pressure limit is unknown, so only the host limit "
+                   f"--max-kpa {driver.max_kpa:g} kPa guards the setpoints")
+    if cfg.watchdog_s > 0 and not driver.supports("WDOG"):
+        out.append(f"firmware {name} has no WDOG: the device cannot vent by itself if the host stops talking "
+                   "(pulled cable, crashed host); keep the emergency stop at hand")
+    if cfg.mode == "blocked" and not driver.supports("LOAD"):
+        out.append(f"firmware {name} has no load-cell commands (LOAD/TARE/SCALE), which --mode blocked needs")
+    return out
+
+
 def run_session(
     driver: PicoDriver,
     camera: Camera,
@@ -213,7 +241,8 @@ def run_session(
     cfg : SessionConfig
         The run.
     stop_up : callable, optional
-        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached -psi0).
+        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached -psi0);
+        ``settings`` are the photo set's, resolved once.
     progress : bool or None
         Show the tqdm bar (``None``: only on a terminal).
     stream : text stream, optional
@@ -225,11 +254,27 @@ def run_session(
         ``status`` is one of :data:`EXIT_CODES`; every row written stays written.
     """
     stream = stream or sys.stderr
-    result = SessionResult()
+    result = SessionResult(unused=unused_features(driver, cfg))
+    for note in result.unused:
+        print(f"acquire: not used: {note}", file=stream)
+    if cfg.mode == "blocked" and not driver.supports("LOAD"):
+        result.status, result.message = "error", (
+            "blocked mode needs the load cell, which this firmware does not speak; nothing was done "
+            "(flash the firmware of pipeline/rig/firmware or use --mode bending)")
+        print(f"acquire: {result.message}", file=stream)
+        return result
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
-    settings = {**cfg.settings, **camera.photoset_settings()}
-    if session.check_settings(cfg.out_dir, settings):
-        write_settings(cfg.out_dir, settings)
+    raw_settings = {**cfg.settings, **camera.photoset_settings()}
+    if session.check_settings(cfg.out_dir, raw_settings):
+        write_settings(cfg.out_dir, raw_settings)
+    settings: MeasureSettings | None = None
+    if stop_up is not None:
+        try:
+            settings = resolve_settings({k: v for k, v in raw_settings.items() if v is not None}, folder=cfg.out_dir)
+        except SettingsError as exc:
+            result.status, result.message = "error", f"the psi0 stop needs valid photo-set settings: {exc}; nothing was done"
+            print(f"acquire: {result.message}", file=stream)
+            return result
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     if up[-1] > driver.max_kpa + 1e-9:
         result.status, result.message = "limit", f"--max-kpa {cfg.max_kpa:g} is above the driver limit {driver.max_kpa:g} kPa (calibration max_kpa); nothing was done"
@@ -244,14 +289,15 @@ def run_session(
     interrupts = _Interrupts()
     try:
         with interrupts:
+            watchdog = cfg.watchdog_s > 0 and driver.supports("WDOG")
             driver.vent()
-            if cfg.watchdog_s > 0:
+            if watchdog:
                 driver.set_watchdog(cfg.watchdog_s)
             driver.sleep(cfg.settle_s)
             for trial, seq, recorded in plans:
                 _run_trial(driver, camera, cfg, trial, seq, recorded, up, stop_up, settings, bar, interrupts, result)
             driver.vent()
-            if cfg.watchdog_s > 0:
+            if watchdog:
                 driver.set_watchdog(0.0)
     except KeyboardInterrupt:
         result.status, result.message = "interrupted", "interrupted (Ctrl-C / SIGTERM)"
@@ -276,7 +322,7 @@ def run_session(
 
 
 def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: int, seq: list[session.StepPlan],
-               recorded: set[int], up: list[float], stop_up: StopCriterion | None, settings: dict[str, Any],
+               recorded: set[int], up: list[float], stop_up: StopCriterion | None, settings: MeasureSettings | None,
                bar: tqdm, interrupts: _Interrupts, result: SessionResult) -> None:
     """Run one trial from its first missing step."""
     start = session.first_missing(seq, recorded)
@@ -286,7 +332,7 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
     if stop_up is not None and not peak_known and start > 0:
         # the up leg may already have ended early: re-check the recorded up photos
         for plan in seq[:start]:
-            if plan.direction == "up" and 0 < plan.step and _recorded_image_stops(cfg, plan, stop_up, settings):
+            if plan.direction == "up" and 0 < plan.step and settings is not None and _recorded_image_stops(cfg, plan, stop_up, settings):
                 seq = session.trial_sequence(trial, up, plan.step)
                 bar.total -= len(session.trial_sequence(trial, up)) - len(seq)
                 start = session.first_missing(seq, recorded)
@@ -309,7 +355,7 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
         image_bytes = _record_step(driver, camera, cfg, plan, interrupts)
         result.photos_taken += 1
         bar.update(1)
-        if (stop_up is not None and plan.direction == "up" and 0 < plan.step < len(up) - 1
+        if (stop_up is not None and settings is not None and plan.direction == "up" and 0 < plan.step < len(up) - 1
                 and stop_up(image_bytes, settings)):
             new_seq = session.trial_sequence(trial, up, plan.step)
             bar.total -= len(seq) - len(new_seq)
@@ -365,7 +411,7 @@ def _append_row(cfg: SessionConfig, row: dict[str, Any]) -> None:
 
 
 def _recorded_image_stops(cfg: SessionConfig, plan: session.StepPlan, stop_up: StopCriterion,
-                          settings: dict[str, Any]) -> bool:
+                          settings: MeasureSettings) -> bool:
     rows = session.recorded_steps(cfg.out_dir, cfg.material, cfg.actuator)
     hit = rows[(rows["trial_n"] == plan.trial) & (rows["step_n"] == plan.step)]
     if hit.empty:
@@ -379,6 +425,7 @@ def _final_message(cfg: SessionConfig, result: SessionResult) -> str:
         with open(cfg.out_dir / MANIFEST) as fh:
             n_rows = max(sum(1 for _ in fh) - 1, 0)
     garbage = f"; ignored {result.garbage_lines} garbage line(s) from the device" if result.garbage_lines else ""
+    garbage += "".join(f"\nacquire: not used: {note}" for note in result.unused)
     if result.status == "done":
         return (f"acquire: done: {result.photos_taken} photo(s) taken, {result.steps_skipped} already recorded; "
                 f"{n_rows} row(s) in {cfg.out_dir / MANIFEST}{garbage}")
@@ -403,20 +450,14 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
     if measure_image is None:
         from pipeline.measure import measure_image
 
-    def stop(image_bytes: bytes, settings: dict[str, Any]) -> bool:
+    def stop(image_bytes: bytes, settings: MeasureSettings) -> bool:
         import cv2
 
         image = cv2.imdecode(np.frombuffer(image_bytes, np.uint8), cv2.IMREAD_COLOR)
         if image is None:
             return False
-        fe = settings.get("fixed_end", "auto")
         try:
-            r = measure_image(
-                image, l0_mm=float(settings["l0_mm"]), mm_per_px=settings.get("mm_per_px"),
-                line_color=settings.get("line_color", "black"),
-                fixed_end_px=None if fe in (None, "auto") else (float(fe[0]), float(fe[1])),
-                positive_turn=settings.get("positive_turn", "ccw"),
-            )
+            r = measure_image(image, settings)
         except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
             log.warning("live psi measurement failed (%s: %s); the ramp continues to --max-kpa", type(exc).__name__, exc)
             return False
@@ -433,6 +474,6 @@ def summarise(result: SessionResult) -> dict[str, Any]:
 
 __all__ = [
     "EXIT_CODES", "SessionConfig", "SessionResult", "describe_plan", "psi0_stop_criterion", "run_session",
-    "summarise", "trial_plans",
+    "summarise", "trial_plans", "unused_features",
 ]
 

@@ -12,7 +12,6 @@ Re-running the same command on the same ``--out`` resumes at the first missing s
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
 from pathlib import Path
 from typing import Any
@@ -67,12 +66,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _material_defaults(material: str) -> Any:
-    try:
-        from pipeline.model import load_materials
+    from pipeline.model import load_materials  # ~0.5 s: only when a default is needed
 
-        return load_materials().get(material)
-    except ImportError:
-        return None
+    return load_materials().get(material)
 
 
 def _settings(args: argparse.Namespace) -> dict[str, Any]:
@@ -118,10 +114,7 @@ def run(args: argparse.Namespace) -> int:
                         watchdog_s=args.watchdog_s if args.watchdog_s is not None else 3 * args.settle_s + args.camera_timeout_s + 10)
     synthetic = args.camera.strip().startswith("synthetic")
     wants_stop = args.stop_at_psi0 if args.stop_at_psi0 is not None else (synthetic and args.mode == "bending")
-    measure_ok = wants_stop and importlib.util.find_spec("pipeline.measure") is not None and _has_measure_image()
-    stop_at_psi0 = bool(measure_ok) if args.stop_at_psi0 is None else args.stop_at_psi0
-    if stop_at_psi0 and not measure_ok:
-        raise UserInputError("--stop-at-psi0 needs pipeline.measure.measure_image, which is not available; drop the option")
+    stop_at_psi0 = bool(wants_stop)
     if args.dry_run:
         print(describe_plan(cfg, stop_at_psi0=stop_at_psi0, camera_spec=args.camera, port=args.port or ""))
         return 0
@@ -145,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, stop_up: Any, settings: dict[str, Any]) -> int:
     from pipeline.rig.cameras import CameraError, open_camera
-    from pipeline.rig.driver import PicoDriver, RigError
+    from pipeline.rig.driver import PicoDriver, RigError, UnsupportedError
 
     try:
         camera = open_camera(args.camera, material=args.material, l0_mm=settings["l0_mm"], seed=args.seed,
@@ -156,6 +149,8 @@ def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, sto
     try:
         try:
             driver = PicoDriver.open(args.port, max_kpa=args.max_kpa, calibration=calibration, timeout_s=args.timeout_s)
+        except UnsupportedError:
+            raise  # an option this firmware cannot honour: bad input (exit 2), not a lost port
         except RigError as exc:
             print(f"acquire: {exc}", file=sys.stderr)
             return EXIT_CODES["port_lost"]
@@ -168,11 +163,3 @@ def _acquire(args: argparse.Namespace, cfg: SessionConfig, calibration: Any, sto
     if result.status == "done":
         print(f"acquired {result.photos_taken} photo(s) ({result.steps_skipped} already recorded) into {args.out}")
     return result.exit_code
-
-
-def _has_measure_image() -> bool:
-    try:
-        from pipeline.measure import measure_image  # noqa: F401
-    except ImportError:
-        return False
-    return True

@@ -35,7 +35,7 @@ import numpy as np
 import yaml
 
 from pipeline.errors import UserInputError
-from pipeline.photoset import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes
 
 METHODS = ("linear", "piecewise")
 DAC_MAX = 4095

@@ -39,6 +39,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     e.add_argument("--lag-s", type=float, default=0.0, help="first-order time constant of the simulated pressure (s, default 0)")
     e.add_argument("--gain", type=float, default=0.97, help="simulated regulator: achieved / nominal pressure (default 0.97)")
     e.add_argument("--offset-kpa", type=float, default=-1.5, help="simulated regulator offset (kPa, default -1.5)")
+    e.add_argument("--protocol", choices=("full", "base"), default="full",
+                   help="full: every command of pipeline/rig/firmware; base: only ID, SET, GET, VENT and EVT ESTOP, "
+                        "ERR PARSE to the extensions (CFG, WDOG, load cell), like other firmware (default full)")
 
     c = sub.add_parser("calibrate", help="fit kPa <-> DAC code from the regulator monitor or reference readings; write the calibration file")
     c.add_argument("--port", help="serial port of the Pico (not needed with --readings)")
@@ -70,7 +73,8 @@ def _emulate(args: argparse.Namespace) -> int:
 
     faults = parse_faults(args.fault)
     emu = Emulator(plant=PlantParams(gain=args.gain, offset_kpa=args.offset_kpa, lag_s=args.lag_s), faults=faults,
-                   seed=args.seed, cfg=rigcore.Config(max_kpa=args.device_max_kpa), link=args.link)
+                   seed=args.seed, cfg=rigcore.Config(max_kpa=args.device_max_kpa), link=args.link,
+                   protocol=args.protocol)
     done = threading.Event()
 
     def on_signal(signum: int, frame: Any) -> None:
@@ -85,7 +89,8 @@ def _emulate(args: argparse.Namespace) -> int:
         signal.signal(sig, on_signal)
     emu.start()
     print(f"PORT {emu.port}", flush=True)
-    print(f"emulating {rigcore.NAME} {rigcore.VERSION} on {emu.slave_name}; faults: {faults}; stop with Ctrl-C", file=sys.stderr, flush=True)
+    print(f"emulating {rigcore.NAME} {rigcore.VERSION} ({args.protocol} protocol) on {emu.slave_name}; faults: {faults}; "
+          "stop with Ctrl-C", file=sys.stderr, flush=True)
     while not done.wait(0.2):
         if emu._thread is not None and not emu._thread.is_alive():  # dropped without --link: port is gone
             print("emulator: connection dropped (fault drop-after); exiting", file=sys.stderr)

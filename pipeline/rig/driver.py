@@ -5,6 +5,11 @@ pressures through a :class:`~pipeline.rig.calibration.Calibration` when one is g
 garbage lines, notices ``EVT ESTOP`` at any time, and turns a vanished or silent port into
 :class:`PortLostError`.
 
+It needs only the base protocol (``ID``, ``SET``, ``GET``, ``VENT``, ``EVT ESTOP``).  The
+extensions (:data:`~pipeline.rig.protocol.EXTENSIONS`: ``CFG``, ``WDOG``, the load cell) are
+probed at connect and recorded in :attr:`DeviceInfo.extensions`; a command of a missing extension
+raises :class:`UnsupportedError` without being sent.
+
 Examples
 --------
 Against the emulator (a real pseudo-terminal)::
@@ -26,8 +31,9 @@ from types import TracebackType
 import numpy as np
 import serial
 
+from pipeline.errors import UserInputError
 from pipeline.rig.calibration import Calibration
-from pipeline.rig.protocol import BAUDRATE, Reply, encode, parse_reply
+from pipeline.rig.protocol import BAUDRATE, EXTENSIONS, Reply, encode, parse_reply
 
 log = logging.getLogger(__name__)
 
@@ -67,19 +73,46 @@ class DeviceError(RigError):
     """The device answered ``ERR PARSE`` / ``ERR HW`` or something inconsistent."""
 
 
+class ParseError(DeviceError):
+    """The device answered ``ERR PARSE``: it did not understand the command."""
+
+
 class WatchdogError(RigError):
     """The device vented by itself because the host sent nothing for longer than its watchdog."""
 
 
+class UnsupportedError(RigError, UserInputError):
+    """The firmware does not speak the protocol extension a command or an option needs."""
+
+
 @dataclass(frozen=True)
 class DeviceInfo:
-    """What the device says about itself (``ID`` and ``CFG``)."""
+    """What the device says about itself (``ID``, and ``CFG`` when it has that extension).
+
+    Attributes
+    ----------
+    name, version : str
+        From ``ID``.
+    extensions : frozenset of str
+        Names of the :data:`~pipeline.rig.protocol.EXTENSIONS` the firmware answered at connect.
+    kpa_per_code, max_kpa : float or None
+        Nominal kPa per DAC code and the firmware's own limit (kPa), from ``CFG``; ``None``
+        without it.
+    dac_bits : int or None
+        DAC resolution, from ``CFG``.
+    """
 
     name: str
     version: str
-    kpa_per_code: float
-    max_kpa: float
-    dac_bits: int
+    extensions: frozenset[str] = frozenset(EXTENSIONS)
+    kpa_per_code: float | None = None
+    max_kpa: float | None = None
+    dac_bits: int | None = None
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """Extensions the firmware does not have, in :data:`~pipeline.rig.protocol.EXTENSIONS` order."""
+        return tuple(name for name in EXTENSIONS if name not in self.extensions)
 
 
 @dataclass(frozen=True)
@@ -155,15 +188,57 @@ class PicoDriver:
         return driver
 
     def connect(self) -> DeviceInfo:
-        """Discard stale input, read ``ID`` and ``CFG``, send the calibration's load-cell scale."""
+        """Discard stale input, read ``ID``, probe the extensions, send the calibration's load-cell scale.
+
+        Raises
+        ------
+        UnsupportedError
+            A calibration is given but the firmware does not report its DAC scaling (no ``CFG``).
+        """
         self._drain()
-        r = self._command("ID")
-        name, version = r.fields
-        c = self._command("CFG")
-        self.info = DeviceInfo(name, version, float(c.fields[0]), float(c.fields[1]), int(c.fields[2]))
-        if self.calibration and self.calibration.load_counts_per_newton:
+        name, version = self._command("ID").fields
+        cfg = self._probe("CFG")
+        found = {"CFG"} if cfg else set()
+        if self._probe("WDOG", 0.0):  # 0 = off: changes nothing the host relies on
+            found.add("WDOG")
+        if self._probe("SCALE"):  # reads the scale
+            found.add("LOAD")
+        self.info = DeviceInfo(
+            name, version, frozenset(found),
+            kpa_per_code=float(cfg.fields[0]) if cfg else None,
+            max_kpa=float(cfg.fields[1]) if cfg else None,
+            dac_bits=int(cfg.fields[2]) if cfg else None,
+        )
+        if self.calibration is not None and cfg is None:
+            raise UnsupportedError(
+                f"firmware {name} {version} does not report its DAC scaling (no CFG command), so the "
+                "calibration (kPa <-> DAC code) cannot be applied; run without --calibration (the firmware's "
+                "own scaling; measured_pressure_kpa still records the regulator's monitor) or flash the "
+                "firmware of pipeline/rig/firmware"
+            )
+        if self.calibration and self.calibration.load_counts_per_newton and "LOAD" in found:
             self.set_scale(self.calibration.load_counts_per_newton)
         return self.info
+
+    def supports(self, extension: str) -> bool:
+        """Whether the firmware answered the probe of ``extension`` (a key of ``EXTENSIONS``) at connect."""
+        return self.info is not None and extension in self.info.extensions
+
+    def _require(self, extension: str, what: str) -> None:
+        if self.info is not None and extension not in self.info.extensions:
+            commands = "/".join(EXTENSIONS[extension])
+            raise UnsupportedError(
+                f"firmware {self.info.name} {self.info.version} does not speak {commands} (an extension of the "
+                f"protocol), which {what} needs; flash the firmware of pipeline/rig/firmware to use it"
+            )
+
+    def _probe(self, command: str, *args: float) -> Reply | None:
+        """Send an extension command once; ``None`` when the firmware answers ``ERR PARSE``."""
+        try:
+            return self._command(command, *args, retries=0)
+        except ParseError:
+            log.info("firmware does not speak %s (ERR PARSE): extension not used", command)
+            return None
 
     def close(self) -> None:
         """Close the port (never raises)."""
@@ -201,7 +276,7 @@ class PicoDriver:
             )
         want_code = None
         sent = p
-        if self.calibration is not None and self.info is not None:
+        if self.calibration is not None and self.info is not None and self.info.kpa_per_code is not None:
             want_code = self.calibration.kpa_to_code(p)
             sent = want_code * self.info.kpa_per_code
         r = self._command("SET", sent)
@@ -260,6 +335,7 @@ class PicoDriver:
 
     def load_n(self) -> float:
         """One load-cell reading (N, after tare and scale)."""
+        self._require("LOAD", "reading the load cell")
         return float(self._command("LOAD").fields[0])
 
     def load_samples(self, count: int, interval_s: float = 0.0) -> np.ndarray:
@@ -273,22 +349,27 @@ class PicoDriver:
 
     def load_raw(self) -> int:
         """One raw HX711 reading (counts)."""
+        self._require("LOAD", "reading the load cell")
         return int(self._command("LOADRAW").fields[0])
 
     def tare(self, reads: int = 10) -> int:
         """Zero the load cell on the mean of ``reads`` readings; returns the offset (counts)."""
+        self._require("LOAD", "taring the load cell")
         return int(self._command("TARE", int(reads)).fields[0])
 
     def set_scale(self, counts_per_newton: float) -> float:
         """Set the load-cell scale (counts per newton)."""
+        self._require("LOAD", "setting the load-cell scale")
         return float(self._command("SCALE", float(counts_per_newton)).fields[0])
 
     def set_watchdog(self, seconds: float) -> float:
         """Make the device vent by itself after ``seconds`` without a command (0 turns it off)."""
+        self._require("WDOG", "the device watchdog (--watchdog-s)")
         return float(self._command("WDOG", float(seconds)).fields[0])
 
     def get_scale(self) -> float:
         """Current load-cell scale (counts per newton)."""
+        self._require("LOAD", "reading the load-cell scale")
         return float(self._command("SCALE").fields[0])
 
     # -- line handling ----------------------------------------------------------------------------
@@ -364,9 +445,10 @@ class PicoDriver:
                 raise EStopError("emergency stop pressed: the device refused the setpoint and vented; "
                                  "release the button and re-run to resume")
             if reply.command == "LIMIT":
-                limit = f" ({self.info.max_kpa:g} kPa)" if self.info else ""
+                limit = f" ({self.info.max_kpa:g} kPa)" if self.info and self.info.max_kpa is not None else ""
                 raise LimitError(f"device refused {command} {args[0] if args else ''}: above its limit{limit}", sent=True)
-            raise DeviceError(f"device answered {reply.line!r} to {command}")
+            kind = ParseError if reply.command == "PARSE" else DeviceError
+            raise kind(f"device answered {reply.line!r} to {command}")
         if raise_estop:
             self._raise_estop()
         return reply

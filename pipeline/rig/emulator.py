@@ -19,6 +19,10 @@ Faults (``--fault`` in ``python -m pipeline rig emulate``):
 ``garbage-every=N``
     send a garbage line (random bytes, some not ASCII) before every N-th reply.
 
+``protocol="base"`` (``--protocol base``) emulates firmware that speaks only the documented base
+protocol (``ID``, ``SET``, ``GET``, ``VENT``, ``EVT ESTOP``): every extension command
+(:data:`pipeline.rig.protocol.EXTENSIONS`) gets ``ERR PARSE``.
+
 Examples
 --------
 >>> from pipeline.rig.driver import PicoDriver
@@ -45,6 +49,10 @@ import numpy as np
 
 from pipeline.errors import UserInputError
 from pipeline.rig.firmware import rigcore
+from pipeline.rig.protocol import BASE_COMMANDS
+
+#: what the emulated firmware speaks: everything ``rigcore`` does, or the base protocol only
+PROTOCOLS = ("full", "base")
 
 
 @dataclass(frozen=True)
@@ -192,10 +200,17 @@ class Emulator:
         Firmware configuration (limits, scaling).
     link : path, optional
         Also expose the port as this symbolic link (kept across dropped connections).
+    protocol : {"full", "base"}
+        ``"base"``: answer ``ERR PARSE`` to every extension command (firmware that speaks only
+        ``ID``, ``SET``, ``GET``, ``VENT`` and ``EVT ESTOP``).
     """
 
     def __init__(self, *, plant: PlantParams | None = None, faults: Faults | None = None, seed: int = 0,
-                 cfg: rigcore.Config | None = None, link: str | os.PathLike[str] | None = None) -> None:
+                 cfg: rigcore.Config | None = None, link: str | os.PathLike[str] | None = None,
+                 protocol: str = "full") -> None:
+        if protocol not in PROTOCOLS:
+            raise UserInputError(f"emulator protocol {protocol!r}: use one of {', '.join(PROTOCOLS)}")
+        self.protocol = protocol
         self.plant = plant or PlantParams()
         self.faults = faults or Faults()
         self.cfg = cfg or rigcore.Config()
@@ -288,7 +303,7 @@ class Emulator:
             return False
         self.stats.received.append(text)
         self._last_command = time.monotonic()
-        replies = self.controller.handle(line)
+        replies = self._answer(line)
         if self.faults.slow_s > 0:
             time.sleep(self.faults.slow_s)
         for reply in replies:
@@ -301,6 +316,14 @@ class Emulator:
             if self.faults.estop_at_set is not None and self.stats.sets == self.faults.estop_at_set:
                 self.press_estop()
         return True
+
+    def _answer(self, line: bytes) -> list[str]:
+        """The firmware's reply lines; base-protocol firmware does not know the extensions."""
+        if self.protocol == "base":
+            parsed = rigcore.parse_line(line)
+            if parsed is not None and parsed[0] not in BASE_COMMANDS:
+                return [*self.controller.poll(), "ERR PARSE"]
+        return self.controller.handle(line)
 
     def _garbage(self) -> bytes:
         kind = int(self._garbage_rng.integers(3))

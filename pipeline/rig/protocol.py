@@ -25,6 +25,16 @@ OK_FIELDS: dict[str, int] = {
     "ID": 2, "SET": 2, "GET": 3, "VENT": 0, "CFG": 3, "LOAD": 1, "LOADRAW": 1, "TARE": 1, "SCALE": 1, "WDOG": 1,
 }
 ERRORS = ("LIMIT", "ESTOP", "PARSE", "HW")
+#: the documented protocol every firmware speaks (plus the unsolicited ``EVT ESTOP``)
+BASE_COMMANDS = ("ID", "SET", "GET", "VENT")
+#: optional extensions, by name, with the commands each one brings; the driver probes each at
+#: connect with a command that changes nothing (``CFG``, ``WDOG 0``, ``SCALE``) and firmware
+#: without it answers ``ERR PARSE``
+EXTENSIONS: dict[str, tuple[str, ...]] = {
+    "CFG": ("CFG",),
+    "WDOG": ("WDOG",),
+    "LOAD": ("LOAD", "LOADRAW", "TARE", "SCALE"),
+}
 #: unsolicited events
 EVENTS = ("ESTOP", "WDOG")
 

@@ -2,7 +2,13 @@
 
 A :class:`Backdrop` is built once per ramp (it costs ~30 ms at 1280x960) and reused for every
 photo of the ramp; it also holds the lit colour layers of the silicone, the ink and a glare spot,
-and a pool of sensor noise, so that rendering one photo costs only the drawing of the actuator.
+the light field, the seeded look of the body (:class:`pipeline.synth.body.BodyStyle`) and a pool
+of sensor noise, so that rendering one photo costs only the drawing of the actuator.
+
+Clamp styles (``SceneParams.clamp_style``): ``block`` (a dark clamp block with two screws),
+``white`` (a white printed clamp) and ``plate`` (a large black plate whose front edge is the
+clamp face, with a clamp bar across the actuator's base; it reaches the image border in a
+typical view).  In every style the clamp face is the world line x = 0, where the fixed end is.
 """
 
 from __future__ import annotations
@@ -14,20 +20,38 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pipeline.synth.body import BodyStyle, make_body_style, shadow_of
 from pipeline.synth.camera import Camera
 from pipeline.synth.presets import LINE_INK_BGR, SceneParams
 
 #: clamp block behind the fixed end (mm): length along the clamp axis and overhang each side
 CLAMP_LENGTH_MM = 25.0
 CLAMP_OVERHANG_MM = 5.0
+#: the white printed clamp is a little larger
+WHITE_CLAMP_LENGTH_MM = 30.0
+WHITE_CLAMP_OVERHANG_MM = 6.0
+#: black plate: depth behind the clamp face and half-width each side of the actuator (mm)
+PLATE_DEPTH_MM = 170.0
+PLATE_HALF_WIDTH_MM = 160.0
+#: clamp bar on the plate across the actuator's base: length and overhang (mm)
+PLATE_BAR_LENGTH_MM = 18.0
+PLATE_BAR_OVERHANG_MM = 9.0
 TUBE_WIDTH_MM = 6.0
-#: sealed end cap of silicone beyond the free end of the marked layer (mm)
-END_CAP_MM = 4.0
 #: sub-pixel bits used with every OpenCV drawing call (1/16 px)
 SHIFT = 4
 NOISE_PAD = 64
 
-_GLARE_BGR = (250, 250, 250)
+#: colour of a glare spot (BGR, before lighting)
+GLARE_BGR = (250, 250, 250)
+#: seed stream of the body's look (independent of the table's, so older scenes keep their bytes)
+_STYLE_KEY = 7
+
+
+def child_seed(seed: int | np.random.SeedSequence, *keys: int) -> np.random.SeedSequence:
+    """A seed derived from ``seed`` and integer ``keys`` (pure: the same inputs give the same seed)."""
+    if isinstance(seed, np.random.SeedSequence):
+        return np.random.SeedSequence(seed.entropy, spawn_key=tuple(seed.spawn_key) + tuple(keys))
+    return np.random.SeedSequence(int(seed), spawn_key=tuple(keys))
 
 
 @dataclass(frozen=True)
@@ -40,24 +64,35 @@ class Backdrop:
         Placement of the world frame (the clamp) in the image.
     image : ndarray (H, W, 3) uint8
         Lit, blurred table with clamp, tube and distractor marks.
-    body_layer, ink_layer, glare_layer : ndarray (H, W, 3) uint8
-        Silicone, marker ink and glare colours under the same lighting.
     noise_pool : ndarray (H + 64, W + 64, 3) int16 or None
         Sensor noise; each photo adds a randomly offset window of it.
+    gain : ndarray (H, W) float32
+        The light field (multiplies every colour: silicone, ink, glare, fibres, dots).
+    style : BodyStyle
+        Seeded look of the body (light side, fibre spacing, dot positions, shadow direction).
     """
 
     camera: Camera
     image: NDArray[np.uint8]
-    body_layer: NDArray[np.uint8]
-    ink_layer: NDArray[np.uint8]
-    glare_layer: NDArray[np.uint8]
     noise_pool: NDArray[np.int16] | None
+    gain: NDArray[np.float32]
+    style: BodyStyle
+
+    def lit(self, colour: ArrayLike, roi: tuple[int, int, int, int]) -> NDArray[np.uint8]:
+        """A colour (BGR) under the scene's light over ``roi = (x0, y0, x1, y1)``."""
+        x0, y0, x1, y1 = roi
+        return _lit(colour, self.gain[y0:y1, x0:x1])
 
 
-def clamp_outline_mm(body_width_mm: float) -> NDArray[np.float64]:
-    """Corners of the clamp block in world mm (its front edge is the fixed end, x = 0)."""
-    y0, y1 = -CLAMP_OVERHANG_MM, body_width_mm + CLAMP_OVERHANG_MM
-    return np.array([[-CLAMP_LENGTH_MM, y0], [0.0, y0], [0.0, y1], [-CLAMP_LENGTH_MM, y1]])
+def clamp_outline_mm(body_width_mm: float, style: str = "block") -> NDArray[np.float64]:
+    """Corners of the clamp (block, white clamp or plate) in world mm; its front edge is x = 0."""
+    if style == "plate":
+        x0, y0, y1 = -PLATE_DEPTH_MM, body_width_mm / 2 - PLATE_HALF_WIDTH_MM, body_width_mm / 2 + PLATE_HALF_WIDTH_MM
+    elif style == "white":
+        x0, y0, y1 = -WHITE_CLAMP_LENGTH_MM, -WHITE_CLAMP_OVERHANG_MM, body_width_mm + WHITE_CLAMP_OVERHANG_MM
+    else:
+        x0, y0, y1 = -CLAMP_LENGTH_MM, -CLAMP_OVERHANG_MM, body_width_mm + CLAMP_OVERHANG_MM
+    return np.array([[x0, y0], [0.0, y0], [0.0, y1], [x0, y1]])
 
 
 def light_gain(scene: SceneParams, rng: np.random.Generator) -> NDArray[np.float32]:
@@ -92,7 +127,7 @@ def _keepout_mask(scene: SceneParams, camera: Camera, keepout_mm: Sequence[NDArr
     for pts in keepout_mm:
         px = camera.to_px(pts)
         cv2.polylines(mask, [np.round(px * (1 << SHIFT)).astype(np.int32)], False, 255, thick, cv2.LINE_8, SHIFT)
-    cv2.fillPoly(mask, [np.round(camera.to_px(clamp_outline_mm(scene.body_width_mm)) * (1 << SHIFT)).astype(np.int32)],
+    cv2.fillPoly(mask, [np.round(camera.to_px(clamp_outline_mm(scene.body_width_mm, scene.clamp_style)) * (1 << SHIFT)).astype(np.int32)],
                  255, cv2.LINE_8, SHIFT)
     return mask
 
@@ -131,33 +166,101 @@ def _distractors(img: NDArray[np.float32], scene: SceneParams, keepout: NDArray[
         drawn += 1
 
 
-def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: Camera, rng: np.random.Generator) -> None:
+def _poly(img: NDArray[np.float32], camera: Camera, pts_mm: ArrayLike, colour: tuple[float, float, float]) -> None:
+    px = np.round(camera.to_px(pts_mm) * (1 << SHIFT)).astype(np.int32)
+    cv2.fillPoly(img, [px], colour, cv2.LINE_AA, SHIFT)
+
+
+def _screw(img: NDArray[np.float32], camera: Camera, at_mm: tuple[float, float], radius_px: int,
+           head: tuple[float, float, float], socket: tuple[float, float, float]) -> None:
+    s = 1 << SHIFT
+    c = tuple(np.round(camera.to_px([at_mm])[0] * s).astype(int))
+    cv2.circle(img, c, radius_px * s, head, -1, cv2.LINE_AA, SHIFT)
+    cv2.circle(img, c, max(1, radius_px // 2) * s, socket, -1, cv2.LINE_AA, SHIFT)
+
+
+def _clamp_mask(scene: SceneParams, camera: Camera, tube_px: NDArray[np.float64] | None, tube_width: int) -> NDArray[np.uint8]:
+    mask = np.zeros((scene.height, scene.width), np.uint8)
+    s = 1 << SHIFT
+    if tube_px is not None:
+        cv2.polylines(mask, [np.round(tube_px * s).astype(np.int32)], False, 255, tube_width, cv2.LINE_AA, SHIFT)
+    if scene.clamp:
+        outline = camera.to_px(clamp_outline_mm(scene.body_width_mm, scene.clamp_style))
+        cv2.fillPoly(mask, [np.round(outline * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT)
+    return mask
+
+
+def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: Camera, rng: np.random.Generator,
+                         style: BodyStyle | None = None) -> None:
     s = 1 << SHIFT
     bw = scene.body_width_mm
+    px = None
+    width = max(2, round(TUBE_WIDTH_MM / scene.mm_per_px))
     if scene.tube:
         t = np.linspace(0, 700, 200)
         bend = rng.uniform(-1, 1) * 1e-3
         tube = np.column_stack([-CLAMP_LENGTH_MM - t, bw / 2 + bend * t**2])
         px = camera.to_px(tube)
-        width = max(2, round(TUBE_WIDTH_MM / scene.mm_per_px))
+    if scene.shadow > 0 and style is not None and (px is not None or scene.clamp):
+        cast = _clamp_mask(scene, camera, px, width).astype(np.float32) / 255.0
+        img *= (1.0 - scene.shadow * shadow_of(cast, style, scene.mm_per_px))[..., None]
+    if px is not None:
         mask = np.zeros(img.shape[:2], np.uint8)
         cv2.polylines(mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT)
-        a = mask[..., None].astype(np.float32) * (0.55 / 255)
-        img += (np.asarray((215, 222, 225), np.float32) - img) * a
         edge = np.zeros_like(mask)
         cv2.polylines(edge, [np.round(px * s).astype(np.int32)], False, 255, width + 2, cv2.LINE_AA, SHIFT)
         edge = cv2.subtract(edge, cv2.erode(mask, np.ones((3, 3), np.uint8)))
-        img += (np.asarray((120, 125, 128), np.float32) - img) * (edge[..., None].astype(np.float32) * (0.35 / 255))
-    if scene.clamp:
-        outline = camera.to_px(clamp_outline_mm(bw))
+        bx, by, bw_, bh = cv2.boundingRect(cv2.bitwise_or(mask, edge))  # only where the tube is
+        if bw_ > 0:
+            win, m, e = img[by:by + bh, bx:bx + bw_], mask[by:by + bh, bx:bx + bw_], edge[by:by + bh, bx:bx + bw_]
+            win += (np.asarray((215, 222, 225), np.float32) - win) * (m[..., None].astype(np.float32) * (0.55 / 255))
+            win += (np.asarray((120, 125, 128), np.float32) - win) * (e[..., None].astype(np.float32) * (0.35 / 255))
+    if not scene.clamp:
+        return
+    outline_mm = clamp_outline_mm(bw, scene.clamp_style)
+    r = max(2, round(2.5 / scene.mm_per_px))
+    if scene.clamp_style == "block":
+        outline = camera.to_px(outline_mm)
         cv2.fillPoly(img, [np.round(outline * s).astype(np.int32)], (72, 74, 78), cv2.LINE_AA, SHIFT)
-        inner = camera.to_px(clamp_outline_mm(bw) * 0.8 + np.array([-0.1 * CLAMP_LENGTH_MM, 0.1 * bw]))
+        inner = camera.to_px(outline_mm * 0.8 + np.array([-0.1 * CLAMP_LENGTH_MM, 0.1 * bw]))
         cv2.polylines(img, [np.round(inner * s).astype(np.int32)], True, (105, 108, 112), 2, cv2.LINE_AA, SHIFT)
-        r = max(2, round(2.5 / scene.mm_per_px))
         for y in (0.1 * bw, 0.9 * bw):
-            c = camera.to_px([[-CLAMP_LENGTH_MM / 2, y]])[0]
-            cv2.circle(img, tuple(np.round(c * s).astype(int)), r * s, (150, 152, 155), -1, cv2.LINE_AA, SHIFT)
-            cv2.circle(img, tuple(np.round(c * s).astype(int)), (r // 2) * s, (55, 56, 58), -1, cv2.LINE_AA, SHIFT)
+            _screw(img, camera, (-CLAMP_LENGTH_MM / 2, y), r, (150, 152, 155), (55, 56, 58))
+    elif scene.clamp_style == "white":
+        # a white printed clamp: a slightly darker rim (the chamfer), a lit top face, steel screws
+        _poly(img, camera, outline_mm, (196, 199, 202))
+        inset = 1.5  # mm
+        x0, y0, y1 = outline_mm[0, 0], outline_mm[0, 1], outline_mm[2, 1]
+        _poly(img, camera, [[x0 + inset, y0 + inset], [-inset, y0 + inset], [-inset, y1 - inset], [x0 + inset, y1 - inset]],
+              (228, 231, 233))
+        for y in (-0.5 * WHITE_CLAMP_OVERHANG_MM, bw + 0.5 * WHITE_CLAMP_OVERHANG_MM):
+            _screw(img, camera, (-WHITE_CLAMP_LENGTH_MM / 2, y), max(2, round(2.0 / scene.mm_per_px)),
+                   (168, 172, 176), (70, 72, 75))
+    else:
+        # a black anodised plate, lit unevenly, a bevel along its front edge and a clamp bar
+        mask = np.zeros(img.shape[:2], np.uint8)
+        cv2.fillPoly(mask, [np.round(camera.to_px(outline_mm) * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT)
+        h, w = mask.shape
+        ang = rng.uniform(0, 2 * np.pi)
+        bx, by, bw_, bh = cv2.boundingRect(mask)
+        if bw_ > 0:
+            a = mask[by:by + bh, bx:bx + bw_].astype(np.float32)[..., None] / 255.0
+            yy, xx = np.mgrid[by:by + bh, bx:bx + bw_].astype(np.float32)
+            sheen = 8.0 + 8.0 * ((xx / w) * np.cos(ang) + (yy / h) * np.sin(ang))
+            win = img[by:by + bh, bx:bx + bw_]
+            win *= 1 - a
+            win += (np.float32([29, 29, 32])[None, None, :] + sheen[..., None]) * a
+        bevel = camera.to_px([[0.0, outline_mm[1, 1]], [0.0, outline_mm[2, 1]]])
+        cv2.polylines(img, [np.round(bevel * s).astype(np.int32)], False, (68, 69, 73),
+                      max(1, round(0.8 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
+        bar = np.array([[-PLATE_BAR_LENGTH_MM, -PLATE_BAR_OVERHANG_MM], [0.0, -PLATE_BAR_OVERHANG_MM],
+                        [0.0, bw + PLATE_BAR_OVERHANG_MM], [-PLATE_BAR_LENGTH_MM, bw + PLATE_BAR_OVERHANG_MM]])
+        _poly(img, camera, bar, (44, 44, 48))
+        cv2.polylines(img, [np.round(camera.to_px(bar) * s).astype(np.int32)], True, (60, 61, 65),
+                      max(1, round(0.5 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
+        for y in (-0.5 * PLATE_BAR_OVERHANG_MM, bw + 0.5 * PLATE_BAR_OVERHANG_MM):
+            _screw(img, camera, (-PLATE_BAR_LENGTH_MM / 2, y), max(2, round(2.2 / scene.mm_per_px)), (92, 94, 98),
+                   (35, 35, 38))
 
 
 def _lit(colour: ArrayLike, gain: NDArray[np.float32]) -> NDArray[np.uint8]:
@@ -190,12 +293,13 @@ def make_backdrop(
     Backdrop
     """
     rng = np.random.default_rng(seed)
+    style = make_body_style(scene, np.random.default_rng(child_seed(seed, _STYLE_KEY)))
     gain = light_gain(scene, rng) if scene.background != "plain" else np.ones((scene.height, scene.width), np.float32)
     albedo = _table(scene, rng)
     if scene.distractor_marks:
         keepout = _keepout_mask(scene, camera, keepout_mm, scene.body_width_mm + 8.0)
         _distractors(albedo, scene, keepout, rng)
-    _draw_tube_and_clamp(albedo, scene, camera, rng)
+    _draw_tube_and_clamp(albedo, scene, camera, rng, style)
     image = np.clip(albedo * gain[..., None], 0, 255).astype(np.uint8)
     if scene.blur_sigma_px > 0:
         image = cv2.GaussianBlur(image, (0, 0), scene.blur_sigma_px)
@@ -203,11 +307,4 @@ def make_backdrop(
     if scene.noise_sigma > 0:
         shape = (scene.height + NOISE_PAD, scene.width + NOISE_PAD, 3)
         pool = np.rint(rng.standard_normal(shape, dtype=np.float32) * scene.noise_sigma).astype(np.int16)
-    return Backdrop(
-        camera=camera,
-        image=image,
-        body_layer=_lit(scene.body_bgr, gain),
-        ink_layer=_lit(LINE_INK_BGR[scene.line_color], gain),
-        glare_layer=_lit(_GLARE_BGR, gain),
-        noise_pool=pool,
-    )
+    return Backdrop(camera=camera, image=image, noise_pool=pool, gain=gain, style=style)

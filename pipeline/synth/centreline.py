@@ -6,6 +6,12 @@ length ``l0_mm``.  Curvature is ``kappa(u) = (psi / l0) (1 - bulge cos 2 pi u)``
 ``u = s / l0``: constant for ``bulge = 0`` (a circular arc), larger in the middle than at the
 ends for ``bulge > 0`` (the soft actuators past psi = 0), with the same total turning angle.
 
+Real bodies are often not arcs (the curvature concentrated at the tip, or a multi-chamber
+actuator of which only some chambers bend): :func:`curvature_weights` gives such profiles and
+:func:`weighted_centreline_mm` integrates any profile ``kappa(u) = (psi / l0) w(u)`` (``w``
+normalised to mean 1, so the total turning is psi exactly); :func:`actuator_centreline_mm` picks
+the profile a scene asks for (``SceneParams.shape``).
+
 Examples
 --------
 >>> import numpy as np
@@ -14,6 +20,12 @@ Examples
 True
 >>> round(turning_angle_deg(centreline_mm(-200.0, 195.0, bulge=0.3)), 1)
 -200.0
+>>> w = curvature_weights(np.linspace(0, 1, 5), "distal", straight_base_fraction=0.5)
+>>> bool(w[0] == w[1] == 0 and w[-1] > 1)
+True
+>>> round(turning_angle_deg(weighted_centreline_mm(150.0, 195.0, curvature_weights(
+...     np.linspace(0, 1, 4001), "chambers", chamber_bend=(0, 1, 1)))), 1)
+150.0
 """
 
 from __future__ import annotations
@@ -23,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_simpson
 
 from pipeline.errors import UserInputError
+from pipeline.synth.presets import SceneParams
 
 #: default number of points: neighbouring chords turn by < 0.02 deg up to |psi| = 360 deg
 DEFAULT_N = 20001
@@ -89,6 +102,129 @@ def centreline_mm(psi_deg: float, l0_mm: float, *, bulge: float = 0.0, n: int = 
     x = cumulative_simpson(np.cos(theta), dx=ds, initial=0.0)
     y = cumulative_simpson(np.sin(theta), dx=ds, initial=0.0)
     return np.column_stack([x, y])
+
+
+#: ``distal``: the curvature rises from 0 to full over this fraction of the length (a smooth step)
+DISTAL_RAMP = 0.15
+#: ``distal``: the curvature then grows by this factor from the end of the ramp to the tip
+DISTAL_GROWTH = 1.0
+#: ``chambers``: each change of weight between chambers is spread over this fraction of the length
+CHAMBER_BLEND = 0.04
+
+
+def _smoothstep(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def curvature_weights(
+    u: ArrayLike,
+    shape: str,
+    *,
+    bulge: float = 0.0,
+    straight_base_fraction: float = 0.35,
+    chamber_bend: tuple[float, ...] = (1.0,),
+) -> NDArray[np.float64]:
+    """Relative curvature ``w(u) >= 0`` along the body (not normalised) for a named shape.
+
+    Parameters
+    ----------
+    u : array_like
+        Normalised arc length from the fixed end (0) to the free end (1).
+    shape : {"model", "arc", "distal", "chambers"}
+        ``model``: ``1 - bulge cos 2 pi u`` (the renderer's law, :func:`centreline_mm`);
+        ``arc``: 1; ``distal``: 0 on the straight base ``u < straight_base_fraction``, a smooth
+        step up over :data:`DISTAL_RAMP`, then growing linearly towards the tip;
+        ``chambers``: the weight of chamber ``k`` of ``len(chamber_bend)`` equal chambers, its
+        changes blended over :data:`CHAMBER_BLEND` (the joints bend too, a little).
+    bulge, straight_base_fraction, chamber_bend
+        Parameters of the shapes above.
+
+    Returns
+    -------
+    ndarray
+        ``w(u)``; the curvature is ``psi / l0 * w(u) / mean(w)``.
+    """
+    u = np.asarray(u, dtype=float)
+    if shape == "model":
+        return 1.0 - bulge * np.cos(2 * np.pi * u)
+    if shape == "arc":
+        return np.ones_like(u)
+    if shape == "distal":
+        u0 = straight_base_fraction
+        return _smoothstep((u - u0) / DISTAL_RAMP) * (1.0 + DISTAL_GROWTH * np.clip(u - u0, 0, None) / max(1 - u0, 1e-9))
+    if shape == "chambers":
+        b = np.asarray(chamber_bend, dtype=float)
+        w = np.full_like(u, b[0])
+        for k in range(1, len(b)):
+            w += (b[k] - b[k - 1]) * _smoothstep((u - k / len(b)) / CHAMBER_BLEND + 0.5)
+        return w
+    raise UserInputError(f"shape = {shape!r}: use one of model, arc, distal, chambers")
+
+
+def weighted_centreline_mm(psi_deg: float, l0_mm: float, weights: ArrayLike) -> NDArray[np.float64]:
+    """Centreline whose curvature follows ``weights`` (sampled at equal arc-length steps).
+
+    The tangent angle is ``theta(u) = psi W(u) / W(1)`` with ``W`` the cumulative (trapezoid)
+    integral of the weights, so the total turning from the fixed end to the free end -- the tip
+    tangent minus the base tangent -- is ``psi_deg`` exactly, and the curve leaves the origin
+    along +x.
+
+    Parameters
+    ----------
+    psi_deg : float
+        Total turning angle (deg), ccw positive (y up).
+    l0_mm : float
+        Length (mm).
+    weights : array_like, shape (n,)
+        Relative curvature ``>= 0`` at ``n`` equally spaced arc-length positions, not all zero.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        Points in mm, fixed end first.
+    """
+    from scipy.integrate import cumulative_trapezoid
+
+    w = np.asarray(weights, dtype=float)
+    if w.ndim != 1 or len(w) < 3 or not np.isfinite(w).all() or (w < 0).any() or not w.sum() > 0:
+        raise UserInputError("weights must be >= 3 finite curvature weights >= 0, not all zero")
+    if not np.isfinite(psi_deg) or not l0_mm > 0:
+        raise UserInputError(f"psi_deg = {psi_deg!r} must be finite and l0_mm = {l0_mm!r} positive")
+    cum = cumulative_trapezoid(w, initial=0.0)
+    theta = np.radians(psi_deg) * cum / cum[-1]
+    ds = l0_mm / (len(w) - 1)
+    x = cumulative_simpson(np.cos(theta), dx=ds, initial=0.0)
+    y = cumulative_simpson(np.sin(theta), dx=ds, initial=0.0)
+    return np.column_stack([x, y])
+
+
+def actuator_centreline_mm(
+    psi_deg: float, l0_mm: float, scene: SceneParams, *, bulge: float = 0.0, n: int = DEFAULT_N
+) -> NDArray[np.float64]:
+    """The inextensible layer of an actuator bent to total turning ``psi_deg`` in ``scene.shape``.
+
+    ``shape = "model"`` is :func:`centreline_mm` with the given ``bulge`` (byte-identical to
+    today's photos); the other shapes ignore ``bulge`` and follow :func:`curvature_weights`.
+    Truth: the curve turns through ``psi_deg`` in total (tip tangent minus base tangent).
+    """
+    if scene.shape == "model":
+        return centreline_mm(psi_deg, l0_mm, bulge=bulge, n=n)
+    if n < 3:
+        raise UserInputError(f"n = {n!r} must be at least 3 points")
+    u = np.linspace(0.0, 1.0, int(n))
+    w = curvature_weights(u, scene.shape, straight_base_fraction=scene.straight_base_fraction,
+                          chamber_bend=scene.chamber_bend)
+    return weighted_centreline_mm(psi_deg, l0_mm, w)
+
+
+def peak_curvature_per_mm(psi_deg: float, l0_mm: float, scene: SceneParams, *, bulge: float = 0.0) -> float:
+    """Largest signed curvature (1/mm, ccw positive) of :func:`actuator_centreline_mm` (psi > 0: max; < 0: min)."""
+    u = np.linspace(0.0, 1.0, 2001)
+    w = curvature_weights(u, scene.shape, bulge=bulge, straight_base_fraction=scene.straight_base_fraction,
+                          chamber_bend=scene.chamber_bend)
+    k = np.radians(psi_deg) / l0_mm * w / np.trapezoid(w, u)
+    return float(k.max() if psi_deg >= 0 else k.min())
 
 
 def turning_angle_deg(points: ArrayLike, *, y_down: bool = False) -> float:

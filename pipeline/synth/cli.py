@@ -23,12 +23,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define the ``synth`` options."""
     from pipeline.synth.presets import SCENE_PRESETS
 
-    parser.add_argument("out_dir", metavar="OUT_DIR", help="photo-set folder to write (created; files in it are replaced)")
+    parser.add_argument("out_dir", metavar="OUT_DIR", help="photo-set folder to write; it appears only when complete (a previous synthetic set there is replaced)")
     parser.add_argument("--material", required=True, help="material name: DS20, DS30, SS40, SS50 (model's materials)")
     parser.add_argument("--actuators", type=int, default=3, help="number of actuators (default 3)")
     parser.add_argument("--trials", type=int, default=6, help="ramps per actuator (default 6)")
     parser.add_argument("--seed", type=int, default=1, help="random seed; same seed, same bytes (default 1)")
-    parser.add_argument("--scene", default="lab", choices=sorted(SCENE_PRESETS), help="scene preset (default lab)")
+    parser.add_argument("--scene", default="lab", choices=sorted(SCENE_PRESETS),
+                        help="scene preset (default lab): clean, lab, hard draw the marker line; green_fibre, grey_dots, "
+                             "grey_dots_clear, dark_translucent are bodies without a line (photo sets say target: body)")
     parser.add_argument("--step-kpa", type=float, default=10.0, help="pressure step in kPa (default 10)")
     parser.add_argument("--max-kpa", type=float, default=260.0,
                         help="highest pressure in kPa; the ramp also turns back at psi = -psi0 (default 260)")
@@ -70,5 +72,6 @@ def run(args: argparse.Namespace) -> int:
     outside = int((~truth["line_in_frame"].astype(bool)).sum())
     print(f"synth: {len(truth)} images of {args.material} ({args.actuators} actuators x {args.trials} trials, "
           f"scene {args.scene}, psi {truth['psi_deg'].min():.0f}..{truth['psi_deg'].max():.0f} deg) -> {args.out_dir} "
-          f"in {dt:.1f} s ({len(truth) / dt:.0f} images/s)" + (f"; {outside} line(s) leave the frame" if outside else ""))
+          f"in {dt:.1f} s ({len(truth) / dt:.0f} images/s)"
+          + (f"; {outside} photo(s) with the {truth['target'].iloc[0]} partly outside the frame" if outside else ""))
     return 0

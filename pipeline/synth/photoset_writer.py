@@ -1,8 +1,14 @@
 """Render a whole synthetic campaign of one material as a photo set (DESIGN.md format + truth.csv).
 
-Work is split per ramp (one actuator, one trial): the static backdrop is built once per ramp and
+Work is split per ramp (one actuator, one trial): the static backdrop (table, light, clamp, tube:
+the same for every ramp, only the actuator's mounting angle varies) is built once per ramp and
 ramps run in parallel processes.  Everything random is derived from ``seed`` and fixed keys
 (material, actuator, trial, step), so the bytes written do not depend on ``jobs``.
+
+Scenes with ``target: body`` write ``target: body`` and no line colour, the fixed end at the
+body's centre line, optionally ``background.jpg`` (the empty scene, ``background_photo``) and a
+per-photo ``fixed_direction_deg`` column (``known_fixed_direction``); their truth is the body's
+centre line (``psi_image_deg``: its total turning as seen through the camera).
 
 Examples
 --------
@@ -20,6 +26,7 @@ import concurrent.futures
 import dataclasses
 import multiprocessing
 import os
+import signal
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
@@ -29,7 +36,9 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.photoset import MANIFEST, TRUTH, atomic_write_bytes, write_manifest, write_settings
+from pipeline.fileio import atomic_write_bytes
+from pipeline.folders import staged_folder
+from pipeline.photoset import MANIFEST, TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
     PsiFunction,
@@ -41,12 +50,14 @@ from pipeline.synth.actuator import (
 )
 from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import Camera, make_camera, tilt_homography
-from pipeline.synth.centreline import centreline_mm
+from pipeline.synth.centreline import actuator_centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
-from pipeline.synth.scene import _compose, child_seed, world_extent_mm
+from pipeline.synth.scene import _compose, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
 
 #: seed streams (second key after the material)
-_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT = range(6)
+_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND = range(7)
+#: file name of the empty-scene photo of ``background_photo`` scenes
+BACKGROUND_IMAGE = "background.jpg"
 DEFAULT_L0_MM = 195.0
 LAYOUT_MARGIN_PX = 16
 
@@ -115,11 +126,12 @@ def plan_photoset(
     return df
 
 
-def _sample_extents(plan: pd.DataFrame, l0_mm: float, body_w: float, n_curves: int = 48) -> list[np.ndarray]:
+def _sample_extents(plan: pd.DataFrame, l0_mm: float, scene: SceneParams, n_curves: int = 48) -> list[np.ndarray]:
     order = plan.sort_values("psi_deg")
     pick = np.unique(np.round(np.linspace(0, len(order) - 1, min(n_curves, len(order)))).astype(int))
     rows = order.iloc[pick]
-    return [world_extent_mm(centreline_mm(float(r.psi_deg), l0_mm, bulge=float(r.bulge), n=241), body_w)
+    return [world_extent_mm(actuator_centreline_mm(float(r.psi_deg), l0_mm, scene, bulge=float(r.bulge), n=241),
+                            scene.body_width_mm, scene.tip_cap_mm)
             for r in rows.itertuples()]
 
 
@@ -164,6 +176,11 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
     return rot, (float(origin[0]), float(origin[1])), float(need)
 
 
+def _worker_init() -> None:
+    """Ctrl-C reaches the whole process group: a worker just stops, the main process cleans up."""
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(128 + signum))
+
+
 def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     """Render and write the photos of one ramp (runs in a worker process)."""
     import cv2
@@ -171,20 +188,27 @@ def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     cv2.setNumThreads(1)
     scene: SceneParams = task["scene"]
     camera = make_camera(scene, rotation_deg=task["rotation_deg"], fixed_end_px=task["fixed_end_px"])
-    keepout = [_rotate(k, task["base_rotation_deg"] - task["rotation_deg"]) for k in task["keepout_mm"]]
-    backdrop = make_backdrop(scene, camera, seed=task["table_seed"], keepout_mm=keepout)
+    backdrop = _static_scene(scene, task["base_rotation_deg"], task["fixed_end_px"], task["table_seed"], task["keepout_mm"])
     out_dir = Path(task["out_dir"])
     results = []
     for row in task["rows"]:
-        pts = centreline_mm(row["psi_deg"], task["l0_mm"], bulge=row["bulge"])
+        pts = actuator_centreline_mm(row["psi_deg"], task["l0_mm"], scene, bulge=row["bulge"])
         rng = np.random.default_rng(child_seed(*task["image_seed"], row["step"]))
         r = _compose(pts, scene, camera, backdrop, scene.body_width_mm, rng)
         tmp = out_dir / f".{row['image']}.tmp"
         tmp.write_bytes(r.jpeg_bytes)
         os.replace(tmp, out_dir / row["image"])
         results.append({"image": row["image"], "psi_image_deg": r.psi_image_deg, "line_in_frame": r.line_in_frame,
-                        "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+                        "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1],
+                        "fixed_direction_deg": r.fixed_direction_deg})
     return results
+
+
+def _static_scene(scene: SceneParams, rotation_deg: float, fixed_end_px: tuple[float, float], seed: Any,
+                  keepout_mm: list[np.ndarray]) -> Any:
+    """The backdrop every ramp shares (clamp at the base mounting angle), as a background photo shows it."""
+    camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px)
+    return make_backdrop(scene, camera, seed=seed, keepout_mm=keepout_mm)
 
 
 def render_photoset(
@@ -214,7 +238,9 @@ def render_photoset(
     Parameters
     ----------
     out_dir : path
-        Folder to write (created).
+        Folder to write.  It is written under a temporary name beside it and renamed when
+        complete (:func:`pipeline.folders.staged_folder`): an interrupted render leaves no partial
+        set, and an existing synthetic set (one with ``truth.csv``) is replaced as a whole.
     material : str
         Material name (``DS20``, ``DS30``, ``SS40``, ``SS50`` or any name ``psi_fn`` knows).
     actuators, trials : int
@@ -235,7 +261,8 @@ def render_photoset(
     l0_mm : float, optional
         Marked length (default: the model's material file, else 195 mm).
     overwrite : bool
-        Allow writing into a folder that already holds a photo set.
+        Allow replacing a folder that already holds a synthetic photo set (a folder holding other
+        files, such as a real photo set without ``truth.csv``, is never replaced).
     fit_view : bool
         When the campaign's shapes do not fit the frame at ``scene.mm_per_px``, increase
         ``mm_per_px`` just enough (the value used is written to ``photoset.yaml``).
@@ -255,7 +282,10 @@ def render_photoset(
     l0 = float(l0_mm) if l0_mm is not None else default_l0_mm(material)
     plan = plan_photoset(material, actuators=actuators, trials=trials, seed=seed, step_kpa=step_kpa,
                          max_kpa=max_kpa, psi_fn=psi_fn, behaviour=behaviour)
-    extents = _sample_extents(plan, l0, sc.body_width_mm)
+    if sc.target == "body":  # refuse before writing anything: a folded body has no centre line
+        for r in plan.loc[[plan["psi_deg"].idxmax(), plan["psi_deg"].idxmin()]].itertuples():
+            check_body_fits(actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001), sc)
+    extents = _sample_extents(plan, l0, sc)
     base_rot, fixed_flat, need = choose_layout(extents, sc)
     if need > 1.0 and fit_view:
         # zoom the camera out (as the experimenter would) until every shape is in the frame
@@ -266,38 +296,56 @@ def render_photoset(
     jit = 2.5 * sc.rotation_jitter_deg
     keepout = [_rotate(e, d) for e in extents for d in ({-jit, 0.0, jit})]
     mk = material_key(material)
-    out.mkdir(parents=True, exist_ok=True)
-    tasks = []
-    for (act, trial), g in plan.groupby(["actuator", "trial"], sort=False):
-        a, t = int(act[1:]), int(trial)
-        rot = base_rot + float(np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(0, sc.rotation_jitter_deg))
-        tasks.append({
-            "scene": sc, "rotation_deg": rot, "base_rotation_deg": base_rot, "fixed_end_px": fixed_end_px,
-            "keepout_mm": keepout, "table_seed": child_seed(seed, mk, _TABLE), "out_dir": str(out), "l0_mm": l0,
-            "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
-            "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
-        })
-    if jobs == 1 or len(tasks) == 1:
-        results = [_render_ramp(task) for task in tasks]
-    else:
-        ctx = multiprocessing.get_context("spawn")
-        with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-            results = list(pool.map(_render_ramp, tasks))
-    rendered = pd.DataFrame([r for res in results for r in res])
-    truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
-    truth = truth.assign(
-        scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
-        blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
-        occluded_fraction=sc.occluded_fraction, seed=seed,
-    )
-    first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
-             "bulge"]
-    truth = truth[first + [c for c in truth.columns if c not in first]]
-    manifest = truth[["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]]
-    write_manifest(out, manifest)
-    write_settings(out, {
-        "l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
-        "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw",
-    })
-    atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+    with staged_folder(out, marker=TRUTH) as tmp:  # the set appears complete or not at all
+        tasks = []
+        for (act, trial), g in plan.groupby(["actuator", "trial"], sort=False):
+            a, t = int(act[1:]), int(trial)
+            rot = base_rot + float(np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(0, sc.rotation_jitter_deg))
+            tasks.append({
+                "scene": sc, "rotation_deg": rot, "base_rotation_deg": base_rot, "fixed_end_px": fixed_end_px,
+                "keepout_mm": keepout, "table_seed": child_seed(seed, mk, _TABLE), "out_dir": str(tmp), "l0_mm": l0,
+                "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
+                "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
+            })
+        if jobs == 1 or len(tasks) == 1:
+            results = [_render_ramp(task) for task in tasks]
+        else:
+            ctx = multiprocessing.get_context("spawn")
+            pool = concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+            try:
+                results = list(pool.map(_render_ramp, tasks))
+            finally:  # on Ctrl-C/SIGTERM: drop the ramps not started, wait for the (dead) workers
+                pool.shutdown(wait=True, cancel_futures=True)
+        rendered = pd.DataFrame([r for res in results for r in res])
+        truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
+        truth = truth.assign(
+            scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
+            blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
+            occluded_fraction=sc.occluded_fraction, seed=seed, target=sc.target, shape=sc.shape,
+            marker_line=sc.marker_line, body_width_mm=sc.body_width_mm, body_translucency=sc.body_translucency,
+            texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style,
+        )
+        first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
+                 "bulge"]
+        truth = truth[first + [c for c in truth.columns if c not in first]]
+        columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+        manifest = truth[columns + (["fixed_direction_deg"] if sc.known_fixed_direction else [])].round(
+            {"fixed_direction_deg": 3})
+        write_manifest(tmp, manifest)
+        settings: dict[str, Any] = {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px)}
+        if sc.target == "body":
+            # the fixed end of the body's centre line, at the clamp face (base mounting angle)
+            base = Camera(sc.width, sc.height, sc.mm_per_px, base_rot, fixed_flat, tilt_homography(sc))
+            fixed_end_px = tuple(float(v) for v in base.to_px([[0.0, sc.body_width_mm / 2]])[0])
+            settings["target"] = "body"
+        else:
+            settings["line_color"] = sc.line_color
+        settings.update({"fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw"})
+        if sc.background_photo:
+            backdrop = _static_scene(sc, base_rot, tasks[0]["fixed_end_px"], child_seed(seed, mk, _TABLE), keepout)
+            image = render_background(backdrop, sc, seed=child_seed(seed, mk, _BACKGROUND))
+            atomic_write_bytes(tmp / BACKGROUND_IMAGE, encode_jpeg(image, sc.jpeg_quality))
+            settings["background"] = BACKGROUND_IMAGE
+        write_settings(tmp, settings)
+        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth

@@ -1,9 +1,15 @@
 """Scene parameters of the virtual camera and table, and the named presets.
 
 Every knob of a synthetic photo is a field of :class:`SceneParams`; :data:`SCENE_PRESETS` holds
-sensible combinations (``clean``, ``lab``, ``hard``) and :func:`scene_from` derives a scene from a
-preset with overrides (the config's ``synthetic.scene`` mapping and ``--set KEY=VALUE`` on the
-command line end up there).
+sensible combinations and :func:`scene_from` derives a scene from a preset with overrides (the
+config's ``scene_set`` mapping and ``--set KEY=VALUE`` on the command line end up there).
+
+Presets: ``clean``, ``lab``, ``hard`` (the paper's drawn marker line on a bench) and three scenes
+of actuators that carry no drawn line (``target: body``), modelled on the real photo kinds kept
+back for checking: ``green_fibre`` (translucent fibre-wound body, green chroma backdrop, white
+clamp, supply tube), ``grey_dots`` (opaque silicone with motion-capture dots, grey backdrop,
+black clamp plate), ``grey_dots_clear`` (the same rig, a translucent body) and
+``dark_translucent`` (translucent ribbed body with a tip cap over a black backdrop).
 
 Examples
 --------
@@ -12,6 +18,9 @@ Examples
 >>> s = scene_from("lab", width=640, height=480)      # same field of view, half the pixels
 >>> round(s.mm_per_px / SCENE_PRESETS["lab"].mm_per_px, 3)
 2.0
+>>> g = scene_from("green_fibre", table_bgr="grey")   # colour knobs also take a name
+>>> g.target, g.marker_line, g.table_bgr
+('body', False, (128, 130, 129))
 """
 
 from __future__ import annotations
@@ -19,6 +28,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from pipeline.errors import UserInputError
 
@@ -30,8 +41,30 @@ LINE_INK_BGR: dict[str, tuple[int, int, int]] = {
     "green": (60, 150, 35),
 }
 
+#: named colours (BGR) accepted by every colour knob (``table_bgr=green``, ``body_bgr=clear`` ...)
+NAMED_BGR: dict[str, tuple[int, int, int]] = {
+    "bench": (188, 196, 202),      # today's pale bench top
+    "green": (58, 160, 40),        # chroma-key backdrop as a camera sees it under studio light
+    "grey": (128, 130, 129),       # photographer's mid-grey card / painted board
+    "black": (24, 23, 25),         # black velvet / matt black card
+    "white": (236, 238, 240),
+    "clear": (222, 226, 228),      # clear / milky silicone (Ecoflex, Dragon Skin)
+    "pink": (150, 140, 228),       # pigmented silicone
+    "blue": (200, 150, 70),
+    "orange": (60, 140, 240),
+    "tan": (110, 165, 205),        # Kevlar / aramid thread
+}
+
 BACKGROUNDS: tuple[str, ...] = ("plain", "gradient", "textured")
 DISTRACTOR_COLORS: tuple[str, ...] = ("grey", "line")
+TARGETS: tuple[str, ...] = ("line", "body")
+SHAPES: tuple[str, ...] = ("model", "arc", "distal", "chambers")
+TEXTURES: tuple[str, ...] = ("none", "fibre", "ribs")
+CLAMP_STYLES: tuple[str, ...] = ("block", "white", "plate")
+DOT_COLORS: tuple[str, ...] = ("white", "dark")
+DOT_LAYOUTS: tuple[str, ...] = ("centre", "edges")
+#: knobs that are colours (three integers 0-255, B, G, R, or a name of NAMED_BGR)
+COLOR_KEYS: tuple[str, ...] = ("table_bgr", "body_bgr", "texture_bgr", "tip_cap_bgr")
 
 
 @dataclass(frozen=True)
@@ -88,7 +121,66 @@ class SceneParams:
     occluded_fraction : float
         Fraction of the marker length hidden under a glare spot (0-0.5).
     rotation_jitter_deg : float
-        Standard deviation of the mounting angle from one actuator/trial to the next, degrees.
+        Standard deviation of the mounting angle from one actuator/trial to the next, degrees
+        (the actuator turns in its clamp; the clamp, plate, tube and table stay put).
+    marker_line : bool
+        Draw the marker line along the inextensible layer (False: a body with no drawn line).
+    target : str
+        What a photo set of this scene asks the measurement to measure, and what its truth
+        curve is: ``line`` (the drawn marker) or ``body`` (the body's own centre line, midway
+        between its two long edges; any curve parallel to the inextensible layer turns through
+        the same total angle psi).  ``line`` needs ``marker_line``.
+    shape : str
+        How the curvature is spread along the body (total turning psi in every case):
+        ``model`` (the virtual actuator's law: an arc, bulging past psi = 0 for soft
+        silicones), ``arc`` (constant curvature), ``distal`` (a straight base, curvature
+        growing towards the tip), ``chambers`` (piecewise: each chamber bends in proportion to
+        its weight in ``chamber_bend``).
+    straight_base_fraction : float
+        ``distal``: fraction of the length at the fixed end that stays straight (0-0.8).
+    chamber_bend : tuple of float
+        One weight per chamber, fixed end first (``--set chamber_bend=0,1,1``: the base chamber
+        stays straight).  More than one chamber also draws the joints between them.
+    body_shading : float
+        Relief across the body, 0-1: 0 is today's flat band; > 0 shades the body as a rounded
+        tube (light from a seeded side), draws rims on both long edges and thins a
+        translucent body towards its edges.
+    texture : str
+        ``none``, ``fibre`` (a double helix of thin strands wound around the body, seeded
+        irregular spacing) or ``ribs`` (pleats: periodic bands across the body with slightly
+        bulging edges, seeded irregular spacing).
+    texture_pitch_mm : float
+        Winding pitch of the fibre or spacing of the ribs (mm).
+    texture_contrast : float
+        Strength of the strands or grooves, 0-1.
+    texture_bgr : tuple of int
+        Colour of the fibre strands (BGR).
+    specular : float
+        Strength of the specular highlight streaks along the body, 0-1.
+    dots : int
+        Number of motion-capture dots on the body (0 = none), spread along its length.
+    dot_color : str
+        ``white`` (retro-reflective markers lit from the camera) or ``dark`` (printed dots).
+    dot_diameter_mm : float
+        Dot diameter (mm).
+    dot_layout : str
+        ``centre`` (on the body's centre line) or ``edges`` (alternating near the two faces).
+    tip_cap_mm : float
+        Length of a rigid end block at the free end (mm, 0 = none); it is a little wider than
+        the body and coloured ``tip_cap_bgr``.
+    tip_cap_bgr : tuple of int
+        Colour of the tip cap (BGR).
+    clamp_style : str
+        ``block`` (today's dark clamp), ``white`` (a white printed clamp) or ``plate`` (a large
+        black plate the actuator emerges from; it may reach the image border).
+    shadow : float
+        Strength of the soft shadows the body and clamp cast on the backdrop, 0-1.
+    background_photo : bool
+        Photo sets of this scene also hold ``background.jpg``, the empty scene (same camera,
+        light and clamp, no actuator, its own sensor noise), named in ``photoset.yaml``.
+    known_fixed_direction : bool
+        Photo sets of this scene state, per photo, the on-screen direction in which the
+        actuator leaves the clamp (manifest column ``fixed_direction_deg``).
     """
 
     width: int = 1280
@@ -117,6 +209,33 @@ class SceneParams:
     jpeg_quality: int = 92
     occluded_fraction: float = 0.0
     rotation_jitter_deg: float = 1.5
+    marker_line: bool = True
+    target: str = "line"
+    shape: str = "model"
+    straight_base_fraction: float = 0.35
+    chamber_bend: tuple[float, ...] = (1.0,)
+    body_shading: float = 0.0
+    texture: str = "none"
+    texture_pitch_mm: float = 3.0
+    texture_contrast: float = 0.35
+    texture_bgr: tuple[int, int, int] = (70, 80, 90)
+    specular: float = 0.0
+    dots: int = 0
+    dot_color: str = "white"
+    dot_diameter_mm: float = 4.0
+    dot_layout: str = "centre"
+    tip_cap_mm: float = 0.0
+    tip_cap_bgr: tuple[int, int, int] = (40, 40, 44)
+    clamp_style: str = "block"
+    shadow: float = 0.0
+    background_photo: bool = False
+    known_fixed_direction: bool = False
+
+    @property
+    def plain_body(self) -> bool:
+        """The body is today's flat translucent band (no relief, texture, highlights, dots or cap)."""
+        return (self.body_shading == 0 and self.texture == "none" and self.specular == 0 and self.dots == 0
+                and self.tip_cap_mm == 0 and len(self.chamber_bend) == 1 and self.shadow == 0)
 
     def __post_init__(self) -> None:
         problems = _problems(self)
@@ -128,14 +247,15 @@ def _problems(s: SceneParams) -> list[str]:
     out = []
     if not (16 <= s.width <= 20000 and 16 <= s.height <= 20000):
         out.append(f"width/height = {s.width}x{s.height} px must be 16..20000")
-    for key in ("mm_per_px", "line_width_px", "body_width_mm", "focal_px_per_width"):
+    for key in ("mm_per_px", "line_width_px", "body_width_mm", "focal_px_per_width", "texture_pitch_mm",
+                "dot_diameter_mm"):
         if not getattr(s, key) > 0:
             out.append(f"{key} = {getattr(s, key)!r} must be > 0")
     for key in ("texture_strength", "noise_sigma", "blur_sigma_px", "lighting_gradient", "vignetting",
-                "tilt_deg", "rotation_jitter_deg"):
+                "tilt_deg", "rotation_jitter_deg", "tip_cap_mm"):
         if not getattr(s, key) >= 0:
             out.append(f"{key} = {getattr(s, key)!r} must be >= 0")
-    for key in ("line_contrast", "body_translucency"):
+    for key in ("line_contrast", "body_translucency", "body_shading", "texture_contrast", "specular", "shadow"):
         if not 0 <= getattr(s, key) <= 1:
             out.append(f"{key} = {getattr(s, key)!r} must be between 0 and 1")
     if s.background not in BACKGROUNDS:
@@ -152,10 +272,25 @@ def _problems(s: SceneParams) -> list[str]:
         out.append(f"occluded_fraction = {s.occluded_fraction!r} must be 0..0.5")
     if s.tilt_deg > 20:
         out.append(f"tilt_deg = {s.tilt_deg} is more than 20 deg; a copy stand is never that far off")
-    for key in ("table_bgr", "body_bgr"):
+    for key in COLOR_KEYS:
         v = getattr(s, key)
         if len(v) != 3 or any(not 0 <= int(c) <= 255 for c in v):
-            out.append(f"{key} = {v!r} must be three integers 0-255 (B, G, R)")
+            out.append(f"{key} = {v!r} must be three integers 0-255 (B, G, R) or a colour name {sorted(NAMED_BGR)}")
+    for key, allowed in (("target", TARGETS), ("shape", SHAPES), ("texture", TEXTURES), ("clamp_style", CLAMP_STYLES),
+                         ("dot_color", DOT_COLORS), ("dot_layout", DOT_LAYOUTS)):
+        if getattr(s, key) not in allowed:
+            out.append(f"{key} = {getattr(s, key)!r}: use one of {list(allowed)}")
+    if s.target == "line" and not s.marker_line:
+        out.append("target = 'line' needs marker_line = true (a body without a drawn line is measured as target = 'body')")
+    if not 0 <= s.straight_base_fraction <= 0.8:
+        out.append(f"straight_base_fraction = {s.straight_base_fraction!r} must be 0..0.8")
+    bend = s.chamber_bend
+    if not 1 <= len(bend) <= 8 or any(not (np.isfinite(b) and b >= 0) for b in bend) or not sum(bend) > 0:
+        out.append(f"chamber_bend = {bend!r} must be 1 to 8 weights >= 0, not all 0 (e.g. 0,1,1)")
+    if not 0 <= s.dots <= 60:
+        out.append(f"dots = {s.dots!r} must be 0..60")
+    if s.body_width_mm > 60:
+        out.append(f"body_width_mm = {s.body_width_mm} mm is wider than any actuator this renders (<= 60 mm)")
     return out
 
 
@@ -175,6 +310,44 @@ SCENE_PRESETS: dict[str, SceneParams] = {
         distractor_marks=12, distractor_color="line", line_width_px=4.0, line_contrast=0.85,
         body_translucency=0.3, tilt_deg=3.0, noise_sigma=6.0, blur_sigma_px=1.5, jpeg_quality=75,
         occluded_fraction=0.05, rotation_jitter_deg=3.0,
+    ),
+    # (A) a translucent fibre-wound segment of three chambers on a green chroma backdrop (cloth),
+    # white printed clamp and its supply tube; the base chamber bends little
+    "green_fibre": SceneParams(
+        background="textured", table_bgr=NAMED_BGR["green"], texture_strength=5.0, lighting_gradient=0.2,
+        vignetting=0.22, marker_line=False, target="body", shape="chambers", chamber_bend=(0.25, 1.0, 1.0),
+        body_width_mm=16.0, body_bgr=NAMED_BGR["clear"], body_translucency=0.5, body_shading=0.6,
+        texture="fibre", texture_pitch_mm=2.5, texture_contrast=0.55, texture_bgr=(55, 75, 95), specular=0.5,
+        tip_cap_mm=6.0, tip_cap_bgr=(228, 230, 232), clamp_style="white", tube=True, shadow=0.25,
+        tilt_deg=1.0, noise_sigma=2.5, blur_sigma_px=0.8, jpeg_quality=90, rotation_jitter_deg=1.5,
+        background_photo=True,
+    ),
+    # (B) an opaque pigmented silicone actuator with retro-reflective motion-capture dots, clamped
+    # in a black plate on a grey board; curvature concentrated towards the tip
+    "grey_dots": SceneParams(
+        background="textured", table_bgr=NAMED_BGR["grey"], texture_strength=3.0, lighting_gradient=0.25,
+        vignetting=0.25, marker_line=False, target="body", shape="distal", straight_base_fraction=0.3,
+        body_width_mm=20.0, body_bgr=NAMED_BGR["pink"], body_translucency=0.08, body_shading=0.7,
+        specular=0.35, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
+        shadow=0.2, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
+        known_fixed_direction=True,
+    ),
+    # (B) the same rig with a translucent (clear) silicone actuator: the body over the plate is faint
+    "grey_dots_clear": SceneParams(
+        background="textured", table_bgr=NAMED_BGR["grey"], texture_strength=3.0, lighting_gradient=0.25,
+        vignetting=0.25, marker_line=False, target="body", shape="distal", straight_base_fraction=0.3,
+        body_width_mm=18.0, body_bgr=NAMED_BGR["clear"], body_translucency=0.7, body_shading=0.7,
+        specular=0.5, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
+        shadow=0.15, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
+        known_fixed_direction=True, background_photo=True,
+    ),
+    # (B) a translucent ribbed silicone actuator over a black backdrop, with a printed tip cap
+    "dark_translucent": SceneParams(
+        background="textured", table_bgr=NAMED_BGR["black"], texture_strength=2.0, lighting_gradient=0.15,
+        vignetting=0.3, marker_line=False, target="body", body_width_mm=14.0, body_bgr=NAMED_BGR["white"],
+        body_translucency=0.6, body_shading=0.8, texture="ribs", texture_pitch_mm=6.0, texture_contrast=0.4,
+        specular=0.7, tip_cap_mm=8.0, tip_cap_bgr=(190, 192, 196), clamp_style="block", tube=True, shadow=0.0,
+        tilt_deg=1.0, noise_sigma=3.5, blur_sigma_px=0.8, jpeg_quality=90, rotation_jitter_deg=1.5,
     ),
 }
 
@@ -223,6 +396,11 @@ def scene_from(preset: str | SceneParams = "lab", **overrides: Any) -> ScenePara
     return dataclasses.replace(base, **values)
 
 
+def _items(text: str) -> list[str]:
+    """``"0,1,1"``, ``"[0, 1, 1]"`` or ``"(0,1,1)"`` -> ``["0", "1", "1"]``."""
+    return [x for x in text.strip().strip("[]()").replace(" ", "").split(",") if x != ""]
+
+
 def _convert(key: str, value: Any) -> Any:
     kind = str(_FIELD_TYPES[key])
     try:
@@ -239,12 +417,18 @@ def _convert(key: str, value: Any) -> Any:
                     raise ValueError(value)
                 return low in ("true", "yes", "1", "on")
             return bool(value)
+        if kind == "tuple[float, ...]":
+            items = _items(value) if isinstance(value, str) else list(np.atleast_1d(value))
+            return tuple(float(x) for x in items)
         if kind.startswith("tuple"):
-            items = value.split(",") if isinstance(value, str) else list(value)
+            if isinstance(value, str) and value.strip().lower() in NAMED_BGR:
+                return NAMED_BGR[value.strip().lower()]
+            items = _items(value) if isinstance(value, str) else list(value)
             out = tuple(int(x) for x in items)
             if len(out) != 3:
                 raise ValueError(value)
             return out
-        return str(value)
+        return str(value).strip()
     except (TypeError, ValueError) as exc:
-        raise UserInputError(f"scene key {key} = {value!r} is not a valid {kind}") from exc
+        hint = f" or a colour name {sorted(NAMED_BGR)}" if key in COLOR_KEYS else ""
+        raise UserInputError(f"scene key {key} = {value!r} is not a valid {kind}{hint}") from exc

@@ -4,6 +4,13 @@ The marker line is filled as the exact polygon ``centreline +- width/2`` at 4x s
 area-averaged, so the centre of the drawn line is the centreline to within ~0.01 px; the
 returned ``centreline_px`` is the dense exact curve mapped through the same camera.
 
+Scenes with ``target: body`` (no drawn line needed) take as truth the body's own centre line,
+midway between its two long edges (the layer offset by half the body width): parallel to the
+layer, it turns through the same total angle psi in the world; ``psi_image_deg`` is its turning
+as seen on screen through the camera (tip tangent minus base tangent, ccw positive), exactly as
+for the line.  Bodies with relief, texture, highlights, dots or a tip cap are painted by
+:mod:`pipeline.synth.body`; the plain flat band of the line scenes keeps its old pixels.
+
 Examples
 --------
 >>> from pipeline.synth import render_actuator, scene_from
@@ -12,10 +19,14 @@ Examples
 ((240, 320, 3), 2)
 >>> abs(r.psi_image_deg - 120.0) < 0.05
 True
+>>> b = render_actuator(120.0, 195.0, scene_from("green_fibre", width=320, height=240), seed=1)
+>>> b.target, abs(b.psi_image_deg - 120.0) < 0.6     # 1 deg of camera tilt shows a little
+('body', True)
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 from dataclasses import dataclass
@@ -26,27 +37,49 @@ from numpy.typing import ArrayLike, NDArray
 
 from pipeline.errors import UserInputError
 from pipeline.synth.backdrop import (
-    END_CAP_MM,
+    GLARE_BGR,
     NOISE_PAD,
     SHIFT,
     Backdrop,
+    child_seed,
     clamp_outline_mm,
     make_backdrop,
 )
+from pipeline.synth.body import (
+    CAP_OVERHANG,
+    END_CAP_MM,
+    RIB_BULGE,
+    BodyFrame,
+    over,
+    paint_body,
+    paint_cap,
+    paint_dots,
+    relief_mm,
+    shadow_of,
+)
 from pipeline.synth.camera import Camera, make_camera
-from pipeline.synth.centreline import DEFAULT_N, centreline_mm, turning_angle_deg
-from pipeline.synth.presets import SceneParams
+from pipeline.synth.centreline import DEFAULT_N, actuator_centreline_mm, turning_angle_deg
+from pipeline.synth.presets import LINE_INK_BGR, SceneParams
 
 #: supersampling factor of the marker-line mask
 LINE_SUPERSAMPLING = 4
+#: how far beyond the body a soft shadow reaches (mm)
+SHADOW_REACH_MM = 10.0
 _GLARE_OPACITY = 0.93
+#: a body whose far edge would come closer than this fraction of the radius of curvature to the
+#: centre of curvature is refused (its outline would fold over itself)
+FOLD_LIMIT = 0.92
+
+__all__ = ["RenderedImage", "child_seed", "encode_jpeg", "render_actuator", "render_background", "render_curve",
+           "world_extent_mm"]
 
 
-def child_seed(seed: int | np.random.SeedSequence, *keys: int) -> np.random.SeedSequence:
-    """A seed derived from ``seed`` and integer ``keys`` (pure: the same inputs give the same seed)."""
-    if isinstance(seed, np.random.SeedSequence):
-        return np.random.SeedSequence(seed.entropy, spawn_key=tuple(seed.spawn_key) + tuple(keys))
-    return np.random.SeedSequence(int(seed), spawn_key=tuple(keys))
+def encode_jpeg(image: NDArray[np.uint8], quality: int) -> bytes:
+    """``image`` encoded as JPEG at ``quality`` (deterministic bytes)."""
+    ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
+    if not ok:  # pragma: no cover - OpenCV always encodes a valid uint8 image
+        raise RuntimeError("JPEG encoding failed")
+    return buf.tobytes()
 
 
 @dataclass(frozen=True)
@@ -58,16 +91,25 @@ class RenderedImage:
     image : ndarray (H, W, 3) uint8
         BGR image before JPEG compression.
     centreline_px : ndarray (N, 2) float
-        Exact centreline of the marker, fixed end first, image coordinates (x right, y down).
+        Exact centre line of the target (the marker for ``target: line``, the body's centre
+        line for ``target: body``), fixed end first, image coordinates (x right, y down).
     fixed_end_px : tuple of float
-        Where the fixed end of the marker is in the image.
+        Where the fixed end of that centre line is in the image (at the clamp face).
     psi_image_deg : float
         Turning angle of ``centreline_px`` as seen on screen (ccw positive): psi itself up to the
         perspective of a tilted camera.
     line_in_frame : bool
-        The whole marker line lies inside the image.
+        The whole of ``centreline_px`` lies inside the image.
     jpeg_quality : int
         Quality used by :attr:`jpeg_bytes`.
+    target : str
+        ``line`` or ``body`` (what ``centreline_px`` is).
+    layer_px : ndarray (N, 2) float or None
+        The marked inextensible layer (where a marker line is, or would be, drawn).
+    fixed_direction_deg : float
+        On-screen direction in which ``centreline_px`` leaves the clamp (deg, ccw from +x).
+    dots_px : ndarray (k, 2) float
+        Centres of the motion-capture dots (empty without dots).
     """
 
     image: NDArray[np.uint8]
@@ -76,14 +118,15 @@ class RenderedImage:
     psi_image_deg: float
     line_in_frame: bool
     jpeg_quality: int = 92
+    target: str = "line"
+    layer_px: NDArray[np.float64] | None = None
+    fixed_direction_deg: float = float("nan")
+    dots_px: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros((0, 2)))
 
     @functools.cached_property
     def jpeg_bytes(self) -> bytes:
         """The image encoded as JPEG with the scene's quality (deterministic)."""
-        ok, buf = cv2.imencode(".jpg", self.image, [cv2.IMWRITE_JPEG_QUALITY, int(self.jpeg_quality)])
-        if not ok:  # pragma: no cover - OpenCV always encodes a valid uint8 image
-            raise RuntimeError("JPEG encoding failed")
-        return buf.tobytes()
+        return encode_jpeg(self.image, self.jpeg_quality)
 
 
 def _normals(points: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -132,10 +175,53 @@ def _roi(polys: list[NDArray[np.float64]], margin: float, width: int, height: in
     return x0, y0, x1, y1
 
 
-def world_extent_mm(points_mm: NDArray[np.float64], body_width_mm: float) -> NDArray[np.float64]:
-    """World points bounding the actuator (line, body, clamp) for framing."""
-    body = points_mm + _normals(points_mm) * body_width_mm
-    return np.vstack([points_mm, body, clamp_outline_mm(body_width_mm)])
+def world_extent_mm(points_mm: NDArray[np.float64], body_width_mm: float, tip_mm: float = 0.0) -> NDArray[np.float64]:
+    """World points bounding the actuator (line, body, its end and tip cap, clamp block) for framing.
+
+    A clamp plate is left out: it is meant to reach the border.
+    """
+    nrm = _normals(points_mm)
+    body = points_mm + nrm * body_width_mm
+    parts = [points_mm, body, clamp_outline_mm(body_width_mm)]
+    if tip_mm > 0:
+        t = points_mm[-1] - points_mm[-2]
+        t = t / np.hypot(*t)
+        reach, over_mm = END_CAP_MM + tip_mm, CAP_OVERHANG * body_width_mm + 0.5
+        parts.append(np.array([points_mm[-1] + t * reach - nrm[-1] * over_mm, body[-1] + t * reach + nrm[-1] * over_mm]))
+    return np.vstack(parts)
+
+
+def _fixed_direction_deg(camera: Camera, curve_mm: NDArray[np.float64]) -> float:
+    """On-screen direction (deg, ccw from +x) of the tangent of ``curve_mm`` at its first point."""
+    t = -3 * curve_mm[0] + 4 * curve_mm[1] - curve_mm[2]  # one-sided, second order
+    ends = camera.to_px([curve_mm[0], curve_mm[0] + 1e-3 * t / np.hypot(*t)])
+    d = ends[1] - ends[0]
+    return float(np.degrees(np.arctan2(-d[1], d[0])))
+
+
+def check_body_fits(points_mm: NDArray[np.float64], scene: SceneParams, body_width_mm: float | None = None) -> None:
+    """Refuse a body whose outline would fold over itself on the inside of a bend.
+
+    The body lies on the left of the layer (ccw side), so where the layer turns ccw with
+    curvature ``kappa``, the far edge (``body_width_mm``, default the scene's, plus the ribs'
+    bulge) must stay inside the radius ``1 / kappa``: ``kappa * width < FOLD_LIMIT``.
+
+    Raises
+    ------
+    UserInputError
+        Naming the curvature and the knobs that relieve it.
+    """
+    width = (scene.body_width_mm if body_width_mm is None else body_width_mm) * (
+        1 + (RIB_BULGE if scene.texture == "ribs" else 0.0))
+    d = np.diff(points_mm, axis=0)
+    ds = np.hypot(d[:, 0], d[:, 1])
+    k = np.diff(np.unwrap(np.arctan2(d[:, 1], d[:, 0]))) / np.maximum((ds[1:] + ds[:-1]) / 2, 1e-12)
+    k_max = float(k.max()) if len(k) else 0.0
+    if k_max * width >= FOLD_LIMIT:
+        raise UserInputError(
+            f"the body would fold over itself: curvature {k_max:.4f} /mm (radius {1 / k_max:.1f} mm) on the side of a "
+            f"{width:g} mm wide body; use a smaller |psi|, a narrower body (body_width_mm), a longer l0 or a "
+            "gentler shape (straight_base_fraction, chamber_bend)")
 
 
 def render_curve(
@@ -172,6 +258,13 @@ def render_curve(
     Returns
     -------
     RenderedImage
+        With ``target: body`` its truth is the body's centre line, ``points_mm`` offset to the
+        left by half the body width (the same total turning in the world).
+
+    Raises
+    ------
+    UserInputError
+        For bad points, or (``target: body``) a body that would fold over itself.
     """
     pts = np.asarray(points_mm, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.isfinite(pts).all():
@@ -179,7 +272,7 @@ def render_curve(
     body_w = scene.body_width_mm if body_width_mm is None else float(body_width_mm)
     if backdrop is None:
         camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px,
-                             extent_mm=world_extent_mm(pts, body_w))
+                             extent_mm=world_extent_mm(pts, body_w, scene.tip_cap_mm))
         backdrop = make_backdrop(scene, camera, seed=child_seed(seed, 0), keepout_mm=[pts])
     camera = backdrop.camera
     rng = np.random.default_rng(child_seed(seed, 1))
@@ -188,6 +281,11 @@ def render_curve(
 
 def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
              body_w: float, rng: np.random.Generator) -> RenderedImage:
+    """One photo of the actuator whose layer is ``pts_mm`` over ``backdrop``, seen by ``camera``."""
+    if scene.target == "body":
+        check_body_fits(pts_mm, scene, body_w)
+    if not scene.plain_body:
+        return _compose_body(pts_mm, scene, camera, backdrop, body_w, rng)
     h, w = scene.height, scene.width
     centre_px = camera.to_px(pts_mm)
     idx = _decimate(centre_px)
@@ -222,37 +320,163 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
         big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
         _fill(big, line_polys, off, f)
         ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
-        a_ink = ink.astype(np.float32) * (scene.line_contrast / 255.0)
-        a_glare = None
-        if scene.occluded_fraction > 0:
-            u0 = rng.uniform(0.15, 0.85 - scene.occluded_fraction)
-            n = len(centre_px)
-            seg = centre_px[int(u0 * (n - 1)): int((u0 + scene.occluded_fraction) * (n - 1)) + 1]
-            glare = np.zeros(shape, np.uint8)
-            cv2.polylines(glare, [np.round((seg - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
-                          round(2.5 * scene.line_width_px + 4), cv2.LINE_AA, SHIFT)
-            a_glare = cv2.GaussianBlur(glare, (0, 0), 1.0 + scene.line_width_px / 4).astype(np.float32) * (
-                _GLARE_OPACITY / 255.0)
+        a_ink = ink.astype(np.float32) * ((scene.line_contrast if scene.marker_line else 0.0) / 255.0)
+        a_glare = _glare(centre_px, scene, rng, shape, off)
         if blur > 0:
             a_body = cv2.GaussianBlur(a_body, (0, 0), blur)
             a_ink = cv2.GaussianBlur(a_ink, (0, 0), blur)
         out = image[y0:y1, x0:x1]
-        for layer, alpha in ((backdrop.body_layer, a_body), (backdrop.ink_layer, a_ink), (backdrop.glare_layer, a_glare)):
+        for colour, alpha in ((scene.body_bgr, a_body), (LINE_INK_BGR[scene.line_color], a_ink), (GLARE_BGR, a_glare)):
             if alpha is not None:
-                out = cv2.blendLinear(out, layer[y0:y1, x0:x1], 1.0 - alpha, alpha)
+                out = cv2.blendLinear(out, backdrop.lit(colour, roi), 1.0 - alpha, alpha)
         image[y0:y1, x0:x1] = out
     if backdrop.noise_pool is not None:
         dy, dx = rng.integers(0, NOISE_PAD, size=2)
         image = cv2.add(image, backdrop.noise_pool[dy:dy + h, dx:dx + w], dtype=cv2.CV_8U)
-    in_frame = bool(((centre_px >= 0) & (centre_px <= [w - 1, h - 1])).all())
+    return _result(image, scene, camera, pts_mm, nrm_mm, body_w, centre_px)
+
+
+def _glare(centre_px: NDArray[np.float64], scene: SceneParams, rng: np.random.Generator, shape: tuple[int, int],
+           off: NDArray[np.float64]) -> NDArray[np.float32] | None:
+    """Opacity of a glare spot hiding ``occluded_fraction`` of the layer (None without one)."""
+    if scene.occluded_fraction <= 0:
+        return None
+    u0 = rng.uniform(0.15, 0.85 - scene.occluded_fraction)
+    n = len(centre_px)
+    seg = centre_px[int(u0 * (n - 1)): int((u0 + scene.occluded_fraction) * (n - 1)) + 1]
+    glare = np.zeros(shape, np.uint8)
+    cv2.polylines(glare, [np.round((seg - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
+                  round(2.5 * scene.line_width_px + 4), cv2.LINE_AA, SHIFT)
+    return cv2.GaussianBlur(glare, (0, 0), 1.0 + scene.line_width_px / 4).astype(np.float32) * (_GLARE_OPACITY / 255.0)
+
+
+def _result(image: NDArray[np.uint8], scene: SceneParams, camera: Camera, pts_mm: NDArray[np.float64],
+            nrm_mm: NDArray[np.float64], body_w: float, layer_px: NDArray[np.float64],
+            dots_px: NDArray[np.float64] | None = None) -> RenderedImage:
+    """The photo with its truth: the target's exact centre line through the camera and its turning."""
+    h, w = scene.height, scene.width
+    curve_mm = pts_mm if scene.target == "line" else pts_mm + nrm_mm * (body_w / 2)
+    curve = layer_px if scene.target == "line" else camera.to_px(curve_mm)
+    in_frame = bool(((curve >= 0) & (curve <= [w - 1, h - 1])).all())
     return RenderedImage(
         image=image,
-        centreline_px=centre_px,
-        fixed_end_px=tuple(float(v) for v in centre_px[0]),
-        psi_image_deg=turning_angle_deg(centre_px, y_down=True),
+        centreline_px=curve,
+        fixed_end_px=tuple(float(v) for v in curve[0]),
+        psi_image_deg=turning_angle_deg(curve, y_down=True),
         line_in_frame=in_frame,
         jpeg_quality=scene.jpeg_quality,
+        target=scene.target,
+        layer_px=layer_px,
+        fixed_direction_deg=_fixed_direction_deg(camera, curve_mm),
+        dots_px=np.zeros((0, 2)) if dots_px is None else dots_px,
     )
+
+
+def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
+                  body_w: float, rng: np.random.Generator) -> RenderedImage:
+    """One photo of a rounded / textured / dotted body (see :mod:`pipeline.synth.body`)."""
+    h, w = scene.height, scene.width
+    mpp = scene.mm_per_px
+    style, gain_full = backdrop.style, backdrop.gain
+    layer_px = camera.to_px(pts_mm)
+    nrm_mm = _normals(pts_mm)
+    hw = body_w / 2
+    chord = np.hypot(*np.diff(pts_mm, axis=0).T)
+    s_dense = np.concatenate([[0.0], np.cumsum(chord)])
+    l0 = float(s_dense[-1])
+    centre_mm = pts_mm + nrm_mm * hw
+    idx = _decimate(camera.to_px(centre_mm))  # ~1 px apart on screen
+    tang = pts_mm[-1] - pts_mm[-2]
+    tang /= np.hypot(*tang)
+    m = max(2, int(np.ceil(END_CAP_MM / mpp)) + 1)
+    ext = np.linspace(0.0, END_CAP_MM, m)[1:]
+    s_ax = np.concatenate([s_dense[idx], l0 + ext])
+    c_ax = np.vstack([centre_mm[idx], centre_mm[-1] + ext[:, None] * tang])
+    n_ax = np.vstack([nrm_mm[idx], np.repeat(nrm_mm[-1:], len(ext), axis=0)])
+    half_ax = (hw + relief_mm(s_ax, scene, style, l0))[:, None]
+    frame = BodyFrame(centre_px=camera.to_px(c_ax), inner_px=camera.to_px(c_ax - n_ax * half_ax),
+                      outer_px=camera.to_px(c_ax + n_ax * half_ax), s_mm=s_ax)
+    body_polys = _band_polygons(frame.inner_px, frame.outer_px)
+    polys = list(body_polys)
+    cap_px = None
+    if scene.tip_cap_mm > 0:
+        base = c_ax[-1]
+        half_cap = hw + CAP_OVERHANG * body_w + 0.5
+        cap_mm = np.array([base - nrm_mm[-1] * half_cap, base - nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm,
+                           base + nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm, base + nrm_mm[-1] * half_cap])
+        cap_px = camera.to_px(cap_mm)
+        polys.append(cap_px)
+    dots_px = np.zeros((0, 2))
+    if len(style.dot_u):
+        s_k = style.dot_u * l0
+        at = np.column_stack([np.interp(s_k, s_dense, pts_mm[:, j]) for j in range(2)])
+        nk = np.column_stack([np.interp(s_k, s_dense, nrm_mm[:, j]) for j in range(2)])
+        dots_px = camera.to_px(at + nk * (hw * (1 + style.dot_v))[:, None])
+    line_polys: list[NDArray[np.float64]] = []
+    if scene.marker_line:
+        lidx = _decimate(layer_px)
+        line_c, line_n = layer_px[lidx], _normals(layer_px)[lidx]
+        half = scene.line_width_px / 2
+        line_polys = _band_polygons(line_c - line_n * half, line_c + line_n * half)
+    blur = scene.blur_sigma_px
+    margin = 3 * blur + 4 + (SHADOW_REACH_MM / mpp if scene.shadow > 0 else 0.0)
+    roi = _roi(polys + line_polys, margin, w, h)
+    image = backdrop.image.copy()
+    if roi is not None:
+        x0, y0, x1, y1 = roi
+        off = np.array([x0, y0], float)
+        shape = (y1 - y0, x1 - x0)
+        gain = gain_full[y0:y1, x0:x1]
+        cover = np.zeros(shape, np.uint8)
+        _fill(cover, body_polys, off)
+        prem, alpha = paint_body(scene, style, frame, cover.astype(np.float32) / 255.0, gain, off, l0)
+        if cap_px is not None:
+            cm = np.zeros(shape, np.uint8)
+            _fill(cm, [cap_px], off)
+            colour, a = paint_cap(scene, style, cap_px, cm.astype(np.float32) / 255.0, gain, off)
+            prem, alpha = over(prem, alpha, colour, a)
+        if len(dots_px):
+            radius = scene.dot_diameter_mm / 2 / mpp
+            colour, a, ring = paint_dots(scene, dots_px, radius, shape, off, gain, SHIFT)
+            prem, alpha = over(prem, alpha, np.zeros_like(colour) + np.float32(40) * gain[..., None], ring)
+            prem, alpha = over(prem, alpha, colour, a)
+        if line_polys:
+            f = LINE_SUPERSAMPLING
+            big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
+            _fill(big, line_polys, off, f)
+            a_ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32) * (
+                scene.line_contrast / 255.0)
+            prem, alpha = over(prem, alpha, backdrop.lit(LINE_INK_BGR[scene.line_color], roi).astype(np.float32), a_ink)
+        out = image[y0:y1, x0:x1].astype(np.float32)
+        if scene.shadow > 0:
+            out *= (1.0 - scene.shadow * shadow_of(alpha, style, mpp))[..., None]
+        if blur > 0:
+            prem = cv2.GaussianBlur(prem, (0, 0), blur)
+            alpha = cv2.GaussianBlur(alpha, (0, 0), blur)
+        out = out * (1.0 - alpha[..., None]) + prem
+        a_glare = _glare(layer_px, scene, rng, shape, off)
+        if a_glare is not None:
+            out += (backdrop.lit(GLARE_BGR, roi).astype(np.float32) - out) * a_glare[..., None]
+        image[y0:y1, x0:x1] = np.clip(out + 0.5, 0, 255).astype(np.uint8)
+    if backdrop.noise_pool is not None:
+        dy, dx = rng.integers(0, NOISE_PAD, size=2)
+        image = cv2.add(image, backdrop.noise_pool[dy:dy + h, dx:dx + w], dtype=cv2.CV_8U)
+    return _result(image, scene, camera, pts_mm, nrm_mm, body_w, layer_px, dots_px)
+
+
+def render_background(backdrop: Backdrop, scene: SceneParams, *, seed: int | np.random.SeedSequence) -> NDArray[np.uint8]:
+    """The empty scene: the backdrop (table, light, clamp, tube) with its own sensor noise, no actuator.
+
+    Same camera, lighting and clamp as the photos rendered on ``backdrop``; the noise window is
+    drawn from ``seed`` (a real background photo has its own noise too).
+    """
+    image = backdrop.image.copy()
+    if backdrop.noise_pool is not None:
+        dy, dx = np.random.default_rng(seed).integers(0, NOISE_PAD, size=2)
+        image = cv2.add(image, backdrop.noise_pool[dy:dy + scene.height, dx:dx + scene.width], dtype=cv2.CV_8U)
+    return image
+
+
 
 
 def render_actuator(
@@ -277,11 +501,13 @@ def render_actuator(
     l0_mm : float
         Length of the marked inextensible layer (mm).
     bulge : float
-        Curvature non-uniformity, 0 <= bulge < 1 (see ``centreline_mm``).
+        Curvature non-uniformity, 0 <= bulge < 1 (see ``centreline_mm``), for ``scene.shape``
+        ``model``; the other shapes (``arc``, ``distal``, ``chambers``) spread the same total
+        turning as :func:`pipeline.synth.centreline.actuator_centreline_mm` says.
     n : int
         Number of centreline points.
     Other parameters are those of :func:`render_curve`.
     """
-    pts = centreline_mm(psi_deg, l0_mm, bulge=bulge, n=n)
+    pts = actuator_centreline_mm(psi_deg, l0_mm, scene, bulge=bulge, n=n)
     return render_curve(pts, scene, seed=seed, fixed_end_px=fixed_end_px, rotation_deg=rotation_deg,
                         backdrop=backdrop, body_width_mm=body_width_mm)

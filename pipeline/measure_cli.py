@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
+from pipeline.folders import staged_folder
 from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
 
@@ -19,14 +20,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--overlays", metavar="DIR", default=None, help="also write per-photo overlays (<= 640 px wide) and contact sheets per ramp into DIR")
     parser.add_argument("--jobs", type=int, default=1, help="worker processes (photos measured in parallel; default 1)")
+    parser.add_argument("--no-ramp-check", dest="ramp_check", action="store_false",
+                        help="do not check each photo's psi against its ramp's trend (flagging jumps, re-trusting cosmetic flags)")
 
 
 def run(args: argparse.Namespace) -> int:
     """Measure the set, write angles.csv, print a one-line summary."""
-    from pipeline.measure.photoset_measure import measure_photoset, summary, write_angles
+    from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
-    angles = measure_photoset(args.photoset, method=args.method, jobs=args.jobs, overlays_dir=args.overlays)
+    kw = dict(method=args.method, jobs=args.jobs, ramp_check=args.ramp_check)
+    if args.overlays is None:
+        angles = measure_photoset(args.photoset, **kw)
+    else:  # the overlay folder appears only when complete
+        with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
+            angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
     print(f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}")
     return 0

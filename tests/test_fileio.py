@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from pipeline.errors import UserInputError
-from pipeline.tables import read_table
+from pipeline.fileio import read_table
 
 
 def test_reads_a_good_table(tmp_path):

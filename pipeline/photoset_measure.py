@@ -7,9 +7,7 @@ One bad photo never stops the set: it becomes a ``failed`` row with the reason.
 
 from __future__ import annotations
 
-import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import cv2
@@ -17,41 +15,33 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
-from pipeline.measure.extract import resolve_ranges
-from pipeline.measure.worker import Task, init_worker, run_task
-from pipeline.photoset import OVERRIDE_COLUMNS, atomic_write_bytes, load_photoset
+from pipeline.measure.settings import OVERRIDE_COLUMNS
+from pipeline.measure.worker import Task, run_task
+from pipeline.photoset import PhotoSet, load_photoset
+from pipeline.pool import map_photos
+from pipeline.ramp_check import check_ramps
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see :class:`~pipeline.measure.AngleResult`;
-#: empty on failed rows)
+#: empty on failed rows; ``l0_mm``: the length psi was computed with)
 RESULT_COLUMNS: tuple[str, ...] = (
-    "image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason", "seconds",
-    "degree",
+    "image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px", "status", "reason",
+    "seconds", "degree", "l0_mm",
 )
 #: manifest columns carried over first (when present), then any others
 CARRIED_FIRST: tuple[str, ...] = ("pressure_kpa", "direction", "material", "actuator", "trial", "step")
 
 
-def _tasks(folder: Path, manifest: pd.DataFrame, method: str, overlays_dir: Path | None) -> list[Task]:
+def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
     tasks = []
-    for _, row in manifest.iterrows():
-        line = int(row["manifest_line"])
-        l0 = row["l0_mm"]
-        if pd.isna(l0):
-            raise UserInputError(f"{folder / 'manifest.csv'} line {line}: no l0_mm (set it in photoset.yaml or the row)")
-        try:
-            ranges = resolve_ranges(row["line_color"])
-        except UserInputError as exc:
-            raise UserInputError(f"{folder / 'manifest.csv'} line {line}: {exc}") from exc
-        fx, fy = row["fixed_end_x"], row["fixed_end_y"]
-        fixed = None if pd.isna(fx) or pd.isna(fy) else (float(fx), float(fy))
-        mpp = None if pd.isna(row["mm_per_px"]) else float(row["mm_per_px"])
-        image = str(row["image"])
+    for i, (image, pressure, direction) in enumerate(zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])):
+        image = str(image)
         overlay = None if overlays_dir is None else str(overlays_dir / f"{Path(image).stem}.jpg")
-        title = f"{image}  {row['pressure_kpa']:g} kPa {row['direction']}"
-        tasks.append(Task(str(folder / image), float(l0), mpp, ranges, fixed, str(row["positive_turn"]), method, overlay, title))
+        title = f"{image}  {pressure:g} kPa {direction}"
+        tasks.append(Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i)))
     return tasks
 
 
@@ -61,8 +51,9 @@ def measure_photoset(
     method: str = DEFAULT_METHOD,
     jobs: int = 1,
     overlays_dir: str | os.PathLike[str] | None = None,
+    ramp_check: bool = True,
 ) -> pd.DataFrame:
-    """Measure psi on every photo of a photo set.
+    """Measure psi on every photo of a photo set; a bad photo or manifest row is a ``failed`` row.
 
     Parameters
     ----------
@@ -74,18 +65,24 @@ def measure_photoset(
         Worker processes (1 = measure in this process).
     overlays_dir : path, optional
         Write ``<image stem>.jpg`` overlays and ``contact_<material>_<actuator>_<trial>.jpg``.
+    ramp_check : bool
+        Check every photo against its ramp (:mod:`pipeline.ramp_check`): flag the ones that
+        break its trend, trust again the cosmetically flagged ones that follow it.
 
     Returns
     -------
     pandas.DataFrame
         The angles.csv table: :data:`RESULT_COLUMNS`, then the manifest's columns
         (pressure_kpa, direction, material, actuator, trial, step, and any others such as
-        measured_pressure_kpa, timestamp or force columns).  One row per manifest row, same order.
+        measured_pressure_kpa, timestamp or force columns) and ``l0_mm``, the marked length
+        each photo was measured with (the row's or the folder's setting).  One row per manifest
+        row, same order.
 
     Raises
     ------
     UserInputError
-        If the photo set is invalid or the method unknown.
+        If the photo set cannot be read at all (see :func:`pipeline.photoset.load_photoset`) or
+        the method is unknown.
     """
     if method not in METHODS:
         raise UserInputError(f"--method {method!r} is unknown; use one of {sorted(METHODS)}")
@@ -96,26 +93,17 @@ def measure_photoset(
     odir = None if overlays_dir is None else Path(overlays_dir)
     if odir is not None:
         odir.mkdir(parents=True, exist_ok=True)
-    tasks = _tasks(ps.folder, manifest, method, odir)
-    if jobs == 1 or len(tasks) <= 1:
-        rows = [run_task(t) for t in tasks]
-    else:
-        # forkserver (never plain fork: forking a process that runs OpenCV / BLAS threads can
-        # deadlock); the server preloads the light worker module once, so workers start fast
-        methods = multiprocessing.get_all_start_methods()
-        ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-        if "forkserver" in methods:
-            ctx.set_forkserver_preload(["pipeline.measure.worker"])
-        chunk = max(1, len(tasks) // (4 * jobs))
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
-            rows = list(pool.map(run_task, tasks, chunksize=chunk))
+    rows = map_photos(run_task, _tasks(ps, method, odir), jobs=jobs, preload=["pipeline.measure.worker"])
     result = pd.DataFrame(rows, index=manifest.index)
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
+    result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
+    if ramp_check:
+        out = check_ramps(out)
     if odir is not None:
         write_contact_sheets(out, odir)
     return out
@@ -123,7 +111,7 @@ def measure_photoset(
 
 def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]:
     """One ``contact_<material>_<actuator>_<trial>.jpg`` per ramp, photos in manifest order."""
-    from pipeline.measure.overlay import contact_sheet
+    from pipeline.measure.overlay import contact_sheet  # cv2 drawing only when overlays are asked for
 
     written = []
     for (material, actuator, trial), g in angles.groupby(["material", "actuator", "trial"], sort=False):
@@ -139,10 +127,7 @@ def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]
 
 def write_angles(angles: pd.DataFrame, out: str | os.PathLike[str]) -> None:
     """Write angles.csv atomically (failed rows have an empty psi_deg)."""
-    path = Path(out)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = angles.to_csv(index=False, lineterminator="\n", float_format="%.6g")
-    atomic_write_bytes(path, text.encode())
+    write_table(angles, out)
 
 
 def summary(angles: pd.DataFrame) -> str:

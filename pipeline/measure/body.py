@@ -1,0 +1,538 @@
+"""The actuator's own centre line, for photos without a drawn line (``target: body``).
+
+Any curve parallel to the inextensible layer turns through the same total angle, so the centre
+line of the body between its two long edges gives psi.  Steps:
+
+1. segmentation (:func:`body_mask`): the body is what lies in ``line_color`` (when given) and
+   differs from the background: from a ``background`` photo of the empty scene when there is one,
+   else from the backdrop, modelled as a smooth colour field (a quadratic in x and y per Lab
+   channel, fitted robustly to the pixels that look like backdrop, starting from the border of
+   the ``roi``); ``roi`` and ``exclude`` restrict it;
+2. clean-up: a closing as wide as the texture (fibre winding, ribs, pleats, dots and highlights
+   leave gaps and holes), holes filled unless they are large (the inside of a ring), specks
+   opened away, and the component at the fixed end (else the largest) kept;
+3. centre line: the path between the fixed end and the farthest point that keeps farthest from
+   the edges (a minimal path weighted by the distance transform), so it runs along the ridge of
+   the body and ignores texture; each point is then moved to the middle of the two edges
+   measured along the normal (sub-pixel), and the caps at both ends (one half-width) dropped,
+   where "between the two edges" no longer holds.
+
+The result is a :class:`pipeline.measure.extract.LineExtraction` (with the body's widths), so
+the estimators and quality checks of the drawn line apply unchanged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.sparse.csgraph import dijkstra
+
+from pipeline.measure.colors import color_mask
+from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
+from pipeline.measure.settings import MeasureSettings
+
+#: the body must differ from the backdrop by at least this many noise sigmas (robust, Lab units)
+NOISE_SIGMAS = 6.0
+#: ... and by at least this colour distance (Lab, L weighted by LIGHTNESS_WEIGHT)
+MIN_DIFFERENCE = 12.0
+#: lightness counts this much in the colour distance (shadows change lightness most)
+LIGHTNESS_WEIGHT = 0.6
+#: holes larger than this fraction of the body's area stay open (the inside of a ring)
+MAX_HOLE_FRACTION = 0.04
+#: the centre line is smoothed over this many half-widths (ragged, textured edges)
+SMOOTH_HALF_WIDTHS = 0.6
+
+
+@dataclass(frozen=True)
+class BodyExtraction:
+    """What the body segmentation found, beyond the centre line (for quality and previews).
+
+    Attributes
+    ----------
+    line : LineExtraction
+        The centre line and its quality facts.
+    mask : ndarray (H, W) uint8
+        The chosen body (work image pixels).
+    widths_px : ndarray
+        Edge-to-edge width along the centre line (original px).
+    selected_fraction : float
+        Fraction of the allowed region that the selection (before choosing a component) covers.
+    """
+
+    line: LineExtraction
+    mask: np.ndarray
+    widths_px: np.ndarray
+    selected_fraction: float
+
+
+def _lab(image_bgr: np.ndarray) -> np.ndarray:
+    lab = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2LAB).astype(np.float32)
+    lab[:, :, 0] *= LIGHTNESS_WEIGHT
+    return lab
+
+
+def _design(xs: np.ndarray, ys: np.ndarray, w: int, h: int) -> np.ndarray:
+    u, v = xs / max(w, 1) - 0.5, ys / max(h, 1) - 0.5
+    return np.c_[np.ones_like(u), u, v, u * u, u * v, v * v]
+
+
+#: a colour seen on this fraction of the region's border (or more) is backdrop too ...
+BACKDROP_CLASS_FRACTION = 0.15
+#: ... and so is a colour covering this fraction of the whole region (the actuator never does)
+DOMINANT_FRACTION = 0.35
+
+
+def _ring(allowed: np.ndarray) -> np.ndarray:
+    h, w = allowed.shape
+    k = max(3, int(0.04 * max(h, w)))
+    inner = cv2.erode(allowed, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    return cv2.subtract(allowed, inner) > 0
+
+
+def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, float]:
+    """Colour distance of each pixel from the backdrop, and the backdrop's noise.
+
+    The colours along the border of the allowed region are the backdrop's: they are grouped
+    (k-means, 3 groups) and every group seen on at least :data:`BACKDROP_CLASS_FRACTION` of the
+    border is a backdrop colour (a table and the dark corners of a vignetted or cropped photo,
+    say), and so is a colour covering :data:`DOMINANT_FRACTION` of the whole region (a backdrop
+    that the border does not show, inside a circular crop).  The most common border colour is
+    modelled as a smooth field -- a quadratic in x and y per Lab channel, refitted twice to every
+    allowed pixel that still looks like it (uneven light) -- the others as constant colours.  The
+    difference is the distance to the nearest of them.
+
+    Parameters
+    ----------
+    image_bgr : ndarray (H, W, 3) uint8
+    allowed : ndarray (H, W) uint8
+        Where the actuator may be (1) -- the roi minus the excluded polygons.
+
+    Returns
+    -------
+    difference : ndarray (H, W) float32
+        Colour distance (Lab, lightness weighted).
+    sigma : float
+        Robust spread of the difference over backdrop pixels.
+    """
+    h, w = allowed.shape
+    lab = _lab(image_bgr)
+    ring = _ring(allowed)
+    step = max(1, int(np.sqrt(max(h * w, 1) / 40000.0)))  # fit on about 40k pixels at most
+    grid = np.zeros((h, w), bool)
+    grid[::step, ::step] = True
+    ring_px = lab[ring & grid] if (ring & grid).sum() >= 12 else lab[(allowed > 0) & grid]
+    k = min(3, len(ring_px))
+    _, labels, centres = cv2.kmeans(
+        ring_px.astype(np.float32), k, None, (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 20, 0.5), 3,
+        cv2.KMEANS_PP_CENTERS,
+    )
+    share = np.bincount(labels.ravel(), minlength=k) / max(len(labels), 1)
+    order = [int(i) for i in np.argsort(-share) if share[i] >= BACKDROP_CLASS_FRACTION]
+    main = order[0]
+    # smooth field of the main backdrop colour
+    sample = ring & grid
+    near_main = np.zeros((h, w), bool)
+    near_main[sample] = labels.ravel()[: int(sample.sum())] == main if (ring & grid).sum() >= 12 else False
+    if near_main.sum() < 12:
+        near_main = sample
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    full = _design(xx.ravel(), yy.ravel(), w, h)
+    diff = np.zeros((h, w), np.float32)
+    fit = near_main
+    for _ in range(3):
+        ys, xs = np.nonzero(fit)
+        coef, *_ = np.linalg.lstsq(_design(xs.astype(np.float32), ys.astype(np.float32), w, h), lab[ys, xs], rcond=None)
+        model = (full @ coef).reshape(h, w, 3)
+        diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
+        vals = diff[near_main]
+        med = float(np.median(vals))
+        spread = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
+        fit = (allowed > 0) & grid & (diff < med + 3.0 * spread + 2.0)
+        if fit.sum() < 12:
+            break
+    others = [centres[c] for c in order[1:]]
+    region_px = lab[(allowed > 0) & grid].astype(np.float32)
+    if len(region_px) >= 3:
+        _, glabels, gcentres = cv2.kmeans(
+            region_px, 3, None, (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 20, 0.5), 3, cv2.KMEANS_PP_CENTERS
+        )
+        gshare = np.bincount(glabels.ravel(), minlength=3) / len(glabels)
+        others += [gcentres[c] for c in range(3) if gshare[c] >= DOMINANT_FRACTION]
+    for centre in others:
+        diff = np.minimum(diff, np.sqrt(((lab - centre) ** 2).sum(axis=2)).astype(np.float32))
+    vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
+    med = float(np.median(vals))
+    sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
+    return diff, sigma
+
+
+def background_difference(image_bgr: np.ndarray, background_bgr: np.ndarray) -> tuple[np.ndarray, float]:
+    """Colour distance of each pixel from the same pixel of the empty-scene photo, and its noise."""
+    lab, ref = _lab(image_bgr), _lab(background_bgr)
+    diff = np.sqrt(((lab - ref) ** 2).sum(axis=2)).astype(np.float32)
+    med = float(np.median(diff))
+    sigma = max(1.4826 * float(np.median(np.abs(diff - med))), 0.5)
+    return diff, sigma
+
+
+def _otsu(values: np.ndarray) -> float:
+    v = np.clip(values, 0, 255).astype(np.uint8)
+    thr, _ = cv2.threshold(v.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY | cv2.THRESH_OTSU)
+    return float(thr)
+
+
+def body_mask(
+    image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float = 1.0, background_bgr: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The pixels of the actuator body (before choosing one component).
+
+    Parameters
+    ----------
+    image_bgr : ndarray (H, W, 3) uint8
+        The photo, reduced by ``scale``.
+    settings : MeasureSettings
+        ``color``, ``roi``, ``exclude`` are used.
+    scale : float
+        Original px per px of ``image_bgr``.
+    background_bgr : ndarray, optional
+        The empty-scene photo at the same size.
+
+    Returns
+    -------
+    mask : ndarray (H, W) uint8 0/1
+    strength : ndarray (H, W) float32
+        How clearly each pixel differs (for previews), 0 where not computed.
+    contrast : float
+        Median difference of the selected pixels in backdrop-noise sigmas (inf for colour only).
+    """
+    h, w = image_bgr.shape[:2]
+    region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    allowed = np.ones((h, w), np.uint8) if region is None else region
+    strength = np.zeros((h, w), np.float32)
+    contrast = float("inf")
+    mask = allowed.copy()
+    if settings.color is not None:
+        mask &= color_mask(image_bgr, settings.color)
+    if settings.color is None or background_bgr is not None:
+        if background_bgr is not None:
+            diff, sigma = background_difference(image_bgr, background_bgr)
+        else:
+            diff, sigma = backdrop_difference(image_bgr, allowed)
+        inside = diff[allowed > 0]
+        thr = max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
+        strong = inside[inside > thr]
+        if strong.size > 50:  # split the clear differences in two: faint halo vs. body proper
+            thr = max(thr, 0.5 * _otsu(np.r_[inside[inside <= thr][:: max(1, inside.size // 20000)], strong]))
+        mask &= (diff > thr).astype(np.uint8)
+        strength = diff / max(thr, 1e-6)
+        sel = diff[mask > 0]
+        contrast = float(np.median(sel) / sigma) if sel.size else 0.0
+    return mask, strength, contrast
+
+
+def _clean(mask: np.ndarray) -> np.ndarray:
+    """Close texture gaps, fill small holes, open away specks."""
+    h, w = mask.shape
+    k = max(3, int(round(0.006 * max(h, w))) | 1)
+    m = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    m = cv2.morphologyEx(m, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    contours, hier = cv2.findContours(m, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
+    if hier is not None:
+        area = float(m.sum())
+        holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1 and cv2.contourArea(c) < MAX_HOLE_FRACTION * area]
+        if holes:
+            cv2.drawContours(m, holes, -1, 1, cv2.FILLED)
+    return m
+
+
+def _component(mask: np.ndarray, fixed_xy: tuple[float, float] | None) -> tuple[np.ndarray, int, bool]:
+    """The body component: nearest the fixed end (among large ones), else the largest.
+
+    Returns (component mask, number of rival components of comparable size, fixed end reached).
+    """
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    if n <= 1:
+        raise NoLineFound("nothing selected")
+    areas = stats[1:, cv2.CC_STAT_AREA].astype(float)
+    order = np.argsort(-areas)
+    big = [int(i) + 1 for i in order if areas[i] >= 0.25 * areas[order[0]]]
+    pick, reached = big[0], fixed_xy is None
+    if fixed_xy is not None:
+        h, w = mask.shape
+        fx, fy = int(np.clip(round(fixed_xy[0]), 0, w - 1)), int(np.clip(round(fixed_xy[1]), 0, h - 1))
+        best = None
+        for lab in big + [int(i) + 1 for i in order if int(i) + 1 not in big][:5]:
+            comp = (labels == lab).astype(np.uint8)
+            d = cv2.distanceTransform(1 - comp, cv2.DIST_L2, 3)[fy, fx]
+            if best is None or d < best[0]:
+                best = (d, lab)
+        assert best is not None
+        near = 0.05 * float(np.hypot(h, w))
+        if best[0] <= near:
+            pick, reached = best[1], True
+    rivals = sum(1 for lab in big if lab != pick)
+    return (labels == pick).astype(np.uint8), rivals, reached
+
+
+def _ridge_path(comp: np.ndarray, dt: np.ndarray, start_xy: tuple[float, float] | None) -> tuple[np.ndarray, bool]:
+    """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end."""
+    ys, xs = np.nonzero(comp)
+    graph = _pixel_graph(ys, xs, comp.shape)
+    # edge cost: length / (distance to the edge)^2 -> the path keeps to the middle of the body
+    cost = 1.0 / np.maximum(dt[ys, xs], 0.5) ** 2
+    graph = graph.tocoo()
+    graph.data = graph.data * 0.5 * (cost[graph.row] + cost[graph.col])
+    graph = graph.tocsr()
+    plain = _pixel_graph(ys, xs, comp.shape)
+    guessed = start_xy is None
+    if start_xy is None:
+        d0 = dijkstra(plain, directed=True, indices=int(np.argmax(dt[ys, xs])))
+        d0[~np.isfinite(d0)] = -1
+        seed = int(np.argmax(d0))
+    else:
+        seed = int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
+    geo = dijkstra(plain, directed=True, indices=seed)
+    geo[~np.isfinite(geo)] = -1
+    far = int(np.argmax(geo))
+    _, pred = dijkstra(graph, directed=True, indices=far, return_predecessors=True)
+    path = [seed]
+    while path[-1] != far and pred[path[-1]] >= 0:
+        path.append(int(pred[path[-1]]))
+    idx = np.array(path)
+    return np.c_[xs[idx], ys[idx]].astype(float), guessed
+
+
+def _resample(points: np.ndarray, step: float) -> np.ndarray:
+    seg = np.hypot(*np.diff(points, axis=0).T)
+    s = np.concatenate(([0.0], np.cumsum(seg)))
+    if s[-1] <= step:
+        return points
+    u = np.arange(0.0, s[-1] + 1e-9, step)
+    return np.c_[np.interp(u, s, points[:, 0]), np.interp(u, s, points[:, 1])]
+
+
+def _smooth(points: np.ndarray, sigma: float) -> np.ndarray:
+    """Smooth a 1-px-spaced polyline over about ``sigma`` px with local quadratic fits.
+
+    Savitzky-Golay (order 2, ends fitted, not mirrored) keeps the curvature at the ends, where
+    a mirrored Gaussian would straighten them and bias the end tangents.
+    """
+    from scipy.signal import savgol_filter
+
+    win = int(2 * round(1.5 * sigma) + 1)
+    if sigma <= 0 or len(points) < max(win, 5):
+        return points
+    return np.c_[savgol_filter(points[:, 0], win, 2, mode="interp"), savgol_filter(points[:, 1], win, 2, mode="interp")]
+
+
+def _normals(points: np.ndarray) -> np.ndarray:
+    t = np.gradient(points, axis=0)
+    t /= np.maximum(np.hypot(t[:, 0], t[:, 1]), 1e-9)[:, None]
+    return np.c_[-t[:, 1], t[:, 0]]
+
+
+#: edge-to-edge width outside [END_WIDTH_LOW, END_WIDTH_HIGH] x the median at an end of the centre
+#: line: the normal there runs into the clamp or round the tip, and that end is dropped
+END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
+#: the centre line holds where the body is at least this fraction of its usual half-width ...
+TIP_THICKNESS = 0.95
+#: ... and at most this multiple of it (thicker: the clamp or a blob the body runs into)
+BLOB_THICKNESS = 1.6
+
+
+def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[np.ndarray, tuple[float, float]]:
+    """Drop the path's ends where the body tapers (tips, corners) or thickens (clamp, blobs).
+
+    Returns the kept path and the length dropped at each end (px): the line goes on that far.
+    """
+    xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
+    thick = dt[yi, xi]
+    good = (thick >= TIP_THICKNESS * half) & (thick <= BLOB_THICKNESS * half)
+    if good.sum() < 8:
+        return path, (0.0, 0.0)
+    i0, i1 = int(np.argmax(good)), len(good) - 1 - int(np.argmax(good[::-1]))
+    s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+    # a tapering tip ends about one half-width beyond the last thick point
+    return path[i0 : i1 + 1], (float(s[i0]), float(s[-1] - s[i1]))
+
+
+def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
+    """The body as a 0..1 field whose 0.5 level is its sub-pixel edge.
+
+    Inside and outside it is the chosen component; in a band along its outline it is the colour
+    difference scaled so that the body's typical difference is 1 (the 0.5 crossing of a blurred
+    step is the edge), which follows the true, anti-aliased outline instead of the mask's pixel
+    staircase.  Without a difference (a colour-only selection) the mask is blurred instead.
+    """
+    body = comp.astype(np.float32)
+    inner = cv2.erode(comp, np.ones((5, 5), np.uint8))
+    level = float(np.median(strength[inner > 0])) if inner.any() else 0.0
+    if level <= 1.0:  # no difference image, or too faint to locate edges by
+        return cv2.GaussianBlur(body, (0, 0), 0.7)
+    band = (cv2.dilate(comp, np.ones((5, 5), np.uint8)) > 0) & (inner == 0)
+    soft = body.copy()
+    soft[band] = np.clip(strength[band] / level, 0.0, 1.0)
+    return soft
+
+
+def _extensions(
+    comp: np.ndarray, pts: np.ndarray, half: float, fixed_xy: tuple[float, float] | None, capped: bool
+) -> tuple[float, float]:
+    """How far the body goes on beyond each end of the centre line, along the end tangents (px).
+
+    The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel.
+    The free end: to the body's last pixel within the body's width around the tangent -- unless
+    the centre line stopped where the width changed (a tip cap, which does not bend): then 0.
+    """
+    ys, xs = np.nonzero(comp)
+    q = np.c_[xs, ys].astype(float)
+    out = []
+    k = min(len(pts) - 1, 5)
+    for end, inner in ((0, k), (-1, -1 - k)):
+        p = pts[end]
+        t = pts[end] - pts[inner]
+        t = t / max(float(np.hypot(*t)), 1e-9)  # outward tangent
+        if end == 0 and fixed_xy is not None:
+            out.append(max(0.0, float((np.asarray(fixed_xy) - p) @ t)))
+            continue
+        if end == -1 and capped:
+            out.append(0.0)
+            continue
+        d = q - p
+        along, across = d @ t, np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
+        sel = (across <= half) & (along > 0) & (along <= 2.5 * half + 2.0)  # this end's tip, not what lies beyond a gap
+        if sel.any():  # the tip's pixels run on from the end without a gap
+            a = np.sort(along[sel])
+            gap = np.nonzero(np.diff(np.r_[0.0, a]) > 2.0)[0]
+            out.append(float(a[gap[0] - 1]) if gap.size and gap[0] > 0 else (0.0 if gap.size else float(a[-1])))
+        else:
+            out.append(0.0)
+    return out[0], out[1]
+
+
+def _midpoints(soft: np.ndarray, points: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Move each point to the middle of the two edges along its normal; return points and widths."""
+    n = _normals(points)
+    k = int(np.ceil(reach * 2))
+    off = np.arange(-k, k + 1, dtype=np.float32) / 2.0
+    mx = (points[:, 0:1] + n[:, 0:1] * off).astype(np.float32)
+    my = (points[:, 1:2] + n[:, 1:2] * off).astype(np.float32)
+    prof = cv2.remap(soft, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0.0)
+    c = k  # the centre sample
+    inside = prof >= 0.5
+    # the run of inside samples around the centre
+    left = np.full(len(points), np.nan)
+    right = np.full(len(points), np.nan)
+    for side, out in ((-1, left), (1, right)):
+        idx = np.arange(c, -1, -1) if side < 0 else np.arange(c, 2 * k + 1)
+        run = np.cumprod(inside[:, idx], axis=1)
+        last = run.sum(axis=1) - 1  # steps the run lasts
+        ok = (last >= 0) & (last < len(idx) - 1)
+        j0 = idx[np.clip(last, 0, len(idx) - 1)]
+        j1 = idx[np.clip(last + 1, 0, len(idx) - 1)]
+        rows = np.arange(len(points))
+        p0, p1 = prof[rows, j0], prof[rows, j1]
+        frac = np.clip((p0 - 0.5) / np.maximum(p0 - p1, 1e-6), 0.0, 1.0)
+        out[ok] = (off[j0] + frac * (off[j1] - off[j0]))[ok]
+    good = np.isfinite(left) & np.isfinite(right) & inside[:, c]
+    mid = np.where(good, 0.5 * (left + right), 0.0)
+    width = np.where(good, right - left, np.nan)
+    return points + mid[:, None] * n, width
+
+
+def extract_body(
+    image_bgr: np.ndarray,
+    settings: MeasureSettings,
+    *,
+    scale: float = 1.0,
+    background_bgr: np.ndarray | None = None,
+) -> BodyExtraction:
+    """Segment the actuator body and return its centre line (see the module docstring).
+
+    Parameters
+    ----------
+    image_bgr : ndarray (H, W, 3) uint8
+        The photo, reduced by ``scale`` from the original.
+    settings : MeasureSettings
+        ``target: body`` settings (colour, background, roi, exclude, fixed end).
+    scale : float
+        Original px per px of ``image_bgr``.
+    background_bgr : ndarray, optional
+        Empty-scene photo at the size of ``image_bgr``.
+
+    Returns
+    -------
+    BodyExtraction
+
+    Raises
+    ------
+    NoLineFound
+        When the selection is empty, covers most of the photo, or holds nothing elongated.
+    """
+    if image_bgr is None or image_bgr.ndim != 3:
+        raise NoLineFound("unreadable image (not a colour image)")
+    h, w = image_bgr.shape[:2]
+    raw, strength, contrast = body_mask(image_bgr, settings, scale=scale, background_bgr=background_bgr)
+    region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    allowed_px = float(h * w if region is None else region.sum())
+    selected = float(raw.sum()) / max(allowed_px, 1.0)
+    what = settings.describe_color()
+    if raw.sum() < 20:
+        raise NoLineFound(f"no body found: nothing {what}; check line_color / background / roi (python -m pipeline photoset preview shows what they select)")
+    if selected > 0.6:
+        raise NoLineFound(f"no body found: {100 * selected:.0f}% of the photo is selected ({what}); narrow line_color or roi (python -m pipeline photoset preview)")
+    mask = _clean(raw)
+    fe = None
+    if settings.fixed_end_px is not None:
+        fe = ((settings.fixed_end_px[0] - (scale - 1) / 2) / scale, (settings.fixed_end_px[1] - (scale - 1) / 2) / scale)
+    try:
+        comp, rivals, reached = _component(mask, fe)
+    except NoLineFound:
+        raise NoLineFound(f"no body found: nothing {what} survives the clean-up; check line_color / background / roi (python -m pipeline photoset preview)") from None
+    dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+    half = float(np.median(dt[(dt > 0) & (dt >= cv2.dilate(dt, np.ones((3, 3), np.uint8)))])) if comp.any() else 0.0
+    path, guessed = _ridge_path(comp, dt, fe if reached else None)
+    length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
+    if length < max(4.0 * half, 10.0):
+        raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
+    path, _ = _trim_by_thickness(path, dt, half)
+    soft = _soft_body(comp, strength)
+    pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
+    widths = np.full(len(pts), np.nan)
+    capped = False  # the free end was cut where the width changed (a tip cap, a blob)
+    for _ in range(2):
+        moved, wid = _midpoints(soft, pts, reach=3.0 * half + 4.0)
+        med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
+        bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * med) | (wid < END_WIDTH_LOW * med)
+        moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
+        if (~bad).sum() >= 8:  # the ends where the profile runs into the clamp or the tip: dropped
+            i0, i1 = int(np.argmax(~bad)), len(bad) - 1 - int(np.argmax(~bad[::-1]))
+            capped = capped or bool(np.isfinite(wid[i1 + 1 :]).any() and (wid[i1 + 1 :] > END_WIDTH_HIGH * med).any())
+            moved, wid = moved[i0 : i1 + 1], wid[i0 : i1 + 1]
+        pts = _smooth(_resample(moved, 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))
+        fill = np.nan_to_num(wid, nan=med)
+        widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(fill)), fill)
+    trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
+    ys, xs = np.nonzero(comp)
+    touches = bool(xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1)
+    contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
+    holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1] if hier is not None else []
+    loop = bool(holes) and max(cv2.contourArea(c) for c in holes) > 4.0 * half * half
+    ends_gap = float(np.hypot(*(path[0] - path[-1])))
+    line = LineExtraction(
+        centreline_px=pts * scale + (scale - 1) / 2,
+        width_px=float(2.0 * half * scale),
+        touches_border=touches,
+        n_candidates=1 + rivals,
+        contrast=float(min(contrast * 10.0, 441.0)),
+        ends_gap_px=ends_gap * scale,
+        branched_fraction=1.0 if loop else 0.0,
+        fixed_end_auto=guessed,
+        clamp_removed=not guessed,
+        trimmed_px=(trimmed[0] * scale, trimmed[1] * scale),
+        gap_bridged=False,
+        fixed_end_found=reached,
+    )
+    return BodyExtraction(line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected)

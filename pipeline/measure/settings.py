@@ -1,0 +1,334 @@
+"""The settings one photo is measured with, resolved once into a typed, frozen object.
+
+A photo set's ``photoset.yaml`` holds folder-wide values and ``manifest.csv`` may override any
+of them per row (DESIGN.md, "Photo set").  :func:`resolve_settings` turns the merged raw values
+of one row into a :class:`MeasureSettings` -- or into the list of problems that prevent it --
+and nothing downstream (measure, force, rig, preview) decodes a setting again.
+
+Keys
+----
+``l0_mm``
+    Length of the marked inextensible layer (mm, > 0). Required.
+``mm_per_px``
+    Image scale (mm per px, > 0); without it psi is the total turning of the measured line.
+``line_color``
+    Colour of the target (see :mod:`pipeline.measure.colors`).  For ``target: line`` the
+    default is ``black``; for ``target: body`` the default is none: the body is whatever
+    differs from the background.
+``fixed_end``
+    ``auto`` or a pixel ``[x, y]`` near the clamped end (manifest: ``fixed_end_x``,
+    ``fixed_end_y``).
+``positive_turn``
+    ``ccw`` or ``cw``: the on-screen turning (fixed end -> free end) that counts positive.
+``target``
+    ``line`` (a drawn line, the paper's method) or ``body`` (the actuator's own outline).
+``background``
+    A photo of the empty scene (file name in the folder): the body is what differs from it.
+``roi``
+    Where the actuator can be: a box ``[x0, y0, x1, y1]`` or a polygon ``[[x, y], ...]`` (px).
+``exclude``
+    Polygons (or boxes) to ignore: a ruler, a clamp plate, a label.
+``fixed_direction_deg``
+    Direction in which the actuator leaves the clamp, on screen, degrees counter-clockwise from
+    +x: psi is then the free end's tangent against this direction.
+``method``
+    The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
+    run's method (``--method``, config ``measure.method``) applies.
+
+Examples
+--------
+>>> s = resolve_settings({"l0_mm": 210, "roi": [0, 0, 100, 50], "target": "body"})
+>>> s.target, s.color, s.roi[2]
+('body', None, (100.0, 50.0))
+>>> resolve_settings({"l0_mm": -1})
+Traceback (most recent call last):
+...
+pipeline.measure.settings.SettingsError: l0_mm = -1 must be a positive number (fix: set l0_mm to the length of the marked layer in mm)
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from pipeline.measure.colors import BLACK, ColorError, ColorSpec, parse_color
+
+#: a polygon in image pixels: ((x, y), ...)
+Polygon = tuple[tuple[float, float], ...]
+
+TARGETS: tuple[str, ...] = ("line", "body")
+POSITIVE_TURNS: tuple[str, ...] = ("ccw", "cw")
+#: every settings key, as it may appear in photoset.yaml (fixed_end as fixed_end_x/_y in rows)
+KEYS: tuple[str, ...] = (
+    "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
+    "exclude", "fixed_direction_deg", "method",
+)
+#: manifest columns that override photoset.yaml per row
+OVERRIDE_COLUMNS: tuple[str, ...] = (
+    "l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y", "positive_turn", "target", "background",
+    "roi", "exclude", "fixed_direction_deg", "method",
+)
+
+
+@dataclass(frozen=True)
+class SettingProblem:
+    """Why one setting cannot be used: the key, what is wrong, and the fix."""
+
+    key: str
+    message: str
+    fix: str
+
+    def __str__(self) -> str:
+        return f"{self.message} (fix: {self.fix})"
+
+
+class SettingsError(ValueError):
+    """Settings that cannot be resolved; ``problems`` lists each one."""
+
+    def __init__(self, problems: Sequence[SettingProblem]):
+        self.problems = tuple(problems)
+        super().__init__("; ".join(map(str, self.problems)))
+
+
+@dataclass(frozen=True)
+class MeasureSettings:
+    """Everything that says how one photo is measured (resolved, validated, picklable).
+
+    Attributes
+    ----------
+    l0_mm : float
+        Length of the marked inextensible layer (mm).
+    mm_per_px : float or None
+        Image scale; None: psi is the total turning of the measured line.
+    color : ColorSpec or None
+        Colour of the line or body; None (body only): whatever differs from the background.
+    fixed_end_px : (x, y) or None
+        Pixel near the clamped end; None: guessed.
+    positive_turn : {"ccw", "cw"}
+        On-screen turning (fixed end -> free end) that counts as positive psi.
+    target : {"line", "body"}
+        A drawn line, or the actuator's body.
+    background_path : str or None
+        Photo of the empty scene (absolute path).
+    roi : Polygon or None
+        Where the actuator can be (px); None: the whole photo.
+    exclude : tuple of Polygon
+        Regions to ignore (px).
+    fixed_direction_deg : float or None
+        Known direction (deg, ccw from +x on screen) in which the actuator leaves the clamp.
+    method : str or None
+        Estimator for these photos; None: the run's.
+    """
+
+    l0_mm: float
+    mm_per_px: float | None = None
+    color: ColorSpec | None = BLACK
+    fixed_end_px: tuple[float, float] | None = None
+    positive_turn: str = "ccw"
+    target: str = "line"
+    background_path: str | None = None
+    roi: Polygon | None = None
+    exclude: tuple[Polygon, ...] = ()
+    fixed_direction_deg: float | None = None
+    method: str | None = None
+
+    @property
+    def sign(self) -> float:
+        """+1 for ``ccw``, -1 for ``cw``."""
+        return 1.0 if self.positive_turn == "ccw" else -1.0
+
+    def describe_color(self) -> str:
+        """The selection in words, for reasons and previews."""
+        if self.color is None:
+            return "differs from the " + ("background photo" if self.background_path else "backdrop")
+        return f"line_color {self.color.describe()}"
+
+
+def is_missing(value: Any) -> bool:
+    """True for None, NaN and empty strings (an empty manifest cell).
+
+    Examples
+    --------
+    >>> is_missing(float("nan")), is_missing(""), is_missing(0)
+    (True, True, False)
+    """
+    if value is None:
+        return True
+    if isinstance(value, float) and math.isnan(value):
+        return True
+    return isinstance(value, str) and not value.strip()
+
+
+def _number(raw: Mapping[str, Any], key: str, problems: list[SettingProblem], fix: str) -> float | None:
+    value = raw.get(key)
+    if is_missing(value):
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = float("nan")
+    if isinstance(value, bool) or not math.isfinite(number) or number <= 0:
+        problems.append(SettingProblem(key, f"{key} = {value!r} must be a positive number", fix))
+        return None
+    return number
+
+
+def _points(value: Any, key: str) -> Polygon:
+    """A polygon from ``[[x, y], ...]`` or a box ``[x0, y0, x1, y1]`` (strings parsed as YAML)."""
+    if isinstance(value, str):
+        import yaml
+
+        try:
+            value = yaml.safe_load(value)
+        except yaml.YAMLError as exc:
+            raise ValueError(f"{key} {value!r} is not a list ({exc})") from None
+    if not isinstance(value, (list, tuple)):
+        raise ValueError(f"{key} = {value!r} is not a box [x0, y0, x1, y1] or a polygon [[x, y], ...]")
+    if len(value) == 4 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value):
+        x0, y0, x1, y1 = (float(v) for v in value)
+        if not (x1 > x0 and y1 > y0):
+            raise ValueError(f"{key} box {list(value)} needs x1 > x0 and y1 > y0")
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+    pts = []
+    for p in value:
+        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in p)):
+            raise ValueError(f"{key} point {p!r} is not [x, y]")
+        pts.append((float(p[0]), float(p[1])))
+    if len(pts) < 3:
+        raise ValueError(f"{key} polygon has {len(pts)} point(s); a polygon needs at least 3")
+    return tuple(pts)
+
+
+def _fixed_end(raw: Mapping[str, Any], problems: list[SettingProblem]) -> tuple[float, float] | None:
+    if "fixed_end_x" in raw or "fixed_end_y" in raw:
+        x, y = raw.get("fixed_end_x"), raw.get("fixed_end_y")
+        if not (is_missing(x) and is_missing(y)):
+            try:
+                fx, fy = float(x), float(y)  # type: ignore[arg-type]
+                if math.isfinite(fx) and math.isfinite(fy):
+                    return fx, fy
+            except (TypeError, ValueError):
+                pass
+            problems.append(SettingProblem("fixed_end", f"fixed_end_x, fixed_end_y = {x!r}, {y!r}", "give both as pixel numbers, or leave both empty"))
+            return None
+    fe = raw.get("fixed_end", "auto")
+    if is_missing(fe) or fe == "auto":
+        return None
+    if isinstance(fe, (list, tuple)) and len(fe) == 2 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in fe):
+        return float(fe[0]), float(fe[1])
+    problems.append(SettingProblem("fixed_end", f"fixed_end = {fe!r}", "use 'auto' or a pixel position [x, y] near the clamped end"))
+    return None
+
+
+def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[MeasureSettings | None, list[SettingProblem]]:
+    """Resolve one row's raw settings; return the settings (None if impossible) and every problem.
+
+    Parameters
+    ----------
+    raw : mapping
+        Merged ``photoset.yaml`` and manifest-row values (missing keys take their defaults).
+    folder : path, optional
+        Photo-set folder; ``background`` is resolved against it and must exist.
+
+    Returns
+    -------
+    settings : MeasureSettings or None
+    problems : list of SettingProblem
+    """
+    from pathlib import Path
+
+    problems: list[SettingProblem] = []
+    l0 = _number(raw, "l0_mm", problems, "set l0_mm to the length of the marked layer in mm")
+    if l0 is None and not any(p.key == "l0_mm" for p in problems):
+        problems.append(SettingProblem("l0_mm", "l0_mm is missing", "add 'l0_mm: <length of the marked layer in mm>' to photoset.yaml (or an l0_mm manifest column)"))
+    mpp = _number(raw, "mm_per_px", problems, "set mm_per_px to the image scale in mm per pixel, or leave it out")
+    target = raw.get("target")
+    target = "line" if is_missing(target) else str(target).strip().lower()
+    if target not in TARGETS:
+        problems.append(SettingProblem("target", f"target = {raw.get('target')!r}", "use 'line' (a drawn line) or 'body' (the actuator's outline)"))
+        target = "line"
+    turn = raw.get("positive_turn")
+    turn = "ccw" if is_missing(turn) else str(turn).strip().lower()
+    if turn not in POSITIVE_TURNS:
+        problems.append(SettingProblem("positive_turn", f"positive_turn = {raw.get('positive_turn')!r}", "use 'ccw' or 'cw'"))
+        turn = "ccw"
+    color: ColorSpec | None = BLACK if target == "line" else None
+    if not is_missing(raw.get("line_color")):
+        try:
+            color = parse_color(raw["line_color"])
+        except ColorError as exc:
+            problems.append(SettingProblem("line_color", str(exc), "fix line_color"))
+    fixed_end = _fixed_end(raw, problems)
+    direction = raw.get("fixed_direction_deg")
+    fixed_direction: float | None = None
+    if not is_missing(direction):
+        try:
+            fixed_direction = float(direction)
+        except (TypeError, ValueError):
+            fixed_direction = float("nan")
+        if isinstance(direction, bool) or not math.isfinite(fixed_direction):
+            problems.append(SettingProblem("fixed_direction_deg", f"fixed_direction_deg = {direction!r} is not a number", "give the direction in degrees, counter-clockwise from +x on screen (0 = to the right, 90 = up)"))
+            fixed_direction = None
+    roi: Polygon | None = None
+    if not is_missing(raw.get("roi")):
+        try:
+            roi = _points(raw["roi"], "roi")
+        except ValueError as exc:
+            problems.append(SettingProblem("roi", str(exc), "write roi as [x0, y0, x1, y1] or [[x, y], [x, y], [x, y], ...] in pixels"))
+    exclude: list[Polygon] = []
+    ex = raw.get("exclude")
+    if not is_missing(ex):
+        if isinstance(ex, str):
+            import yaml
+
+            try:
+                ex = yaml.safe_load(ex)
+            except yaml.YAMLError:
+                pass
+        items = ex if isinstance(ex, (list, tuple)) else [ex]
+        if items and all(isinstance(v, numbers.Real) for v in items):
+            items = [items]  # one box
+        for i, item in enumerate(items):
+            try:
+                exclude.append(_points(item, f"exclude[{i}]"))
+            except ValueError as exc:
+                problems.append(SettingProblem("exclude", str(exc), "write exclude as a list of polygons [[[x, y], [x, y], [x, y]], ...] or boxes [[x0, y0, x1, y1], ...]"))
+    method: str | None = None
+    if not is_missing(raw.get("method")):
+        from pipeline.measure.estimators import METHODS
+
+        method = str(raw["method"]).strip()
+        if method not in METHODS:
+            problems.append(SettingProblem("method", f"method = {raw['method']!r} is unknown", f"use one of {', '.join(METHODS)}"))
+    background: str | None = None
+    if not is_missing(raw.get("background")):
+        path = Path(str(raw["background"]))
+        if folder is not None and not path.is_absolute():
+            path = Path(folder) / path
+        if not path.is_file():
+            problems.append(SettingProblem("background", f"background photo {str(raw['background'])!r} does not exist", "put a photo of the empty scene in the photo-set folder and name it in 'background'"))
+        background = str(path)
+    if problems or l0 is None:
+        return None, problems
+    return MeasureSettings(
+        l0_mm=l0, mm_per_px=mpp, color=color, fixed_end_px=fixed_end, positive_turn=turn, target=target,
+        background_path=background, roi=roi, exclude=tuple(exclude), fixed_direction_deg=fixed_direction,
+        method=method,
+    ), []
+
+
+def resolve_settings(raw: Mapping[str, Any] | None = None, *, folder: Any = None, **values: Any) -> MeasureSettings:
+    """Resolve settings given as a mapping and/or keywords; raise :class:`SettingsError` if bad.
+
+    Examples
+    --------
+    >>> resolve_settings(l0_mm=150, line_color="red", fixed_end=[10, 20]).fixed_end_px
+    (10.0, 20.0)
+    """
+    settings, problems = settings_problems({**(raw or {}), **values}, folder=folder)
+    if settings is None:
+        raise SettingsError(problems)
+    return settings

@@ -1,0 +1,109 @@
+"""Body mode (``target: body``): the actuator's own centre line, without a drawn line."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from pipeline.measure import measure_image
+from pipeline.measure.settings import resolve_settings
+
+W, H = 1280, 960
+
+
+def body_photo(psi_deg, *, length=600.0, width=46.0, clamp=True, backdrop=(190, 196, 200), body=(90, 140, 200),
+               noise=2.0, texture=False, seed=0, shift=(0.0, 0.0)):
+    """A thick arc-shaped body (square ends) leaving a dark clamp along +x, with its exact psi.
+
+    The inextensible layer is the body's lower edge (walking from the clamp); the body lies on
+    its left.  Returns (image, fixed end pixel, clamp polygon in px).
+    """
+    k = np.deg2rad(psi_deg) / length
+    s = np.linspace(0.0, length, 3000)
+    x, y = (s, 0 * s) if abs(k) < 1e-12 else (np.sin(k * s) / k, (1 - np.cos(k * s)) / k)
+    pts = np.c_[x, y]
+    n = np.c_[-np.sin(k * s), np.cos(k * s)]
+    outline = np.r_[pts, (pts + n * width)[::-1]]
+    mid = pts + n * width / 2
+    off = np.array([W / 2 - mid[:, 0].mean() + shift[0], H / 2 + mid[:, 1].mean() + shift[1]])
+
+    def to_px(q):
+        return np.c_[q[:, 0], -q[:, 1]] + off
+
+    rng = np.random.default_rng(seed)
+    img = np.empty((H, W, 3), np.uint8)
+    img[:] = backdrop
+    cv2.fillPoly(img, [np.round(to_px(outline) * 16).astype(np.int32)], body, cv2.LINE_AA, 4)
+    if texture:  # fibre winding: thin darker strands across the body
+        for t in np.arange(0.0, length, 14.0):
+            i = int(t / length * (len(s) - 1))
+            a, b = to_px(pts[i : i + 1])[0], to_px((pts + n * width)[min(i + 40, len(s) - 1) : min(i + 40, len(s) - 1) + 1])[0]
+            cv2.line(img, tuple(np.round(a).astype(int)), tuple(np.round(b).astype(int)), tuple(int(0.7 * c) for c in body), 2, cv2.LINE_AA)
+    clamp_px = to_px(np.array([[-60.0, -20.0], [0.0, -20.0], [0.0, width + 20.0], [-60.0, width + 20.0]]))
+    if clamp:
+        cv2.fillPoly(img, [np.round(clamp_px * 16).astype(np.int32)], (60, 60, 66), cv2.LINE_AA, 4)
+    img = np.clip(img + rng.normal(0.0, noise, img.shape), 0, 255).astype(np.uint8)
+    ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 90])
+    img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    return img, tuple(to_px(pts[:1])[0]), [tuple(map(float, p)) for p in clamp_px]
+
+
+def settings_for(fixed_end, **kw):
+    return resolve_settings(l0_mm=180.0, target="body", fixed_end=[float(v) for v in fixed_end], **kw)
+
+
+@pytest.mark.parametrize("psi", [210.0, 120.0, 45.0, 3.0, -60.0, -150.0, -225.0])
+def test_body_psi_is_the_total_turning(psi):
+    img, fe, _ = body_photo(psi, seed=int(abs(psi)))
+    res = measure_image(img, settings_for(fe))
+    assert res.status == "ok", res.reason
+    assert res.method == "tangents"
+    assert res.psi_deg == pytest.approx(psi, abs=2.5)
+
+
+@pytest.mark.parametrize("psi", [150.0, -120.0])
+def test_textured_body_and_excluded_clamp(psi):
+    img, fe, clamp = body_photo(psi, texture=True, seed=3)
+    res = measure_image(img, settings_for(fe, exclude=[clamp]))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=3.0)
+
+
+def test_fixed_direction_gives_psi_against_the_known_clamp_direction():
+    img, fe, _ = body_photo(100.0, seed=5)
+    res = measure_image(img, settings_for(fe, fixed_direction_deg=0.0))
+    assert res.status == "ok" and "fixed_direction_deg" in res.reason
+    assert res.psi_deg == pytest.approx(100.0, abs=2.5)
+    # a clamp direction that disagrees with the photo by 30 deg is used, and said to be doubtful
+    off = measure_image(img, settings_for(fe, fixed_direction_deg=30.0))
+    assert off.status == "flagged" and "off fixed_direction_deg" in off.reason
+    assert off.psi_deg == pytest.approx(res.psi_deg - 30.0, abs=1.0)
+
+
+def test_nothing_selected_fails_naming_the_setting_and_the_preview():
+    img, fe, _ = body_photo(80.0)
+    res = measure_image(img, settings_for(fe, line_color="green"))
+    assert res.status == "failed" and np.isnan(res.psi_deg)
+    assert "line_color green" in res.reason and "photoset preview" in res.reason
+
+
+def test_a_selection_covering_the_photo_fails():
+    img, fe, _ = body_photo(80.0)
+    res = measure_image(img, settings_for(fe, line_color="0,0,0-179,255,255"))
+    assert res.status == "failed" and "of the photo is selected" in res.reason
+
+
+def test_a_body_leaving_the_photo_is_flagged():
+    img, fe, _ = body_photo(20.0, shift=(420.0, 0.0))
+    res = measure_image(img, settings_for(fe))
+    assert res.status == "flagged" and "border" in res.reason
+
+
+def test_roi_restricts_the_search():
+    img, fe, _ = body_photo(60.0)
+    cv2.rectangle(img, (20, 20), (400, 90), (90, 140, 200), -1)  # a second thing of the body's colour
+    plain = measure_image(img, settings_for(fe))
+    boxed = measure_image(img, settings_for(fe, roi=[0, 120, W, H]))
+    assert boxed.status == "ok" and boxed.psi_deg == pytest.approx(60.0, abs=2.5)
+    assert plain.psi_deg == pytest.approx(60.0, abs=2.5)  # the fixed end already picks the body

@@ -1,0 +1,82 @@
+"""The ramp check: a photo off its ramp's trend is flagged; a cosmetically flagged one on it is trusted."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline.ramp_check import check_ramps
+
+UP = np.arange(0.0, 120.0, 10.0)
+
+
+def _ramp(psi_up, psi_down=None, **columns) -> pd.DataFrame:
+    p = list(UP[: len(psi_up)])
+    psi = list(psi_up)
+    direction = ["up"] * len(psi_up)
+    if psi_down is not None:
+        p += list(UP[: len(psi_down)][::-1])
+        psi += list(psi_down)
+        direction += ["down"] * len(psi_down)
+    n = len(psi)
+    df = pd.DataFrame({"image": [f"i{k}.jpg" for k in range(n)], "psi_deg": psi, "status": "ok", "reason": "",
+                       "pressure_kpa": p, "direction": direction, "material": "DS20", "actuator": "A1", "trial": "1",
+                       "step": range(n), "length_px": 900.0})
+    for key, value in columns.items():
+        df[key] = value
+    return df
+
+
+def _ds20_like(n=12):
+    # slow near psi0, very fast through psi = 0 (as in the paper), slow again when curled
+    return list(210.0 - 420.0 / (1.0 + np.exp(-(UP[:n] - 60.0) / 8.0)))
+
+
+def test_a_smooth_fast_ramp_is_left_alone():
+    out = check_ramps(_ramp(_ds20_like(), _ds20_like()[::-1]))
+    assert (out["status"] == "ok").all(), out[["psi_deg", "reason"]]
+
+
+@pytest.mark.parametrize("k, wrong", [(3, lambda v: -v), (6, lambda v: v + 360.0), (9, lambda v: v + 80.0), (0, lambda v: v - 200.0)])
+def test_a_photo_off_its_ramp_is_flagged(k, wrong):
+    psi = _ds20_like()
+    psi[k] = wrong(psi[k])
+    out = check_ramps(_ramp(psi))
+    assert out.loc[k, "status"] == "flagged" and out.loc[k, "reason"].startswith("breaks its ramp")
+    assert (out.drop(index=k)["status"] == "ok").all()  # the outlier does not drag its neighbours down
+
+
+def test_a_partial_line_is_flagged_by_its_length():
+    df = _ramp(_ds20_like())
+    df.loc[4, "length_px"] = 600.0
+    out = check_ramps(df)
+    assert out.loc[4, "status"] == "flagged" and "length 67%" in out.loc[4, "reason"]
+
+
+def test_a_cosmetic_flag_on_a_photo_that_follows_its_ramp_is_lifted():
+    df = _ramp(_ds20_like())
+    df.loc[5, ["status", "reason"]] = ["flagged", "line partly hidden: gap bridged"]
+    df.loc[8, ["status", "reason"]] = ["flagged", "2 candidate lines"]  # not cosmetic: stays
+    out = check_ramps(df)
+    assert out.loc[5, "status"] == "ok" and "agrees with its ramp" in out.loc[5, "reason"]
+    assert "gap bridged" in out.loc[5, "reason"]
+    assert out.loc[8, "status"] == "flagged"
+
+
+def test_a_cosmetic_flag_off_the_trend_stays_and_failed_rows_are_skipped():
+    psi = _ds20_like()
+    df = _ramp(psi)
+    df.loc[1, ["psi_deg", "status", "reason"]] = [psi[1] + 30.0, "flagged", "line partly hidden: 80% of l0 visible"]
+    df.loc[3, ["psi_deg", "status", "reason"]] = [np.nan, "failed", "unreadable image"]
+    out = check_ramps(df)
+    assert out.loc[1, "status"] == "flagged" and out.loc[3, "status"] == "failed"
+    assert "breaks its ramp" in out.loc[1, "reason"]
+    assert (out.drop(index=[1, 3])["status"] == "ok").all()
+
+
+def test_short_legs_and_separate_ramps():
+    a = _ramp([200.0, -150.0])  # two photos: nothing to compare
+    b = _ramp(_ds20_like(), actuator="A2")
+    out = check_ramps(pd.concat([a, b], ignore_index=True))
+    assert (out["status"] == "ok").all()
