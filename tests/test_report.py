@@ -53,7 +53,7 @@ def fake_psi(material: str, p: np.ndarray, direction: str) -> np.ndarray:
 
 def make_dataset(root: Path, material: str, *, name: str | None = None, actuators=3, trials=2, step=10.0,
                  directions=("up", "down"), photos=True, overlays=True, seed=0, synthetic=False,
-                 timestamps: str | None = None) -> Dataset:
+                 timestamps: str | None = None, l0_mm: float | None = None) -> Dataset:
     """Write angles.csv (+ a small photo set and overlays) shaped like the measure stage's outputs."""
     rng = np.random.default_rng(seed)
     folder = root / (name or material)
@@ -89,6 +89,8 @@ def make_dataset(root: Path, material: str, *, name: str | None = None, actuator
                             cv2.putText(img, f"{ang:.0f}", (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 255), 1)
                             cv2.imwrite(str(overlay_dir / (Path(image).stem + ".jpg")), img)
     table = pd.DataFrame(rows)
+    if l0_mm is not None:
+        table["l0_mm"] = l0_mm
     if timestamps:
         table["timestamp"] = pd.date_range(timestamps, periods=len(table), freq="37min").strftime("%Y-%m-%dT%H:%M:%S")
     table.to_csv(folder / "angles.csv", index=False)
@@ -118,10 +120,11 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         out = d.angles_csv.parent / "hysteresis.csv"
         assert main(["aggregate", str(d.angles_csv), "--out", str(out)]) == 0
         hyst.append(out)
-    h = pd.concat([pd.read_csv(p).assign(dataset=str(d.angles_csv)) for p, d in zip(hyst, datasets, strict=True)])
-    sources = {str(d.angles_csv): "synthetic" if (d.photoset_dir and (d.photoset_dir / "truth.csv").is_file())
+    h = pd.concat([pd.read_csv(p).assign(dataset=d.name) for p, d in zip(hyst, datasets, strict=True)])
+    angles = pd.concat([read_angles([d.angles_csv]).assign(dataset=d.name) for d in datasets])
+    sources = {d.name: "synthetic" if (d.photoset_dir and (d.photoset_dir / "truth.csv").is_file())
                else "measured" for d in datasets}
-    table = compare(h, read_angles([d.angles_csv for d in datasets]), data_sources=sources,
+    table = compare(h, angles, data_sources=sources, default_l0_mm={m: 255.0 for m in P_ZERO},
                     model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0,
                     fit_k_p=lambda m, p, s, l0_mm: (1.0 + 0.01 * len(p), None), n_boot=20)
     rms = tmp / "rms.csv"
@@ -225,7 +228,8 @@ def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: 
 def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
     """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders) and
     the report built from them."""
-    datasets = [make_dataset(tmp, "DS20", name="sample", actuators=1, seed=9, timestamps="2026-03-02 09:00")]
+    datasets = [make_dataset(tmp, "DS20", name="sample", actuators=1, seed=9, timestamps="2026-03-02 09:00",
+                             l0_mm=270.0)]  # its own actuator length: its own model curve
     datasets += [make_dataset(tmp, m, seed=i, synthetic=True) for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))]
     hyst, rms = pipeline_tables(tmp, datasets)
     config = tmp / "config.yaml"
@@ -311,18 +315,20 @@ def test_page_one_figures_read_back_match_rms_csv(default):
     text = pdf_text(pdf, 0)
     all_lines = text.split("\r\n")
     table = pd.read_csv(rms)
-    assert len(table) == 4
+    assert len(table) == 5  # DS20 twice: the sample set has its own l0 (270 mm), the others the default
     first = next(i for i, line in enumerate(all_lines) if line.startswith("Material Data run paper"))
-    lines = {line.split(" ")[0]: line for line in all_lines[first + 1:first + 1 + len(table)]}
-    for r in table.to_dict("records"):
-        line = lines[r["material"]]
+    lines = all_lines[first + 1:first + 1 + len(table)]
+    for line, r in zip(lines, table.to_dict("records"), strict=True):
+        several = (table["material"] == r["material"]).sum() > 1
+        label = f"{r['curve']} ({r['datasets']})" if several else r["material"]
+        source = r["data_source"].replace("measured", "real") if several else "synthetic"
         ci = f"{fmt(r['k_p_fit'], 2)} [{fmt(r['k_p_ci_low'], 2)}, {fmt(r['k_p_ci_high'], 2)}]"
         expected = [fmt(r["range_deg"]), fmt(r["paper_range_deg"]), fmt(r["p_zero_up_kpa"]), fmt(r["p_zero_down_kpa"]),
                     fmt(r["paper_p_zero_kpa"]), fmt(r["rms_deg"], 1), fmt(r["paper_rms_deg"], 1), ci,
                     fmt(r["k_p_paper"], 1)]
-        assert line == " ".join([r["material"], "real + synthetic" if r["material"] == "DS20" else "synthetic"]
-                                + expected), line
-    ss50 = lines["SS50"].split(" ")
+        assert line == " ".join([label, source] + expected), line
+    assert lines[0].startswith("DS20, l0 255 mm (DS20) synthetic") and lines[1].startswith("DS20, l0 270 mm (sample) real")
+    ss50 = lines[-1].split(" ")
     assert ss50[4:7] == [NA, NA, NA]  # never straightens below 250 kPa, and the paper gives no value
     assert "SS50: the mean curve never reaches ψ = 0 up to 250 kPa" in " ".join(text.split())
 

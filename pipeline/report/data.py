@@ -356,3 +356,21 @@ def rms_row(data: ReportData, material: str) -> dict[str, float]:
     if sel.empty:
         return {}
     return {k: v for k, v in sel.iloc[0].to_dict().items()}
+
+
+def comparisons(data: ReportData) -> list[tuple[str, str, dict[str, object]]]:
+    """``(material, label, rms.csv row)`` of every comparison, materials in order.
+
+    A material has one comparison per l0 (``compare`` writes one row per model curve, the
+    model's default l0 first); with one, its label is the material, with several the curve and
+    its datasets, e.g. ``"DS20, l0 270 mm (sample)"``.  A material without a row gets ``{}``.
+    """
+    out: list[tuple[str, str, dict[str, object]]] = []
+    for m in data.materials:
+        rows = data.rms[data.rms["material"].astype(str) == m].to_dict("records")
+        if not rows:
+            out.append((m, m, {}))
+        for r in rows:
+            label = m if len(rows) == 1 else f"{r.get('curve', m)} ({r.get('datasets', '')})"
+            out.append((m, label, r))
+    return out

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from pipeline.report.data import ReportData, rms_row
+from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
 from pipeline.report.style import (
@@ -132,7 +132,7 @@ def overview_page(data: ReportData) -> Figure:
 # one material
 
 
-def metric_table(row: dict[str, float], *, title: str = "") -> Table:
+def metric_table(row: dict[str, object], *, title: str = "", extra_notes: tuple[str, ...] = ()) -> Table:
     """The comparison figures of one material, this run beside the paper."""
     g = row.get
     k_ci = NA if fmt(g("k_p_fit"), 2) == NA else (
@@ -154,7 +154,7 @@ def metric_table(row: dict[str, float], *, title: str = "") -> Table:
                           Column("both"), Column("paper")),
                  rows=rows, title=title, size=8.0,
                  notes=("paper n/a: the paper reports no such value.  k_P is fitted, not predicted: the paper's "
-                        "value stands beside it for reference only.",))
+                        "value stands beside it for reference only.", *extra_notes))
 
 
 def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -> None:
@@ -212,7 +212,11 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
 def material_page(data: ReportData, material: str) -> Figure:
     """One material: Fig. 6 plot, per-actuator curves, comparison table, Fig. 5-style photo strip."""
     color = material_colors(data.materials)[material]
-    table = metric_table(rms_row(data, material), title=f"{material}: this run beside the paper (rms.csv)")
+    mine = [(label, row) for m, label, row in comparisons(data) if m == material]
+    label, row = mine[0]
+    others = [f"{lab}: RMS {fmt(r.get('rms_deg'), 1)} deg, k_P fitted {fmt(r.get('k_p_fit'), 2)}" for lab, r in mine[1:]]
+    table = metric_table(row, title=f"{label}: this run beside the paper (rms.csv)",
+                         extra_notes=tuple(f"Also compared: {o} (all comparisons: the model-curve page)." for o in others))
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)
     fig.suptitle(f"{material}: bending angle versus pressure", color=color, fontweight="bold")
@@ -246,13 +250,14 @@ def comparison_notes(data: ReportData) -> list[str]:
 def comparison_table(data: ReportData) -> Table:
     """Every rms.csv figure per material, beside the paper's."""
     colors = material_colors(data.materials)
-    rows = []
-    for m in data.materials:
-        g = rms_row(data, m).get
+    rows, row_colors = [], []
+    for m, label, row in comparisons(data):
+        g = row.get
+        row_colors.append(colors[m])
         ci = NA if fmt(g("k_p_fit"), 2) == NA else (
             f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
         width = fmt(g("hysteresis_width_deg"), 0)
-        rows.append((m, fmt(g("rms_deg"), 1), fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1),
+        rows.append((label, fmt(g("rms_deg"), 1), fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1),
                      fmt(g("paper_rms_deg"), 1), fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0),
                      fmt(g("paper_p_zero_kpa"), 0), fmt(g("p_minus_psi0_up_kpa"), 0),
                      fmt(g("p_minus_psi0_down_kpa"), 0), fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0),
@@ -267,7 +272,7 @@ def comparison_table(data: ReportData) -> Table:
         groups=(("", 1), ("RMS vs model (deg)", 4), ("P at ψ = 0 (kPa)", 3), ("P at ψ = -ψ0 (kPa)", 2),
                 ("Range (deg)", 2), ("Span (kPa)", 2), ("Hysteresis", 1), ("k_P (-)", 2)),
         rows=tuple(rows), title="Every figure of rms.csv, beside the values reported in the paper (Section III.A)",
-        notes=tuple(comparison_notes(data)), size=8.0, row_colors=tuple(colors[m] for m in data.materials),
+        notes=tuple(comparison_notes(data)), size=8.0, row_colors=tuple(row_colors),
     )
 
 
