@@ -38,7 +38,7 @@ from pipeline.report.textcheck import FOOTER_GID
 CONTENTS: dict[str, str] = {
     "overview": "All materials (as Fig. 6)",
     "material": "One page per material: curves, table, photos",
-    "comparison": "Model versus measurements, beside the paper",
+    "comparison": "Comparison with the model and the paper",
     "model-curves": "Which model curve and l0; fitted or predicted",
     "speed-accuracy": "Angle methods: speed against accuracy",
     "stability": "Angle methods: stability, where each breaks",

@@ -271,7 +271,7 @@ def comparison_table(data: ReportData) -> Table:
                  Column("fitted [95 % CI]"), Column("paper")),
         groups=(("", 1), ("RMS vs model (deg)", 4), ("P at ψ = 0 (kPa)", 3), ("P at ψ = -ψ0 (kPa)", 2),
                 ("Range (deg)", 2), ("Span (kPa)", 2), ("Hysteresis", 1), ("k_P (-)", 2)),
-        rows=tuple(rows), title="Every figure of rms.csv, beside the values reported in the paper (Section III.A)",
+        rows=tuple(rows), title="Every figure of rms.csv, one row per comparison (material and l0)",
         notes=tuple(comparison_notes(data)), size=8.0, row_colors=tuple(row_colors),
     )
 
@@ -285,7 +285,8 @@ def comparison_page(data: ReportData) -> Figure:
     table_h = table_height_pt(table, width)
     fig = page(landscape=True, label="comparison", top_pt=36.0 + 22.0 + table_h + 8.0)
     flow = Flow(fig, top_pt=36.0, width_pt=width)
-    flow.text("Model versus measurements", size=12.0, weight="bold")
+    flow.text("Model versus measurements, beside the values reported in the paper (Section III.A)", size=12.0,
+              weight="bold")
     flow.space(3.0)
     flow.table(table)
     axes = fig.subplots(1, 3)
