@@ -36,7 +36,8 @@ import yaml
 from pipeline.constants import DIRECTIONS, VACUUM_KPA
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
-from pipeline.measure.settings import KEYS, OVERRIDE_COLUMNS, MeasureSettings, is_missing, settings_problems
+from pipeline.measure.calibration import CalibrationCache
+from pipeline.measure.settings import KEYS, OVERRIDE_COLUMNS, MeasureSettings, is_missing, merge_calibration, settings_problems
 
 MANIFEST = "manifest.csv"
 SETTINGS = "photoset.yaml"
@@ -48,7 +49,7 @@ OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa
 SETTING_DEFAULTS: dict[str, Any] = {"l0_mm": None, "mm_per_px": None, "fixed_end": "auto", "positive_turn": "ccw"}
 #: manifest columns read as text
 _TEXT_COLUMNS = ("image", "material", "actuator", "direction", "trial", "line_color", "positive_turn", "target",
-                 "background", "roi", "exclude", "method")
+                 "background", "roi", "exclude", "method", "calibration")
 
 IMAGE_SUFFIXES: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp")
 
@@ -136,8 +137,8 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
     if not isinstance(raw, dict):
         return None, [Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")]
     problems = [
-        Problem(name, None, f"unknown key {key!r} is ignored", f"use only {', '.join(KEYS)} (and 'calibration')", warning=True)
-        for key in raw if key not in KEYS and key != "calibration"
+        Problem(name, None, f"unknown key {key!r} is ignored", f"use only {', '.join(KEYS)}", warning=True)
+        for key in raw if key not in KEYS
     ]
     return {**SETTING_DEFAULTS, **raw}, problems
 
@@ -217,7 +218,8 @@ def _resolve_rows(
     """Per-row settings; returns (rows, row problems, folder-wide settings problems)."""
     sname, mpath = str(folder / SETTINGS), str(folder / MANIFEST)
     folder_raw = {k: v for k, v in settings.items() if k in KEYS}
-    _, folder_problems = settings_problems(folder_raw, folder=folder)
+    calibrations = CalibrationCache(folder)  # each board photo set is calibrated (or read) once
+    _, folder_problems = settings_problems(folder_raw, folder=folder, calibrations=calibrations)
     # a folder-wide l0_mm may be missing when every row has its own
     folder_bad = [Problem(sname, None, p.message, p.fix) for p in folder_problems if p.key != "l0_mm" or "missing" not in p.message]
     overrides = [c for c in OVERRIDE_COLUMNS if c in df.columns]
@@ -227,7 +229,9 @@ def _resolve_rows(
     for line, row in zip(df["manifest_line"], records):
         raw = dict(folder_raw)
         raw.update({k: v for k, v in row.items() if not is_missing(v)})
-        resolved, row_problems = settings_problems(raw, folder=folder)
+        if not is_missing(row.get("calibration")) and not is_missing(folder_raw.get("calibration")):
+            raw["calibration"] = merge_calibration(folder_raw["calibration"], row["calibration"])
+        resolved, row_problems = settings_problems(raw, folder=folder, calibrations=calibrations)
         rows.append(resolved)
         problems += [Problem(mpath, int(line), p.message, p.fix) for p in row_problems]
     return tuple(rows), problems, folder_bad
@@ -330,14 +334,49 @@ def validate_photoset(
             problems.append(Problem(mpath, int(line), f"image {image!r} cannot be decoded (corrupt, truncated or not an image)", "re-export or re-take the photo, or remove the row"))
         elif settings_row is not None:
             problems += _geometry_problems(mpath, int(line), settings_row, size)
-    if any(r is not None and r.mm_per_px is None for r in ps.rows):
+    problems += _calibration_problems(ps)
+    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
         problems.append(Problem(str(folder / SETTINGS), None, "no mm_per_px: psi will be the turning of the measured line, so a line cut short by the clamp or the border reads low", "measure the image scale (mm per pixel) and set mm_per_px", warning=True))
     return [p for p in problems if warnings or not p.warning]
+
+
+def _calibration_problems(ps: PhotoSet) -> list[Problem]:
+    """Doubts about the calibrations: a large reprojection error (every row using it), not stored, mm_per_px unused."""
+    from pipeline.measure.calibration import MAX_RMS_PX
+
+    mpath, sname = str(ps.folder / MANIFEST), str(ps.folder / SETTINGS)
+    out: list[Problem] = []
+    seen: set[tuple[object, ...]] = set()
+    for line, s in zip(ps.manifest["manifest_line"], ps.rows):
+        cal = None if s is None else s.calibration
+        if cal is None or cal.plane is None:
+            continue
+        board = Path(cal.boards[0]).name
+        if cal.plane.doubtful:
+            out.append(Problem(mpath, int(line), f"calibration {board}: reprojection error {cal.plane.rms_px:.2f} px is above "
+                               f"{MAX_RMS_PX:g} px: the row's psi is flagged", "re-take the board photo flat, sharp and evenly lit, "
+                               "check square_mm and inner_corners, or add board photos in other poses", warning=True))
+        if cal.key not in seen:
+            seen.add(cal.key)
+            if not cal.stored:
+                out.append(Problem(sname, None, f"calibration {board} is not stored (computed each time the set is read)",
+                                   f"run 'python -m pipeline photoset calibrate {ps.folder}'", warning=True))
+        if s is not None and s.mm_per_px is not None and ("mm_per_px", cal.key) not in seen:
+            seen.add(("mm_per_px", cal.key))
+            out.append(Problem(sname, None, f"mm_per_px is not used where calibration {board} applies (the plane gives the scale)",
+                               "remove mm_per_px, or keep it for the uncalibrated rows", warning=True))
+    return out
 
 
 def _geometry_problems(file: str, line: int, s: MeasureSettings, size: tuple[int, int]) -> list[Problem]:
     w, h = size
     out = []
+    cal = s.calibration
+    if cal is not None and cal.plane is not None and tuple(cal.plane.image_size) != (w, h):
+        cw, ch = cal.plane.image_size
+        out.append(Problem(file, line, f"the photo is {w}x{h} px but calibration board photo {Path(cal.boards[0]).name} is "
+                           f"{cw}x{ch} px", "take the board photo with the camera and resolution of the actuator photos "
+                           "(or give this row its own calibration)"))
     if s.roi is not None:
         xs, ys = [p[0] for p in s.roi], [p[1] for p in s.roi]
         if max(xs) <= 0 or max(ys) <= 0 or min(xs) >= w or min(ys) >= h:

@@ -1,4 +1,4 @@
-"""``python -m pipeline photoset {init,check}``: start or validate a photo-set folder."""
+"""``python -m pipeline photoset {init,check,calibrate,preview,pick-color}``: start, validate, calibrate or preview a photo set."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pipeline.measure.settings import POSITIVE_TURNS
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define ``photoset init`` and ``photoset check``."""
-    sub = parser.add_subparsers(dest="photoset_command", metavar="{init,check,preview,pick-color}", required=True)
+    sub = parser.add_subparsers(dest="photoset_command", metavar="{init,check,calibrate,preview,pick-color}", required=True)
     init = sub.add_parser(
         "init",
         help="write a starter manifest.csv and photoset.yaml from the image file names",
@@ -43,6 +43,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     check.add_argument("folder", metavar="DIR", help="photo-set folder")
     check.add_argument("--no-decode", action="store_true", help="only check that images exist (faster)")
+    calibrate = sub.add_parser(
+        "calibrate",
+        help="compute the camera calibration from the set's checkerboard photo(s) and store it (calibration.json)",
+        description="For every calibration the photo set uses (photoset.yaml 'calibration: {board: ..., square_mm: ..., "
+        "inner_corners: [columns, rows]}' or a manifest column): find the board, fit the lens and the plane, print "
+        "the reprojection error in px and mm and store the result in DIR/calibration.json, which measuring then reads. "
+        "Exit 1 if a calibration cannot be computed.",
+    )
+    calibrate.add_argument("folder", metavar="DIR", help="photo-set folder")
+    calibrate.add_argument("--max-error-px", type=float, default=None,
+                           help="warn above this reprojection error, px (default 1; rows using such a calibration are flagged when measured)")
     preview = sub.add_parser(
         "preview",
         help="write one contact sheet showing what the settings select and measure, first and last photo of every ramp",
@@ -83,7 +94,44 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.photoset_command == "pick-color":
         return _pick(args)
+    if args.photoset_command == "calibrate":
+        return _calibrate(args)
     return _check(args)
+
+
+def _calibrate(args: argparse.Namespace) -> int:
+    from pipeline.measure.calibration import MAX_RMS_PX, write_store
+
+    limit = MAX_RMS_PX if args.max_error_px is None else args.max_error_px
+    ps = photoset.load_photoset(args.folder)  # a folder-wide calibration that fails refuses the set, naming the file
+    used: dict[object, tuple[object, list[int]]] = {}
+    for line, row in zip(ps.manifest["manifest_line"], ps.rows):
+        if row is not None and row.calibration is not None:
+            used.setdefault(row.calibration.key, (row.calibration, []))[1].append(int(line))
+    failed = [p for p in ps.problems if "calibration" in p.message]
+    for p in failed:
+        print(f"  {p}", file=sys.stderr)
+    if not used:
+        if not failed:
+            print(f"{args.folder}: no calibration in {photoset.SETTINGS} or the manifest (fix: add 'calibration: "
+                  "{board: board.jpg, square_mm: 25, inner_corners: [9, 6]}' naming a photo of a checkerboard "
+                  "lying where the actuator lies)", file=sys.stderr)
+        return 1
+    path = write_store(args.folder, [c for c, _ in used.values()])  # type: ignore[misc]
+    for cal, lines in used.values():
+        plane = cal.plane  # type: ignore[attr-defined]
+        boards = ", ".join(Path(b).name for b in cal.boards)  # type: ignore[attr-defined]
+        f = plane.camera_matrix[0]
+        print(f"{boards}: {cal.board_size}, {cal.square_mm:g} mm squares; {plane.views} photo(s), {plane.corners} corners; "  # type: ignore[attr-defined]
+              f"{len(lines)} row(s)")
+        print(f"  reprojection error {plane.rms_px:.3f} px, {plane.rms_mm:.4f} mm on the plane; "
+              f"{plane.mm_per_px:.4f} mm per px at the board centre; focal {f:.0f} px, k1 {plane.k1:+.4f}"
+              + (f", k2 {plane.dist_coeffs[1]:+.4f}" if plane.views >= 3 else ""))
+        if plane.rms_px > limit:
+            print(f"  warning: reprojection error above {limit:g} px: the rows using it are flagged (fix: re-take the board "
+                  "photo flat, sharp and evenly lit, check square_mm and inner_corners, or add board photos in other poses)")
+    print(f"stored {len(used)} calibration(s) in {path}")
+    return 1 if failed else 0
 
 
 def _init(args: argparse.Namespace) -> int:

@@ -26,10 +26,11 @@ from pipeline.ramp_check import check_ramps
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see :class:`~pipeline.measure.AngleResult`;
-#: empty on failed rows; ``l0_mm``: the length psi was computed with)
+#: empty on failed rows; ``l0_mm``: the length psi was computed with; ``calibration_px`` /
+#: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
     "image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px", "status", "reason",
-    "seconds", "degree", "l0_mm",
+    "seconds", "degree", "l0_mm", "calibration_px", "calibration_mm",
 )
 #: manifest columns carried over first (when present), then any others
 CARRIED_FIRST: tuple[str, ...] = ("pressure_kpa", "direction", "material", "actuator", "trial", "step")
@@ -41,6 +42,9 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
         image = str(image)
         overlay = None if overlays_dir is None else str(overlays_dir / f"{Path(image).stem}.jpg")
         title = f"{image}  {pressure:g} kPa {direction}"
+        cal = None if ps.rows[i] is None else ps.rows[i].calibration
+        if cal is not None and cal.plane is not None:
+            title += f"  calibrated ({cal.plane.rms_px:.2f} px)"
         tasks.append(Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i)))
     return tasks
 
@@ -98,14 +102,33 @@ def measure_photoset(
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
+    planes = [None if r is None or r.calibration is None else r.calibration.plane for r in ps.rows]
+    result["calibration_px"] = [np.nan if c is None else c.rms_px for c in planes]
+    result["calibration_mm"] = [np.nan if c is None else c.rms_mm for c in planes]
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
     if ramp_check:
         out = check_ramps(out)
+    out = flag_doubtful_calibration(out)
     if odir is not None:
         write_contact_sheets(out, odir)
+    return out
+
+
+def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
+    """Flag the measured rows whose calibration's reprojection error is above ``MAX_RMS_PX``."""
+    from pipeline.measure.calibration import MAX_RMS_PX
+
+    bad = (angles["calibration_px"] > MAX_RMS_PX) & (angles["status"] != "failed")
+    if not bad.any():
+        return angles
+    out = angles.copy()
+    note = out.loc[bad, "calibration_px"].map(lambda e: f"calibration reprojection error {e:.2f} px > {MAX_RMS_PX:g} px")
+    old = out.loc[bad, "reason"].fillna("").astype(str)
+    out.loc[bad, "reason"] = [f"{r}; {n}" if r else n for r, n in zip(old, note)]
+    out.loc[bad, "status"] = "flagged"
     return out
 
 

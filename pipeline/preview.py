@@ -4,7 +4,9 @@ For the first and the last photo of every ramp, a tile shows the photo with what
 select tinted (the line colour, or the body), the ``roi`` (yellow) and ``exclude`` (red)
 outlines, the other candidates outlined in grey, the chosen line or body centre line (green when
 ``ok``, orange when ``flagged``), the fixed end (blue circle), the ``fixed_direction_deg`` arrow,
-and psi with the status and the reason -- beside the bare selection mask.  It is the measurement
+and psi with the status and the reason -- beside the bare selection mask, and for a calibrated
+photo the photo rectified to the actuator's plane (undistorted, seen from straight above) with the
+centre line as measured there and the calibration's reprojection error.  It is the measurement
 itself (:func:`pipeline.measure.core.measure_decoded`), drawn, so what the preview shows is what
 ``measure`` will do.
 """
@@ -91,7 +93,38 @@ def preview_tile(path: str | os.PathLike[str], settings: MeasureSettings | None,
         cv2.putText(tint, t, (8, 20 + 20 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.48, colour if i else (255, 255, 255), 1, cv2.LINE_AA)
     right = cv2.cvtColor(mask_small, cv2.COLOR_GRAY2BGR)
     cv2.putText(right, f"selected: {settings.describe_color()}"[:60], (8, right.shape[0] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 200, 255), 1, cv2.LINE_AA)
-    return np.hstack([tint, right])
+    rectified = rectified_panel(img, float(f), settings, res, (small.shape[1], small.shape[0]))
+    return np.hstack([tint, right] + ([] if rectified is None else [rectified]))
+
+
+def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, res: AngleResult,
+                    size: tuple[int, int]) -> np.ndarray | None:
+    """A calibrated photo on the plane, with the centre line mapped there (None when uncalibrated)."""
+    from pipeline.measure.calibration import CalibrationMismatch, check_size, rectify
+
+    cal = settings.calibration
+    if cal is None or cal.plane is None:
+        return None
+    base = img if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    try:
+        check_size(cal.plane, base.shape, scale)
+    except CalibrationMismatch as exc:
+        panel = np.full((size[1], size[0], 3), 60, np.uint8)
+        cv2.putText(panel, str(exc)[:60], (8, 24), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (40, 40, 230), 1, cv2.LINE_AA)
+        return panel
+    panel = rectify(base, cal.plane, scale)
+    k = size[0] / panel.shape[1]
+    panel = cv2.resize(panel, size, interpolation=cv2.INTER_AREA)
+    if len(res.centreline_px):
+        q = cal.plane.to_plane(res.centreline_px) / scale * k
+        colour = _STATUS_BGR.get(res.status, (255, 255, 255))
+        cv2.polylines(panel, [np.round(q * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
+    text = [f"on the plane ({Path(cal.boards[0]).name})", f"reprojection error {cal.plane.rms_px:.2f} px, {cal.plane.rms_mm:.3f} mm",
+            f"{cal.plane.mm_per_px:.4f} mm/px, k1 {cal.plane.k1:+.3f}"]
+    warn = cal.plane.doubtful
+    for i, t in enumerate(text):
+        cv2.putText(panel, t, (8, 20 + 20 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.48, (0, 165, 255) if warn else (255, 255, 255), 1, cv2.LINE_AA)
+    return panel
 
 
 def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
@@ -116,8 +149,9 @@ def write_preview(folder: str | os.PathLike[str], out: str | os.PathLike[str], *
         row = ps.manifest.iloc[i]
         title = f"{row['image']}  {row['material']} {row['actuator']} t{row['trial']}  {row['pressure_kpa']:g} kPa {row['direction']}"
         tiles.append(preview_tile(ps.image_path(str(row["image"])), ps.rows[i], method=method, title=title, reason=ps.row_reason(i)))
-    height = max(t.shape[0] for t in tiles)
-    tiles = [cv2.copyMakeBorder(t, 0, height - t.shape[0] + 4, 0, 0, cv2.BORDER_CONSTANT, value=(30, 30, 30)) for t in tiles]
+    height, width = max(t.shape[0] for t in tiles), max(t.shape[1] for t in tiles)
+    tiles = [cv2.copyMakeBorder(t, 0, height - t.shape[0] + 4, 0, width - t.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30))
+             for t in tiles]
     sheet = np.vstack([np.hstack(tiles[i : i + 2]) if i + 1 < len(tiles) else np.hstack([tiles[i], np.zeros_like(tiles[i])]) for i in range(0, len(tiles), 2)])
     ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 88])
     path = Path(out)

@@ -274,9 +274,10 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:12]) == ["image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px",
-                                      "status", "reason", "seconds", "degree", "l0_mm"]
-    assert list(par.columns[12:18]) == ["pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    assert list(par.columns[:14]) == ["image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px",
+                                      "status", "reason", "seconds", "degree", "l0_mm", "calibration_px", "calibration_mm"]
+    assert list(par.columns[14:20]) == ["pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    assert par["calibration_px"].isna().all()  # no calibration: measured in the image
     # constant curvature: auto stays with the arc; the failed row has no degree
     assert (par["degree"][:6] == 1).all() and pd.isna(par["degree"].iloc[-1])
     assert "measured_pressure_kpa" in par.columns and "fixed_end_x" not in par.columns
@@ -297,7 +298,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "6 ok" in run.stdout and "1 failed" in run.stdout
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[9:13]) == ["seconds", "degree", "l0_mm", "pressure_kpa"]
+    assert list(angles.columns[9:15]) == ["seconds", "degree", "l0_mm", "calibration_px", "calibration_mm", "pressure_kpa"]
     assert (angles["degree"][:6] >= 1).all() and np.isnan(angles["degree"].iloc[-1])
     np.testing.assert_allclose(angles["psi_deg"][:6], truth, atol=1.0)
     assert np.isnan(angles["psi_deg"].iloc[-1])

@@ -37,6 +37,10 @@ from pipeline.measure.settings import MeasureSettings
 NOISE_SIGMAS = 6.0
 #: ... and by at least this colour distance (Lab, L weighted by LIGHTNESS_WEIGHT)
 MIN_DIFFERENCE = 12.0
+#: ... while fainter differences (a translucent body's edges) count when they touch a clear one,
+#: within this fraction of the photo's size of it
+WEAK_SIGMAS = 3.0
+GROW_FRACTION = 0.012
 #: lightness counts this much in the colour distance (shadows change lightness most)
 LIGHTNESS_WEIGHT = 0.6
 #: holes larger than this fraction of the body's area stay open (the inside of a ring)
@@ -59,12 +63,23 @@ class BodyExtraction:
         Edge-to-edge width along the centre line (original px).
     selected_fraction : float
         Fraction of the allowed region that the selection (before choosing a component) covers.
+    continues : bool
+        More of the selection lies just beyond the free end, along its course: the body may go
+        on past a gap (a faint or hidden stretch), so its end, and psi, may be wrong.
+    start_gap_px : float
+        How far the body's centre line starts from the given fixed end (original px; 0 without).
+    end_short_px : float
+        How much of the body's ridge, at the free end, the centre line does not cover (original
+        px): where the outline was too uneven to find the middle between two edges.
     """
 
     line: LineExtraction
     mask: np.ndarray
     widths_px: np.ndarray
     selected_fraction: float
+    continues: bool = False
+    start_gap_px: float = 0.0
+    end_short_px: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -78,10 +93,36 @@ def _design(xs: np.ndarray, ys: np.ndarray, w: int, h: int) -> np.ndarray:
     return np.c_[np.ones_like(u), u, v, u * u, u * v, v * v]
 
 
+#: the backdrop fits use about this many pixels of the photo, its colour groups this many
+FIT_PIXELS, KMEANS_PIXELS = 8000, 3000
 #: a colour seen on this fraction of the region's border (or more) is backdrop too ...
 BACKDROP_CLASS_FRACTION = 0.15
 #: ... and so is a colour covering this fraction of the whole region (the actuator never does)
 DOMINANT_FRACTION = 0.35
+
+
+def kmeans3(points: np.ndarray, iterations: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """Deterministic k-means with 3 groups (labels, centres): seeded at the 10th, 50th and 90th
+    percentile of the first coordinate (lightness), so the same photo always gives the same groups.
+
+    Examples
+    --------
+    >>> pts = np.r_[np.zeros((10, 3)), np.full((10, 3), 50.0), np.full((10, 3), 100.0)]
+    >>> labels, centres = kmeans3(pts)
+    >>> sorted(np.bincount(labels).tolist()), centres[:, 0].round().tolist()
+    ([10, 10, 10], [0.0, 50.0, 100.0])
+    """
+    pts = points.astype(np.float64)
+    order = np.argsort(pts[:, 0], kind="stable")
+    centres = pts[order[(np.array([0.1, 0.5, 0.9]) * (len(pts) - 1)).astype(int)]].copy()
+    labels = np.zeros(len(pts), int)
+    for _ in range(iterations):
+        d = ((pts[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+        labels = np.argmin(d, axis=1)
+        for k in range(3):
+            if (labels == k).any():
+                centres[k] = pts[labels == k].mean(axis=0)
+    return labels, centres
 
 
 def _ring(allowed: np.ndarray) -> np.ndarray:
@@ -119,49 +160,48 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     h, w = allowed.shape
     lab = _lab(image_bgr)
     ring = _ring(allowed)
-    step = max(1, int(np.sqrt(max(h * w, 1) / 40000.0)))  # fit on about 40k pixels at most
+    step = max(1, int(np.sqrt(max(h * w, 1) / FIT_PIXELS)))  # the fits use a sparse grid of pixels
     grid = np.zeros((h, w), bool)
     grid[::step, ::step] = True
-    ring_px = lab[ring & grid] if (ring & grid).sum() >= 12 else lab[(allowed > 0) & grid]
-    k = min(3, len(ring_px))
-    _, labels, centres = cv2.kmeans(
-        ring_px.astype(np.float32), k, None, (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 20, 0.5), 3,
-        cv2.KMEANS_PP_CENTERS,
-    )
-    share = np.bincount(labels.ravel(), minlength=k) / max(len(labels), 1)
-    order = [int(i) for i in np.argsort(-share) if share[i] >= BACKDROP_CLASS_FRACTION]
-    main = order[0]
-    # smooth field of the main backdrop colour
     sample = ring & grid
-    near_main = np.zeros((h, w), bool)
-    near_main[sample] = labels.ravel()[: int(sample.sum())] == main if (ring & grid).sum() >= 12 else False
-    if near_main.sum() < 12:
-        near_main = sample
-    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
-    full = _design(xx.ravel(), yy.ravel(), w, h)
-    diff = np.zeros((h, w), np.float32)
-    fit = near_main
+    if sample.sum() < 12:
+        sample = (allowed > 0) & grid
+    ring_px = lab[sample]
+    labels, centres = kmeans3(ring_px[:: max(1, len(ring_px) // KMEANS_PIXELS)])
+    d_ring = ((ring_px[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    labels = np.argmin(d_ring, axis=1)
+    share = np.bincount(labels, minlength=3) / max(len(labels), 1)
+    order = [int(i) for i in np.argsort(-share) if share[i] >= BACKDROP_CLASS_FRACTION]
+    # smooth field of the main backdrop colour, fitted on the grid, evaluated on a coarse one
+    ry, rx = np.nonzero(sample)
+    main = labels == order[0]
+    a_ring = _design(rx[main].astype(np.float32), ry[main].astype(np.float32), w, h)
+    gy, gx = np.nonzero((allowed > 0) & grid)
+    a_grid = _design(gx.astype(np.float32), gy.astype(np.float32), w, h)
+    lab_grid = lab[gy, gx]
+    fit_a, fit_v = a_ring, ring_px[main]
+    coef = np.zeros((6, 3))
     for _ in range(3):
-        ys, xs = np.nonzero(fit)
-        coef, *_ = np.linalg.lstsq(_design(xs.astype(np.float32), ys.astype(np.float32), w, h), lab[ys, xs], rcond=None)
-        model = (full @ coef).reshape(h, w, 3)
-        diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
-        vals = diff[near_main]
-        med = float(np.median(vals))
-        spread = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
-        fit = (allowed > 0) & grid & (diff < med + 3.0 * spread + 2.0)
-        if fit.sum() < 12:
+        if len(fit_v) < 12:
             break
+        coef, *_ = np.linalg.lstsq(fit_a, fit_v, rcond=None)
+        on_ring = np.sqrt(((ring_px[main] - a_ring @ coef) ** 2).sum(axis=1))
+        med = float(np.median(on_ring))
+        spread = max(1.4826 * float(np.median(np.abs(on_ring - med))), 0.5)
+        like = np.sqrt(((lab_grid - a_grid @ coef) ** 2).sum(axis=1)) < med + 3.0 * spread + 2.0
+        fit_a, fit_v = a_grid[like], lab_grid[like]  # every allowed pixel that looks like it (uneven light)
+    cy, cx = np.mgrid[0 : h + 7 : 8, 0 : w + 7 : 8].astype(np.float32)
+    coarse = (_design(cx.ravel(), cy.ravel(), w, h) @ coef).reshape(cy.shape[0], cy.shape[1], 3).astype(np.float32)
+    model = cv2.resize(coarse, (cx.shape[1] * 8, cy.shape[0] * 8), interpolation=cv2.INTER_LINEAR)[:h, :w]
+    diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
     others = [centres[c] for c in order[1:]]
-    region_px = lab[(allowed > 0) & grid].astype(np.float32)
+    region_px = lab_grid[:: max(1, len(lab_grid) // KMEANS_PIXELS)]
     if len(region_px) >= 3:
-        _, glabels, gcentres = cv2.kmeans(
-            region_px, 3, None, (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 20, 0.5), 3, cv2.KMEANS_PP_CENTERS
-        )
-        gshare = np.bincount(glabels.ravel(), minlength=3) / len(glabels)
+        glabels, gcentres = kmeans3(region_px)
+        gshare = np.bincount(glabels, minlength=3) / len(glabels)
         others += [gcentres[c] for c in range(3) if gshare[c] >= DOMINANT_FRACTION]
     for centre in others:
-        diff = np.minimum(diff, np.sqrt(((lab - centre) ** 2).sum(axis=2)).astype(np.float32))
+        diff = np.minimum(diff, np.sqrt(((lab - centre.astype(np.float32)) ** 2).sum(axis=2)))
     vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
     med = float(np.median(vals))
     sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
@@ -177,10 +217,26 @@ def background_difference(image_bgr: np.ndarray, background_bgr: np.ndarray) -> 
     return diff, sigma
 
 
-def _otsu(values: np.ndarray) -> float:
-    v = np.clip(values, 0, 255).astype(np.uint8)
-    thr, _ = cv2.threshold(v.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY | cv2.THRESH_OTSU)
-    return float(thr)
+def _hysteresis(diff: np.ndarray, high: float, low: float) -> np.ndarray:
+    """0/1 mask of the pixels above ``low`` connected to a pixel above ``high`` (as Canny's edges).
+
+    Examples
+    --------
+    >>> d = np.array([[0, 5, 9, 5, 0, 5, 0]], np.float32)
+    >>> _hysteresis(d, 8.0, 4.0).tolist()
+    [[0, 1, 1, 1, 0, 0, 0]]
+
+    Faint pixels count only within a few pixels of a clear one (:data:`GROW_FRACTION`).
+    """
+    strong = (diff > high).astype(np.uint8)
+    reach = max(3, int(round(GROW_FRACTION * max(diff.shape))))  # faint pixels next to clear ones only
+    near = cv2.dilate(strong, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2))
+    weak = ((diff > low) & (near > 0)).astype(np.uint8)
+    n, labels = cv2.connectedComponents(weak, connectivity=8)
+    seeded = np.zeros(n, bool)
+    seeded[np.unique(labels[diff > high])] = True
+    seeded[0] = False
+    return seeded[labels].astype(np.uint8)
 
 
 def body_mask(
@@ -221,11 +277,10 @@ def body_mask(
         else:
             diff, sigma = backdrop_difference(image_bgr, allowed)
         inside = diff[allowed > 0]
+        # any clear difference is body: a translucent body differs faintly (splitting the differences
+        # in two, faint vs strong, cut translucent bodies down to their highlights)
         thr = max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
-        strong = inside[inside > thr]
-        if strong.size > 50:  # split the clear differences in two: faint halo vs. body proper
-            thr = max(thr, 0.5 * _otsu(np.r_[inside[inside <= thr][:: max(1, inside.size // 20000)], strong]))
-        mask &= (diff > thr).astype(np.uint8)
+        mask &= _hysteresis(diff, thr, max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE))
         strength = diff / max(thr, 1e-6)
         sel = diff[mask > 0]
         contrast = float(np.median(sel) / sigma) if sel.size else 0.0
@@ -377,14 +432,100 @@ def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
     return soft
 
 
+#: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
+MARCH_HALF_WIDTHS = 2.0
+#: ... in steps of this length (px)
+MARCH_STEP_PX = 2.0
+
+
+def _uncovered(ridge: np.ndarray, end: np.ndarray) -> float:
+    """Length of the ridge path beyond the point nearest ``end`` (px)."""
+    seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ridge, axis=0).T))))
+    i = int(np.argmin(np.hypot(*(ridge - end).T)))
+    return float(seg[-1] - seg[i])
+
+
+def _continues(others: np.ndarray, pts: np.ndarray, half: float) -> bool:
+    """Whether other selected pixels lie just ahead of the centre line's free end, on its course."""
+    if not others.any() or len(pts) < 8:
+        return False
+    t = pts[-1] - pts[-6]
+    t = t / max(float(np.hypot(*t)), 1e-9)
+    ys, xs = np.nonzero(others)
+    d = np.c_[xs, ys].astype(float) - pts[-1]
+    along = d @ t
+    across = np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
+    ahead = (along > 0) & (along <= 6.0 * half + 10.0) & (across <= half + 0.6 * along)
+    return int(ahead.sum()) >= max(10, int(half * half))
+
+
+def _good_span(good: np.ndarray, run: int) -> tuple[int, int] | None:
+    """First and last index of the part between the first and the last run of ``run`` good points.
+
+    Examples
+    --------
+    >>> _good_span(np.array([1, 0, 1, 1, 1, 1, 0, 1, 1, 1, 0, 1], bool), 3)
+    (2, 9)
+    """
+    if good.sum() < max(run, 8):
+        return None
+    ok = np.convolve(good.astype(int), np.ones(run, int), mode="valid") == run  # a run starts here
+    if not ok.any():
+        return None
+    first = int(np.argmax(ok))
+    last = len(ok) - 1 - int(np.argmax(ok[::-1])) + run - 1
+    return first, last
+
+
+def _march(soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, med: float) -> tuple[np.ndarray, np.ndarray]:
+    """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
+    edges": each new point is the middle of the profile across the body ahead, kept while the
+    body's width there is within [END_WIDTH_LOW, END_WIDTH_HIGH] of its median.
+
+    The ridge path stops about a half-width short of each end (there the medial axis forks into
+    the corners); marching recovers that part, so a tip that curls to its end is measured to its
+    end, and a straight sealed cap is followed to its end face.
+    """
+    k = 6
+    ends = []
+    for forward in (False, True):
+        line = pts if forward else pts[::-1]
+        new: list[np.ndarray] = []
+        new_w: list[float] = []
+        cur = line[-1]
+        prev = line[max(len(line) - 1 - k, 0)]
+        for _ in range(int(MARCH_HALF_WIDTHS * half / MARCH_STEP_PX) + 2):
+            t = cur - prev
+            t = t / max(float(np.hypot(*t)), 1e-9)
+            ahead = cur + MARCH_STEP_PX * t
+            mid, wid = _midpoints(soft, np.array([cur, ahead]), reach=3.0 * half + 4.0)
+            if not np.isfinite(wid[1]) or not END_WIDTH_LOW * med <= wid[1] <= END_WIDTH_HIGH * med:
+                break
+            step = mid[1]
+            d = step - prev  # the course over the last few points, not one step's jitter
+            if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or float(d @ t) < np.cos(np.deg2rad(25.0)) * np.hypot(*d):
+                break  # not moving on, or turning off the line's course (a corner, a cap)
+            new.append(step)
+            new_w.append(float(wid[1]))
+            hist = np.vstack([line[-k:], np.array(new)])
+            prev, cur = hist[max(len(hist) - 1 - k, 0)], step
+        ends.append((np.array(new).reshape(-1, 2), np.array(new_w)))
+    (head, head_w), (tail, tail_w) = ends
+    pts = np.vstack([head[::-1], pts, tail])
+    widths = np.concatenate([head_w[::-1], widths, tail_w])
+    return pts, widths
+
+
 def _extensions(
     comp: np.ndarray, pts: np.ndarray, half: float, fixed_xy: tuple[float, float] | None, capped: bool
 ) -> tuple[float, float]:
-    """How far the body goes on beyond each end of the centre line, along the end tangents (px).
+    """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
-    The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel.
-    The free end: to the body's last pixel within the body's width around the tangent -- unless
-    the centre line stopped where the width changed (a tip cap, which does not bend): then 0.
+    The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel:
+    the body bends right from the clamp.  The free end: 0.  Past the centre line's last point lies
+    the actuator's sealed end (a cap), which does not bend, so the tip's direction is the centre
+    line's own at its end; carrying the curvature on over the cap read |psi| 5 % high on rendered
+    capped bodies.
     """
     ys, xs = np.nonzero(comp)
     q = np.c_[xs, ys].astype(float)
@@ -397,7 +538,7 @@ def _extensions(
         if end == 0 and fixed_xy is not None:
             out.append(max(0.0, float((np.asarray(fixed_xy) - p) @ t)))
             continue
-        if end == -1 and capped:
+        if end == -1:
             out.append(0.0)
             continue
         d = q - p
@@ -497,6 +638,7 @@ def extract_body(
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
+    ridge = path  # the whole ridge, end to end: what the centre line should cover
     path, _ = _trim_by_thickness(path, dt, half)
     soft = _soft_body(comp, strength)
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
@@ -507,16 +649,21 @@ def extract_body(
         med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
         bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * med) | (wid < END_WIDTH_LOW * med)
         moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
-        if (~bad).sum() >= 8:  # the ends where the profile runs into the clamp or the tip: dropped
-            i0, i1 = int(np.argmax(~bad)), len(bad) - 1 - int(np.argmax(~bad[::-1]))
-            capped = capped or bool(np.isfinite(wid[i1 + 1 :]).any() and (wid[i1 + 1 :] > END_WIDTH_HIGH * med).any())
+        span = _good_span(~bad, max(3, int(round(half))))
+        if span is not None:  # the ends where the profile runs into the clamp or round the tip: dropped
+            i0, i1 = span
             moved, wid = moved[i0 : i1 + 1], wid[i0 : i1 + 1]
         pts = _smooth(_resample(moved, 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))
         fill = np.nan_to_num(wid, nan=med)
         widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(fill)), fill)
+    med = float(np.median(widths)) if len(widths) else 2.0 * half
+    pts, widths = _march(soft, pts, widths, half, med)
     trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
-    ys, xs = np.nonzero(comp)
-    touches = bool(xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1)
+    # the body proper (not the tube or a plate joined to it at the clamp) may not reach the border
+    near = np.zeros_like(comp)
+    cv2.polylines(near, [np.round(pts * 16).astype(np.int32)], False, 1, max(3, int(2 * half)) * 2 + 1, cv2.LINE_8, 4)
+    ys, xs = np.nonzero(near & comp)
+    touches = bool(len(xs)) and bool(xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1)
     contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
     holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1] if hier is not None else []
     loop = bool(holes) and max(cv2.contourArea(c) for c in holes) > 4.0 * half * half
@@ -535,4 +682,9 @@ def extract_body(
         gap_bridged=False,
         fixed_end_found=reached,
     )
-    return BodyExtraction(line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected)
+    gap = float(np.hypot(*(pts[0] - np.asarray(fe)))) if fe is not None and reached else 0.0
+    return BodyExtraction(
+        line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
+        continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
+        end_short_px=_uncovered(ridge, pts[-1]) * scale,
+    )

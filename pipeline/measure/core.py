@@ -19,6 +19,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from pipeline.measure.calibration import CalibrationMismatch, plane_centreline
 from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.quality import assess, assess_body
@@ -144,11 +145,14 @@ def measure_work_image(
     if fine is not None:
         refined = refine_centreline(fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px)
         line = replace(line, centreline_px=refined)
-    pts = line.centreline_px * np.array([1.0, -1.0])  # y-up: on-screen ccw is positive
+    try:  # y-up: on-screen ccw is positive; calibrated: undistorted, on the plane (plane px)
+        pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
+    except CalibrationMismatch as exc:
+        return failed(method, str(exc))
+    mm_per_px = settings.mm_per_px
     rng = np.random.default_rng(SEED)
     sign = settings.sign
     try:
-        ends = line.trimmed_px
         arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
         trn = turning_quick(pts, rng, ends_px=ends)
         if method == "hyper":
@@ -220,10 +224,12 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     except NoLineFound as exc:
         return failed(method, str(exc))
     line = body.line
-    pts = line.centreline_px * np.array([1.0, -1.0])
+    try:  # ends: the tangents are carried to the clamp face and to the tip (not over a cap); calibrated: on the plane
+        pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
+    except CalibrationMismatch as exc:
+        return failed(method, str(exc))
     rng = np.random.default_rng(SEED)
     base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
-    ends = line.trimmed_px  # the tangents are carried to the clamp face and to the tip (not over a cap)
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
@@ -242,6 +248,9 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         length_px=est.length_px,
         base_mismatch_deg=mismatch,
         selected_fraction=body.selected_fraction,
+        continues=body.continues,
+        start_gap_px=body.start_gap_px,
+        end_short_px=body.end_short_px,
     )
     mm = settings.mm_per_px
     return AngleResult(

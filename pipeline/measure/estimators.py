@@ -461,21 +461,26 @@ def turning_quick(
 TANGENT_WINDOW_FRACTION = 0.15
 
 
+#: tangents: polynomial degree of the tangent angle against arc length in each end window
+TANGENT_DEGREE = 1
+
+
 def _end_angle(s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool) -> tuple[float, float]:
-    """Tangent angle at arc length ``at`` from a line fit over the first/last ``window``; and its RMS."""
+    """Tangent angle at arc length ``at`` from a fit over the first/last ``window``; and its RMS."""
     sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
     if sel.sum() < 3:
         sel = np.zeros_like(sel)
         sel[:3] = True if from_start else False
         if not from_start:
             sel[-3:] = True
-    slope, icpt = np.polyfit(s_mid[sel], theta[sel], 1)
-    resid = theta[sel] - (slope * s_mid[sel] + icpt)
-    return float(slope * at + icpt), float(np.sqrt(np.mean(resid**2)))
+    deg = min(TANGENT_DEGREE, int(sel.sum()) - 2)
+    coef = np.polyfit(s_mid[sel], theta[sel], deg)
+    resid = theta[sel] - np.polyval(coef, s_mid[sel])
+    return float(np.polyval(coef, at)), float(np.sqrt(np.mean(resid**2)))
 
 
 def end_tangents(
-    points: np.ndarray, *, ends_px: tuple[float, float] = (0.0, 0.0), window_fraction: float = TANGENT_WINDOW_FRACTION
+    points: np.ndarray, *, ends_px: tuple[float, float] = (0.0, 0.0), window_fraction: float | None = None
 ) -> tuple[float, float, float]:
     """Tangent angles (rad, y-up, unwrapped along the line) at both ends of the whole line.
 
@@ -486,8 +491,8 @@ def end_tangents(
     ends_px : (float, float)
         Length of the line beyond the first and the last point (px): the tangent is
         extrapolated to the line's true ends.
-    window_fraction : float
-        Fraction of the line each end's fit uses.
+    window_fraction : float, optional
+        Fraction of the line each end's fit uses (default :data:`TANGENT_WINDOW_FRACTION`).
 
     Returns
     -------
@@ -503,6 +508,8 @@ def end_tangents(
     >>> print(round(float(np.rad2deg(b - a)), 2))
     300.0
     """
+    if window_fraction is None:
+        window_fraction = TANGENT_WINDOW_FRACTION
     means, piece = chunk_means(points)
     d = np.diff(means, axis=0)
     theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
@@ -530,7 +537,7 @@ def tangents(
     if len(points) < 4:
         raise ValueError("need at least 4 centre-line points")
     a, b, rms = end_tangents(points, ends_px=ends_px)
-    a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)
+    a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)  # the check
     if base_rad is not None:
         base = base_rad + 2 * np.pi * np.round((a - base_rad) / (2 * np.pi))
         a2, a = a2 - a + base, base

@@ -159,6 +159,9 @@ def assess_body(
     length_px: float,
     base_mismatch_deg: float | None,
     selected_fraction: float,
+    continues: bool = False,
+    start_gap_px: float = 0.0,
+    end_short_px: float = 0.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -192,6 +195,12 @@ def assess_body(
         flags.append("body closes on itself")
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
+    if continues:
+        flags.append("the selection goes on past a gap beyond the free end: part of the body may be missed (photoset preview shows it)")
+    if end_short_px > 1.5 * line.width_px + 4.0:
+        flags.append(f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven outline there): check with photoset preview")
+    if start_gap_px > 2.0 * line.width_px + 4.0:
+        flags.append(f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or fixed_end is off")
     if expected_length_px and length_px < 0.8 * expected_length_px:
         flags.append(f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible")
     if base_mismatch_deg is not None:

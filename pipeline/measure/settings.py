@@ -34,6 +34,13 @@ Keys
 ``method``
     The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
     run's method (``--method``, config ``measure.method``) applies.
+``calibration``
+    A photo of a printed checkerboard lying in the actuator's plane, its square size and inner
+    corners: ``{board: board.jpg, square_mm: 25, inner_corners: [9, 6]}`` (``board`` may list
+    more photos, the first in the plane, the others for the lens).  psi is then measured on the
+    plane (:mod:`pipeline.measure.calibration`) and ``mm_per_px`` is not used.  In a manifest
+    column: such a mapping, or only the board photo's name (square and corners from
+    photoset.yaml), for sets taken over several sessions.
 
 Examples
 --------
@@ -54,6 +61,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from pipeline.measure.calibration import Calibration, CalibrationCache, CalibrationError, describe_problem
 from pipeline.measure.colors import BLACK, ColorError, ColorSpec, parse_color
 
 #: a polygon in image pixels: ((x, y), ...)
@@ -64,12 +72,12 @@ POSITIVE_TURNS: tuple[str, ...] = ("ccw", "cw")
 #: every settings key, as it may appear in photoset.yaml (fixed_end as fixed_end_x/_y in rows)
 KEYS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
-    "exclude", "fixed_direction_deg", "method",
+    "exclude", "fixed_direction_deg", "method", "calibration",
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y", "positive_turn", "target", "background",
-    "roi", "exclude", "fixed_direction_deg", "method",
+    "roi", "exclude", "fixed_direction_deg", "method", "calibration",
 )
 
 
@@ -121,6 +129,9 @@ class MeasureSettings:
         Known direction (deg, ccw from +x on screen) in which the actuator leaves the clamp.
     method : str or None
         Estimator for these photos; None: the run's.
+    calibration : Calibration or None
+        Board photo(s), square size, inner corners and the computed plane calibration; None:
+        measured in the image (scaled by ``mm_per_px``).
     """
 
     l0_mm: float
@@ -134,6 +145,7 @@ class MeasureSettings:
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None
     method: str | None = None
+    calibration: Calibration | None = None
 
     @property
     def sign(self) -> float:
@@ -223,7 +235,101 @@ def _fixed_end(raw: Mapping[str, Any], problems: list[SettingProblem]) -> tuple[
     return None
 
 
-def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[MeasureSettings | None, list[SettingProblem]]:
+_CALIBRATION_FIX = "write calibration as {board: <board photo>, square_mm: <square side in mm>, inner_corners: [<columns>, <rows>]}"
+
+
+def _yaml_value(value: Any) -> Any:
+    if isinstance(value, str):
+        import yaml
+
+        try:
+            return yaml.safe_load(value)
+        except yaml.YAMLError:
+            return value
+    return value
+
+
+def merge_calibration(folder_value: Any, row_value: Any) -> Any:
+    """A row's ``calibration`` on top of the folder-wide one: a board photo name (or list) keeps
+    the folder's square size and corners; a mapping overrides the keys it gives.
+
+    Examples
+    --------
+    >>> merge_calibration({"board": "a.jpg", "square_mm": 20, "inner_corners": [9, 6]}, "b.jpg")["board"]
+    'b.jpg'
+    >>> merge_calibration({"board": "a.jpg", "square_mm": 20}, "{square_mm: 25}")
+    {'board': 'a.jpg', 'square_mm': 25}
+    """
+    row = _yaml_value(row_value)
+    base = _yaml_value(folder_value)
+    if not isinstance(base, Mapping):
+        return row
+    if isinstance(row, Mapping):
+        return {**base, **row}
+    return {**base, "board": row}
+
+
+def _calibration(
+    raw: Mapping[str, Any], folder: Any, problems: list[SettingProblem], cache: CalibrationCache | None
+) -> Calibration | None:
+    """The ``calibration`` setting, computed (or read from the store) -- or its problems."""
+    from pathlib import Path
+
+    value = raw.get("calibration")
+    if is_missing(value):
+        return None
+    value = _yaml_value(value)
+    if isinstance(value, (str, list, tuple)):
+        value = {"board": value}
+    if not isinstance(value, Mapping):
+        problems.append(SettingProblem("calibration", f"calibration = {raw.get('calibration')!r} is not a mapping", _CALIBRATION_FIX))
+        return None
+    bad = len(problems)
+    unknown = sorted(set(map(str, value)) - {"board", "square_mm", "inner_corners"})
+    if unknown:
+        problems.append(SettingProblem("calibration", f"calibration key(s) {unknown} unknown", _CALIBRATION_FIX))
+    boards = value.get("board")
+    boards = [boards] if isinstance(boards, str) else boards
+    paths: list[str] = []
+    if not isinstance(boards, (list, tuple)) or not boards or not all(isinstance(b, str) and b.strip() for b in boards):
+        problems.append(SettingProblem("calibration", f"calibration board = {value.get('board')!r}: name the board photo(s)", _CALIBRATION_FIX))
+    else:
+        for b in boards:
+            path = Path(b.strip())
+            if folder is not None and not path.is_absolute():
+                path = Path(folder) / path
+            if not path.is_file():
+                problems.append(SettingProblem("calibration", f"calibration board photo {b!r} does not exist", "put the photo of the checkerboard (lying where the actuator lies) in the photo-set folder and name it in calibration: board"))
+            paths.append(str(path.resolve()))
+    square = _number(value, "square_mm", problems, "set calibration square_mm to the side of one board square in mm (measure the print)")
+    if square is None and not any(p.key == "square_mm" for p in problems[bad:]):
+        problems.append(SettingProblem("calibration", "calibration square_mm is missing", "add square_mm: <side of one board square in mm> to calibration"))
+    corners = value.get("inner_corners")
+    if isinstance(corners, str):  # "9x6" or "9, 6"
+        corners = corners.lower().replace("x", ",").split(",")
+    try:
+        if not (isinstance(corners, (list, tuple)) and len(corners) == 2):
+            raise ValueError(corners)
+        cols, rows = (int(str(c).strip()) for c in corners)  # "9.5" and True are refused
+        if not (2 <= cols <= 100 and 2 <= rows <= 100):
+            raise ValueError(corners)
+    except ValueError:
+        problems.append(SettingProblem("calibration", f"calibration inner_corners = {value.get('inner_corners')!r}", "give [columns, rows] of inner corners (where four squares meet): a board of 10 x 7 squares has [9, 6]"))
+        cols = rows = 0
+    if len(problems) > bad or square is None:
+        return None
+    spec = Calibration(tuple(paths), square, (cols, rows))
+    try:
+        return (cache if cache is not None else CalibrationCache(folder)).resolve(spec)
+    except CalibrationError as exc:
+        message, fix = describe_problem(spec, exc)
+        problems.append(SettingProblem("calibration", message, fix))
+        return None
+
+
+def settings_problems(
+    raw: Mapping[str, Any], *, folder: Any = None, calibrations: CalibrationCache | None = None
+) -> tuple[MeasureSettings | None, list[SettingProblem]]:
     """Resolve one row's raw settings; return the settings (None if impossible) and every problem.
 
     Parameters
@@ -231,7 +337,11 @@ def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[Me
     raw : mapping
         Merged ``photoset.yaml`` and manifest-row values (missing keys take their defaults).
     folder : path, optional
-        Photo-set folder; ``background`` is resolved against it and must exist.
+        Photo-set folder; ``background`` and the calibration board photos are resolved against
+        it and must exist.
+    calibrations : CalibrationCache, optional
+        The calibrations of this photo set (stored ones, and each computed once); by default a
+        new one reading the folder's store.
 
     Returns
     -------
@@ -311,16 +421,20 @@ def settings_problems(raw: Mapping[str, Any], *, folder: Any = None) -> tuple[Me
         if not path.is_file():
             problems.append(SettingProblem("background", f"background photo {str(raw['background'])!r} does not exist", "put a photo of the empty scene in the photo-set folder and name it in 'background'"))
         background = str(path)
+    calibration = _calibration(raw, folder, problems, calibrations)
     if problems or l0 is None:
         return None, problems
     return MeasureSettings(
         l0_mm=l0, mm_per_px=mpp, color=color, fixed_end_px=fixed_end, positive_turn=turn, target=target,
         background_path=background, roi=roi, exclude=tuple(exclude), fixed_direction_deg=fixed_direction,
-        method=method,
+        method=method, calibration=calibration,
     ), []
 
 
-def resolve_settings(raw: Mapping[str, Any] | None = None, *, folder: Any = None, **values: Any) -> MeasureSettings:
+def resolve_settings(
+    raw: Mapping[str, Any] | None = None, *, folder: Any = None, calibrations: CalibrationCache | None = None,
+    **values: Any,
+) -> MeasureSettings:
     """Resolve settings given as a mapping and/or keywords; raise :class:`SettingsError` if bad.
 
     Examples
@@ -328,7 +442,7 @@ def resolve_settings(raw: Mapping[str, Any] | None = None, *, folder: Any = None
     >>> resolve_settings(l0_mm=150, line_color="red", fixed_end=[10, 20]).fixed_end_px
     (10.0, 20.0)
     """
-    settings, problems = settings_problems({**(raw or {}), **values}, folder=folder)
+    settings, problems = settings_problems({**(raw or {}), **values}, folder=folder, calibrations=calibrations)
     if settings is None:
         raise SettingsError(problems)
     return settings

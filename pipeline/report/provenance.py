@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 
 from pipeline.report.data import ReportData
 from pipeline.report.style import text_page
+from pipeline.report.summary import calibration_summary
 from pipeline.report.typeset import MONO, Column, Flow, Table, rows_that_fit
 
 #: libraries whose versions can change a number or a pixel of the report
@@ -43,6 +44,8 @@ def provenance_pages(data: ReportData, version: str, infos: Sequence[str], warni
         flow.text(line, size=8.0, color="0.25")
     for line in warnings:
         flow.text(f"WARNING: {line}", size=8.0, color="#b00000")
+    for style, line in calibration_summary(data):
+        flow.text(f"Camera calibration: {line}", size=8.0, color="#b00000" if style == "w" else "0.25")
     flow.space(4.0)
     rows = tuple((f.role, f.path, f.sha256) for f in data.files)
     pages = [fig]

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.reasons import top_reasons
 from pipeline.report.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
@@ -155,6 +156,23 @@ def quality_table(data: ReportData, *, width_pt: float = 511.0, height_pt: float
     return candidate
 
 
+def calibration_summary(data: ReportData) -> list[tuple[str, str]]:
+    """Which photo sets were measured on a calibrated plane (:mod:`pipeline.report.calibration`):
+    one line per dataset, or one for all when they are alike.  ``("w", text)`` is a warning."""
+    names = [d.name for d in data.datasets]
+    lines: list[tuple[str, str]] = []
+    for style, text in calibration_lines(data.angles, names)[1:]:  # after its heading; rejoin wrapped lines
+        if text.startswith(" ") and lines:
+            lines[-1] = (lines[-1][0], f"{lines[-1][1]} {text.strip()}")
+        else:
+            lines.append((style, text))
+    said = {(style, text.split(": ", 1)[-1]) for style, text in lines}
+    if len(lines) > 1 and len(said) == 1:  # the same for every set: say it once
+        style, text = said.pop()
+        return [(style, f"every photo set: {text}")]
+    return lines
+
+
 def summary_page(data: ReportData, version: str, warnings: Sequence[str],
                  contents: Sequence[tuple[str, int]]) -> Figure:
     """Page 1 (portrait A4).
@@ -186,8 +204,13 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     contents_h = 9.0 * 1.32 * (1 + int(np.ceil(len(contents) / 2))) + 14.0
     notes_h = sum(8.0 * 1.32 * (1 + len(n) // 110) for n in notes) + 16.0
     warnings_h = sum(8.0 * 1.32 * (1 + len(w) // 100) for w in shown) + (16.0 if shown else 0.0)
+    calibration = calibration_summary(data)
+    calibration_h = sum(8.0 * 1.32 * (1 + len(t) // 110) for _, t in calibration) + 16.0
     flow.table(quality_table(data, width_pt=flow.width,
-                             height_pt=flow.remaining_pt - contents_h - notes_h - warnings_h - 8.0))
+                             height_pt=flow.remaining_pt - contents_h - notes_h - warnings_h - calibration_h - 8.0))
+    flow.heading("Camera calibration", size=9.5)
+    for style, text in calibration:
+        flow.text(text, size=8.0, color="#b00000" if style == "w" else "black", hanging_pt=9.0)
     if shown:
         flow.heading("Warnings", size=9.5)
         flow.bullets(shown, color="#b00000")

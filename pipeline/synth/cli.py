@@ -40,6 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="scene_set", action="append", metavar="KEY=VALUE",
                         help="override a scene knob, e.g. --set noise_sigma=4 --set width=640 --set height=480 "
                              "(see pipeline.synth.SceneParams for keys and units); repeatable")
+    parser.add_argument("--board", action="store_true",
+                        help="also photograph a checkerboard in the actuator's plane (board.jpg) and name it in "
+                             "photoset.yaml's calibration (try with --set tilt_deg=6 --set lens_k1=-0.1)")
     parser.add_argument("--behaviour", dest="behaviour_set", action="append", metavar="KEY=VALUE",
                         help="override the virtual actuator's variability, e.g. --behaviour hysteresis=0.1 "
                              "(fraction, 0-0.25), psi0_sd_deg=3 (deg), stiffness_sd=0.04, photo_sd_deg=1 (deg), "
@@ -67,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         args.out_dir, args.material, actuators=args.actuators, trials=args.trials, seed=args.seed,
         scene=args.scene, step_kpa=args.step_kpa, max_kpa=args.max_kpa,
         scene_overrides=_pairs(args.scene_set, "--set"), jobs=args.jobs, behaviour=beh, l0_mm=args.l0_mm,
+        board=args.board,
     )
     dt = time.perf_counter() - t0
     outside = int((~truth["line_in_frame"].astype(bool)).sum())

@@ -49,15 +49,17 @@ from pipeline.synth.actuator import (
     plan_ramp,
 )
 from pipeline.synth.backdrop import make_backdrop
-from pipeline.synth.camera import Camera, make_camera, tilt_homography
+from pipeline.synth.camera import Camera, camera_for, make_camera
 from pipeline.synth.centreline import actuator_centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
 from pipeline.synth.scene import _compose, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
 
 #: seed streams (second key after the material)
-_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND = range(7)
+_TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND, _BOARD = range(8)
 #: file name of the empty-scene photo of ``background_photo`` scenes
 BACKGROUND_IMAGE = "background.jpg"
+#: the checkerboard photo of a set rendered with ``board=True``
+BOARD_PHOTO = "board.jpg"
 DEFAULT_L0_MM = 195.0
 LAYOUT_MARGIN_PX = 16
 
@@ -166,9 +168,8 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
             best = (need, float(rot), (px.max(axis=0) + px.min(axis=0)) / 2)
     _, rot, centre = best
     origin = np.array([scene.width / 2, scene.height / 2]) - centre
-    h = tilt_homography(scene)
     for _ in range(3):  # centre the shapes as seen through the tilted camera
-        px = Camera(scene.width, scene.height, scene.mm_per_px, rot, tuple(origin), h).to_px(pts)
+        px = camera_for(scene, rotation_deg=rot, origin_px=tuple(origin)).to_px(pts)
         lo, hi = px.min(axis=0), px.max(axis=0)
         origin = origin + np.array([scene.width / 2, scene.height / 2]) - (lo + hi) / 2
     size = hi - lo
@@ -228,6 +229,7 @@ def render_photoset(
     l0_mm: float | None = None,
     overwrite: bool = True,
     fit_view: bool = True,
+    board: bool = False,
 ) -> pd.DataFrame:
     """Render the pressure-ramp photos of ``actuators`` x ``trials`` of one material.
 
@@ -266,6 +268,10 @@ def render_photoset(
     fit_view : bool
         When the campaign's shapes do not fit the frame at ``scene.mm_per_px``, increase
         ``mm_per_px`` just enough (the value used is written to ``photoset.yaml``).
+    board : bool
+        Also photograph a checkerboard lying in the actuator's plane with the same camera
+        (``board.jpg``, :mod:`pipeline.synth.board`) and name it in ``photoset.yaml``'s
+        ``calibration``.
 
     Returns
     -------
@@ -292,7 +298,7 @@ def render_photoset(
         sc = dataclasses.replace(sc, mm_per_px=float(np.ceil(sc.mm_per_px * need * 1000) / 1000))
         base_rot, fixed_flat, need = choose_layout(extents, sc)
     # the fixed end as seen (after the tilt) of the chosen placement; the same for every ramp
-    fixed_end_px = Camera(sc.width, sc.height, sc.mm_per_px, base_rot, fixed_flat, tilt_homography(sc)).fixed_end_px
+    fixed_end_px = camera_for(sc, rotation_deg=base_rot, origin_px=fixed_flat).fixed_end_px
     jit = 2.5 * sc.rotation_jitter_deg
     keepout = [_rotate(e, d) for e in extents for d in ({-jit, 0.0, jit})]
     mk = material_key(material)
@@ -323,7 +329,7 @@ def render_photoset(
             blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
             occluded_fraction=sc.occluded_fraction, seed=seed, target=sc.target, shape=sc.shape,
             marker_line=sc.marker_line, body_width_mm=sc.body_width_mm, body_translucency=sc.body_translucency,
-            texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style,
+            texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style, lens_k1=sc.lens_k1,
         )
         first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
                  "bulge"]
@@ -335,7 +341,7 @@ def render_photoset(
         settings: dict[str, Any] = {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px)}
         if sc.target == "body":
             # the fixed end of the body's centre line, at the clamp face (base mounting angle)
-            base = Camera(sc.width, sc.height, sc.mm_per_px, base_rot, fixed_flat, tilt_homography(sc))
+            base = camera_for(sc, rotation_deg=base_rot, origin_px=fixed_flat)
             fixed_end_px = tuple(float(v) for v in base.to_px([[0.0, sc.body_width_mm / 2]])[0])
             settings["target"] = "body"
         else:
@@ -346,6 +352,12 @@ def render_photoset(
             image = render_background(backdrop, sc, seed=child_seed(seed, mk, _BACKGROUND))
             atomic_write_bytes(tmp / BACKGROUND_IMAGE, encode_jpeg(image, sc.jpeg_quality))
             settings["background"] = BACKGROUND_IMAGE
+        if board:
+            from pipeline.synth.board import write_board_photo
+
+            del settings["mm_per_px"]  # the board gives the scale (truth.csv keeps the scene's)
+            settings["calibration"] = write_board_photo(tmp / BOARD_PHOTO, sc, make_camera(
+                sc, rotation_deg=base_rot, fixed_end_px=tasks[0]["fixed_end_px"]), seed=child_seed(seed, mk, _BOARD))
         write_settings(tmp, settings)
         atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
     return truth

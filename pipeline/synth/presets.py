@@ -181,6 +181,9 @@ class SceneParams:
     known_fixed_direction : bool
         Photo sets of this scene state, per photo, the on-screen direction in which the
         actuator leaves the clamp (manifest column ``fixed_direction_deg``).
+    lens_k1 : float
+        Radial lens distortion (OpenCV's k1 at ``focal_px_per_width``; > 0 pincushion, < 0
+        barrel, 0 an ideal lens), see :mod:`pipeline.synth.camera`.
     """
 
     width: int = 1280
@@ -230,6 +233,7 @@ class SceneParams:
     shadow: float = 0.0
     background_photo: bool = False
     known_fixed_direction: bool = False
+    lens_k1: float = 0.0
 
     @property
     def plain_body(self) -> bool:
@@ -270,6 +274,8 @@ def _problems(s: SceneParams) -> list[str]:
         out.append(f"jpeg_quality = {s.jpeg_quality!r} must be 1..100")
     if not 0 <= s.occluded_fraction <= 0.5:
         out.append(f"occluded_fraction = {s.occluded_fraction!r} must be 0..0.5")
+    if not abs(s.lens_k1) <= 0.3:
+        out.append(f"lens_k1 = {s.lens_k1!r} must be within -0.3..0.3 (a phone or action camera is about -0.1)")
     if s.tilt_deg > 20:
         out.append(f"tilt_deg = {s.tilt_deg} is more than 20 deg; a copy stand is never that far off")
     for key in COLOR_KEYS:

@@ -1,0 +1,40 @@
+"""Real photographs with independent labels (tests/data/xia2023_strips, see its README).
+
+The committed photo set is measured as a lab runs it (``measure`` on the folder, one
+photoset.yaml, a fixed end per row because the strips are free) and scored against labels.csv.
+What must hold: no row is ``ok`` outside its tolerance (a wrong number is flagged or failed, with a
+reason in words), and at least as many rows are within tolerance as today (5 of 10; the issue's
+target of 9 is not reached: see ``python -m pipeline.bench.realscenes``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from pipeline.bench.realscenes import dev_set
+
+DEV_SET = Path(__file__).parent / "data" / "xia2023_strips"
+
+
+@pytest.fixture(scope="module")
+def measured():
+    return dev_set(DEV_SET)
+
+
+def test_no_wrong_ok_on_real_photos(measured):
+    ok = measured[measured["status"] == "ok"]
+    wrong = ok[ok["error_deg"].abs() > ok["tolerance_deg"]]
+    assert wrong.empty, wrong[["image", "psi_deg", "psi_signed_net_deg", "tolerance_deg"]]
+
+
+def test_real_photos_within_tolerance(measured):
+    within = (measured["error_deg"].abs() <= measured["tolerance_deg"]).sum()
+    assert within >= 5, measured[["image", "psi_deg", "psi_signed_net_deg", "status", "reason"]]
+
+
+def test_every_doubtful_real_photo_says_why(measured):
+    doubtful = measured[measured["status"] != "ok"]
+    assert len(doubtful) and doubtful["reason"].str.len().min() > 10
+    assert not doubtful["reason"].str.contains(r"\(\(\(|array\(|np\.", regex=True).any()  # words, not reprs
