@@ -323,7 +323,8 @@ def test_preview_shows_the_rectified_photo(calibrated, tmp_path: Path) -> None:
 
 def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
     from pipeline.report.data import Dataset, ReportInputs, load_report_data
-    from pipeline.report.pages import summary_lines
+    from pipeline.report.style import report_style
+    from pipeline.report.summary import calibration_summary, summary_page
 
     datasets = []
     for name, err in (("bench", 0.05), ("old", None), ("shaky", 1.4)):
@@ -335,11 +336,13 @@ def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
         pd.DataFrame(rows).to_csv(path, index=False)
         datasets.append(Dataset(name, path))
     data = load_report_data(ReportInputs(datasets=tuple(datasets)))
-    lines = summary_lines(data, "x", None, [], [])
-    i = lines.index(("h", "Camera calibration"))
-    assert lines[i + 1] == ("b", "bench: calibrated, 4 of 4 photos; reprojection error 0.05 px (0.017 mm on the plane)")
-    assert lines[i + 2][1].startswith("old: not calibrated")
-    assert lines[i + 3][0] == "w" and "1.40 px" in lines[i + 3][1] and "flagged" in " ".join(t for _, t in lines[i + 3:])
+    lines = calibration_summary(data)  # page 1's "Camera calibration" lines
+    assert lines[0] == ("b", "bench: calibrated, 4 of 4 photos; reprojection error 0.05 px (0.017 mm on the plane)")
+    assert lines[1][1].startswith("old: not calibrated")
+    assert lines[2][0] == "w" and "1.40 px" in lines[2][1] and "flagged" in lines[2][1]
+    with report_style():
+        page1 = " ".join(t.get_text() for t in summary_page(data, "x", [], []).texts)
+    assert "Camera calibration" in page1 and "bench: calibrated, 4 of 4 photos" in page1
 
 
 def test_body_mode_on_a_calibrated_plane_keeps_the_clamp_direction() -> None:

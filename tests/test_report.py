@@ -1,27 +1,47 @@
-"""The PDF report: builds with 1 and 4 materials and an increasing-only set, pages not blank,
-identical bytes for identical inputs, bench/force pages fetched defensively."""
+"""The PDF report an advisor reads.
+
+A report shaped like the default run's (four materials, a second DS20 dataset pooled with the
+first, bench and force folders) is built once per module; the tests check what a reader sees:
+every page A4, no two drawn labels overlapping, no font below 7 pt, nothing on the footer band,
+page 1's figures equal to rms.csv (read back from the PDF's text), reasons in words, real versus
+synthetic, dates from the inputs, n/a for missing values, identical bytes for identical inputs.
+"""
 
 from __future__ import annotations
 
+import dataclasses
+import fcntl
+import os
+import pickle
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pandas as pd
+import pypdfium2 as pdfium
 import pytest
+from PIL import Image
 
+from pipeline.bench import analysis
 from pipeline.cli import main
 from pipeline.errors import UserInputError
-from pipeline.report import Dataset, ReportInputs, build_report
-
-pdfium = pytest.importorskip("pypdfium2")
+from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure
+from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
+from pipeline.report.build import build_report, report_figures
+from pipeline.report.data import Dataset, ReportInputs, dataset_dates, load_report_data
+from pipeline.report.reasons import top_reasons, words
+from pipeline.report.style import FOOTER_PT, MIN_FONT_PT, report_style
+from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
+from pipeline.report.typeset import NA, fmt
 
 #: rough p(psi=0) per material, only to make curves of the right shape
 P_ZERO = {"DS20": 65.0, "DS30": 105.0, "SS40": 215.0, "SS50": 600.0}
 P_MAX = {"DS20": 110.0, "DS30": 170.0, "SS40": 250.0, "SS50": 250.0}
+A4_PT = (595.28, 841.89)
+#: a failure reason as the measure stage writes it (quotes an HSV range, then the fix after ';')
+NO_LINE = "no line found: no long thin component of line_color=(((0, 0, 0), (180, 255, 80)),); check line_color"
 
 
 def fake_psi(material: str, p: np.ndarray, direction: str) -> np.ndarray:
@@ -31,11 +51,12 @@ def fake_psi(material: str, p: np.ndarray, direction: str) -> np.ndarray:
     return 210.0 - 210.0 * x**2.2
 
 
-def make_dataset(root: Path, material: str, *, actuators=3, trials=2, step=10.0, directions=("up", "down"),
-                 photos=True, overlays=True, seed=0) -> Dataset:
+def make_dataset(root: Path, material: str, *, name: str | None = None, actuators=3, trials=2, step=10.0,
+                 directions=("up", "down"), photos=True, overlays=True, seed=0, synthetic=False,
+                 timestamps: str | None = None, l0_mm: float | None = None) -> Dataset:
     """Write angles.csv (+ a small photo set and overlays) shaped like the measure stage's outputs."""
     rng = np.random.default_rng(seed)
-    folder = root / material
+    folder = root / (name or material)
     photo_dir, overlay_dir = folder / "photos", folder / "overlays"
     photo_dir.mkdir(parents=True)
     overlay_dir.mkdir()
@@ -50,13 +71,13 @@ def make_dataset(root: Path, material: str, *, actuators=3, trials=2, step=10.0,
                     psi = float(fake_psi(material, p, direction) + rng.normal(0, 6.0))
                     status, reason = "ok", ""
                     if rng.random() < 0.05:
-                        status, reason, psi = "failed", "no line found", float("nan")
+                        status, reason, psi = "failed", NO_LINE, float("nan")
                     elif rng.random() < 0.05:
-                        status, reason = "flagged", "high residual"
+                        status, reason = "flagged", "line touches the image border; low contrast (31)"
                     rows.append({"image": image, "psi_deg": psi, "kappa_per_mm": np.radians(psi) / 195.0,
                                  "length_mm": 195.0, "method": "paper", "residual_px": 0.4, "status": status,
                                  "reason": reason, "seconds": 0.02, "pressure_kpa": p, "direction": direction,
-                                 "material": material, "actuator": a, "trial": t, "step": k})
+                                 "material": material, "actuator": f"A{a}", "trial": t, "step": k})
                     if a == 1 and t == 1 and (photos or overlays):
                         img = np.full((120, 160, 3), 235, np.uint8)
                         ang = 0.0 if not np.isfinite(psi) else psi
@@ -64,10 +85,19 @@ def make_dataset(root: Path, material: str, *, actuators=3, trials=2, step=10.0,
                         if photos:
                             cv2.imwrite(str(photo_dir / image), img)
                         if overlays and k % 2 == 0:  # some overlays missing: falls back to raw
-                            cv2.putText(img, f"{ang:.0f}", (5, 20), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 255), 1)
+                            img[:24] = (img[:24] * 0.35).astype(np.uint8)  # the overlay's text band
+                            cv2.putText(img, f"{ang:.0f}", (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 255), 1)
                             cv2.imwrite(str(overlay_dir / (Path(image).stem + ".jpg")), img)
-    pd.DataFrame(rows).to_csv(folder / "angles.csv", index=False)
-    return Dataset(material, folder / "angles.csv", photo_dir if photos else None,
+    table = pd.DataFrame(rows)
+    if l0_mm is not None:
+        table["l0_mm"] = l0_mm
+    if timestamps:
+        table["timestamp"] = pd.date_range(timestamps, periods=len(table), freq="37min").strftime("%Y-%m-%dT%H:%M:%S")
+    table.to_csv(folder / "angles.csv", index=False)
+    (photo_dir / "manifest.csv").write_text("image\n")
+    if synthetic:
+        (photo_dir / "truth.csv").write_text("image,psi_deg\n")
+    return Dataset(name or material, folder / "angles.csv", photo_dir if photos else None,
                    overlay_dir if overlays else None)
 
 
@@ -90,72 +120,322 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         out = d.angles_csv.parent / "hysteresis.csv"
         assert main(["aggregate", str(d.angles_csv), "--out", str(out)]) == 0
         hyst.append(out)
-    h = pd.concat([pd.read_csv(p) for p in hyst])
-    table = compare(h, read_angles([d.angles_csv for d in datasets]),
-                    model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0, fit_k_p=None)
+    h = pd.concat([pd.read_csv(p).assign(dataset=d.name) for p, d in zip(hyst, datasets, strict=True)])
+    angles = pd.concat([read_angles([d.angles_csv]).assign(dataset=d.name) for d in datasets])
+    sources = {d.name: "synthetic" if (d.photoset_dir and (d.photoset_dir / "truth.csv").is_file())
+               else "measured" for d in datasets}
+    table = compare(h, angles, data_sources=sources, default_l0_mm={m: 255.0 for m in P_ZERO},
+                    model_psi=lambda m, p, l0_mm: fake_psi(m, p, "up") + 10.0,
+                    fit_k_p=lambda m, p, s, l0_mm: (1.0 + 0.01 * len(p), None), n_boot=20)
     rms = tmp / "rms.csv"
     table.to_csv(rms, index=False)
     return hyst, rms
 
 
-def cli_in_fresh_process(args: list[str]) -> str:
-    """Run ``python -m pipeline ARGS`` in a new interpreter; return stderr ('' on success)."""
-    proc = subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True, check=False)
-    return "" if proc.returncode == 0 else proc.stderr or f"exit {proc.returncode}"
+METHODS = ("paper", "paper_corrected", "pratt", "taubin", "hyper", "turning", "auto")
+SWEEPS = {"psi": (0.0, (-360.0, -30.0, 0.0, 30.0, 360.0)), "noise": (2.5, (0.0, 2.5, 8.0, 20.0)),
+          "tilt": (1.0, (0.0, 1.0, 5.0, 12.0)), "bulge": (0.0, (0.0, 0.2, 0.5))}
 
 
-def page_images(pdf: Path, scale: float = 0.6) -> list[np.ndarray]:
+def bench_results() -> pd.DataFrame:
+    """Per-image bench results with known structure: five circle fits give identical errors (their
+    labels would print over each other in a time-against-error scatter), paper is far off, turning
+    is slow and fails at psi = 360."""
+    rows = []
+    speed = {"paper": 15.0, "paper_corrected": 12.1, "pratt": 10.3, "taubin": 12.5, "hyper": 10.4,
+             "turning": 46.9, "auto": 10.3}
+    for cond, (nominal, values) in SWEEPS.items():
+        for v in values:
+            for seed in range(3):
+                for m in METHODS:
+                    err = 0.15 + 0.01 * seed + (0.05 if m == "turning" else 0.0)
+                    if m == "paper":
+                        err = 40.0 + 10 * seed
+                    elif cond == "tilt" and v == 12.0:
+                        err = 6.0
+                    elif cond == "bulge" and v > 0 and m not in ("turning", "auto"):
+                        err = 20.0
+                    elif cond == "psi" and v == -360.0:
+                        err = 9.0
+                    failed = m == "turning" and cond == "psi" and v == 360.0
+                    rows.append({"case_id": f"{cond}-{v}-{seed}", "kind": "sweep", "condition": cond, "value": v,
+                                 "nominal": nominal, "psi_true_deg": v if cond == "psi" else 60.0,
+                                 "bulge": v if cond == "bulge" else 0.0, "seed": seed, "method": m,
+                                 "psi_deg": np.nan if failed else 60.0 + err, "abs_error_deg": np.nan if failed else err,
+                                 "status": "failed" if failed else "ok",
+                                 "degree": (2 if cond == "bulge" and v > 0 else 1) if m in ("turning", "auto") else np.nan,
+                                 "seconds": speed[m] / 1e3, "decode_seconds": 0.004})
+    for seed in range(4):
+        for m in METHODS:
+            rows.append({"case_id": f"rep-{seed}", "kind": "repeat", "condition": "repeat", "value": 120.0,
+                         "nominal": 120.0, "psi_true_deg": 120.0, "bulge": 0.0, "seed": seed, "method": m,
+                         "psi_deg": 120.0 + 0.01 * seed, "abs_error_deg": 0.01 * seed, "status": "ok",
+                         "degree": 1.0 if m in ("turning", "auto") else np.nan, "seconds": speed[m] / 1e3,
+                         "decode_seconds": 0.004})
+    return pd.DataFrame(rows)
+
+
+def write_bench(folder: Path) -> Path:
+    """The bench tables, computed by the real analysis functions from :func:`bench_results`."""
+    folder.mkdir()
+    res = bench_results()
+    stab = analysis.stability(res)
+    tables = {"speed_accuracy.csv": analysis.speed_accuracy(res), "stability.csv": stab,
+              "breakdown.csv": analysis.breakdown(stab), "repeatability.csv": analysis.repeatability(res),
+              "model_choice.csv": analysis.model_choice(res),
+              "model_cost.csv": pd.DataFrame({"grid_n": [2, 4, 8], "seconds": [0.02, 0.027, 0.04],
+                                              "max_rel_error": [4.8e-4, 3.6e-8, 2.0e-13]})}
+    for name, t in tables.items():
+        t.to_csv(folder / name, index=False)
+    return folder
+
+
+def write_force(folder: Path) -> Path:
+    """Force tables from the real aggregation of a per-photo table, a photo and the example grasp log."""
+    folder.mkdir()
+    img = np.full((300, 400, 3), 180, np.uint8)
+    cv2.ellipse(img, (200, 150), (120, 90), 0, 0, 360, (40, 40, 40), 4)
+    cv2.imwrite(str(folder / "photo.jpg"), img)
+    rows = []
+    for j, m in enumerate(("DS20", "DS30", "SS40", "SS50")):
+        for trial in ("1", "2"):
+            for p in (0.0, 30.0, 60.0, 90.0):
+                rows.append({"material": m, "direction": "up", "pressure_kpa": p, "actuator": "A1", "trial": trial,
+                             "force_n": 0.02 * p / (1 + j) + 0.01 * int(trial), "eccentricity": 0.004 * p / (1 + j),
+                             "status": "ok", "image": "photo.jpg", "image_path": "photo.jpg", "centre_x_px": 200.0,
+                             "centre_y_px": 150.0, "semi_major_px": 120.0, "semi_minor_px": 90.0, "angle_deg": 0.0})
+    per_photo = pd.DataFrame(rows)
+    force_vs_pressure(per_photo).to_csv(folder / "force_summary.csv", index=False)
+    eccentricity_at_max_pressure(per_photo).to_csv(folder / "eccentricity_summary.csv", index=False)
+    heaviest_held(read_grasp_log(EXAMPLE_LOG)).to_csv(folder / "grasp_summary.csv", index=False)
+    return folder
+
+
+def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: ignore[no-untyped-def]
+    """``make(folder)`` computed once per test run, however many xdist workers ask (lock, then pickle)."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return make(tmp_path_factory.mktemp(name))
+    root = tmp_path_factory.getbasetemp().parent  # one folder per run, shared by its workers
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        done = root / f"{name}.pickle"
+        if not done.is_file():
+            (root / name).mkdir()
+            done.write_bytes(pickle.dumps(make(root / name)))
+        return pickle.loads(done.read_bytes())
+
+
+def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
+    """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders) and
+    the report built from them."""
+    datasets = [make_dataset(tmp, "DS20", name="sample", actuators=1, seed=9, timestamps="2026-03-02 09:00",
+                             l0_mm=270.0)]  # its own actuator length: its own model curve
+    datasets += [make_dataset(tmp, m, seed=i, synthetic=True) for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))]
+    hyst, rms = pipeline_tables(tmp, datasets)
+    config = tmp / "config.yaml"
+    config.write_text("datasets: []\n")
+    inputs = ReportInputs(datasets=tuple(datasets), hysteresis=tuple(hyst), rms=(rms,),
+                          model_curves=(model_curves(tmp / "curves.csv", P_ZERO),), bench_dir=write_bench(tmp / "bench"),
+                          force_dir=write_force(tmp / "force"), config=config)
+    pdf = tmp / "report.pdf"
+    build_report(inputs, pdf)
+    return inputs, pdf, rms
+
+
+@pytest.fixture(scope="module")
+def default(tmp_path_factory):
+    """(inputs, report.pdf, rms.csv) of a report shaped like the default run's."""
+    return shared(tmp_path_factory, "report-default", make_default)
+
+
+@pytest.fixture(scope="module")
+def pages(default, tmp_path_factory):
+    """(label, texts drawn) of every page of the default report, each page drawn once (not saved)."""
+    def make(_folder: Path) -> list:
+        with report_style():
+            made, _ = report_figures(load_report_data(default[0]))
+            return [(f.get_label(), drawn_texts(f)) for f in made]
+
+    return shared(tmp_path_factory, "report-pages", make)
+
+
+def pdf_text(pdf: Path, page: int) -> str:
     doc = pdfium.PdfDocument(str(pdf))
     try:
-        return [np.asarray(doc[i].render(scale=scale).to_pil().convert("L")) for i in range(len(doc))]
+        return doc[page].get_textpage().get_text_range()
     finally:
         doc.close()
 
 
-def assert_not_blank(images) -> None:
-    for i, img in enumerate(images):
-        ink = float(np.mean(img < 200))
-        assert ink > 0.003, f"page {i + 1} looks blank (ink {ink:.4f})"
+def test_every_page_is_a4(default):
+    _inputs, pdf, _rms = default
+    doc = pdfium.PdfDocument(str(pdf))
+    try:
+        sizes = [tuple(sorted(doc[i].get_size())) for i in range(len(doc))]
+    finally:
+        doc.close()
+    assert len(sizes) >= 16
+    for i, (w, h) in enumerate(sizes, start=1):
+        assert w == pytest.approx(A4_PT[0], abs=0.5) and h == pytest.approx(A4_PT[1], abs=0.5), f"page {i}: {w} x {h}"
+    assert "Provenance" in pdf_text(pdf, 15)
 
 
-@pytest.fixture(scope="module")
-def four(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("four")
-    datasets = [make_dataset(tmp, m, seed=i) for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))]
-    hyst, rms = pipeline_tables(tmp, datasets)
-    curves = model_curves(tmp / "curves.csv", P_ZERO)
-    config = tmp / "config.yaml"
-    config.write_text("datasets: []\n")
-    return tmp, datasets, hyst, rms, curves, config
+def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
+    labels = [label for label, _ in pages]
+    assert labels[:15] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
+                           "comparison", "model-curves", "speed-accuracy", "stability", "bench-tables", "model-cost",
+                           "force", "eccentricity", "grasp"]
+    assert labels[15] == "provenance" and all(x == "provenance (continued)" for x in labels[16:])  # long tmp paths
+    for label, texts in pages:
+        assert len(texts) > 10, label
+        assert overlapping_texts(texts) == [], label
+        assert [(t.text, t.size_pt) for t in texts if t.size_pt < MIN_FONT_PT] == [], label
+        assert [t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5] == [], label
 
 
-def test_four_materials_deterministic_and_not_blank(four, tmp_path):
-    _tmp, datasets, hyst, rms, curves, config = four
-    args = ["report", "--angles", *[str(d.angles_csv) for d in datasets],
-            "--photosets", *[str(d.photoset_dir) for d in datasets],
-            "--overlays", *[str(d.overlays_dir) for d in datasets],
-            "--hysteresis", *map(str, hyst), "--rms", str(rms), "--model-curves", str(curves),
-            "--config", str(config)]
-    a, b = tmp_path / "a.pdf", tmp_path / "b.pdf"
-    assert cli_in_fresh_process(args + ["--out", str(a)]) == ""
-    assert cli_in_fresh_process(args + ["--out", str(b)]) == ""
-    assert a.read_bytes() == b.read_bytes()
-    raw = a.read_bytes()
-    assert b"CreationDate" not in raw
-    images = page_images(a)
-    # summary, overview, one per material, comparison table, which model curve (l0) each used
-    assert len(images) == 1 + 1 + 4 + 1 + 1
-    assert_not_blank(images)
-    # the config digest changes the bytes (it is printed on the summary page)
-    config.write_text("datasets: [changed]\n")
-    c = tmp_path / "c.pdf"
-    assert cli_in_fresh_process(args + ["--out", str(c)]) == ""
-    assert c.read_bytes() != raw
+def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
+    from pipeline.report.style import page
+
+    with report_style():
+        fig = page()
+        ax = fig.subplots()
+        ax.set_xlim(0, 1)
+        ax.text(0.5, 0.5, "paper_corrected")
+        ax.text(0.52, 0.5, "pratt")  # prints over the first
+        ax.text(0.5, 0.1, "apart")
+        ax.text(0.5, 0.9, "hidden", visible=False)
+        texts = drawn_texts(fig)
+    assert overlapping_texts(texts) == [("paper_corrected", "pratt")]
+    assert "hidden" not in [t.text for t in texts]
+    assert all(t.box.x1 <= 72 * fig.get_figwidth() + 1 for t in texts)
+
+
+def test_page_one_figures_read_back_match_rms_csv(default):
+    _inputs, pdf, rms = default
+    text = pdf_text(pdf, 0)
+    all_lines = text.split("\r\n")
+    table = pd.read_csv(rms)
+    assert len(table) == 5  # DS20 twice: the sample set has its own l0 (270 mm), the others the default
+    first = next(i for i, line in enumerate(all_lines) if line.startswith("Material Data run paper"))
+    lines = all_lines[first + 1:first + 1 + len(table)]
+    for line, r in zip(lines, table.to_dict("records"), strict=True):
+        several = (table["material"] == r["material"]).sum() > 1
+        label = f"{r['curve']} ({r['datasets']})" if several else r["material"]
+        source = r["data_source"].replace("measured", "real") if several else "synthetic"
+        ci = f"{fmt(r['k_p_fit'], 2)} [{fmt(r['k_p_ci_low'], 2)}, {fmt(r['k_p_ci_high'], 2)}]"
+        expected = [fmt(r["range_deg"]), fmt(r["paper_range_deg"]), fmt(r["p_zero_up_kpa"]), fmt(r["p_zero_down_kpa"]),
+                    fmt(r["paper_p_zero_kpa"]), fmt(r["rms_deg"], 1), fmt(r["paper_rms_deg"], 1), ci,
+                    fmt(r["k_p_paper"], 1)]
+        assert line == " ".join([label, source] + expected), line
+    assert lines[0].startswith("DS20, l0 255 mm (DS20) synthetic") and lines[1].startswith("DS20, l0 270 mm (sample) real")
+    ss50 = lines[-1].split(" ")
+    assert ss50[4:7] == [NA, NA, NA]  # never straightens below 250 kPa, and the paper gives no value
+    assert "SS50: the mean curve never reaches ψ = 0 up to 250 kPa" in " ".join(text.split())
+
+
+def test_page_one_quality_reasons_in_words_sources_and_dates(default):
+    inputs, pdf, _rms = default
+    text = " ".join(pdf_text(pdf, 0).split())
+    assert "Photos taken: 2026-03-02 to 2026-03-03 (from the timestamps; no date for DS20, DS30, SS40, SS50)" in text
+    assert "no marker line found" in text and "line touches the image border" in text
+    assert "(((" not in text and "#" not in text
+    angles = pd.concat([pd.read_csv(d.angles_csv).assign(dataset=d.name) for d in inputs.datasets])
+    for d in inputs.datasets:
+        a = angles[angles["dataset"] == d.name]
+        counts = [str(len(a)), str((a["status"] == "ok").sum()), str((a["status"] == "flagged").sum()),
+                  str((a["status"] == "failed").sum())]
+        kind = "real" if d.name == "sample" else "synthetic"
+        assert f"{d.name} {kind} DS20 " in text or f"{d.name} {kind} {d.name} " in text
+        assert " ".join(counts) in text, d.name
+    total = len(angles)
+    assert f"all {total} {(angles['status'] == 'ok').sum()}" in text
+    assert "synthetic: the photos were rendered from this model" in text
+
+
+def test_reasons_are_counted_once_per_photo_in_words():
+    assert words(NO_LINE) == "no marker line found"
+    assert words(" line partly hidden: 65% of l0 visible") == "line partly hidden"
+    assert words("odd board ((1, 2), (3, 4)) seen") == "odd board"
+    rows = pd.DataFrame({"dataset": ["a"] * 4, "status": ["failed", "flagged", "flagged", "ok"],
+                         "reason": [NO_LINE, "low contrast (31); line touches the image border",
+                                    "low contrast (12); low contrast (9)", ""]})
+    assert top_reasons(rows) == {"a": [("low contrast", 2), ("line touches the image border", 1),
+                                       ("no marker line found", 1)]}
+
+
+def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
+    rows = pd.DataFrame({"image": ["a.jpg", "b.jpg"], "timestamp": ["2025-11-30T23:59:00+00:00", "nonsense"]})
+    assert dataset_dates(rows, None) == ("2025-11-30", "2025-11-30", "timestamps")
+    exif = Image.Exif()
+    exif[306] = "2024:05:06 10:11:12"
+    for name in ("a.jpg", "b.jpg"):
+        Image.new("RGB", (8, 8)).save(tmp_path / name, exif=exif.tobytes())
+    assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == ("2024-05-06", "2024-05-06", "EXIF")
+    Image.new("RGB", (8, 8)).save(tmp_path / "a.jpg")
+    Image.new("RGB", (8, 8)).save(tmp_path / "b.jpg")
+    assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == (None, None, "")
+
+
+def test_missing_values_read_na_on_the_comparison_page(pages):
+    comparison = dict(pages)["comparison"]
+    assert sum(t.text == NA for t in comparison) >= 2 + 2  # SS50: table cells and the two bars of P at psi = 0
+
+
+def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default):
+    from pipeline.report.strip import build_strip, crop_banner
+
+    data = load_report_data(default[0])
+    strip = build_strip(data, "DS20")
+    assert strip.actuator_label == "DS20/A1" and strip.dataset == "DS20"
+    assert {p.source for p in strip.photos} == {"overlay", "raw"}
+    overlay = cv2.imread(str(default[0].datasets[1].overlays_dir / (Path(strip.images[0]).stem + ".jpg")))
+    assert crop_banner(overlay).shape[0] == overlay.shape[0] - 24
+    text = " ".join(pdf_text(default[1], 2).split())
+    assert "actuator DS20/A1, trial 1" in text
+
+
+def test_bench_pages_say_where_each_method_breaks(pages):
+    stability = " ".join(t.text for t in dict(pages)["stability"])
+    assert ("paper_corrected, pratt, taubin, hyper: break at true bending angle psi -360 deg (fine at -30), "
+            "camera tilt 12 deg (fine at 5), non-constant curvature 0.2 (fine at 0)") in stability
+    assert "turning: breaks at true bending angle psi -360 deg (fine at -30), true bending angle" not in stability
+    assert "an image failed" in stability and "(none in this run)" not in stability
+    assert "paper: already beyond 2° at the nominal value of psi, noise, tilt, bulge." in stability
+    speed = " ".join(t.text for t in dict(pages)["speed-accuracy"])
+    assert "5 methods reach a p95 error within 5 % of the best" in speed
+    assert "breakdown threshold: p95 = 2°" in speed
+    # the five methods of equal accuracy each get their own row, label and value
+    labels = [t.text for t in dict(pages)["speed-accuracy"]]
+    for m in METHODS:
+        assert any(label.startswith(m) for label in labels), m
+    assert labels.count("0.17°") == 5 and labels.count("0.22°") == 1
+
+
+def test_identical_inputs_identical_bytes_across_processes(default, tmp_path):
+    inputs, pdf, rms = default
+    d = inputs.datasets
+    args = ["report", "--datasets", *[x.name for x in d], "--angles", *[str(x.angles_csv) for x in d],
+            "--photosets", *[str(x.photoset_dir) for x in d], "--overlays", *[str(x.overlays_dir) for x in d],
+            "--hysteresis", *map(str, inputs.hysteresis), "--rms", str(rms),
+            "--model-curves", *map(str, inputs.model_curves), "--bench-dir", str(inputs.bench_dir),
+            "--force-dir", str(inputs.force_dir), "--config", str(inputs.config)]
+    out = tmp_path / "cli.pdf"
+    proc = subprocess.run([sys.executable, "-m", "pipeline", *args, "--out", str(out)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert out.read_bytes() == pdf.read_bytes()  # a fresh process (as Snakemake runs it) = this one
+    assert b"CreationDate" not in out.read_bytes()
+    small = dataclasses.replace(inputs, datasets=inputs.datasets[:1], hysteresis=(), rms=(), model_curves=(),
+                                bench_dir=None, force_dir=None)
+    build_report(small, tmp_path / "a.pdf")
+    inputs.config.write_text("datasets: [changed]\n")
+    try:
+        build_report(small, tmp_path / "b.pdf")
+    finally:
+        inputs.config.write_text("datasets: []\n")
+    assert (tmp_path / "a.pdf").read_bytes() != (tmp_path / "b.pdf").read_bytes()  # its digest is printed
 
 
 def test_the_summary_says_which_model_readings_were_used(tmp_path):
-    from pipeline.report.data import load_report_data
-
     d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
     config = tmp_path / "config.yaml"
     config.write_text("model: {readings: {l0_factor: metres, jacobian: deformed}}\n")
@@ -174,17 +454,10 @@ def test_one_material_without_optional_tables(tmp_path):
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert res.materials == ("SS40",)
-    images = page_images(out)
-    assert len(images) == res.pages == 4
-    assert_not_blank(images)
-    again = tmp_path / "again.pdf"
-    build_report(ReportInputs(datasets=(d,)), again)
-    assert again.read_bytes() == out.read_bytes()
-    # the command line (a fresh process, as Snakemake runs it) writes the same bytes as the API
-    other = tmp_path / "other.pdf"
-    assert cli_in_fresh_process(["report", "--angles", str(d.angles_csv), "--datasets", d.name,
-                                 "--out", str(other)]) == ""
-    assert other.read_bytes() == out.read_bytes()
+    assert res.pages == 5  # summary, overview, SS40, comparison, provenance (no rms.csv: no model-curve page)
+    text = " ".join(pdf_text(out, 0).split())
+    assert "SS40 unknown" in text  # no photo-set folder: neither real nor synthetic can be told
+    assert "SS40: no row in --rms" in text
 
 
 def test_increasing_only_photoset(tmp_path):
@@ -192,68 +465,59 @@ def test_increasing_only_photoset(tmp_path):
     hyst, rms = pipeline_tables(tmp_path, [d])
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)), out)
-    assert res.pages == 5  # summary, overview, DS20, comparison, model provenance
-    assert_not_blank(page_images(out))
+    assert res.pages == 6  # summary, overview, DS20, comparison, model curves, provenance
     table = pd.read_csv(rms)
     assert np.isnan(table["rms_down_deg"].iloc[0]) and np.isfinite(table["rms_up_deg"].iloc[0])
+    line = next(x for x in pdf_text(out, 0).split("\r\n") if x.startswith("DS20 "))
+    assert line.split(" ")[5] == NA  # no decreasing branch: P at psi = 0, falling, reads n/a
 
 
-def _fake_module(monkeypatch, name: str, figures) -> None:
-    mod = types.ModuleType(name)
-    mod.figures = figures
-    monkeypatch.setitem(sys.modules, name, mod)
-
-
-def test_extra_pages_added_and_errors_reported(tmp_path, monkeypatch, capsys):
-    from matplotlib.figure import Figure
-
+def test_bench_and_force_folders_missing_or_broken(tmp_path):
     d = make_dataset(tmp_path, "SS50", trials=1, photos=False, overlays=False)
-    bench_dir, force_dir = tmp_path / "bench", tmp_path / "force"
-    bench_dir.mkdir()
-    force_dir.mkdir()
-
-    def bench_figures(folder: Path):
-        assert folder == bench_dir
-        fig = Figure(figsize=(8.27, 11.69))
-        ax = fig.subplots()
-        ax.plot([0, 1], [0, 1])
-        ax.set_xlabel("x (px)")
-        return [fig]
-
-    def broken(folder: Path):
-        raise RuntimeError("force table is corrupt")
-
-    _fake_module(monkeypatch, "pipeline.bench.pages", bench_figures)
-    _fake_module(monkeypatch, "pipeline.force.pages", broken)
     out = tmp_path / "r.pdf"
-    res = build_report(ReportInputs(datasets=(d,), bench_dir=bench_dir, force_dir=force_dir), out)
-    assert res.pages == 5  # summary, overview, SS50, table, bench
-    assert any("force table is corrupt" in w for w in res.warnings)
-    doc = pdfium.PdfDocument(str(out))
-    summary_text = " ".join(doc[0].get_textpage().get_text_range().split())
-    doc.close()
-    assert "WARNING: pipeline.force.pages.figures" in summary_text
-    assert "RuntimeError: force table is corrupt" in summary_text
-    assert "force table is corrupt" in capsys.readouterr().err  # traceback on stderr too
+    res = build_report(ReportInputs(datasets=(d,), bench_dir=tmp_path / "absent"), out)
+    assert any("--bench-dir" in w and "does not exist" in w for w in res.warnings)
+    assert "does not exist" in " ".join(pdf_text(out, 0).split())
+    bench = tmp_path / "bench"
+    bench.mkdir()
+    (bench / "stability.csv").write_bytes(b"")
+    with pytest.raises(UserInputError, match="stability.csv"):
+        build_report(ReportInputs(datasets=(d,), bench_dir=bench), out)
 
 
-def test_missing_module_adds_no_pages(tmp_path, monkeypatch):
-    from pipeline.report.extra import extra_pages
-
-    monkeypatch.setitem(sys.modules, "pipeline.nonexistent_stage", None)
-    res = extra_pages("pipeline.nonexistent_stage.pages", tmp_path)
-    assert res.figures == [] and res.warnings == [] and res.infos
-    assert extra_pages("pipeline.bench.pages", None).figures == []
-    assert extra_pages("pipeline.bench.pages", tmp_path / "absent").warnings
-
-
-def test_bad_inputs_exit_2(four, tmp_path):
-    _tmp, datasets, *_ = four
+def test_bad_inputs_exit_2(tmp_path):
+    angles = str(make_dataset(tmp_path, "DS30", actuators=1, trials=1, photos=False, overlays=False).angles_csv)
     out = str(tmp_path / "r.pdf")
-    assert main(["report", "--angles", str(datasets[0].angles_csv), "--photosets", "a", "b", "--out", out]) == 2
+    assert main(["report", "--angles", angles, "--photosets", "a", "b", "--out", out]) == 2
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2
-    assert main(["report", "--angles", str(datasets[0].angles_csv), "--rms", str(datasets[0].angles_csv),
-                 "--model-curves", str(datasets[0].angles_csv), "--out", out]) == 2
+    assert main(["report", "--angles", angles, "--rms", angles, "--model-curves", angles, "--out", out]) == 2
+
+
+def test_each_material_has_one_colour_on_every_page(default):
+    from matplotlib.colors import to_rgb
+
+    from pipeline.force import pages as force_pages
+    from pipeline.report.pages import overview_page
+    from pipeline.report.style import material_colors
+    from pipeline.report.summary import summary_page
+
+    data = load_report_data(default[0])
+    colors = material_colors(data.materials)
+    with report_style():
+        figures = [summary_page(data, "0", [], []), overview_page(data)]
+        figures += force_pages.figures(data.inputs.force_dir, colors=colors)
+        figures += force_pages.figures(data.inputs.force_dir)  # the force CLI's pages, without the report
+    seen = 0
+    for fig in figures:
+        for ax in fig.axes:
+            for line in ax.get_lines():
+                if line.get_label() in colors:
+                    assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), fig.get_label()
+                    seen += 1
+            if ax.get_title() in colors:
+                assert to_rgb(ax.title.get_color()) == pytest.approx(colors[ax.get_title()])  # overview panels
+                seen += 1
+    assert seen >= 4 + 4 + 2 * (4 + 7)  # summary plot, overview titles; force and grasp lines (report and CLI)
 
 
 def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_path):
@@ -261,13 +525,13 @@ def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_p
     cluster) differ only there, and the report (which prints the table's digest) must not.
     The pages are pure functions of ReportData, so equal data means equal bytes (the SLURM test
     compares whole PDFs)."""
-    from pipeline.report.data import load_report_data, sha256_file, sha256_measurements
+    from pipeline.report.data import sha256_file, sha256_measurements
 
     d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
-    first = load_report_data(ReportInputs(datasets=(d,))).digests
+    first = load_report_data(ReportInputs(datasets=(d,))).files
     angles = pd.read_csv(d.angles_csv)
     angles.assign(seconds=angles["seconds"] * 3.7 + 0.011).to_csv(d.angles_csv, index=False)
-    assert load_report_data(ReportInputs(datasets=(d,))).digests == first
+    assert load_report_data(ReportInputs(datasets=(d,))).files == first
     digest = sha256_measurements(d.angles_csv)
     angles.assign(psi_deg=angles["psi_deg"] + 0.001).to_csv(d.angles_csv, index=False)
     assert sha256_measurements(d.angles_csv) != digest

@@ -1,7 +1,7 @@
 """Report pages of the study: ``figures(bench_dir)`` reads the CSV tables and draws them.
 
-Used by the report (``pipeline.report``) when a bench directory exists; draws nothing for a
-table that is missing, so a partial study still gives the pages it can.
+Draws nothing for a table that is missing, so a partial study still gives the pages it can; a
+table that is present but unreadable stops the report with an error naming the file.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from pipeline.bench import charts
+from pipeline.fileio import read_table
 
 #: the tables a bench directory holds (written by ``python -m pipeline bench``)
 TABLES: tuple[str, ...] = (
@@ -22,7 +23,7 @@ TABLES: tuple[str, ...] = (
 
 def _read(bench_dir: Path, name: str) -> pd.DataFrame | None:
     path = Path(bench_dir) / name
-    return pd.read_csv(path) if path.is_file() else None
+    return read_table(path, f"the bench's {name} (rerun 'python -m pipeline bench')") if path.is_file() else None
 
 
 def figures(bench_dir: Path) -> list[Figure]:

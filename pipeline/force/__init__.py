@@ -7,8 +7,8 @@ ellipse          ``fit_ellipse(points_px) -> EllipseFit``: direct (Fitzgibbon) f
 blocked          ``measure_blocked_image`` / ``measure_blocked_photoset`` -> eccentricity.csv
 synth_blocked    ``render_blocked_photoset``: synthetic blocked-force sets with known e and force
 aggregate_force  ``force_vs_pressure``, ``eccentricity_at_max_pressure`` (mean +- sd per material)
-grasp            ``read_grasp_log``, ``heaviest_held``, ``grasp_figure`` (Fig. 8B)
-pages            ``figures(force_dir) -> list[Figure]`` for the PDF report
+grasp            ``read_grasp_log``, ``heaviest_held`` (Fig. 8B data)
+pages            ``figures(force_dir) -> list[Figure]`` for the PDF report (and ``grasp_figure``)
 cli              ``python -m pipeline force synth|measure|aggregate|grasp|pages``
 bench            ``python -m pipeline.force.bench``: eccentricity accuracy on points and photos
 

@@ -182,7 +182,8 @@ def _aggregate(args: argparse.Namespace) -> int:
 
 
 def _grasp(args: argparse.Namespace) -> int:
-    from pipeline.force.grasp import EXAMPLE_LOG, grasp_figure, heaviest_held, read_grasp_log
+    from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
+    from pipeline.force.pages import grasp_figure
 
     if args.example == (args.log is not None):
         raise UserInputError("force grasp: give either a grasp-log CSV or --example (not both, not neither)")

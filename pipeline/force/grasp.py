@@ -30,7 +30,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
@@ -178,45 +177,3 @@ def heaviest_held(log: pd.DataFrame) -> pd.DataFrame:
         )
     return pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
 
-
-def grasp_figure(summary: pd.DataFrame) -> Figure:
-    """Fig. 8B-style plot: heaviest mass held (g) against pressure (kPa), one line per material.
-
-    One panel per (side, object diameter); pressures where nothing was held are drawn as
-    open markers on the x axis.
-
-    Parameters
-    ----------
-    summary : pandas.DataFrame
-        Output of :func:`heaviest_held`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    groups = list(summary.groupby(["side", "diameter_mm"], sort=True))
-    n = max(1, len(groups))
-    fig = Figure(figsize=(8.27, 2.2 + 2.6 * n))
-    if not groups:
-        ax = fig.add_subplot(1, 1, 1)
-        ax.text(0.5, 0.5, "grasp log has no rows", ha="center", va="center", transform=ax.transAxes)
-        ax.set_axis_off()
-        return fig
-    for k, ((side, diameter), g) in enumerate(groups, start=1):
-        ax = fig.add_subplot(n, 1, k)
-        for j, (material, m) in enumerate(g.groupby("material", sort=True)):
-            m = m.sort_values("pressure_kpa")
-            colour = f"C{j}"
-            ok = m["max_mass_held_g"].notna()
-            ax.plot(m.loc[ok, "pressure_kpa"], m.loc[ok, "max_mass_held_g"], "o-", color=colour, label=str(material))
-            if (~ok).any():
-                ax.plot(m.loc[~ok, "pressure_kpa"], np.zeros(int((~ok).sum())), "o", mfc="none", color=colour)
-        ax.set_xlabel("pressure (kPa)")
-        ax.set_ylabel("heaviest mass held (g)")
-        ax.set_title(f"grasping {side} an object of {diameter:g} mm diameter (open marker: not held)", fontsize=9)
-        ax.set_ylim(bottom=0)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle("Grasp log: heaviest mass held against pressure (cf. paper Fig. 8B)")
-    fig.tight_layout()
-    return fig

@@ -1,16 +1,16 @@
-"""The PDF report: summary, Fig. 6-style hysteresis plots, Fig. 5-style photo strips, comparison table.
+"""The PDF report an advisor reads: a one-minute summary, Fig. 6-style plots, photo strips,
+the comparison with the paper, the angle-method bench, blocked force and grasping, provenance.
 
-Public API
-----------
-build_report(inputs: ReportInputs, out) -> ReportResult
-ReportInputs, Dataset                 (what the report is built from)
-load_report_data(inputs) -> ReportData
-
-Bench and force pages come from ``pipeline.bench.pages.figures(dir)`` and
-``pipeline.force.pages.figures(dir)`` when those modules and folders exist.
+Modules (import what you need; this package import stays light)
+---------------------------------------------------------------
+build      ``build_report(inputs, out) -> ReportResult``: every page in order, written atomically
+data       ``ReportInputs``, ``Dataset``, ``load_report_data(inputs) -> ReportData``
+summary    page 1 (results per material beside the paper, data quality, real or synthetic)
+pages      the overview, one page per material and the comparison page
+strip      the Fig. 5-style photo strip of one ramp
+provenance the last page: software, config and the sha256 of every input
+reasons    flag and failure reasons in words
+style      A4 pages, fonts, one colour per material (used by the bench and force pages too)
+typeset    text and typeset tables placed in points (``Flow``, ``Table``, ``fmt``)
+textcheck  the texts a page draws, with their extents (tests check overlaps and sizes)
 """
-
-from pipeline.report.build import ReportResult, build_report
-from pipeline.report.data import Dataset, ReportData, ReportInputs, load_report_data
-
-__all__ = ["Dataset", "ReportData", "ReportInputs", "ReportResult", "build_report", "load_report_data"]

@@ -17,7 +17,8 @@ import pandas as pd
 
 from pipeline.aggregate import aggregate_hysteresis
 from pipeline.compare import compare, model_callables
-from pipeline.report import Dataset, ReportInputs, build_report
+from pipeline.report.build import build_report
+from pipeline.report.data import Dataset, ReportInputs
 
 P_MAX_KPA = {"DS20": 110.0, "DS30": 170.0, "SS40": 250.0, "SS50": 250.0}
 

@@ -12,42 +12,57 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
 import numpy as np
-
-matplotlib.use("Agg", force=False)
-import matplotlib.pyplot as plt
 from matplotlib.backends import backend_pdf
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from pipeline import __version__
+from pipeline.bench import pages as bench_pages
 from pipeline.fileio import atomic_write_bytes
+from pipeline.force import pages as force_pages
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
-from pipeline.report.extra import extra_pages
-from pipeline.report.model_page import add_comparison_note, model_provenance_page
-from pipeline.report.pages import (
-    comparison_page,
-    material_page,
-    overview_page,
-    summary_lines,
-    text_pages,
-)
-from pipeline.report.style import report_style
+from pipeline.report.model_page import model_provenance_page
+from pipeline.report.pages import comparison_page, material_page, overview_page
+from pipeline.video import pages as video_pages
+from pipeline.report.provenance import provenance_pages
+from pipeline.report.style import FOOTER_PT, material_colors, report_style
+from pipeline.report.summary import summary_page
+from pipeline.report.textcheck import FOOTER_GID
+
+#: what each page is, for the contents list on page 1 (by figure label; first page of a run of pages)
+CONTENTS: dict[str, str] = {
+    "overview": "All materials (as Fig. 6)",
+    "material": "One page per material: curves, table, photos",
+    "comparison": "Comparison with the model and the paper",
+    "model-curves": "Which model curve and l0; fitted or predicted",
+    "speed-accuracy": "Angle methods: speed against accuracy",
+    "stability": "Angle methods: stability, where each breaks",
+    "bench-tables": "Angle methods: breakdown, repeatability tables",
+    "model-cost": "Model: accuracy against cost",
+    "force": "Blocked force and eccentricity (Fig. 7A)",
+    "eccentricity": "Eccentricity at the highest pressure (Fig. 7B)",
+    "grasp": "Grasping: heaviest mass held (Fig. 8B)",
+    "provenance": "Provenance: software, config, sha256 of inputs",
+}
 
 
 @dataclass(frozen=True)
 class ReportResult:
-    """What was written."""
+    """What was written, and how long each part took (wall seconds; they never reach the PDF)."""
 
     path: Path
     pages: int
     materials: tuple[str, ...]
     warnings: tuple[str, ...]
+    load_s: float = 0.0
+    pages_s: float = 0.0
+    pdf_s: float = 0.0
 
 
 #: decimals of the numbers matplotlib writes into the PDF (it writes 10; paths already use 6)
@@ -79,15 +94,14 @@ def pdf_float_decimals(decimals: int = PDF_FLOAT_DECIMALS) -> Iterator[None]:
 
 
 def render_pdf(figures: list[Figure], title: str) -> bytes:
-    """Save figures as pages of one PDF; no timestamps, so the bytes depend on the figures only."""
+    """Save figures as pages of one PDF with a footer; no timestamps, so the bytes depend on the figures only."""
     buf = io.BytesIO()
     metadata = {"Title": title, "Creator": f"pipeline {__version__}", "CreationDate": None}
     saved_epoch = os.environ.pop("SOURCE_DATE_EPOCH", None)  # would re-introduce a date
     try:
         with pdf_float_decimals(), PdfPages(buf, metadata=metadata) as pdf:
             for i, fig in enumerate(figures, start=1):
-                fig.text(0.99, 0.004, f"{title} | page {i} of {len(figures)}", ha="right", va="bottom",
-                         fontsize=6.5, color="0.4")
+                add_footer(fig, f"{title} | page {i} of {len(figures)}")
                 pdf.savefig(fig)
     finally:
         if saved_epoch is not None:
@@ -95,12 +109,42 @@ def render_pdf(figures: list[Figure], title: str) -> bytes:
     return buf.getvalue()
 
 
+def add_footer(fig: Figure, text: str) -> None:
+    """The page line, bottom right, inside the footer band (nothing else is drawn there)."""
+    fig.text(1.0 - 30.0 / (72.0 * fig.get_figwidth()), 0.45 * FOOTER_PT / (72.0 * fig.get_figheight()), text,
+             ha="right", va="center", fontsize=7.0, color="0.4", gid=FOOTER_GID)
+
+
+def contents(figures: list[Figure]) -> list[tuple[str, int]]:
+    """(what, first page) of each part, from the page labels (page 1 is the summary)."""
+    out: list[tuple[str, int]] = []
+    seen: set[str] = set()
+    for number, fig in enumerate(figures, start=2):
+        kind = fig.get_label().split(" ")[0]
+        if kind in CONTENTS and kind not in seen:
+            seen.add(kind)
+            out.append((CONTENTS[kind], number))
+    return out
+
+
 def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     """Every page in order, and the warnings printed on the summary page."""
-    bench = extra_pages("pipeline.bench.pages", data.inputs.bench_dir)
-    force = extra_pages("pipeline.force.pages", data.inputs.force_dir)
-    videos = [extra_pages("pipeline.video.pages", d) for d in data.inputs.video_dirs]  # one page per video dataset
-    warnings = bench.warnings + force.warnings + [w for v in videos for w in v.warnings]
+    warnings: list[str] = []
+    infos: list[str] = []
+    extra: list[Figure] = []
+    colors = material_colors(data.materials)
+    sources = [("--bench-dir", data.inputs.bench_dir, bench_pages.figures),
+               ("--force-dir", data.inputs.force_dir, lambda d: force_pages.figures(d, colors=colors))]
+    sources += [("--video-dirs", d, video_pages.figures) for d in data.inputs.video_dirs]  # a page per video dataset
+    for name, folder, build in sources:
+        if folder is None:
+            continue
+        if not folder.is_dir():
+            warnings.append(f"{name} {folder} does not exist; its pages are missing")
+            continue
+        figs = build(folder)
+        extra += figs
+        infos.append(f"{len(figs)} page(s) from {name} {folder}")
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
@@ -112,15 +156,10 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
-    config_digest = data.digests.get(str(data.inputs.config)) if data.inputs.config is not None else None
-    lines = summary_lines(data, __version__, config_digest, warnings, bench.infos + force.infos + [i for v in videos for i in v.infos])
-    figures = text_pages(data.inputs.title, lines)
-    figures.append(overview_page(data))
-    figures += [material_page(data, m) for m in data.materials]
-    comparison = comparison_page(data)
-    add_comparison_note(comparison, data)  # self-checks named; which l0, what was fitted: next page
-    figures += [comparison] + [f for f in [model_provenance_page(data)] if f is not None]
-    return figures + [f for v in videos for f in v.figures] + bench.figures + force.figures, warnings
+    body = [overview_page(data)] + [material_page(data, m) for m in data.materials] + [comparison_page(data)]
+    body += [f for f in [model_provenance_page(data)] if f is not None]  # which l0, what was fitted
+    body += extra + provenance_pages(data, __version__, infos, warnings)
+    return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
 
 
 def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportResult:
@@ -136,15 +175,15 @@ def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportRes
     -------
     ReportResult
     """
+    t0 = time.perf_counter()
     data = load_report_data(inputs)
+    t1 = time.perf_counter()
     with report_style():
         figures, warnings = report_figures(data)
-        try:
-            pdf = render_pdf(figures, inputs.title)
-        finally:
-            for fig in figures:
-                plt.close(fig)
+        t2 = time.perf_counter()
+        pdf = render_pdf(figures, inputs.title)
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(path, pdf)
-    return ReportResult(path=path, pages=len(figures), materials=tuple(data.materials), warnings=tuple(warnings))
+    return ReportResult(path=path, pages=len(figures), materials=tuple(data.materials), warnings=tuple(warnings),
+                        load_s=t1 - t0, pages_s=t2 - t1, pdf_s=time.perf_counter() - t2)

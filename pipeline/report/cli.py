@@ -18,12 +18,14 @@ NONE_MARK = "-"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define the ``report`` options."""
     parser.description = (
-        "Write the PDF report: a summary page (datasets, image counts, ok/flagged/failed with reasons, "
-        "software version, config sha256), a Fig. 6-style overview, one page per material (psi in deg "
-        "versus P in kPa, mean +- 1 sd, model dashed; per-actuator curves; model-comparison table; "
-        "a Fig. 5-style photo strip of one ramp), a comparison table beside the paper's values, and "
-        "the bench/force pages when given.  Lists are aligned by dataset; use '-' for a dataset "
-        "without photos or overlays.  The same inputs give the same PDF bytes."
+        "Write the PDF report on A4 pages: page 1 a summary (per material the range of motion, the pressure "
+        "at psi = 0, the RMS against the model and the fitted k_P beside the paper's values; ok/flagged/failed "
+        "photos with the top reasons; real or synthetic datasets), a Fig. 6-style overview, one page per "
+        "material (psi in deg versus P in kPa, mean +- 1 sd, model dashed; per-actuator curves; comparison "
+        "table; a Fig. 5-style photo strip), the comparison beside the paper, the bench and force pages when "
+        "given, and a last provenance page (software, config and the sha256 of every input).  Lists are "
+        "aligned by dataset; use '-' for a dataset without photos or overlays.  The same inputs give the same "
+        "PDF bytes."
     )
     parser.add_argument("--angles", nargs="+", type=Path, required=True, metavar="ANGLES.csv",
                         help="angles.csv of each dataset (psi in deg per photo, from 'measure')")
@@ -41,13 +43,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model-curves", nargs="+", type=Path, default=None, metavar="C.csv",
                         help="model curves from 'model curve' (columns material, psi_deg, pressure_kpa), drawn dashed")
     parser.add_argument("--bench-dir", type=Path, default=None, metavar="DIR",
-                        help="bench output folder; adds pipeline.bench.pages.figures(DIR) pages")
+                        help="output folder of 'python -m pipeline bench'; adds its speed/accuracy, stability and table pages")
     parser.add_argument("--force-dir", type=Path, default=None, metavar="DIR",
-                        help="force output folder; adds pipeline.force.pages.figures(DIR) pages")
+                        help="output folder of 'python -m pipeline force'; adds the blocked-force, eccentricity and grasp pages")
     parser.add_argument("--video-dirs", nargs="+", type=Path, default=(), metavar="DIR",
                         help="'continuous --out-dir' folder of each video dataset (named as the dataset); adds its page")
     parser.add_argument("--config", type=Path, default=None, metavar="FILE",
-                        help="workflow config file; its sha256 is printed on the summary page")
+                        help="workflow config file; its sha256 is printed on the provenance page")
     parser.add_argument("--title", default="Circular actuator characterisation",
                         help="report title (text, on every page footer)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE", help="report.pdf to write")
@@ -104,4 +106,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {w}", file=sys.stderr)
     print(f"report: {result.pages} pages, materials {', '.join(result.materials) or 'none'}, "
           f"{len(result.warnings)} warning(s) -> {result.path}")
+    print(f"report: built in {result.load_s + result.pages_s + result.pdf_s:.1f} s (reading inputs "
+          f"{result.load_s:.1f} s, drawing pages {result.pages_s:.1f} s, writing the PDF {result.pdf_s:.1f} s)")
     return 0

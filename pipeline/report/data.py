@@ -1,6 +1,8 @@
 """Everything the report shows, loaded and checked once: a :class:`ReportData`.
 
-The pages are pure functions of this object, so the PDF depends on the inputs' content only.
+The pages are pure functions of this object, so the PDF depends on the inputs' content only
+(never on the clock, the machine or file times): the date printed on page 1 is the date the
+photos were taken, read from the inputs (:func:`dataset_dates`).
 """
 
 from __future__ import annotations
@@ -8,13 +10,13 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
-import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
+from PIL import Image
 
 from pipeline.aggregate import (
     aggregate_hysteresis,
@@ -23,8 +25,14 @@ from pipeline.aggregate import (
     read_angles,
 )
 from pipeline.compare import check_hysteresis
+from pipeline.bench.pages import TABLES as BENCH_TABLES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
+from pipeline.force.pages import FILES as FORCE_FILES
+from pipeline.photoset import MANIFEST, SETTINGS, TRUTH
+
+#: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
+EXIF_IFD, EXIF_DATETIME_ORIGINAL, EXIF_DATETIME = 0x8769, 36867, 306
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,39 @@ class ReportInputs:
 
 
 @dataclass(frozen=True)
+class InputFile:
+    """One file the report was built from, for the provenance page."""
+
+    role: str
+    path: str
+    sha256: str
+
+
+@dataclass(frozen=True)
+class DatasetInfo:
+    """What the report says about a dataset besides its numbers.
+
+    Attributes
+    ----------
+    name : str
+    source : str
+        ``"synthetic"`` (its photo set holds the renderer's ``truth.csv``), ``"real"`` (a photo
+        set without one) or ``"unknown"`` (no photo-set folder given).
+    first_date, last_date : str or None
+        ``YYYY-MM-DD`` of the first and last photo, from the manifest's ``timestamp`` column
+        or else the photos' EXIF dates; ``None`` when the inputs hold no date.
+    date_source : str
+        Where the dates come from (``"timestamps"``, ``"EXIF"`` or ``""``).
+    """
+
+    name: str
+    source: str
+    first_date: str | None
+    last_date: str | None
+    date_source: str
+
+
+@dataclass(frozen=True)
 class ReportData:
     """Loaded tables.
 
@@ -81,9 +122,11 @@ class ReportData:
         rms.csv rows (may be empty).
     model_curves : pandas.DataFrame
         ``material``, ``psi_deg``, ``pressure_kpa`` (may be empty).
-    digests : dict of str to str
-        sha256 of every input file (path as given -> hex digest); for angles tables without
-        their timing column (:func:`sha256_measurements`).
+    files : tuple of InputFile
+        Every input file with its sha256, in a fixed order; angles tables without their timing
+        column (:func:`sha256_measurements`).
+    datasets : tuple of DatasetInfo
+        Source and dates of each dataset, in input order.
     notes : list of str
         Things the reader should know (e.g. hysteresis recomputed from angles).
     """
@@ -94,7 +137,8 @@ class ReportData:
     per_actuator: pd.DataFrame
     rms: pd.DataFrame
     model_curves: pd.DataFrame
-    digests: dict[str, str]
+    files: tuple[InputFile, ...]
+    datasets: tuple[DatasetInfo, ...]
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -210,15 +254,75 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         notes.append("no --model-curves given: plots show the measurements only")
     if inputs.config is not None:
         notes.append(model_readings_note(inputs.config))
-    files: list[Path] = list(inputs.hysteresis) + list(inputs.rms) + list(inputs.model_curves)
-    if inputs.config is not None:
-        files.append(inputs.config)
-    digests = {str(d.angles_csv): sha256_measurements(d.angles_csv) for d in inputs.datasets}
-    digests |= {str(p): sha256_file(p) for p in files}
     return ReportData(
         inputs=inputs, angles=angles, hysteresis=hysteresis, per_actuator=per_actuator, rms=rms,
-        model_curves=curves, digests=digests, notes=notes,
+        model_curves=curves, files=input_files(inputs), notes=notes,
+        datasets=tuple(dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets),
     )
+
+
+def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
+    """Every file the report reads, with its sha256 (photos are covered by their manifests; angles
+    tables are hashed without their run-time column, :func:`sha256_measurements`)."""
+    files: list[tuple[str, Path]] = []
+    for d in inputs.datasets:
+        files.append((f"{d.name}: angles", d.angles_csv))
+        if d.photoset_dir is not None:
+            files += [(f"{d.name}: photo set", d.photoset_dir / n) for n in (MANIFEST, SETTINGS)
+                      if (d.photoset_dir / n).is_file()]
+    files += [("hysteresis", p) for p in inputs.hysteresis]
+    files += [("comparison", p) for p in inputs.rms]
+    files += [("model curve", p) for p in inputs.model_curves]
+    for role, folder, names in (("bench", inputs.bench_dir, BENCH_TABLES), ("force", inputs.force_dir, FORCE_FILES)):
+        if folder is not None:
+            files += [(role, folder / n) for n in names if (folder / n).is_file()]
+    if inputs.config is not None:
+        files.append(("config", inputs.config))
+    return tuple(InputFile(role, str(p), sha256_measurements(p) if role.endswith(": angles") else sha256_file(p))
+                 for role, p in files)
+
+
+def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
+    """Source (synthetic, real or unknown) and photo dates of one dataset."""
+    folder = dataset.photoset_dir
+    source = "unknown" if folder is None or not folder.is_dir() else (
+        "synthetic" if (folder / TRUTH).is_file() else "real")
+    first, last, where = dataset_dates(angles, folder)
+    return DatasetInfo(dataset.name, source, first, last, where)
+
+
+def dataset_dates(angles: pd.DataFrame, photoset_dir: Path | None) -> tuple[str | None, str | None, str]:
+    """First and last date (``YYYY-MM-DD``) the photos of a dataset were taken.
+
+    From the ``timestamp`` column when it holds dates, else from the EXIF date of the first and
+    last photo (in table order); ``(None, None, "")`` when neither exists (synthetic photos carry
+    no date).  Never the clock or file times, so the same inputs give the same report.
+    """
+    if "timestamp" in angles.columns:
+        stamps = pd.to_datetime(angles["timestamp"], errors="coerce", utc=True, format="mixed").dropna()
+        if len(stamps):
+            return stamps.min().strftime("%Y-%m-%d"), stamps.max().strftime("%Y-%m-%d"), "timestamps"
+    if photoset_dir is None or angles.empty:
+        return None, None, ""
+    dates = [exif_date(photoset_dir / str(angles["image"].iloc[i])) for i in (0, -1)]
+    found = sorted(d for d in dates if d)
+    if not found:
+        return None, None, ""
+    return found[0], found[-1], "EXIF"
+
+
+def exif_date(path: Path) -> str | None:
+    """``YYYY-MM-DD`` from a photo's EXIF (DateTimeOriginal, else DateTime); ``None`` if absent."""
+    try:
+        with Image.open(path) as im:
+            exif = im.getexif()
+    except OSError:
+        return None
+    value = exif.get_ifd(EXIF_IFD).get(EXIF_DATETIME_ORIGINAL) or exif.get(EXIF_DATETIME)
+    if not isinstance(value, str) or len(value) < 10:
+        return None
+    date = value[:10].replace(":", "-")
+    return date if pd.notna(pd.to_datetime(date, errors="coerce", format="%Y-%m-%d")) else None
 
 
 def model_readings_note(config_path: Path) -> str:
@@ -255,12 +359,19 @@ def rms_row(data: ReportData, material: str) -> dict[str, float]:
     return {k: v for k, v in sel.iloc[0].to_dict().items()}
 
 
-def fmt(value: object, digits: int = 0, unit: str = "") -> str:
-    """Number as text for a table: ``"n/a"`` for missing/NaN values."""
-    try:
-        x = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return "n/a"
-    if not math.isfinite(x):
-        return "n/a"
-    return f"{x:.{digits}f}{unit}"
+def comparisons(data: ReportData) -> list[tuple[str, str, dict[str, object]]]:
+    """``(material, label, rms.csv row)`` of every comparison, materials in order.
+
+    A material has one comparison per l0 (``compare`` writes one row per model curve, the
+    model's default l0 first); with one, its label is the material, with several the curve and
+    its datasets, e.g. ``"DS20, l0 270 mm (sample)"``.  A material without a row gets ``{}``.
+    """
+    out: list[tuple[str, str, dict[str, object]]] = []
+    for m in data.materials:
+        rows = data.rms[data.rms["material"].astype(str) == m].to_dict("records")
+        if not rows:
+            out.append((m, m, {}))
+        for r in rows:
+            label = m if len(rows) == 1 else f"{r.get('curve', m)} ({r.get('datasets', '')})"
+            out.append((m, label, r))
+    return out

@@ -1,113 +1,41 @@
-"""The report's own pages, each a function returning matplotlib Figures (call inside report_style())."""
+"""The report's own result pages: the Fig. 6 overview, one page per material, the comparison.
+
+Each function returns one A4 :class:`~matplotlib.figure.Figure` (call inside
+:func:`pipeline.report.style.report_style`).
+"""
 
 from __future__ import annotations
 
 import math
-import textwrap
-from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.layout_engine import ConstrainedLayoutEngine
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
-from pipeline.aggregate import status_counts
-from pipeline.report.calibration import calibration_lines
-from pipeline.report.data import ReportData, fmt, rms_row
-from pipeline.report.strip import Strip, build_strip
-from pipeline.report.style import LANDSCAPE_SIZE_IN, PAGE_SIZE_IN, lighter, material_colors
+from pipeline.report.data import ReportData, comparisons, rms_row
+from pipeline.report.model_page import comparison_note
+from pipeline.report.strip import Strip, build_strip, strip_image
+from pipeline.report.style import (
+    A4_PORTRAIT_IN,
+    P_LABEL,
+    PSI_LABEL,
+    Color,
+    footer_fraction,
+    lighter,
+    material_colors,
+    page,
+)
+from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
-PSI_LABEL = "Bending angle ψ (deg)"
-P_LABEL = "Input pressure P (kPa)"
-#: characters per line of wrapped text on a portrait page at 9 pt
-WRAP_CHARS = 100
-#: text lines per summary page
-LINES_PER_PAGE = 62
-
-
-#: share of the page height kept free at the bottom for the footer
-FOOTER_BAND = 0.022
-
-
-def page(size_in: tuple[float, float] = PAGE_SIZE_IN) -> Figure:
-    """A new page laid out by constrained layout, leaving the footer band free."""
-    return Figure(figsize=size_in, layout=ConstrainedLayoutEngine(rect=(0.0, FOOTER_BAND, 1.0, 1.0 - FOOTER_BAND)))
-
-
-# ------------------------------------------------------------------------------------------
-# summary (text) pages
-
-
-def summary_lines(data: ReportData, version: str, config_digest: str | None, warnings: Sequence[str],
-                  infos: Sequence[str]) -> list[tuple[str, str]]:
-    """The summary as (style, text) lines; style is ``"h"`` (heading), ``"b"`` (body) or ``"w"`` (warning)."""
-    lines: list[tuple[str, str]] = []
-
-    def body(text: str, indent: str = "") -> None:
-        for part in textwrap.wrap(text, WRAP_CHARS - len(indent), subsequent_indent="    ") or [""]:
-            lines.append(("b", indent + part))
-
-    lines.append(("h", "Software and configuration"))
-    body(f"pipeline version {version}")
-    if data.inputs.config is not None:
-        body(f"config {data.inputs.config}: sha256 {config_digest}")
-    else:
-        body("config: none given (--config); the digest cannot be reported")
-    lines.append(("h", "Datasets"))
-    counts = status_counts(data.angles)
-    for d in data.inputs.datasets:
-        c = counts[counts["dataset"] == d.name]
-        body(f"{d.name}: {d.angles_csv} (sha256 {data.digests[str(d.angles_csv)][:16]} without the seconds column)")
-        body(f"photos {d.photoset_dir or 'not given'}; overlays {d.overlays_dir or 'not given'}", "    ")
-        for r in c.itertuples():
-            body(f"{r.material}: {r.images} images, {r.ok} ok, {r.flagged} flagged, {r.failed} failed", "    ")
-            if r.reasons:
-                body(f"reasons: {r.reasons}", "        ")
-    tot = counts[["images", "ok", "flagged", "failed"]].sum()
-    body(f"total: {int(tot['images'])} images, {int(tot['ok'])} ok, {int(tot['flagged'])} flagged, "
-         f"{int(tot['failed'])} failed (flagged and failed are left out of the curves and fits)")
-    lines += calibration_lines(data.angles, [d.name for d in data.inputs.datasets])  # issue 17
-    lines.append(("h", "Other inputs"))
-    for path, digest in data.digests.items():
-        if path not in {str(d.angles_csv) for d in data.inputs.datasets}:
-            body(f"{path}: sha256 {digest[:16]}")
-    for note in list(data.notes) + list(infos):
-        body(note)
-    lines.append(("h", "Materials"))
-    for m in data.materials:
-        h = data.hysteresis[data.hysteresis["material"] == m]
-        dirs = ", ".join(d for d in ("up", "down") if (h["direction"] == d).any())
-        body(f"{m}: {len(h)} pressure levels ({dirs}), up to {fmt(h['pressure_kpa'].max(), 0)} kPa, "
-             f"{int(h['n_actuators'].max()) if len(h) else 0} actuator(s)")
-    lines.append(("h", "Warnings"))
-    if warnings:
-        for w in warnings:
-            for part in textwrap.wrap("WARNING: " + w, WRAP_CHARS, subsequent_indent="    "):
-                lines.append(("w", part))
-    else:
-        body("none")
-    return lines
-
-
-def text_pages(title: str, lines: Sequence[tuple[str, str]]) -> list[Figure]:
-    """Lay (style, text) lines out on as many portrait pages as needed."""
-    pages: list[Figure] = []
-    chunks = [lines[i:i + LINES_PER_PAGE] for i in range(0, max(len(lines), 1), LINES_PER_PAGE)]
-    for k, chunk in enumerate(chunks):
-        fig = Figure(figsize=PAGE_SIZE_IN)
-        fig.text(0.08, 0.955, title + ("" if k == 0 else " (continued)"), fontsize=14, weight="bold", va="top")
-        y, step = 0.91, 0.0135
-        for style, text in chunk:
-            if style == "h":
-                y -= step * 0.5
-                fig.text(0.08, y, text, fontsize=10.5, weight="bold", va="top")
-            else:
-                fig.text(0.08, y, text, fontsize=8.5, va="top", family="DejaVu Sans Mono",
-                         color="#b00000" if style == "w" else "black")
-            y -= step
-        pages.append(fig)
-    return pages
+#: height kept for the legend under the overview panels (pt)
+LEGEND_BAND_PT = 44.0
+#: height of the strip photos (px) and the white gap between them (px)
+STRIP_PHOTO_PX, STRIP_GAP_PX = 180, 18
+#: height of the photo strip band of a material page (pt)
+STRIP_BAND_PT = 118.0
 
 
 # ------------------------------------------------------------------------------------------
@@ -141,8 +69,8 @@ def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple
     return out
 
 
-def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: tuple[float, float, float],
-                    *, legend: bool = True, title: str | None = None) -> None:
+def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, legend: bool = True,
+                    title: str | None = None) -> None:
     """Fig. 6 style: mean +- 1 sd shaded (darker increasing, lighter decreasing), model dashed."""
     h = data.hysteresis[data.hysteresis["material"] == material]
     p_max = float(h["pressure_kpa"].max()) if len(h) else 1.0
@@ -163,64 +91,73 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: tuple[floa
     ax.set_xlim(left=0.0, right=max(p_max, 1.0) * 1.03)
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
-    ax.set_title(material if title is None else title)
+    ax.set_title(material if title is None else title, color=color if title is None else "black",
+                 fontweight="bold" if title is None else "normal")
     if legend:
         ax.legend(loc="best", frameon=False)
 
 
+def legend_proxies() -> tuple[list[object], list[str]]:
+    """Neutral legend entries for the hysteresis plots of every material."""
+    dark, light = (0.3, 0.3, 0.3), lighter((0.3, 0.3, 0.3))
+    return ([Line2D([], [], color=dark, marker="o", markersize=2.5), Patch(color=dark, alpha=0.35, linewidth=0),
+             Line2D([], [], color=light, marker="o", markersize=2.5), Patch(color=light, alpha=0.35, linewidth=0),
+             Line2D([], [], color="0.15", linestyle="--", linewidth=1.2)],
+            ["mean, increasing P", "± 1 sd, increasing P", "mean, decreasing P", "± 1 sd, decreasing P",
+             "analytical model"])
+
+
 def overview_page(data: ReportData) -> Figure:
-    """All materials side by side, as the paper's Fig. 6."""
+    """All materials side by side, as the paper's Fig. 6 (one legend for all panels)."""
     materials = data.materials
     colors = material_colors(materials)
     n = max(len(materials), 1)
     ncols = 1 if n == 1 else 2
     nrows = math.ceil(n / ncols)
-    fig = page()
+    fig = page(label="overview", bottom_pt=LEGEND_BAND_PT)
     fig.suptitle("Bending angle versus input pressure (as Fig. 6 of the paper)")
     axes = fig.subplots(nrows, ncols, squeeze=False)
     for ax, m in zip(axes.flat, materials, strict=False):
-        plot_hysteresis(ax, data, m, colors[m], legend=(m == materials[0]))
+        plot_hysteresis(ax, data, m, colors[m], legend=False)
     for ax in list(axes.flat)[len(materials):]:
         ax.set_axis_off()
-    fig.supxlabel("Shaded: mean ± 1 standard deviation over actuators and trials; darker = increasing,\n"
-                  "lighter = decreasing pressure; dashed: analytical model (loading branch).\n", fontsize=7.5)
+    handles, labels = legend_proxies()
+    fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, footer_fraction(A4_PORTRAIT_IN)),
+               ncols=3, frameon=False,
+               title="Each panel in its material's colour; shading: ± 1 standard deviation over actuators and trials")
     return fig
 
 
-def _metric_rows(row: dict[str, float]) -> list[tuple[str, str, str]]:
+# ------------------------------------------------------------------------------------------
+# one material
+
+
+def metric_table(row: dict[str, object], *, title: str = "", extra_notes: tuple[str, ...] = ()) -> Table:
+    """The comparison figures of one material, this run beside the paper."""
     g = row.get
-    k_ci = f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]"
-    return [
-        ("RMS model error, both directions (deg)", fmt(g("rms_deg"), 1), fmt(g("paper_rms_deg"), 1)),
-        ("RMS, increasing / decreasing P (deg)", f"{fmt(g('rms_up_deg'), 1)} / {fmt(g('rms_down_deg'), 1)}", "n/a"),
-        ("P at ψ = 0, increasing / decreasing (kPa)",
-         f"{fmt(g('p_zero_up_kpa'), 0)} / {fmt(g('p_zero_down_kpa'), 0)}", fmt(g("paper_p_zero_kpa"), 0)),
-        ("P at ψ = -ψ0, increasing / decreasing (kPa)",
-         f"{fmt(g('p_minus_psi0_up_kpa'), 0)} / {fmt(g('p_minus_psi0_down_kpa'), 0)}", "n/a"),
-        ("Range of motion (deg)", fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0)),
-        ("... over a pressure span of (kPa)", fmt(g("range_kpa"), 0), fmt(g("paper_range_kpa"), 0)),
-        ("Hysteresis width, max |ψ_up - ψ_down| (deg)",
-         f"{fmt(g('hysteresis_width_deg'), 0)} at {fmt(g('hysteresis_width_at_kpa'), 0)} kPa", "n/a"),
-        ("k_P fitted [95 % bootstrap CI]", k_ci, fmt(g("k_p_paper"), 1)),
-    ]
+    k_ci = NA if fmt(g("k_p_fit"), 2) == NA else (
+        f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+    width = fmt(g("hysteresis_width_deg"), 0)
+    if width != NA:
+        width += f" at {fmt(g('hysteresis_width_at_kpa'), 0)} kPa"
+    rows = (
+        ("RMS against the model (deg)", fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1), fmt(g("rms_deg"), 1),
+         fmt(g("paper_rms_deg"), 1)),
+        ("P at ψ = 0 (kPa)", fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0), "", fmt(g("paper_p_zero_kpa"), 0)),
+        ("P at ψ = -ψ0 (kPa)", fmt(g("p_minus_psi0_up_kpa"), 0), fmt(g("p_minus_psi0_down_kpa"), 0), "", NA),
+        ("Range of motion (deg)", "", "", fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0)),
+        ("... over a pressure span of (kPa)", "", "", fmt(g("range_kpa"), 0), fmt(g("paper_range_kpa"), 0)),
+        ("Hysteresis width, max |ψ_up - ψ_down| (deg)", "", "", width, NA),
+        ("k_P fitted to these photos [95 % CI] (-)", "", "", k_ci, fmt(g("k_p_paper"), 1)),
+    )
+    return Table(columns=(Column("Quantity", "left"), Column("increasing P"), Column("decreasing P"),
+                          Column("both"), Column("paper")),
+                 rows=rows, title=title, size=8.0,
+                 notes=("paper n/a: the paper reports no such value.  k_P is fitted, not predicted: the paper's "
+                        "value stands beside it for reference only.", *extra_notes))
 
 
-def _table(ax: Axes, header: Sequence[str], rows: Sequence[Sequence[str]], col_widths: Sequence[float],
-           fontsize: float = 8.0) -> None:
-    ax.set_axis_off()
-    table = ax.table(cellText=[list(r) for r in rows], colLabels=list(header), colWidths=list(col_widths),
-                     loc="upper center", cellLoc="left", colLoc="left")
-    table.auto_set_font_size(False)
-    table.set_fontsize(fontsize)
-    table.scale(1.0, 1.35)
-    for (r, _c), cell in table.get_celld().items():
-        cell.set_linewidth(0.4)
-        if r == 0:
-            cell.set_text_props(weight="bold")
-            cell.set_facecolor("#eeeeee")
-
-
-def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: tuple[float, float, float]) -> None:
+def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -> None:
     """Mean psi of each actuator (over its trials): solid increasing, dashed decreasing pressure."""
     per = data.per_actuator[data.per_actuator["material"] == material]
     markers = "os^vD<>ph*"
@@ -236,91 +173,144 @@ def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: tuple[fl
     ax.set_xlim(left=0.0)
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
-    ax.set_title("Per actuator (solid: increasing, dashed: decreasing P)", fontsize=8.5)
+    ax.set_title("Per actuator, mean over its trials (solid: increasing, dashed: decreasing P)")
     if len(per):
-        ax.legend(title="actuator", loc="best", frameon=False, fontsize=6.5, title_fontsize=7)
+        ax.legend(title="actuator", loc="best", frameon=False, ncols=2 if per["actuator"].nunique() > 4 else 1)
 
 
-def draw_strip(fig_or_sub: Figure, strip: Strip | None) -> None:
-    """Photos of one ramp in a row, captioned with pressure and measured psi."""
+def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
+    """Photos of one ramp in a row at the flow's position (down to its bottom), captioned with pressure
+    and measured psi."""
     if strip is None or not strip.photos:
-        ax = fig_or_sub.subplots()
-        ax.set_axis_off()
-        ax.text(0.5, 0.5, "no photos for this material", ha="center", va="center")
+        flow.text("No photos for this material (pass --photosets / --overlays to show a ramp).", size=8.0)
         return
-    axes = fig_or_sub.subplots(1, len(strip.photos), squeeze=False)[0]
-    for ax, photo in zip(axes, strip.photos, strict=True):
-        ax.set_axis_off()
-        if photo.image is not None:
-            ax.imshow(photo.image, interpolation="none")
-        else:
-            ax.text(0.5, 0.5, "photo\nnot found", ha="center", va="center", fontsize=7, transform=ax.transAxes)
+    direction = "increasing" if strip.direction == "up" else "decreasing"
+    names = f"{strip.images[0]} to {strip.images[-1]}" if len(strip.images) > 1 else strip.images[0]
+    flow.text(f"Photos across one ramp (as Fig. 5): actuator {strip.actuator_label}, trial {strip.trial}, "
+              f"{direction} pressure; files {names}; {strip.note}.", size=7.5)
+    flow.space(2.0)
+    caption = 2 * 7.5 * 1.32
+    image, spans = strip_image(strip.photos, STRIP_PHOTO_PX, STRIP_GAP_PX)
+    scale = min(flow.width / image.shape[1], max(flow.remaining_pt - caption, 20.0) / image.shape[0])  # pt per px
+    top = flow.y
+    for (x0, x1), photo in zip(spans, strip.photos, strict=True):
+        x = flow.x + scale * (x0 + x1) / 2
         psi = "ψ: none" if not math.isfinite(photo.psi_deg) else f"ψ = {photo.psi_deg:.0f}°"
         flag = "" if photo.status == "ok" else f" ({photo.status})"
-        ax.set_title(f"{photo.pressure_kpa:g} kPa\n{psi}{flag}", fontsize=7.5)
-    direction = "increasing" if strip.direction == "up" else "decreasing"
-    fig_or_sub.suptitle(
-        f"Photos across the ramp (as Fig. 5): actuator {strip.actuator}, trial {strip.trial} ({strip.dataset}), "
-        f"{direction} pressure\n{strip.note}",
-        fontsize=8,
-    )
+        fig.text(x, top, f"{photo.pressure_kpa:g} kPa", transform=flow.transform, fontsize=7.5, ha="center", va="top")
+        fig.text(x, top + 7.5 * 1.32, psi + flag + (", photo not found" if photo.image is None else ""),
+                 transform=flow.transform, fontsize=7.5, ha="center", va="top",
+                 color="black" if photo.status == "ok" else "#b00000")
+    width, height = scale * image.shape[1], scale * image.shape[0]
+    ax = fig.add_axes((flow.x / flow.page_w, (flow.page_h - top - caption - height) / flow.page_h,
+                       width / flow.page_w, height / flow.page_h))
+    ax.set_axis_off()
+    ax.imshow(image, interpolation="none", aspect="auto")
+    flow.y = top + caption + height
 
 
 def material_page(data: ReportData, material: str) -> Figure:
-    """One material: Fig. 6 plot, per-actuator curves, metric table, Fig. 5-style photo strip."""
+    """One material: Fig. 6 plot, per-actuator curves, comparison table, Fig. 5-style photo strip."""
     color = material_colors(data.materials)[material]
-    fig = page()
-    fig.suptitle(f"{material}: bending angle versus pressure")
-    top, middle, bottom = fig.subfigures(3, 1, height_ratios=[4.6, 3.6, 1.8])
+    mine = [(label, row) for m, label, row in comparisons(data) if m == material]
+    label, row = mine[0]
+    others = [f"{lab}: RMS {fmt(r.get('rms_deg'), 1)} deg, k_P fitted {fmt(r.get('k_p_fit'), 2)}" for lab, r in mine[1:]]
+    table = metric_table(row, title=f"{label}: this run beside the paper (rms.csv)",
+                         extra_notes=tuple(f"Also compared: {o} (all comparisons: the model-curve page)." for o in others))
+    table_h = table_height_pt(table, 595.0 - 84.0)
+    fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)
+    fig.suptitle(f"{material}: bending angle versus pressure", color=color, fontweight="bold")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[1.45, 1.0])
     plot_hysteresis(top.subplots(), data, material, color,
-                    title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: model")
-    left, right = middle.subfigures(1, 2, width_ratios=[1.0, 1.25])
-    plot_per_actuator(left.subplots(), data, material, color)
-    ax = right.subplots()
-    _table(ax, ["", "this run", "paper"], _metric_rows(rms_row(data, material)), [0.56, 0.30, 0.14], fontsize=7)
-    ax.set_title("Model comparison (rms.csv)", fontsize=8.5)
-    draw_strip(bottom, build_strip(data, material))
+                    title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: analytical model")
+    plot_per_actuator(bottom.subplots(), data, material, color)
+    flow = Flow(fig, top_pt=72.0 * fig.get_figheight() - (22.0 + table_h + STRIP_BAND_PT + 6.0))
+    flow.table(table)
+    flow.space(4.0)
+    draw_strip(fig, flow, build_strip(data, material))
     return fig
+
+
+# ------------------------------------------------------------------------------------------
+# all materials
+
+
+def comparison_notes(data: ReportData) -> list[str]:
+    """Sentences under the comparison table (what each figure is; what is fitted; self-checks named)."""
+    notes = [
+        "RMS: the model's loading branch at the measured pressure levels against the mean curve.  Crossings: "
+        "interpolated linearly along each ramp.  n/a: not reached by the mean curve, or not reported by the paper.",
+        "k_P is fitted to this run's photos (bootstrap interval over actuators): a fitted value, so its closeness "
+        "to the paper's k_P is not evidence for the model.",
+    ]
+    note = comparison_note(data)
+    return notes + ([note] if note else [])
+
+
+def comparison_table(data: ReportData) -> Table:
+    """Every rms.csv figure per material, beside the paper's."""
+    colors = material_colors(data.materials)
+    rows, row_colors = [], []
+    for m, label, row in comparisons(data):
+        g = row.get
+        row_colors.append(colors[m])
+        ci = NA if fmt(g("k_p_fit"), 2) == NA else (
+            f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+        width = fmt(g("hysteresis_width_deg"), 0)
+        rows.append((label, fmt(g("rms_deg"), 1), fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1),
+                     fmt(g("paper_rms_deg"), 1), fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0),
+                     fmt(g("paper_p_zero_kpa"), 0), fmt(g("p_minus_psi0_up_kpa"), 0),
+                     fmt(g("p_minus_psi0_down_kpa"), 0), fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0),
+                     fmt(g("range_kpa"), 0), fmt(g("paper_range_kpa"), 0),
+                     width if width == NA else f"{width} at {fmt(g('hysteresis_width_at_kpa'), 0)}",
+                     ci, fmt(g("k_p_paper"), 1)))
+    return Table(
+        columns=(Column("Material", "left"), Column("both"), Column("incr."), Column("decr."), Column("paper"),
+                 Column("incr."), Column("decr."), Column("paper"), Column("incr."), Column("decr."),
+                 Column("run"), Column("paper"), Column("run"), Column("paper"), Column("deg at kPa"),
+                 Column("fitted [95 % CI]"), Column("paper")),
+        groups=(("", 1), ("RMS vs model (deg)", 4), ("P at ψ = 0 (kPa)", 3), ("P at ψ = -ψ0 (kPa)", 2),
+                ("Range (deg)", 2), ("Span (kPa)", 2), ("Hysteresis", 1), ("k_P (-)", 2)),
+        rows=tuple(rows), title="Every figure of rms.csv, one row per comparison (material and l0)",
+        notes=tuple(comparison_notes(data)), size=8.0, row_colors=tuple(row_colors),
+    )
 
 
 def comparison_page(data: ReportData) -> Figure:
     """Table of RMS, crossings and range per material beside the paper's values, and bar charts."""
     materials = data.materials
-    fig = page(LANDSCAPE_SIZE_IN)
-    fig.suptitle("Model versus measurements, beside the values reported in the paper (Section III.A)")
-    upper, lower = fig.subfigures(2, 1, height_ratios=[0.8, 1.2])
-    ax = upper.subplots()
-    rows_by_m = {m: _metric_rows(rms_row(data, m)) for m in materials}
-    labels = [r[0] for r in _metric_rows({})]
-    body = []
-    for i, label in enumerate(labels):
-        cells = []
-        for m in materials:
-            ours, paper = rows_by_m[m][i][1], rows_by_m[m][i][2]
-            cells.append(ours if paper == "n/a" else f"{ours}   (paper {paper})")
-        body.append([label] + cells)
-    n = max(len(materials), 1)
-    _table(ax, ["this run (paper)"] + materials, body, [0.28] + [0.72 / n] * len(materials),
-           fontsize=7.5 if n <= 2 else 7.0)
-    axes = lower.subplots(1, 3)
+    colors = material_colors(materials)
+    table = comparison_table(data)
+    width = 842.0 - 84.0
+    table_h = table_height_pt(table, width)
+    fig = page(landscape=True, label="comparison", top_pt=36.0 + 22.0 + table_h + 8.0)
+    flow = Flow(fig, top_pt=36.0, width_pt=width)
+    flow.text("Model versus measurements, beside the values reported in the paper (Section III.A)", size=12.0,
+              weight="bold")
+    flow.space(3.0)
+    flow.table(table)
+    axes = fig.subplots(1, 3)
     x = np.arange(len(materials))
     bars = (
-        ("RMS model error, both directions", "RMS (deg)", "rms_deg", "paper_rms_deg"),
-        ("Pressure at ψ = 0 (increasing P)", "P at ψ = 0 (kPa)", "p_zero_up_kpa", "paper_p_zero_kpa"),
-        ("Total range of motion", "Range of motion (deg)", "range_deg", "paper_range_deg"),
+        ("RMS against the model, both directions", "RMS (deg)", "rms_deg", "paper_rms_deg", 1),
+        ("Pressure at ψ = 0 (increasing P)", "P at ψ = 0 (kPa)", "p_zero_up_kpa", "paper_p_zero_kpa", 0),
+        ("Total range of motion", "Range of motion (deg)", "range_deg", "paper_range_deg", 0),
     )
-    for ax, (title, ylabel, ours_key, paper_key) in zip(axes, bars, strict=True):
-        ours = [float(rms_row(data, m).get(ours_key, math.nan)) for m in materials]
-        paper = [float(rms_row(data, m).get(paper_key, math.nan)) for m in materials]
-        ax.bar(x - 0.2, np.nan_to_num(ours), width=0.4, color="#4c72b0", label="this run")
-        ax.bar(x + 0.2, np.nan_to_num(paper), width=0.4, color="#bbbbbb", label="paper")
+    for ax, (title, ylabel, ours_key, paper_key, _digits) in zip(axes, bars, strict=True):
+        ours = np.array([float(rms_row(data, m).get(ours_key, math.nan)) for m in materials])
+        paper = np.array([float(rms_row(data, m).get(paper_key, math.nan)) for m in materials])
+        c = [colors[m] for m in materials]
+        ax.bar(x - 0.2, np.nan_to_num(ours), width=0.4, color=c)
+        ax.bar(x + 0.2, np.nan_to_num(paper), width=0.4, color=[lighter(v, 0.6) for v in c], hatch="///",
+               edgecolor=[lighter(v, 0.2) for v in c], linewidth=0)
+        top = np.nanmax(np.concatenate([ours, paper, [1.0]]))
+        for xi, v in zip(np.concatenate([x - 0.2, x + 0.2]), np.concatenate([ours, paper]), strict=True):
+            if not math.isfinite(v):
+                ax.text(xi, 0.02 * top, NA, ha="center", va="bottom", fontsize=7.5, color="0.25")
+        ax.set_ylim(0.0, top * 1.08)
         ax.set_xticks(x, materials)
-        ax.set_xlabel("Material")
+        ax.set_xlabel("Material (left bar: this run; right, hatched: paper)")
         ax.set_ylabel(ylabel)
-        ax.set_title(title, fontsize=9)
+        ax.set_title(title)
         ax.grid(axis="x", visible=False)
-    axes[0].legend(frameon=False)
-    lower.supxlabel("RMS: model (loading branch) at the measured pressure levels against the mean curve; "
-                    "crossings interpolated linearly along each ramp; missing values drawn as 0 and shown n/a "
-                    "in the table.", fontsize=7)
     return fig

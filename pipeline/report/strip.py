@@ -1,7 +1,9 @@
 """Fig. 5-style strip: one actuator's photos across the pressure ramp, with the extracted line.
 
 Photos come from the ``measure --overlays`` folder (``<image stem>.jpg``, line and psi drawn) when
-present, else the raw photo from the photo-set folder (and the strip says so).
+present, else the raw photo from the photo-set folder (and the strip says so).  The text band an
+overlay carries at its top (file name, psi, reason) would print at about 2 pt in a strip, so it is
+cut off (:func:`crop_banner`); the strip's captions say the same in readable type.
 """
 
 from __future__ import annotations
@@ -17,8 +19,8 @@ from pipeline.report.data import Dataset, ReportData
 
 #: photos per strip
 STRIP_PHOTOS = 6
-#: widest thumbnail kept (px); larger photos are reduced with area averaging
-THUMB_MAX_WIDTH_PX = 480
+#: widest thumbnail kept (px): twice its printed width at 150 dpi; larger photos are reduced (area averaging)
+THUMB_MAX_WIDTH_PX = 240
 
 
 @dataclass(frozen=True)
@@ -54,6 +56,13 @@ class Strip:
     trial: str
     direction: str
     photos: tuple[StripPhoto, ...]
+    images: tuple[str, ...] = ()
+    qualified: bool = False
+
+    @property
+    def actuator_label(self) -> str:
+        """The actuator as the per-actuator plot names it (``<dataset>/<actuator>`` when pooled)."""
+        return f"{self.dataset}/{self.actuator}" if self.qualified else self.actuator
 
     @property
     def note(self) -> str:
@@ -68,8 +77,31 @@ class Strip:
         return "no photos found (pass --photosets / --overlays)"
 
 
-def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX) -> np.ndarray | None:
-    """RGB thumbnail of an image file, at most ``max_width_px`` wide; ``None`` if unreadable."""
+def crop_banner(bgr: np.ndarray) -> np.ndarray:
+    """Cut off a dark text band at the top of an overlay (rows far darker than the photo below).
+
+    A photo without such a band is returned unchanged.
+
+    Examples
+    --------
+    >>> img = np.full((100, 80, 3), 200, np.uint8)
+    >>> img[:20] = 60
+    >>> crop_banner(img).shape[0], crop_banner(np.full((100, 80, 3), 200, np.uint8)).shape[0]
+    (80, 100)
+    """
+    h = bgr.shape[0]
+    rows = np.median(bgr.mean(axis=2), axis=1)
+    reference = float(np.median(rows[int(0.3 * h):int(0.6 * h)]))
+    dark = rows < 0.5 * reference
+    n = int(np.argmin(dark)) if not dark.all() else h
+    return bgr[n:] if 3 <= n <= 0.3 * h else bgr
+
+
+def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX, *, banner: bool = False) -> np.ndarray | None:
+    """RGB thumbnail of an image file, at most ``max_width_px`` wide; ``None`` if unreadable.
+
+    ``banner=True`` removes an overlay's text band first (:func:`crop_banner`).
+    """
     if not path.is_file():
         return None
     data = np.fromfile(str(path), dtype=np.uint8)
@@ -79,7 +111,48 @@ def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX) -> np.nda
     h, w = bgr.shape[:2]
     if w > max_width_px:
         bgr = cv2.resize(bgr, (max_width_px, max(1, round(h * max_width_px / w))), interpolation=cv2.INTER_AREA)
+    if banner:
+        bgr = crop_banner(bgr)
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+
+
+def strip_image(photos: tuple[StripPhoto, ...], height_px: int, gap_px: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """The photos side by side at a common height, white between them (one image, drawn once).
+
+    Missing photos are light grey tiles of 4:3.
+
+    Returns
+    -------
+    image : numpy.ndarray
+        RGB uint8.
+    spans : list of (int, int)
+        Left and right pixel column of each photo.
+
+    Examples
+    --------
+    >>> p = StripPhoto(np.zeros((30, 40, 3), np.uint8), 0.0, 210.0, "ok", "raw")
+    >>> img, spans = strip_image((p, p), 60, 10)
+    >>> img.shape, spans
+    ((60, 170, 3), [(0, 80), (90, 170)])
+    """
+    tiles = []
+    for photo in photos:
+        if photo.image is None:
+            tiles.append(np.full((height_px, height_px * 4 // 3, 3), 225, np.uint8))
+        else:
+            h, w = photo.image.shape[:2]
+            size = (max(1, round(w * height_px / h)), height_px)
+            tiles.append(cv2.resize(photo.image, size, interpolation=cv2.INTER_AREA if h > height_px else cv2.INTER_LINEAR))
+    spans, x = [], 0
+    parts = []
+    for k, tile in enumerate(tiles):
+        if k:
+            parts.append(np.full((height_px, gap_px, 3), 255, np.uint8))
+            x += gap_px
+        parts.append(tile)
+        spans.append((x, x + tile.shape[1]))
+        x += tile.shape[1]
+    return np.hstack(parts), spans
 
 
 def pick_ramp(angles: pd.DataFrame, material: str) -> pd.DataFrame:
@@ -118,7 +191,7 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
         row = ramp.iloc[int(i)]
         image, source = None, "missing"
         if dataset.overlays_dir is not None:
-            image = load_thumbnail(dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"))
+            image = load_thumbnail(dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"), banner=True)
             source = "overlay" if image is not None else source
         if image is None and dataset.photoset_dir is not None:
             image = load_thumbnail(dataset.photoset_dir / str(row["image"]))
@@ -132,4 +205,5 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
     return Strip(
         material=material, dataset=str(first["dataset"]), actuator=str(first["actuator"]),
         trial=str(first["trial"]), direction=str(first["direction"]), photos=tuple(photos),
+        images=tuple(str(ramp.iloc[int(i)]["image"]) for i in idx), qualified=data.angles["dataset"].nunique() > 1,
     )

@@ -1,0 +1,87 @@
+"""Why photos were flagged or failed, in words a reader understands, counted per dataset.
+
+A flagged row's ``reason`` (angles.csv) lists its causes separated by ``;`` (a failed row's
+reason is one message, whose fix may follow a ``;``); each cause is
+matched against :data:`WORDS` (first match wins) and otherwise shortened to its text before
+the first ``:``, ``(`` or ``=`` with numbers and brackets removed, so a cause that quotes a
+setting (e.g. an HSV range) still reads as words.
+
+Examples
+--------
+>>> words("line partly hidden: 65% of l0 visible")
+'line partly hidden'
+>>> words("no line found: no long thin component of line_color=(((0, 0, 0), (180, 255, 80)),)")
+'no marker line found'
+>>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
+'tilted board'
+"""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+
+import pandas as pd
+
+#: (pattern, words): the causes the measure stage writes, in words
+WORDS: tuple[tuple[str, str], ...] = (
+    (r"^no line found", "no marker line found"),
+    (r"^unreadable image", "photo cannot be read"),
+    (r"^a grey image", "grey photo, colour line expected"),
+    (r"^curvature fit failed", "curvature fit failed"),
+    (r"^internal error", "internal error (please report)"),
+    (r"touches the image border", "line touches the image border"),
+    (r"^line partly hidden", "line partly hidden"),
+    (r"^line \d+% of l0", "line longer than l0 (scale or extra marks)"),
+    (r"candidate lines", "several candidate lines"),
+    (r"^low contrast", "low contrast"),
+    (r"^no line reaches fixed_end", "no line reaches the fixed end"),
+    (r"^non-constant curvature", "curvature not constant"),
+    (r"differs from the arc and turning fits", "angle methods disagree"),
+    (r"closes on itself or branches", "line closes on itself or branches"),
+    (r"^ends almost touching", "ends almost touching"),
+    (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
+)
+
+
+def words(cause: str) -> str:
+    """One cause in words (see module docstring)."""
+    text = cause.strip()
+    if not text:
+        return "no reason given"
+    for pattern, phrase in WORDS:
+        if re.search(pattern, text):
+            return phrase
+    head = re.split(r"[:(=]", text, maxsplit=1)[0]
+    head = re.sub(r"[-+]?\d+(?:\.\d+)?%?|[\[\]{}(),]", " ", head)
+    return " ".join(head.split()) or "other"
+
+
+def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[str, int]]]:
+    """The most frequent causes among the non-ok rows of each dataset.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        angles rows with ``dataset``, ``status`` and ``reason``.
+    limit : int
+        Causes kept per dataset; the rest are summed as ``"other causes"``.
+
+    Returns
+    -------
+    dict
+        dataset -> [(words, count)], most frequent first (ties by name); datasets without
+        non-ok rows are absent.
+    """
+    out: dict[str, list[tuple[str, int]]] = {}
+    bad = angles[angles["status"].astype(str) != "ok"]
+    for dataset, g in bad.groupby("dataset", sort=True):
+        counts: Counter[str] = Counter()
+        for status, reason in zip(g["status"].astype(str), g["reason"].fillna("").astype(str), strict=True):
+            causes = [reason] if status == "failed" else reason.split(";")
+            counts.update({words(part) for part in causes})
+        ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+        if len(ordered) > limit:
+            ordered = ordered[:limit] + [("other causes", sum(c for _, c in ordered[limit:]))]
+        out[str(dataset)] = ordered
+    return out
