@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pypdfium2 as pdfium
 
-from pipeline.report import Dataset, ReportInputs, build_report
+from pipeline.report.build import build_report
+from pipeline.report.data import Dataset, ReportInputs
 from pipeline.video.continuous import write_continuous
 from pipeline.video.pages import figures, write_strip
 

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.report.style import PAGE_SIZE_IN
+from pipeline.report.style import A4_PORTRAIT_IN, footer_fraction, text_page
 
 #: step rows shown in the table (the rest are counted)
 MAX_TABLE_ROWS = 12
@@ -82,10 +82,10 @@ def figures(folder: Path) -> list[Figure]:
     steps, settling = _read(folder, "steps.csv"), _read(folder, "settling.csv")
     if timeline.empty:
         return []
-    fig = Figure(figsize=PAGE_SIZE_IN)
+    fig = text_page(label=f"video {folder.name}")  # A4 portrait, hand-placed axes
     fig.suptitle(f"Video dataset {folder.name}: every frame against the pressure log", x=0.06, ha="left")
     grid = fig.add_gridspec(5, 2, height_ratios=[1.0, 1.2, 0.15, 0.9, 0.55], hspace=0.5, wspace=0.28,
-                            left=0.08, right=0.97, top=0.93, bottom=0.03)
+                            left=0.08, right=0.97, top=0.93, bottom=footer_fraction(A4_PORTRAIT_IN) + 0.03)
     ax_t = fig.add_subplot(grid[0, :])
     ax_p = ax_t.twinx()
     ramps = timeline.groupby(["material", "actuator", "trial"], sort=False)
