@@ -17,7 +17,8 @@ and ``e = sqrt(1 - b**2/a**2)`` is reported with the same status semantics as th
 
 One bad photo never stops the set.  The output table (``eccentricity.csv``) has one row per
 manifest row, same order: :data:`RESULT_COLUMNS`, then the manifest's pressure/force columns
-carried over, then ``image_path`` (absolute path of the photo, for report overlays).
+carried over, then ``image_path`` (the photo's path as the photo set folder was given, for report overlays;
+not resolved, so that the table does not depend on where the working directory lies).
 """
 
 from __future__ import annotations
@@ -324,5 +325,5 @@ def measure_blocked_photoset(
     for c in CARRIED_COLUMNS:
         if c in m.columns:
             out[c] = m[c].to_numpy()
-    out["image_path"] = [str(Path(t.path).resolve()) for t in tasks]
+    out["image_path"] = [t.path for t in tasks]
     return out

@@ -161,7 +161,7 @@ def _draw_photo(ax: Axes, r: pd.Series, base: Path | None, color: Color) -> None
     image = None
     if isinstance(path, str) and path:
         p = Path(path)
-        if not p.is_absolute() and base is not None:
+        if not p.is_absolute() and not p.is_file() and base is not None:
             p = base / p
         if p.is_file():
             image = cv2.imread(str(p), cv2.IMREAD_COLOR)
