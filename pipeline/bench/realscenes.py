@@ -40,7 +40,7 @@ _PRESET = {"lab_body": "lab"}
 
 
 def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 960,
-               fixed_direction: bool = False) -> pd.DataFrame:
+               fixed_direction: bool = False, scenes: tuple[str, ...] | None = None) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
     Parameters
@@ -53,6 +53,8 @@ def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 
         Photo size (px).
     fixed_direction : bool
         Also give ``fixed_direction_deg`` (the clamp's direction, known to the renderer).
+    scenes : tuple of str, optional
+        Only these of :data:`BODY_SCENES` (default: all).
 
     Returns
     -------
@@ -64,6 +66,8 @@ def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 
 
     rows = []
     for name, overrides in BODY_SCENES.items():
+        if scenes is not None and name not in scenes:
+            continue
         scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)  # type: ignore[arg-type]
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
             r = render_actuator(float(psi), 270.0, scene, seed=seed + i, bulge=0.4 if i % 2 else 0.0)

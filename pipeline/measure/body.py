@@ -27,9 +27,11 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+import pandas as pd
 from scipy.sparse.csgraph import dijkstra
 
 from pipeline.measure.colors import color_mask
+from pipeline.measure.estimators import end_tangents
 from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
 from pipeline.measure.settings import MeasureSettings
 
@@ -71,6 +73,13 @@ class BodyExtraction:
     end_short_px : float
         How much of the body's ridge, at the free end, the centre line does not cover (original
         px): where the outline was too uneven to find the middle between two edges.
+    ridge_tip_deg : float
+        How much the free end's direction changes (deg, image axes) when the centre line is
+        carried on along the selection's ridge over that uncovered part: what the uncovered
+        part may hide.
+    free_end_width_ratio : float
+        The body's width near its free end over its median width: well below 1 when one side of
+        the tip was not selected (a faint, translucent side), which shifts the tip's direction.
     """
 
     line: LineExtraction
@@ -80,6 +89,8 @@ class BodyExtraction:
     continues: bool = False
     start_gap_px: float = 0.0
     end_short_px: float = 0.0
+    ridge_tip_deg: float = 0.0
+    free_end_width_ratio: float = 1.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -395,22 +406,57 @@ END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
 TIP_THICKNESS = 0.95
 #: ... and at most this multiple of it (thicker: the clamp or a blob the body runs into)
 BLOB_THICKNESS = 1.6
+#: a taper is judged against the thickness this far (half-widths) inside the end
+LOCAL_FROM_END_HALF_WIDTHS = (3.0, 10.0)
+#: ... but not below this fraction of the whole body's half-width (a long taper is still a tip)
+LOCAL_THICKNESS_FLOOR = 0.7
+#: widths are judged against their running median over this many half-widths of the line
+LOCAL_WIDTH_HALF_WIDTHS = 12.0
 
 
 def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[np.ndarray, tuple[float, float]]:
     """Drop the path's ends where the body tapers (tips, corners) or thickens (clamp, blobs).
 
-    Returns the kept path and the length dropped at each end (px): the line goes on that far.
+    A taper is judged against the body's own thickness just inside that end (a body that is
+    thinner towards its tip, or whose faint side fades there, is not cut in half), but never
+    against less than :data:`LOCAL_THICKNESS_FLOOR` of ``half``; a thickening against the whole
+    body's half-width ``half``.  Returns the kept path and the length dropped at
+    each end (px): the line goes on that far.
     """
     xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
     thick = dt[yi, xi]
-    good = (thick >= TIP_THICKNESS * half) & (thick <= BLOB_THICKNESS * half)
-    if good.sum() < 8:
-        return path, (0.0, 0.0)
-    i0, i1 = int(np.argmax(good)), len(good) - 1 - int(np.argmax(good[::-1]))
     s = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+    not_blob = thick <= BLOB_THICKNESS * half
+    ends = []
+    for from_end in (s, s[-1] - s):
+        near = (from_end >= LOCAL_FROM_END_HALF_WIDTHS[0] * half) & (from_end <= LOCAL_FROM_END_HALF_WIDTHS[1] * half) & not_blob
+        ref = float(np.median(thick[near])) if near.sum() >= 3 else half
+        ends.append((thick >= TIP_THICKNESS * float(np.clip(ref, LOCAL_THICKNESS_FLOOR * half, half))) & not_blob)
+    good_start, good_end = ends
+    if good_start.sum() < 8 or good_end.sum() < 8:
+        return path, (0.0, 0.0)
+    i0, i1 = int(np.argmax(good_start)), len(path) - 1 - int(np.argmax(good_end[::-1]))
+    if i1 - i0 < 8:
+        return path, (0.0, 0.0)
     # a tapering tip ends about one half-width beyond the last thick point
     return path[i0 : i1 + 1], (float(s[i0]), float(s[-1] - s[i1]))
+
+
+def local_widths(widths: np.ndarray, window: int) -> np.ndarray:
+    """Running median of the body's width along its centre line (``window`` points), NaNs ignored.
+
+    The reference a width is judged against at each point: real bodies thin towards the tip, and
+    a faint side fades in one part of a photo, so one median for the whole body would call a
+    whole stretch "too thin".
+
+    Examples
+    --------
+    >>> local_widths(np.array([10.0, 10, np.nan, 10, 6, 6, 6, 6]), 3).tolist()
+    [10.0, 10.0, 10.0, 8.0, 6.0, 6.0, 6.0, 6.0]
+    """
+    w = pd.Series(widths, dtype=float)
+    ref = w.rolling(max(1, window), center=True, min_periods=1).median()
+    return ref.fillna(float(np.nanmedian(widths)) if np.isfinite(widths).any() else np.nan).to_numpy()
 
 
 def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
@@ -432,6 +478,8 @@ def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
     return soft
 
 
+#: the ridge's last this many half-widths are a tip's corners or its cap, not its course
+RIDGE_TIP_HALF_WIDTHS = 2.0
 #: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
@@ -477,10 +525,13 @@ def _good_span(good: np.ndarray, run: int) -> tuple[int, int] | None:
     return first, last
 
 
-def _march(soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, med: float) -> tuple[np.ndarray, np.ndarray]:
+def _march(
+    soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, end_med: tuple[float, float]
+) -> tuple[np.ndarray, np.ndarray]:
     """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
     edges": each new point is the middle of the profile across the body ahead, kept while the
-    body's width there is within [END_WIDTH_LOW, END_WIDTH_HIGH] of its median.
+    body's width there is within [END_WIDTH_LOW, END_WIDTH_HIGH] of its median near that end
+    (``end_med``: start, end).
 
     The ridge path stops about a half-width short of each end (there the medial axis forks into
     the corners); marching recovers that part, so a tip that curls to its end is measured to its
@@ -488,7 +539,7 @@ def _march(soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, m
     """
     k = 6
     ends = []
-    for forward in (False, True):
+    for forward, med in zip((False, True), end_med, strict=True):
         line = pts if forward else pts[::-1]
         new: list[np.ndarray] = []
         new_w: list[float] = []
@@ -514,6 +565,21 @@ def _march(soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, m
     pts = np.vstack([head[::-1], pts, tail])
     widths = np.concatenate([head_w[::-1], widths, tail_w])
     return pts, widths
+
+
+def _follow_ridge(ridge: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray:
+    """The centre line carried on along the mask's ridge where the march between two edges stopped
+    short of the free end (an outline too uneven to find its middle: a faint side, a tip the light
+    leaves).  The ridge is only the middle of what was selected, so this is a check of the tip's
+    direction, not the measurement.  The ridge's last :data:`RIDGE_TIP_HALF_WIDTHS` half-widths
+    (where it forks into the tip's corners, or runs into a rounded cap) are left out."""
+    seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ridge, axis=0).T))))
+    i = int(np.argmin(np.hypot(*(ridge - pts[-1]).T)))
+    rest = (seg > seg[i] + MARCH_STEP_PX) & (seg <= seg[-1] - RIDGE_TIP_HALF_WIDTHS * half)
+    if rest.sum() < half:
+        return pts
+    tail = _smooth(_resample(np.vstack([pts[-1:], ridge[rest]]), 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))[1:]
+    return np.vstack([pts, tail])
 
 
 def _extensions(
@@ -647,7 +713,8 @@ def extract_body(
     for _ in range(2):
         moved, wid = _midpoints(soft, pts, reach=3.0 * half + 4.0)
         med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
-        bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * med) | (wid < END_WIDTH_LOW * med)
+        ref = local_widths(wid, int(round(LOCAL_WIDTH_HALF_WIDTHS * half)))
+        bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * ref) | (wid < END_WIDTH_LOW * ref)
         moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
         span = _good_span(~bad, max(3, int(round(half))))
         if span is not None:  # the ends where the profile runs into the clamp or round the tip: dropped
@@ -656,8 +723,14 @@ def extract_body(
         pts = _smooth(_resample(moved, 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))
         fill = np.nan_to_num(wid, nan=med)
         widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(fill)), fill)
-    med = float(np.median(widths)) if len(widths) else 2.0 * half
-    pts, widths = _march(soft, pts, widths, half, med)
+    reach = max(3, int(round(LOCAL_WIDTH_HALF_WIDTHS * half / 2)))
+    end_med = (float(np.median(widths[:reach])), float(np.median(widths[-reach:]))) if len(widths) else (2.0 * half,) * 2
+    body_width = float(np.nanmedian(widths)) if np.isfinite(widths).any() else 2.0 * half
+    pts, widths = _march(soft, pts, widths, half, end_med)
+    along_ridge = _follow_ridge(ridge, pts, half)
+    ridge_tip_deg = 0.0
+    if len(along_ridge) > len(pts) and len(pts) >= 8:
+        ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
     trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
     # the body proper (not the tube or a plate joined to it at the clamp) may not reach the border
     near = np.zeros_like(comp)
@@ -686,5 +759,6 @@ def extract_body(
     return BodyExtraction(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
-        end_short_px=_uncovered(ridge, pts[-1]) * scale,
+        end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
+        free_end_width_ratio=end_med[1] / max(body_width, 1e-6),
     )

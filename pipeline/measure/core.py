@@ -251,6 +251,8 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         continues=body.continues,
         start_gap_px=body.start_gap_px,
         end_short_px=body.end_short_px,
+        ridge_tip_deg=body.ridge_tip_deg,
+        free_end_width_ratio=body.free_end_width_ratio,
     )
     mm = settings.mm_per_px
     return AngleResult(

@@ -147,6 +147,11 @@ def assess(
 TIP_UNSTABLE_DEG = 8.0
 #: body: width along the centre line (90th / 10th percentile) above this -> uneven outline
 WIDTH_RATIO = 2.2
+#: body: the free end's direction may change this much (deg) when the centre line is carried on
+#: along the selection's ridge over the part of the tip it did not reach
+RIDGE_TIP_DEG = 4.0
+#: body: a free end narrower than this fraction of the body's width has lost a side
+NARROW_FREE_END = 0.6
 #: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
 BASE_MISMATCH_DEG = 20.0
 
@@ -164,6 +169,8 @@ def assess_body(
     continues: bool = False,
     start_gap_px: float = 0.0,
     end_short_px: float = 0.0,
+    ridge_tip_deg: float = 0.0,
+    free_end_width_ratio: float = 1.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -199,7 +206,13 @@ def assess_body(
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
     if continues:
         flags.append("the selection goes on past a gap beyond the free end: part of the body may be missed (photoset preview shows it)")
-    if end_short_px > 1.5 * line.width_px + 4.0:
+    if free_end_width_ratio < NARROW_FREE_END:
+        flags.append(f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: one side of it may not be selected "
+                     "(faint), which turns its direction; check with photoset preview")
+    if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
+        flags.append(f"the free end's direction is uncertain: the centre line stops {end_short_px:.0f} px short of the body's "
+                     f"end, and carried on along the selection there its direction changes by {abs(ridge_tip_deg):.0f} deg (photoset preview shows it)")
+    elif end_short_px > 1.5 * line.width_px + 4.0:
         flags.append(f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven outline there): check with photoset preview")
     if start_gap_px > 2.0 * line.width_px + 4.0:
         flags.append(f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or fixed_end is off")
