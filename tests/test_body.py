@@ -149,3 +149,15 @@ def test_translucent_body_on_grey_without_a_background_photo():
     ok = d[d["status"] == "ok"]
     assert int((ok["error_deg"].abs() <= 5.0).sum()) >= 6, d.to_string()
     assert ok["error_deg"].abs().max() <= 8.0, d.to_string()
+
+
+@pytest.mark.parametrize("psi", [120.0, -200.0])
+def test_a_long_thin_tube_through_the_clamp_does_not_set_the_body_width(psi):
+    # the tube, the clamp and the body are one selected component; the body's half-width is read
+    # along its own ridge, not over the whole component (where the tube's would win)
+    img, fe, clamp = body_photo(psi, length=500.0, width=46.0, seed=5)
+    (x0, y0), (x3, y3) = clamp[0], clamp[3]
+    y_mid = int(round((y0 + y3) / 2))
+    cv2.line(img, (int(min(x0, x3)), y_mid), (0, y_mid), (90, 140, 200), 12, cv2.LINE_AA)
+    res = measure_image(img, settings_for(fe))
+    assert res.psi_deg == pytest.approx(psi, abs=3.0), res.reason

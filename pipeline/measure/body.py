@@ -699,8 +699,11 @@ def extract_body(
     except NoLineFound:
         raise NoLineFound(f"no body found: nothing {what} survives the clean-up; check line_color / background / roi (python -m pipeline photoset preview)") from None
     dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
-    half = float(np.median(dt[(dt > 0) & (dt >= cv2.dilate(dt, np.ones((3, 3), np.uint8)))])) if comp.any() else 0.0
     path, guessed = _ridge_path(comp, dt, fe if reached else None)
+    # the body's half-width along its own ridge (not over the whole component: a tube or a clamp
+    # joined to it would pull a component-wide figure far off)
+    xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
+    half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
