@@ -151,6 +151,9 @@ def test_translucent_body_on_grey_without_a_background_photo():
     assert ok["error_deg"].abs().max() <= 8.0, d.to_string()
 
 
+TUBE_PX = 330
+
+
 @pytest.mark.parametrize("psi", [120.0, -200.0])
 def test_a_long_thin_tube_through_the_clamp_does_not_set_the_body_width(psi):
     # the tube, the clamp and the body are one selected component; the body's half-width is read
@@ -158,6 +161,18 @@ def test_a_long_thin_tube_through_the_clamp_does_not_set_the_body_width(psi):
     img, fe, clamp = body_photo(psi, length=500.0, width=46.0, seed=5)
     (x0, y0), (x3, y3) = clamp[0], clamp[3]
     y_mid = int(round((y0 + y3) / 2))
+    x_clamp = int(min(x0, x3))
+    cv2.line(img, (x_clamp, y_mid), (x_clamp - TUBE_PX, y_mid), (90, 140, 200), 9, cv2.LINE_AA)
+    res = measure_image(img, settings_for(fe))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=3.0), res.reason
+
+
+def test_a_tube_longer_than_the_body_is_never_an_ok_psi():
+    # the farthest point from the fixed end is then the tube's end: flagged, not measured as psi
+    img, fe, clamp = body_photo(120.0, length=300.0, width=46.0, seed=5, shift=(250.0, 0.0))
+    (x0, y0), (x3, y3) = clamp[0], clamp[3]
+    y_mid = int(round((y0 + y3) / 2))
     cv2.line(img, (int(min(x0, x3)), y_mid), (0, y_mid), (90, 140, 200), 12, cv2.LINE_AA)
     res = measure_image(img, settings_for(fe))
-    assert res.psi_deg == pytest.approx(psi, abs=3.0), res.reason
+    assert res.status != "ok" or res.psi_deg == pytest.approx(120.0, abs=5.0), res.reason
