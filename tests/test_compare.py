@@ -277,7 +277,8 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
                  "--photosets", *(str(f) for f in folders), "--bootstrap", "0",
                  "--out", str(rms), "--curves", str(curves)]) == 0
     text = capsys.readouterr().out
-    assert "compare: SS50, l0 220 mm [short; l0 from photo set; self-check]" in text
+    assert ("compare: SS50, l0 220 mm [short; l0 from photo set; materials packaged (pipeline/model/materials.yaml); "
+            "self-check]") in text
     out = pd.read_csv(rms).set_index("datasets")
     default = model.load_materials()["SS50"].l0_mm
     assert out.loc["short", "l0_mm"] == 220.0 and out.loc["long", "l0_mm"] == default
@@ -292,6 +293,91 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
     assert not np.allclose(expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3)
     assert main(["compare", str(folders[0] / "hysteresis.csv"), "--photosets", "a", "b",
                  "--out", str(rms)]) == 2
+
+
+def test_a_dataset_with_its_own_materials_file_is_compared_against_that_files_model():
+    """Own file: its callables, psi0 and l0; pooled only with datasets of the same file; named in each row."""
+    from pipeline.compare import DatasetModel
+
+    angles = pd.concat([_angles("std", "SS50", np.nan), _angles("soft", "SS50", np.nan, psi_offset=7.0),
+                        _angles("soft2", "SS50", np.nan, psi_offset=7.0), _angles("short", "SS50", 220.0, psi_offset=7.0)],
+                       ignore_index=True)
+    calls = []
+
+    def own_model(material, p, l0_mm):
+        calls.append(("own", l0_mm))
+        return linear_model(material, p) + 7.0
+
+    def run_model(material, p, l0_mm):
+        calls.append(("run", l0_mm))
+        return linear_model(material, p)
+
+    soft = DatasetModel("lab/soft.yaml", own_model, ls_fit, {"SS50": 180.0}, {"SS50": 240.0})
+    out = compare(_hyst_of(angles), angles, model_psi=run_model, fit_k_p=None, psi0_deg={"SS50": 210.0},
+                  default_l0_mm={"SS50": 255.0}, materials_file="packaged",
+                  dataset_models={"soft": soft, "soft2": soft, "short": soft})
+    rows = out.set_index("curve")
+    assert list(out["curve"]) == ["SS50, l0 255 mm", "SS50, l0 240 mm, materials lab/soft.yaml",
+                                  "SS50, l0 220 mm, materials lab/soft.yaml"]
+    assert rows["datasets"].tolist() == ["std", "soft + soft2", "short"]
+    assert rows["materials_file"].tolist() == ["packaged", "lab/soft.yaml", "lab/soft.yaml"]
+    assert rows["l0_source"].tolist() == ["materials file", "dataset's materials file", "photo set"]
+    assert rows["psi0_deg"].tolist() == [210.0, 180.0, 180.0]  # the file's geometry
+    # each row met its own model exactly: std the run's, soft (+7 deg) its file's, at the file's or photo set's l0
+    np.testing.assert_allclose(out["rms_deg"], 0.0, atol=1e-12)
+    assert sorted(set(calls)) == [("own", 220.0), ("own", 240.0), ("run", 255.0)]
+    # without its own file the same data are 7 deg off the run's model
+    just_soft = angles[angles["dataset"] == "soft"]
+    plain = compare(_hyst_of(just_soft), just_soft, model_psi=run_model, fit_k_p=None, default_l0_mm={"SS50": 255.0})
+    assert plain["rms_deg"].tolist() == [pytest.approx(7.0)] and plain["curve"].tolist() == ["SS50, l0 255 mm"]
+
+
+SOFT_SS50 = ("geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
+             "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n")
+
+
+def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys):
+    """compare --dataset-materials: the real model of the dataset's file (half SS50's modulus, l0 240 mm)."""
+    from pipeline import model
+    from pipeline.cli import main
+
+    own = tmp_path / "soft.yaml"
+    own.write_text(SOFT_SS50)
+    soft = model.load_materials(own)["SS50"]
+    folders = []
+    for name in ("std", "soft"):
+        p = np.arange(0.0, 241.0, 40.0)
+        psi = model.psi_deg("SS50", p)  # both drawn from the packaged SS50 at its l0
+        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
+                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1}
+                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        folder = tmp_path / name
+        folder.mkdir()
+        pd.DataFrame(rows).to_csv(folder / "angles.csv", index=False)
+        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        folders.append(folder)
+    rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
+    args = ["compare", *(str(f / "hysteresis.csv") for f in folders), "--angles", *(str(f / "angles.csv") for f in folders),
+            "--datasets", "std", "soft", "--bootstrap", "0", "--out", str(rms), "--curves", str(curves)]
+    assert main([*args, "--dataset-materials", "-", str(own)]) == 0
+    assert f"materials {own}; " in capsys.readouterr().out
+    out = pd.read_csv(rms).set_index("datasets")
+    assert out.loc["std", "materials_file"] == "packaged (pipeline/model/materials.yaml)"
+    assert out.loc["soft", "materials_file"] == str(own) and out.loc["soft", "l0_mm"] == 240.0
+    assert out.loc["soft", "l0_source"] == "dataset's materials file"
+    assert out.loc["std", "rms_deg"] < 1e-3  # drawn from the packaged model
+    hyst = pd.read_csv(folders[1] / "hysteresis.csv")
+    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
+    expected = rms_deg(psi, model.psi_deg(soft, p, l0_mm=240.0))[0]
+    assert out.loc["soft", "rms_deg"] == pytest.approx(expected, rel=1e-4) and expected > 5.0
+    c = pd.read_csv(curves)
+    own_curve = c[c["curve"] == out.loc["soft", "curve"]]
+    assert len(own_curve) == 400 and (own_curve["materials_file"] == str(own)).all()
+    np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft, l0_mm=240.0)["pressure_kpa"],
+                               rtol=1e-5, atol=1e-9)
+    std_curve = c[c["curve"] == out.loc["std", "curve"]]
+    assert not np.allclose(std_curve["pressure_kpa"], own_curve["pressure_kpa"], equal_nan=True)
+    assert main([*args, "--dataset-materials", str(own)]) == 2  # one file per dataset, or '-'
 
 
 @pytest.mark.slow
