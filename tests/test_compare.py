@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -473,6 +474,15 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
 
     inputs = next(t for t in pages if "Input files" in t)
     assert hashlib.sha256((tmp_path / "soft.yaml").read_bytes()).hexdigest() in inputs.replace(" ", "")
+    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report), nothing else
+    with (tmp_path / "soft.yaml").open("a") as fh:
+        fh.write("# k_P re-measured\n")
+    dry = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
+                          str(tmp_path), "--cores", "2", "-n"], capture_output=True, text=True)
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    table = dry.stdout.split("Job stats:")[-1]
+    jobs = {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
+    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[-2000:]
     assert f"SS50, l0 {default:g} mm" in provenance
     material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
     assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material
