@@ -35,9 +35,9 @@ rule model_curve_dataset:
         materials=lambda wc: ["--materials", materials_file(DATASETS[wc.dataset])],
         readings=model_readings_option(),
     log:
-        log_file("model/{dataset}/{material}"),
+        log_file("datasets/{dataset}/model/{material}"),
     benchmark:
-        benchmark_file("model/{dataset}/{material}")
+        benchmark_file("datasets/{dataset}/model/{material}")
     threads: 1
     resources:
         **SMALL_JOB,
