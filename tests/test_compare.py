@@ -386,7 +386,7 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     """End to end (real snakemake, tiny config in a temporary folder): SS50 photo sets, one of
     an actuator with l0 = 220 mm; its model curve and its RMS use 220 mm, the other's the default,
     and the report says which l0 each curve used and that synthetic RMS is a self-check.  A third
-    set, the same photos as 'std', names its own materials file (SS50 at half the modulus): its
+    set, the photos of 'short', names its own materials file (SS50 at half the modulus): its
     model curve and RMS are that file's, the report names the file and its sha256."""
     import subprocess
     import sys
@@ -401,14 +401,13 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     assert main(["synth", str(short), "--material", "SS50", "--actuators", "1", "--trials", "1",
                  "--step-kpa", "80", "--max-kpa", "240", "--scene", "clean", "--set", "width=400",
                  "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
-    (tmp_path / "soft.yaml").write_text(SOFT_SS50.replace("l0_mm: 240.0", "l0_mm: 255.0"))  # only mu changes
-    std = {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
-           "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}}
+    (tmp_path / "soft.yaml").write_text(SOFT_SS50)  # SS50 at mu 0.34 MPa; l0 240 mm, but the photos say 220
     config = {
         "datasets": [
-            std,
+            {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
+             "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
             {"name": "short", "source": "folder", "path": str(short)},
-            {**std, "name": "soft", "materials_file": "soft.yaml"},
+            {"name": "soft", "source": "folder", "path": str(short), "materials_file": "soft.yaml"},
         ],
         "compare": {"bootstrap": 5},
         "bench": {"in_report": False},
@@ -427,27 +426,29 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     assert rms.loc["short", "l0_source"] == "photo set"
     assert rms.loc["std", "l0_mm"] == default == 255.0
     assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
-    # 'soft': the photos of 'std' (same seed), compared against its own file's SS50 (mu 0.34 MPa, not 0.68)
+    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at their 220 mm
     soft = model.load_materials(tmp_path / "soft.yaml")["SS50"]
     assert soft.mu_mpa == (0.34,) and model.load_materials()["SS50"].mu_mpa == (0.68,)
-    assert rms.loc["soft", "curve"] == "SS50, l0 255 mm, materials soft.yaml" != rms.loc["std", "curve"]
-    assert rms.loc["soft", "materials_file"] == "soft.yaml" and rms.loc["soft", "l0_source"] == "photo set"  # synth wrote 255
-    assert rms.loc["std", "materials_file"] == "packaged (pipeline/model/materials.yaml)"
-    h_std = pd.read_csv(res / "datasets" / "std" / "hysteresis.csv")
+    assert rms.loc["soft", "curve"] == "SS50, l0 220 mm, materials soft.yaml" != rms.loc["short", "curve"]
+    assert rms.loc["soft", "materials_file"] == "soft.yaml" and rms.loc["soft", "l0_source"] == "photo set"
+    assert rms.loc["soft", "l0_mm"] == 220.0  # the photo set's l0 wins over the file's 240 mm
+    assert (rms.loc[["std", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)").all()
+    h_short = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
     h_soft = pd.read_csv(res / "datasets" / "soft" / "hysteresis.csv")
-    pd.testing.assert_frame_equal(h_std, h_soft)  # same photos: any difference below is the model's
+    pd.testing.assert_frame_equal(h_short, h_soft)  # same photos: any difference below is the model's
     p_s, psi_s = h_soft["pressure_kpa"].to_numpy(float), h_soft["psi_mean_deg"].to_numpy(float)
-    at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s))[0]
+    at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s, l0_mm=220.0))[0]
     assert rms.loc["soft", "rms_deg"] == pytest.approx(at_soft, rel=1e-4)
-    assert rms.loc["std", "rms_deg"] == pytest.approx(rms_deg(psi_s, model.psi_deg("SS50", p_s))[0], rel=1e-4)
-    assert rms.loc["soft", "rms_deg"] > rms.loc["std", "rms_deg"] + 5.0  # drawn from the paper's SS50, not the soft one
+    assert rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0  # drawn from the paper's SS50, not the soft one
     # two datasets naming SS50 with different materials files: two model curves, neither overwritten
     own_curve = pd.read_csv(res / "datasets" / "soft" / "model" / "SS50.csv")
     run_curve = pd.read_csv(res / "model" / "SS50.csv")
     np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9)
     np.testing.assert_allclose(run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9)
-    soft_compared = pd.read_csv(res / "compare_curves.csv").query("curve == 'SS50, l0 255 mm, materials soft.yaml'")
-    np.testing.assert_allclose(soft_compared["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-5)
+    assert not np.allclose(own_curve["pressure_kpa"], run_curve["pressure_kpa"], equal_nan=True)
+    soft_compared = pd.read_csv(res / "compare_curves.csv").query("curve == 'SS50, l0 220 mm, materials soft.yaml'")
+    np.testing.assert_allclose(soft_compared["pressure_kpa"], model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
+                               rtol=1e-5)
     # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
     hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
     p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
@@ -469,7 +470,7 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
         in comparison
     provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
     assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
-    assert "255 (photo set) soft.yaml" in provenance
+    assert "220 (photo set) soft.yaml" in provenance
     import hashlib
 
     inputs = next(t for t in pages if "Input files" in t)
@@ -486,3 +487,4 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     assert f"SS50, l0 {default:g} mm" in provenance
     material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
     assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material
+    assert "model, l0 220 mm, materials soft.yaml" in material
