@@ -18,6 +18,11 @@ model's default l0 (the materials file's, or ``--l0-mm``), and ``l0_source`` say
 dataset holding one material at several l0 cannot be split from its hysteresis.csv, so its row
 keeps the data figures and leaves the model columns empty, with the reason in ``note``.
 
+A dataset may bring its own materials file (its own silicone or actuator geometry): it is then
+compared against a :class:`DatasetModel` built from that file (Ogden terms, k_P, k_t, geometry,
+and l0 unless its photos carry their own), pooled only with datasets of the same file, and
+``materials_file`` names the file of every row.
+
 What the RMS is (``rms_kind``): ``self-check`` when every dataset of the row is synthetic (its
 photos were rendered from this package's model, so the RMS checks the measurement chain, not the
 model), ``prediction`` when none is (no model parameter is fitted to these data: k_P is the
@@ -99,7 +104,7 @@ PAPER_VALUES: dict[str, PaperValues] = {
 
 #: rms.csv columns, in order
 RMS_COLUMNS: tuple[str, ...] = (
-    "material", "curve", "datasets", "l0_mm", "l0_source", "data_source", "rms_kind", "model_fit",
+    "material", "curve", "datasets", "l0_mm", "l0_source", "materials_file", "data_source", "rms_kind", "model_fit",
     "note", "rms_deg", "rms_up_deg", "rms_down_deg", "n_levels", "n_model_nan",
     "p_zero_up_kpa", "p_zero_down_kpa", "p_minus_psi0_up_kpa", "p_minus_psi0_down_kpa", "psi0_deg",
     "range_deg", "psi_max_deg", "psi_min_deg", "range_kpa",
@@ -376,6 +381,29 @@ def included_rows(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Dat
 
 
 @dataclass(frozen=True)
+class DatasetModel:
+    """The model of a dataset's own materials file, as :func:`compare` calls it.
+
+    Attributes
+    ----------
+    materials_file : str
+        The file, as the config names it (its label in rms.csv and in ``curve``).
+    model_psi, fit_k_p : callable
+        As :func:`compare`'s, built from this file (:func:`file_model`).
+    psi0_deg : mapping of str to float
+        Rest angle per material of this file (deg).
+    l0_mm : mapping of str to float
+        This file's l0 per material (mm), for datasets whose photos carry none.
+    """
+
+    materials_file: str
+    model_psi: ModelPsi
+    fit_k_p: FitKp
+    psi0_deg: Mapping[str, float]
+    l0_mm: Mapping[str, float]
+
+
+@dataclass(frozen=True)
 class Group:
     """One comparison: the datasets of one material that share one l0 (one rms.csv row).
 
@@ -391,6 +419,8 @@ class Group:
         The one dataset of this group holds the material at several l0: no model curve fits.
     note : str
         Why the model columns are empty, or an empty string.
+    materials_file : str
+        The datasets' own materials file (:class:`DatasetModel`); empty: the run's model.
     """
 
     material: str
@@ -399,13 +429,19 @@ class Group:
     datasets: tuple[str, ...]
     mixed: bool = False
     note: str = ""
+    materials_file: str = ""
 
     @property
     def curve(self) -> str:
-        """Label of the row and of its model curve, e.g. ``"SS50, l0 220 mm"``."""
+        """Label of the row and of its model curve, e.g. ``"SS50, l0 220 mm"``.
+
+        A dataset's own materials file is named in it: ``"SS50, l0 240 mm, materials soft.yaml"``.
+        """
         if self.mixed:
-            return f"{self.material}, {' + '.join(self.datasets)} (several l0)"
-        return self.material if self.l0_mm is None else f"{self.material}, l0 {self.l0_mm:g} mm"
+            base = f"{self.material}, {' + '.join(self.datasets)} (several l0)"
+        else:
+            base = self.material if self.l0_mm is None else f"{self.material}, l0 {self.l0_mm:g} mm"
+        return f"{base}, materials {self.materials_file}" if self.materials_file else base
 
 
 def comparison_groups(
@@ -413,6 +449,7 @@ def comparison_groups(
     angles: pd.DataFrame | None,
     default_l0_mm: Mapping[str, float] | None = None,
     default_l0_source: str = "materials file",
+    dataset_models: Mapping[str, DatasetModel] | None = None,
 ) -> list[Group]:
     """Split the (dataset, material) pairs of ``hyst`` into comparisons of one material and one l0.
 
@@ -427,18 +464,25 @@ def comparison_groups(
         gets ``l0_mm=None`` (the model's own default, source ``"model default"``).
     default_l0_source : str
         Where ``default_l0_mm`` comes from (shown in ``l0_source``).
+    dataset_models : mapping of str to DatasetModel, optional
+        The own materials file of some datasets: their default l0 is that file's (source
+        ``"dataset's materials file"``) and they pool only with datasets of the same file.
 
     Returns
     -------
     list of Group
-        Sorted by material, the default l0 first, then by l0; a dataset holding one material
-        at several l0 is a group of its own (``mixed``) with the reason in ``note``.
+        Sorted by material, the run's model before datasets' own files, the default l0 first,
+        then by l0; a dataset holding one material at several l0 is a group of its own
+        (``mixed``) with the reason in ``note``.
     """
     defaults = dict(default_l0_mm or {})
+    own = dict(dataset_models or {})
     pairs = hyst[["dataset", "material"]].astype(str).drop_duplicates()
     have_l0 = angles is not None and "l0_mm" in angles.columns
     found: dict[tuple[Any, ...], Group] = {}
     for dataset, material in pairs.itertuples(index=False):
+        fm = own.get(dataset)
+        mfile = fm.materials_file if fm else ""
         l0s: list[float] = []
         if have_l0:
             sel = angles[(angles["dataset"].astype(str) == dataset) & (angles["material"].astype(str) == material)]
@@ -451,27 +495,33 @@ def comparison_groups(
                 "curve fits them; split the photo set into one dataset per l0 to compare with the model"
             )
             found[(material, "several", dataset)] = Group(
-                material, None, "several l0 in one dataset", (dataset,), mixed=True, note=note
+                material, None, "several l0 in one dataset", (dataset,), mixed=True, note=note,
+                materials_file=mfile,
             )
             continue
         if l0s:
             l0, source = l0s[0], "photo set"
-        elif material in defaults:
+        elif fm is not None and material in fm.l0_mm:
+            l0, source = float(fm.l0_mm[material]), "dataset's materials file"
+        elif fm is None and material in defaults:
             l0, source = float(defaults[material]), default_l0_source
         else:
             l0, source = None, "model default"
-        key = (material, l0)
+        key = (material, l0, mfile)
         prev = found.get(key)
         if prev is None:
-            found[key] = Group(material, l0, source, (dataset,))
+            found[key] = Group(material, l0, source, (dataset,), materials_file=mfile)
         else:
             sources = prev.l0_source.split(" + ")
             merged = " + ".join(sources + ([source] if source not in sources else []))
-            found[key] = Group(material, l0, merged, prev.datasets + (dataset,))
+            found[key] = Group(material, l0, merged, prev.datasets + (dataset,), materials_file=mfile)
+    file_l0 = {fm.materials_file: fm.l0_mm for fm in own.values()}
 
-    def order(g: Group) -> tuple[str, int, float]:
+    def order(g: Group) -> tuple[str, int, str, int, float]:
         l0 = math.inf if g.l0_mm is None else g.l0_mm
-        return g.material, 0 if (g.l0_mm is None or g.l0_mm == defaults.get(g.material)) else 1, l0
+        default = file_l0.get(g.materials_file, {}) if g.materials_file else defaults
+        return (g.material, 1 if g.materials_file else 0, g.materials_file,
+                0 if (g.l0_mm is None or g.l0_mm == default.get(g.material)) else 1, l0)
 
     return sorted(found.values(), key=order)
 
@@ -500,6 +550,8 @@ def compare(
     n_boot: int = 200,
     seed: int = 0,
     include_flagged: bool = False,
+    materials_file: str = "",
+    dataset_models: Mapping[str, DatasetModel] | None = None,
 ) -> pd.DataFrame:
     """rms.csv: one row per material and l0 (see the module docstring and :func:`compare_material`).
 
@@ -529,6 +581,11 @@ def compare(
         What in the model is fitted to the paper's numbers (``model_fit`` column).
     n_boot, seed, include_flagged
         Bootstrap resamples, its seed, and whether flagged rows enter the k_P fit.
+    materials_file : str
+        The materials file of the model above (for ``materials_file``).
+    dataset_models : mapping of str to DatasetModel, optional
+        Datasets with their own materials file: they are compared against that file's model
+        (its callables, psi0 and l0) instead of the one above, in rows of their own.
 
     Returns
     -------
@@ -548,18 +605,22 @@ def compare(
     rows_all = None if angles is None else included_rows(angles, include_flagged)
     psi0 = dict(psi0_deg or {})
     sources = dict(data_sources or {})
+    own = dict(dataset_models or {})
+    by_file = {fm.materials_file: fm for fm in own.values()}
     records = []
-    for group in comparison_groups(hyst, angles, dict(default_l0_mm or {}), default_l0_source):
+    for group in comparison_groups(hyst, angles, dict(default_l0_mm or {}), default_l0_source, own):
         material, l0 = group.material, group.l0_mm
+        fm = by_file.get(group.materials_file)
+        run_psi, run_fit, run_psi0 = (fm.model_psi, fm.fit_k_p, fm.psi0_deg) if fm else (model_psi, fit_k_p, psi0)
         in_group = hyst["dataset"].isin(group.datasets) & (hyst["material"].astype(str) == material)
         hm = pool_hysteresis(hyst[in_group].drop(columns="dataset"))
         rows = None
         if rows_all is not None:
             rows = rows_all[rows_all["dataset"].isin(group.datasets) & (rows_all["material"].astype(str) == material)]
         usable = not group.mixed
-        psi_fn = (lambda m, p, l0=l0: model_psi(m, p, l0)) if model_psi is not None and usable else None
-        fit_fn = (lambda m, p, s, l0=l0: fit_k_p(m, p, s, l0)) if fit_k_p is not None and usable else None
-        kwargs = dict(psi0_deg=float(psi0.get(material, 210.0)), n_boot=n_boot, seed=seed)
+        psi_fn = (lambda m, p, l0=l0, f=run_psi: f(m, p, l0)) if run_psi is not None and usable else None
+        fit_fn = (lambda m, p, s, l0=l0, f=run_fit: f(m, p, s, l0)) if run_fit is not None and usable else None
+        kwargs = dict(psi0_deg=float(run_psi0.get(material, 210.0)), n_boot=n_boot, seed=seed)
         note = group.note
         try:
             rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)
@@ -572,7 +633,7 @@ def compare(
         data = [sources.get(d, "unknown") for d in group.datasets]
         rec.update(
             curve=group.curve, datasets=" + ".join(group.datasets), l0_mm=math.nan if l0 is None else l0,
-            l0_source=group.l0_source,
+            l0_source=group.l0_source, materials_file=group.materials_file or materials_file,
             data_source=" + ".join(sorted(set(data))), rms_kind=rms_kind(data), model_fit=model_fit, note=note,
         )
         records.append(rec)
@@ -627,3 +688,26 @@ def model_callables(
         return model.fit_k_p(_material(name), pressure_kpa, psi_deg, l0_mm=l0, **readings)
 
     return model_psi, fit, {n: float(m.psi0_deg) for n, m in table.items()}
+
+
+def file_model(materials_path: str, **options: Any) -> DatasetModel:
+    """:class:`DatasetModel` of one materials file (a dataset's own), with the run's readings.
+
+    Parameters
+    ----------
+    materials_path : str
+        The materials YAML, as the config names it.
+    **options
+        Model readings, as :func:`model_callables` (``l0_mm`` is not this file's l0: the file's
+        own l0 is used for datasets whose photos carry none).
+
+    Raises
+    ------
+    UserInputError
+        If the file cannot be read or an option is bad.
+    """
+    from pipeline import model
+
+    table = model.load_materials(materials_path)
+    model_psi, fit, psi0 = model_callables(materials_path, **options)
+    return DatasetModel(materials_path, model_psi, fit, psi0, {n: float(m.l0_mm) for n, m in table.items()})

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.aggregate import read_angles
-from pipeline.compare import check_hysteresis, compare, model_callables
+from pipeline.compare import check_hysteresis, compare, file_model, model_callables
 from pipeline.errors import UserInputError
 from pipeline.model.cli import add_reading_arguments, reading_options
 from pipeline.fileio import atomic_write_bytes, read_table
@@ -38,6 +38,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--materials", type=str, default=None, metavar="PATH",
         help="materials YAML for the model (default: the packaged DS20/DS30/SS40/SS50 file)",
     )
+    parser.add_argument(
+        "--dataset-materials", nargs="+", default=None, metavar="PATH",
+        help="each dataset's own materials YAML, same order as --datasets ('-' for --materials): that "
+        "dataset is compared against its file's model (Ogden terms, k_P, k_t, geometry; l0 unless its "
+        "angles.csv has l0_mm), in rows of its own",
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of the k_P bootstrap (integer; default 0)")
     parser.add_argument(
         "--bootstrap", "--n-boot", dest="n_boot", type=int, default=200, metavar="N",
@@ -55,8 +61,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--curves", type=Path, default=None, metavar="FILE",
-        help="also write the model curve of every rms.csv row (curve, material, l0_mm in mm, psi_deg, "
-        "pressure_kpa in kPa, reason): the curve each RMS was computed against",
+        help="also write the model curve of every rms.csv row (curve, material, l0_mm in mm, materials_file, "
+        "psi_deg, pressure_kpa in kPa, reason): the curve each RMS was computed against",
     )
     parser.add_argument(
         "--include-flagged", action="store_true",
@@ -128,6 +134,29 @@ def write_csv(table: pd.DataFrame, path: Path) -> None:
     atomic_write_bytes(path, buf.getvalue().encode("utf-8"))
 
 
+#: ``materials_file`` of rows compared against the packaged materials (no machine path in rms.csv)
+PACKAGED = "packaged (pipeline/model/materials.yaml)"
+
+
+def own_files(args: argparse.Namespace, names: list[str], pooled: bool) -> dict[str, str]:
+    """Dataset name -> its own materials file, from ``--dataset-materials`` ('-': none)."""
+    given = args.dataset_materials
+    if given is None:
+        return {}
+    if len(given) != len(names):
+        raise UserInputError(
+            f"--dataset-materials has {len(given)} file(s) but {len(names)} HYSTERESIS.csv file(s) were "
+            "given; pass one per dataset in the same order ('-' for the run's --materials)"
+        )
+    out = {n: f for n, f in zip(names, given, strict=True) if f != "-"}
+    if out and pooled:
+        raise UserInputError(
+            "--dataset-materials needs one ANGLES.csv per dataset (--angles in the order of the "
+            "HYSTERESIS.csv files): otherwise the angles cannot be told apart by dataset"
+        )
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
     """Compare and write rms.csv (and the model curves); print a one-line summary per row."""
     from pipeline import model
@@ -145,6 +174,8 @@ def run(args: argparse.Namespace) -> int:
         frames.append(read_hysteresis([path]).assign(dataset=name))
     hyst = pd.concat(frames, ignore_index=True)
     angles = None
+    pooled = bool(args.angles) and len(args.angles) != len(names)
+    own = own_files(args, names, pooled)
     if args.angles:
         if len(args.angles) == len(names):  # the i-th angles.csv belongs to the i-th dataset
             angles = pd.concat([read_angles([a]).assign(dataset=n) for a, n in zip(args.angles, names, strict=True)],
@@ -159,28 +190,34 @@ def run(args: argparse.Namespace) -> int:
     given_l0 = options.get("l0_mm")
     default_l0 = {n: float(given_l0) if given_l0 is not None else m.l0_mm for n, m in table_m.items()}
     sources = dict(zip(names, [data_source(f) for f in args.photosets], strict=True)) if args.photosets else {}
+    files = {f: file_model(f, **options) for f in sorted(set(own.values()))}
+    tables = {"": table_m, **{f: model.load_materials(f) for f in files}}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         table = compare(
             hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, default_l0_mm=default_l0,
             default_l0_source="--l0-mm" if given_l0 is not None else "materials file", data_sources=sources,
             model_fit=model_fit_text(options), n_boot=args.n_boot, seed=args.seed,
-            include_flagged=args.include_flagged,
+            include_flagged=args.include_flagged, materials_file=args.materials or PACKAGED,
+            dataset_models={n: files[f] for n, f in own.items()},
         )
     for w in caught:
         print(f"warning: {w.message}")
     write_csv(table, args.out)
     if args.curves is not None:
         readings = {k: v for k, v in options.items() if k != "l0_mm"}
+        own_file = {r.curve: r.materials_file if r.materials_file in files else "" for r in table.itertuples()}
         curves = [
-            model.model_curve(table_m[r.material], l0_mm=r.l0_mm, **readings).assign(curve=r.curve)
+            model.model_curve(tables[own_file[r.curve]][r.material], l0_mm=r.l0_mm, **readings).assign(
+                curve=r.curve, materials_file=r.materials_file)
             for r in table.itertuples()
-            if r.material in table_m and np.isfinite(r.l0_mm)
+            if r.material in tables[own_file[r.curve]] and np.isfinite(r.l0_mm)
         ]
-        columns = ["curve", "material", "l0_mm", "psi_deg", "pressure_kpa", "reason"]
+        columns = ["curve", "material", "l0_mm", "materials_file", "psi_deg", "pressure_kpa", "reason"]
         out = pd.concat(curves, ignore_index=True)[columns] if curves else pd.DataFrame(columns=columns)
         write_csv(out, args.curves)
     for r in table.itertuples():
-        print(f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; {r.rms_kind}]: RMS {r.rms_deg:.1f} deg")
+        print(f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; materials {r.materials_file}; {r.rms_kind}]: "
+              f"RMS {r.rms_deg:.1f} deg")
     print(f"compare: {len(table)} comparison(s) -> {args.out}" + (f", curves -> {args.curves}" if args.curves else ""))
     return 0

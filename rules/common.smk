@@ -113,7 +113,22 @@ def dataset_materials(ds):
     return []
 
 
-MATERIALS = sorted({m for ds in DATASETS.values() for m in dataset_materials(ds)})
+def materials_file(ds):
+    """The materials file of a dataset's model: its own, else model.materials_file (None: packaged)."""
+    return ds.get("materials_file") or config["model"]["materials_file"]
+
+
+# Model curves: one per material in results/model/ for datasets on the run's materials file, and one
+# per material of each dataset with its own file under its results folder (never the same path).
+MATERIALS = sorted({m for ds in DATASETS.values() if not ds.get("materials_file") for m in dataset_materials(ds)})
+OWN_MODEL_CURVES = [
+    f"{RESULTS}/datasets/{name}/model/{m}.csv"
+    for name, ds in DATASETS.items()
+    if ds.get("materials_file")
+    for m in dataset_materials(ds)
+]
+# every materials file the run reads: an input of the jobs that use it, so an edit re-runs them
+MATERIALS_FILES = sorted({f for f in [config["model"]["materials_file"]] + [materials_file(d) for d in DATASETS.values()] if f})
 
 
 def per_dataset(pattern):
@@ -125,6 +140,12 @@ def materials_option():
     """`--materials FILE` when the config names a materials file."""
     path = config["model"]["materials_file"]
     return ["--materials", path] if path else []
+
+
+def dataset_materials_option():
+    """`--dataset-materials FILE|- ...` (one per dataset, in config order) when a dataset has its own file."""
+    files = [ds.get("materials_file") or "-" for ds in DATASETS.values()]
+    return ["--dataset-materials", *files] if any(f != "-" for f in files) else []
 
 
 def model_readings_option():

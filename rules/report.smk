@@ -8,7 +8,9 @@ rule report:
         rms=f"{RESULTS}/rms.csv",
         config=f"{RESULTS}/config.resolved.yaml",
         curves=expand(f"{RESULTS}/model/{{material}}.csv", material=MATERIALS)
+        + OWN_MODEL_CURVES
         + [f"{RESULTS}/compare_curves.csv"],
+        materials=MATERIALS_FILES,
         bench=f"{RESULTS}/bench/default" if config["bench"]["in_report"] else [],
         force=FORCE_OUTPUTS,
         video=VIDEO_CONTINUOUS,
@@ -21,6 +23,7 @@ rule report:
         bench=lambda wc, input: ["--bench-dir", input.bench] if input.bench else [],
         force=["--force-dir", f"{RESULTS}/force"] if FORCE_OUTPUTS else [],
         video=lambda wc, input: ["--video-dirs", *input.video] if input.video else [],
+        materials=lambda wc, input: ["--materials-files", *input.materials] if input.materials else [],
         title=config["report"]["title"],
     log:
         log_file("report"),
@@ -36,7 +39,7 @@ rule report:
             "python -m pipeline report --datasets {params.names:q} --angles {input.angles:q}"
             " --hysteresis {input.hysteresis:q} --rms {input.rms:q} --model-curves {input.curves:q}"
             " --photosets {params.photosets:q} --overlays {params.overlays:q}"
-            " {params.bench:q} {params.force:q} {params.video:q} --config {input.config:q} --title {params.title:q}"
+            " {params.bench:q} {params.force:q} {params.video:q} {params.materials:q} --config {input.config:q} --title {params.title:q}"
             " --out {output:q}"
         )
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -277,7 +278,8 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
                  "--photosets", *(str(f) for f in folders), "--bootstrap", "0",
                  "--out", str(rms), "--curves", str(curves)]) == 0
     text = capsys.readouterr().out
-    assert "compare: SS50, l0 220 mm [short; l0 from photo set; self-check]" in text
+    assert ("compare: SS50, l0 220 mm [short; l0 from photo set; materials packaged (pipeline/model/materials.yaml); "
+            "self-check]") in text
     out = pd.read_csv(rms).set_index("datasets")
     default = model.load_materials()["SS50"].l0_mm
     assert out.loc["short", "l0_mm"] == 220.0 and out.loc["long", "l0_mm"] == default
@@ -294,11 +296,98 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
                  "--out", str(rms)]) == 2
 
 
+def test_a_dataset_with_its_own_materials_file_is_compared_against_that_files_model():
+    """Own file: its callables, psi0 and l0; pooled only with datasets of the same file; named in each row."""
+    from pipeline.compare import DatasetModel
+
+    angles = pd.concat([_angles("std", "SS50", np.nan), _angles("soft", "SS50", np.nan, psi_offset=7.0),
+                        _angles("soft2", "SS50", np.nan, psi_offset=7.0), _angles("short", "SS50", 220.0, psi_offset=7.0)],
+                       ignore_index=True)
+    calls = []
+
+    def own_model(material, p, l0_mm):
+        calls.append(("own", l0_mm))
+        return linear_model(material, p) + 7.0
+
+    def run_model(material, p, l0_mm):
+        calls.append(("run", l0_mm))
+        return linear_model(material, p)
+
+    soft = DatasetModel("lab/soft.yaml", own_model, ls_fit, {"SS50": 180.0}, {"SS50": 240.0})
+    out = compare(_hyst_of(angles), angles, model_psi=run_model, fit_k_p=None, psi0_deg={"SS50": 210.0},
+                  default_l0_mm={"SS50": 255.0}, materials_file="packaged",
+                  dataset_models={"soft": soft, "soft2": soft, "short": soft})
+    rows = out.set_index("curve")
+    assert list(out["curve"]) == ["SS50, l0 255 mm", "SS50, l0 240 mm, materials lab/soft.yaml",
+                                  "SS50, l0 220 mm, materials lab/soft.yaml"]
+    assert rows["datasets"].tolist() == ["std", "soft + soft2", "short"]
+    assert rows["materials_file"].tolist() == ["packaged", "lab/soft.yaml", "lab/soft.yaml"]
+    assert rows["l0_source"].tolist() == ["materials file", "dataset's materials file", "photo set"]
+    assert rows["psi0_deg"].tolist() == [210.0, 180.0, 180.0]  # the file's geometry
+    # each row met its own model exactly: std the run's, soft (+7 deg) its file's, at the file's or photo set's l0
+    np.testing.assert_allclose(out["rms_deg"], 0.0, atol=1e-12)
+    assert sorted(set(calls)) == [("own", 220.0), ("own", 240.0), ("run", 255.0)]
+    # without its own file the same data are 7 deg off the run's model
+    just_soft = angles[angles["dataset"] == "soft"]
+    plain = compare(_hyst_of(just_soft), just_soft, model_psi=run_model, fit_k_p=None, default_l0_mm={"SS50": 255.0})
+    assert plain["rms_deg"].tolist() == [pytest.approx(7.0)] and plain["curve"].tolist() == ["SS50, l0 255 mm"]
+
+
+SOFT_SS50 = ("geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
+             "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n")
+
+
+def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys):
+    """compare --dataset-materials: the real model of the dataset's file (half SS50's modulus, l0 240 mm)."""
+    from pipeline import model
+    from pipeline.cli import main
+
+    own = tmp_path / "soft.yaml"
+    own.write_text(SOFT_SS50)
+    soft = model.load_materials(own)["SS50"]
+    folders = []
+    for name in ("std", "soft"):
+        p = np.arange(0.0, 241.0, 40.0)
+        psi = model.psi_deg("SS50", p)  # both drawn from the packaged SS50 at its l0
+        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
+                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1}
+                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        folder = tmp_path / name
+        folder.mkdir()
+        pd.DataFrame(rows).to_csv(folder / "angles.csv", index=False)
+        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        folders.append(folder)
+    rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
+    args = ["compare", *(str(f / "hysteresis.csv") for f in folders), "--angles", *(str(f / "angles.csv") for f in folders),
+            "--datasets", "std", "soft", "--bootstrap", "0", "--out", str(rms), "--curves", str(curves)]
+    assert main([*args, "--dataset-materials", "-", str(own)]) == 0
+    assert f"materials {own}; " in capsys.readouterr().out
+    out = pd.read_csv(rms).set_index("datasets")
+    assert out.loc["std", "materials_file"] == "packaged (pipeline/model/materials.yaml)"
+    assert out.loc["soft", "materials_file"] == str(own) and out.loc["soft", "l0_mm"] == 240.0
+    assert out.loc["soft", "l0_source"] == "dataset's materials file"
+    assert out.loc["std", "rms_deg"] < 1e-3  # drawn from the packaged model
+    hyst = pd.read_csv(folders[1] / "hysteresis.csv")
+    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
+    expected = rms_deg(psi, model.psi_deg(soft, p, l0_mm=240.0))[0]
+    assert out.loc["soft", "rms_deg"] == pytest.approx(expected, rel=1e-4) and expected > 5.0
+    c = pd.read_csv(curves)
+    own_curve = c[c["curve"] == out.loc["soft", "curve"]]
+    assert len(own_curve) == 400 and (own_curve["materials_file"] == str(own)).all()
+    np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft, l0_mm=240.0)["pressure_kpa"],
+                               rtol=1e-5, atol=1e-9)
+    std_curve = c[c["curve"] == out.loc["std", "curve"]]
+    assert not np.allclose(std_curve["pressure_kpa"], own_curve["pressure_kpa"], equal_nan=True)
+    assert main([*args, "--dataset-materials", str(own)]) == 2  # one file per dataset, or '-'
+
+
 @pytest.mark.slow
 def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
-    """End to end (real snakemake, tiny config in a temporary folder): two SS50 photo sets, one of
+    """End to end (real snakemake, tiny config in a temporary folder): SS50 photo sets, one of
     an actuator with l0 = 220 mm; its model curve and its RMS use 220 mm, the other's the default,
-    and the report says which l0 each curve used and that synthetic RMS is a self-check."""
+    and the report says which l0 each curve used and that synthetic RMS is a self-check.  A third
+    set, the photos of 'short', names its own materials file (SS50 at half the modulus): its
+    model curve and RMS are that file's, the report names the file and its sha256."""
     import subprocess
     import sys
 
@@ -312,11 +401,13 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     assert main(["synth", str(short), "--material", "SS50", "--actuators", "1", "--trials", "1",
                  "--step-kpa", "80", "--max-kpa", "240", "--scene", "clean", "--set", "width=400",
                  "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
+    (tmp_path / "soft.yaml").write_text(SOFT_SS50)  # SS50 at mu 0.34 MPa; l0 240 mm, but the photos say 220
     config = {
         "datasets": [
             {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
              "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
             {"name": "short", "source": "folder", "path": str(short)},
+            {"name": "soft", "source": "folder", "path": str(short), "materials_file": "soft.yaml"},
         ],
         "compare": {"bootstrap": 5},
         "bench": {"in_report": False},
@@ -333,8 +424,31 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     rms = pd.read_csv(res / "rms.csv").set_index("datasets")
     assert rms.loc["short", "curve"] == "SS50, l0 220 mm" and rms.loc["short", "l0_mm"] == 220.0
     assert rms.loc["short", "l0_source"] == "photo set"
-    assert rms.loc["std", "l0_mm"] == default
+    assert rms.loc["std", "l0_mm"] == default == 255.0
     assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
+    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at their 220 mm
+    soft = model.load_materials(tmp_path / "soft.yaml")["SS50"]
+    assert soft.mu_mpa == (0.34,) and model.load_materials()["SS50"].mu_mpa == (0.68,)
+    assert rms.loc["soft", "curve"] == "SS50, l0 220 mm, materials soft.yaml" != rms.loc["short", "curve"]
+    assert rms.loc["soft", "materials_file"] == "soft.yaml" and rms.loc["soft", "l0_source"] == "photo set"
+    assert rms.loc["soft", "l0_mm"] == 220.0  # the photo set's l0 wins over the file's 240 mm
+    assert (rms.loc[["std", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)").all()
+    h_short = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
+    h_soft = pd.read_csv(res / "datasets" / "soft" / "hysteresis.csv")
+    pd.testing.assert_frame_equal(h_short, h_soft)  # same photos: any difference below is the model's
+    p_s, psi_s = h_soft["pressure_kpa"].to_numpy(float), h_soft["psi_mean_deg"].to_numpy(float)
+    at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s, l0_mm=220.0))[0]
+    assert rms.loc["soft", "rms_deg"] == pytest.approx(at_soft, rel=1e-4)
+    assert rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0  # drawn from the paper's SS50, not the soft one
+    # two datasets naming SS50 with different materials files: two model curves, neither overwritten
+    own_curve = pd.read_csv(res / "datasets" / "soft" / "model" / "SS50.csv")
+    run_curve = pd.read_csv(res / "model" / "SS50.csv")
+    np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9)
+    np.testing.assert_allclose(run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9)
+    assert not np.allclose(own_curve["pressure_kpa"], run_curve["pressure_kpa"], equal_nan=True)
+    soft_compared = pd.read_csv(res / "compare_curves.csv").query("curve == 'SS50, l0 220 mm, materials soft.yaml'")
+    np.testing.assert_allclose(soft_compared["pressure_kpa"], model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
+                               rtol=1e-5)
     # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
     hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
     p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
@@ -352,8 +466,25 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     doc.close()
     comparison = next(t for t in pages if "Model versus measurements, beside" in t)
     assert "photos rendered from this package's model, so the RMS is a self-check, not a validation" in comparison
+    assert "Materials file of the model curves: packaged (pipeline/model/materials.yaml) (std, short); soft.yaml (soft)" \
+        in comparison
     provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
     assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
+    assert "220 (photo set) soft.yaml" in provenance
+    import hashlib
+
+    inputs = next(t for t in pages if "Input files" in t)
+    assert hashlib.sha256((tmp_path / "soft.yaml").read_bytes()).hexdigest() in inputs.replace(" ", "")
+    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report), nothing else
+    with (tmp_path / "soft.yaml").open("a") as fh:
+        fh.write("# k_P re-measured\n")
+    dry = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
+                          str(tmp_path), "--cores", "2", "-n"], capture_output=True, text=True)
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    table = dry.stdout.split("Job stats:")[-1]
+    jobs = {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
+    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[-2000:]
     assert f"SS50, l0 {default:g} mm" in provenance
     material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
     assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material
+    assert "model, l0 220 mm, materials soft.yaml" in material

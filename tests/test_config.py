@@ -142,3 +142,62 @@ def test_scene_enums_are_the_synth_presets():
     props = load_schema()["properties"]
     dataset = props["datasets"]["items"]["properties"]
     assert dataset["scene"]["enum"] == list(SCENE_PRESETS)
+
+
+SOFT_SS50 = "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2}\ngeometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 240}\n"
+
+
+def _refused(config, workdir):
+    with pytest.raises(UserInputError) as exc:
+        validate_config(config, workdir=workdir)
+    assert "nothing was run" in str(exc.value)
+    return str(exc.value)
+
+
+def test_a_dataset_names_its_own_materials_file(tmp_path):
+    (tmp_path / "soft.yaml").write_text(SOFT_SS50)
+    cfg = validate_config({"datasets": [{"name": "soft", "source": "synthetic", "material": "SS50", "materials_file": "soft.yaml"},
+                                        {"name": "std", "source": "synthetic", "material": "SS50"}]}, workdir=tmp_path)
+    assert [d["materials_file"] for d in cfg["datasets"]] == ["soft.yaml", None]
+    assert cfg["model"]["materials_file"] is None  # the global file is untouched
+
+
+@pytest.mark.parametrize("text, message", [
+    (None, "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' does not exist (relative to"),
+    ("materials: [unclosed\n", "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' cannot be used: "),
+    ("materials:\n  SS50: {mu_mpa: [0.3], alpha: [2.0]}\n", "missing key 'k_p'"),
+    ("materials:\n  EF30: {mu_mpa: [0.05], alpha: [2.0], k_p: 2.0}\ngeometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 220}\n",
+     "datasets[1].materials_file (dataset 'soft'): material 'SS50' (named by the dataset) is not in 'soft.yaml', which holds ['EF30']; add 'SS50' to that file"),
+])
+def test_a_bad_dataset_materials_file_is_refused_naming_key_dataset_and_fix(tmp_path, text, message):
+    if text is not None:
+        (tmp_path / "soft.yaml").write_text(text)
+    out = _refused({"datasets": [{"name": "std", "source": "synthetic", "material": "SS50"},
+                                 {"name": "soft", "source": "synthetic", "material": "SS50", "materials_file": "soft.yaml"}]},
+                   tmp_path)
+    assert message in out
+    assert "datasets[0]" not in out  # the other dataset is fine
+    if text is None:
+        assert "fix the path, or set it to null for model.materials_file" in out
+    elif "unclosed" in text:
+        assert "not valid YAML" in out and "fix the syntax" in out
+
+
+def test_a_folder_dataset_materials_file_must_hold_the_manifests_materials(tmp_path, repo):
+    (tmp_path / "soft.yaml").write_text(SOFT_SS50)
+    folder = {"name": "sample", "source": "folder", "path": str(repo / "sample_images"), "materials_file": "soft.yaml"}
+    out = _refused({"datasets": [folder]}, tmp_path)
+    assert "datasets[0].materials_file (dataset 'sample'): material 'DS20' (named by the dataset) is not in 'soft.yaml'" in out
+    (tmp_path / "soft.yaml").write_text(SOFT_SS50.replace("SS50", "DS20"))
+    assert validate_config({"datasets": [folder]}, workdir=tmp_path)["datasets"][0]["materials_file"] == "soft.yaml"
+
+
+def test_a_bad_global_materials_file_is_refused_and_synthetic_sets_need_a_packaged_material(tmp_path):
+    (tmp_path / "bad.yaml").write_text("materials: [unclosed\n")
+    out = _refused({"datasets": [{"name": "a", "source": "synthetic", "material": "SS50"}],
+                    "model": {"materials_file": "bad.yaml"}}, tmp_path)
+    assert "model.materials_file: materials file 'bad.yaml' cannot be used" in out and "not valid YAML" in out
+    (tmp_path / "own.yaml").write_text(SOFT_SS50.replace("SS50", "EF30"))
+    out = _refused({"datasets": [{"name": "a", "source": "synthetic", "material": "EF30", "materials_file": "own.yaml"}]},
+                   tmp_path)
+    assert "datasets[0].material: synthetic photos are rendered from the packaged model, which has no material 'EF30'" in out

@@ -48,6 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="output folder of 'python -m pipeline force'; adds the blocked-force, eccentricity and grasp pages")
     parser.add_argument("--video-dirs", nargs="+", type=Path, default=(), metavar="DIR",
                         help="'continuous --out-dir' folder of each video dataset (named as the dataset); adds its page")
+    parser.add_argument("--materials-files", nargs="+", type=Path, default=(), metavar="YAML",
+                        help="materials files the model curves were computed from (the run's and the datasets' own); "
+                        "listed with their sha256 on the provenance page")
     parser.add_argument("--config", type=Path, default=None, metavar="FILE",
                         help="workflow config file; its sha256 is printed on the provenance page")
     parser.add_argument("--title", default="Circular actuator characterisation",
@@ -98,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
         bench_dir=args.bench_dir,
         force_dir=args.force_dir,
         video_dirs=tuple(args.video_dirs),
+        materials_files=tuple(args.materials_files),
         config=args.config,
         title=args.title,
     )

@@ -68,6 +68,7 @@ class ReportInputs:
     bench_dir: Path | None = None
     force_dir: Path | None = None
     video_dirs: tuple[Path, ...] = ()
+    materials_files: tuple[Path, ...] = ()
     config: Path | None = None
     title: str = "Circular actuator characterisation"
 
@@ -273,6 +274,7 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
     files += [("hysteresis", p) for p in inputs.hysteresis]
     files += [("comparison", p) for p in inputs.rms]
     files += [("model curve", p) for p in inputs.model_curves]
+    files += [("materials file", p) for p in inputs.materials_files]
     for role, folder, names in (("bench", inputs.bench_dir, BENCH_TABLES), ("force", inputs.force_dir, FORCE_FILES)):
         if folder is not None:
             files += [(role, folder / n) for n in names if (folder / n).is_file()]

@@ -3,7 +3,7 @@
 The comparison page gets a note naming the self-checks (:func:`comparison_note`); the page
 after it (:func:`model_provenance_page`) lists every comparison.  Everything here reads rms.csv
 columns written by ``compare`` (``curve``, ``datasets``, ``l0_mm``,
-``l0_source``, ``data_source``, ``rms_kind``, ``model_fit``, ``note``) and the model curves
+``l0_source``, ``materials_file``, ``data_source``, ``rms_kind``, ``model_fit``, ``note``) and the model curves
 (``compare_curves.csv`` carries ``curve`` and ``l0_mm``); a table without them (an older
 rms.csv) gives no lines rather than an error.
 """
@@ -45,7 +45,13 @@ def comparison_note(data: ReportData) -> str:
         names = ", ".join(f"{r.curve} ({r.datasets})" for r in checks.itertuples())
         parts.append(f"Synthetic: {names}: photos rendered from this package's model, so the RMS "
                      "is a self-check, not a validation.")
-    parts.append("Which l0 each model curve used, and what was fitted: next page.")
+    if _has(data, "materials_file"):
+        files: dict[str, list[str]] = {}
+        for r in data.rms.itertuples():
+            files.setdefault(str(r.materials_file), []).append(str(r.datasets))
+        parts.append("Materials file of the model curves: " + "; ".join(
+            f"{f} ({', '.join(dict.fromkeys(d))})" for f, d in files.items()) + ".")
+    parts.append("Which l0 and materials file each model curve used, and what was fitted: next page.")
     return " ".join(parts)
 
 
@@ -56,6 +62,7 @@ def _row_cells(r: pd.Series) -> tuple[str, ...]:
         str(r.get("curve", r["material"])),
         str(r.get("datasets", "")),
         f"{l0} ({r.get('l0_source', NA)})",
+        str(r.get("materials_file", NA)),
         str(r.get("data_source", NA)),
         fmt(r.get("rms_deg"), 1),
         fmt(r.get("paper_rms_deg"), 1),
@@ -79,9 +86,10 @@ def model_provenance_page(data: ReportData) -> Figure | None:
     rows = tuple(_row_cells(r) for _, r in data.rms.iterrows())
     flow.table(Table(
         columns=(Column("comparison (model curve)", "left"), Column("datasets", "left", wrap_pt=160.0),
-                 Column("l0 (mm, from)", "left"), Column("photos", "left"), Column("run"), Column("paper"),
+                 Column("l0 (mm, from)", "left"), Column("materials file", "left", wrap_pt=120.0),
+                 Column("photos", "left"), Column("run"), Column("paper"),
                  Column("RMS is", "left"), Column("fitted [95 % CI]"), Column("paper")),
-        groups=(("", 4), ("RMS (deg)", 2), ("", 1), ("k_P (-)", 2)),
+        groups=(("", 5), ("RMS (deg)", 2), ("", 1), ("k_P (-)", 2)),
         rows=rows, size=8.0))
     fit = sorted({str(v) for v in data.rms.get("model_fit", pd.Series(dtype=str)).dropna()})
     lines = [
@@ -91,8 +99,10 @@ def model_provenance_page(data: ReportData) -> Figure | None:
         "actuators): it is a fit, not an agreement.",
         "Constants of the model fitted to the paper's own numbers: " + ("; ".join(fit) or NA) + ".",
         "l0: 'photo set' is the marked length the photos were measured with (angles.csv); 'materials file' "
-        "is the model's default, the one parameter the paper's two model results fix (docs/model.md).",
-        "A dataset whose l0 differs from the default has its own model curve and row.",
+        "is the model's default, the one parameter the paper's two model results fix (docs/model.md); "
+        "'dataset's materials file' is the l0 of the dataset's own materials file (config datasets[].materials_file).",
+        "Materials file: the Ogden terms, k_P, k_t and geometry of the curve (its sha256: provenance page).  "
+        "A dataset whose l0 or materials file differs from the default has its own model curve and row.",
     ]
     for r in data.rms.itertuples():
         kind = str(getattr(r, "rms_kind", ""))

@@ -46,15 +46,24 @@ STRIP_BAND_PT = 118.0
 CURVE_STYLES: tuple[object, ...] = ("--", ":", "-.", (0, (5, 1, 1, 1)))
 
 
+def own_file_label(curve: pd.DataFrame) -> str:
+    """``", materials FILE"`` for a compare curve of a dataset's own materials file, else ``""``."""
+    if "materials_file" not in curve.columns:
+        return ""
+    suffix = f", materials {curve['materials_file'].iloc[0]}"
+    return suffix if str(curve["curve"].iloc[0]).endswith(suffix) else ""
+
+
 def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple[str, np.ndarray, np.ndarray, object]]:
     """Model curves of ``material`` to draw: ``(label, pressure, psi, linestyle)``, psi order.
 
-    The curves ``compare`` used (``curve`` column: one per l0, labelled with it) when present,
+    The curves ``compare`` used (``curve`` column: one per l0 and materials file, labelled with
+    them) when present,
     else the plain model curve.  Pressures outside [0, ``p_max_kpa``] are NaN (not drawn).
     """
     c = data.model_curves[data.model_curves["material"].astype(str) == material]
     if "curve" in c.columns and c["curve"].notna().any():
-        groups = [(g, f"model, l0 {float(g['l0_mm'].iloc[0]):g} mm")
+        groups = [(g, f"model, l0 {float(g['l0_mm'].iloc[0]):g} mm" + own_file_label(g))
                   for _, g in c[c["curve"].notna()].groupby("curve", sort=False)]
     else:
         groups = [(c, "analytical model")] if len(c) else []
