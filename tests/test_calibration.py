@@ -23,10 +23,9 @@ from pipeline.measure.calibration import (
     PlaneCalibration,
     calibrate_views,
     find_board,
-    plane_centreline,
     read_store,
 )
-from pipeline.measure.core import measure_image
+from pipeline.measure.core import measure_image, plane_centreline
 from pipeline.measure.extract import LineExtraction
 from pipeline.measure.settings import SettingsError, resolve_settings
 from pipeline.photoset import load_photoset, validate_photoset, write_settings

@@ -8,8 +8,8 @@ radial distortion k1 about the image centre from one photo; k2 as well from thre
 the homography from the undistorted image to the board's plane (``findHomography``).  The
 result, a :class:`PlaneCalibration`, maps image points to the plane.
 
-Only the extracted centre line is mapped (:func:`plane_centreline`, called by
-:mod:`pipeline.measure.core` once the line is ready), never the image: a few hundred points cost
+Only the extracted centre line is mapped (:func:`pipeline.measure.core.plane_centreline`, once
+the line is ready), never the image: a few hundred points cost
 microseconds.  The plane frame is scaled to *plane pixels* of :attr:`PlaneCalibration.mm_per_px`
 mm and turned to match the photo at the board's centre, so every downstream number (lengths,
 residuals, the ramp check) keeps its pixel meaning while psi, the curvature and ``length_mm``
@@ -49,15 +49,11 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-
-if TYPE_CHECKING:  # pragma: no cover - types only (settings imports this module)
-    from pipeline.measure.extract import LineExtraction
-    from pipeline.measure.settings import MeasureSettings
 
 #: a calibration whose reprojection error is above this (px) is doubtful: every row using it is flagged
 MAX_RMS_PX = 1.0
@@ -422,7 +418,7 @@ class CalibrationCache:
 
 
 # --------------------------------------------------------------------------------------------
-# measuring on the plane (the one hook in pipeline.measure.core)
+# measuring on the plane (pipeline.measure.core.plane_centreline maps the centre line)
 
 
 def check_size(plane: PlaneCalibration, shape: Sequence[int], scale: float, board: str = "the board photo") -> None:
@@ -442,67 +438,6 @@ def check_size(plane: PlaneCalibration, shape: Sequence[int], scale: float, boar
         raise CalibrationMismatch(
             f"the photo is {round(shape[1] * scale)}x{round(shape[0] * scale)} px but {board} is {w}x{h} px: "
             "calibrate with a board photo taken by this camera at this resolution")
-
-
-def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float]) -> NDArray[np.float64]:
-    """The two ends of the measured line: the first/last point carried on by the trimmed lengths."""
-    out = []
-    for end, nxt, trim in ((points[0], points[min(3, len(points) - 1)], trimmed_px[0]),
-                           (points[-1], points[max(len(points) - 4, 0)], trimmed_px[1])):
-        d = end - nxt
-        n = float(np.hypot(*d))
-        out.append(end + (d / n * trim if n > 0 else 0.0))
-    return np.asarray(out)
-
-
-def plane_centreline(
-    line: LineExtraction, settings: MeasureSettings, shape: Sequence[int], scale: float
-) -> tuple[NDArray[np.float64], tuple[float, float], MeasureSettings]:
-    """The centre line as the estimators take it: y up, and on the plane when the photo is calibrated.
-
-    Parameters
-    ----------
-    line : LineExtraction
-        The extracted (and refined) centre line, original image px.
-    settings : MeasureSettings
-        The photo's settings.
-    shape : sequence of int
-        Shape of the work image (rows, columns, ...).
-    scale : float
-        Original px per work px.
-
-    Returns
-    -------
-    points : ndarray (N, 2)
-        Centre line in a y-up frame: image px, or plane px when calibrated.
-    ends_px : (float, float)
-        Length of the line beyond the first and the last point, in the same units.
-    settings : MeasureSettings
-        Unchanged without a calibration; else with ``mm_per_px`` the plane px size and
-        ``fixed_direction_deg`` turned to the plane.
-
-    Raises
-    ------
-    CalibrationMismatch
-        When the photo has another resolution than the board photo.
-    """
-    flip = np.array([1.0, -1.0])
-    cal = settings.calibration
-    if cal is None or cal.plane is None:
-        return line.centreline_px * flip, line.trimmed_px, settings
-    plane = cal.plane
-    check_size(plane, shape, scale, f"the board photo {Path(cal.boards[0]).name}")
-    pts = line.centreline_px
-    q = plane.to_plane(pts)
-    ends_img = _extended_ends(pts, line.trimmed_px)
-    ends_q = plane.to_plane(ends_img)
-    ends = (float(np.hypot(*(ends_q[0] - q[0]))), float(np.hypot(*(ends_q[1] - q[-1]))))
-    direction = settings.fixed_direction_deg
-    if direction is not None:
-        a = np.deg2rad(direction)
-        d = plane.to_plane([pts[0], pts[0] + 10.0 * np.array([np.cos(a), -np.sin(a)])])
-        direction = float(np.rad2deg(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0])))
-    return q * flip, ends, replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction)
 
 
 def rectify(image: NDArray[np.uint8], plane: PlaneCalibration, scale: float = 1.0) -> NDArray[np.uint8]:

@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import functools
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
 import numpy as np
+from numpy.typing import NDArray
 
-from pipeline.measure.calibration import CalibrationMismatch, plane_centreline
+from pipeline.measure.calibration import CalibrationMismatch, check_size
 from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.quality import assess, assess_body
@@ -194,6 +196,68 @@ def measure_work_image(
         degree=int(est.degree),
         length_px=float(est.length_px),
     )
+
+
+def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float]) -> NDArray[np.float64]:
+    """The two ends of the measured line: the first/last point carried on by the trimmed lengths."""
+    out = []
+    for end, nxt, trim in ((points[0], points[min(3, len(points) - 1)], trimmed_px[0]),
+                           (points[-1], points[max(len(points) - 4, 0)], trimmed_px[1])):
+        d = end - nxt
+        n = float(np.hypot(*d))
+        out.append(end + (d / n * trim if n > 0 else 0.0))
+    return np.asarray(out)
+
+
+def plane_centreline(
+    line: LineExtraction, settings: MeasureSettings, shape: Sequence[int], scale: float
+) -> tuple[NDArray[np.float64], tuple[float, float], MeasureSettings]:
+    """The centre line as the estimators take it: y up, and on the plane when the photo is calibrated.
+
+    Parameters
+    ----------
+    line : LineExtraction
+        The extracted (and refined) centre line, original image px.
+    settings : MeasureSettings
+        The photo's settings.
+    shape : sequence of int
+        Shape of the work image (rows, columns, ...).
+    scale : float
+        Original px per work px.
+
+    Returns
+    -------
+    points : ndarray (N, 2)
+        Centre line in a y-up frame: image px, or plane px when calibrated.
+    ends_px : (float, float)
+        Length of the line beyond the first and the last point, in the same units.
+    settings : MeasureSettings
+        Unchanged without a calibration; else with ``mm_per_px`` the plane px size and
+        ``fixed_direction_deg`` turned to the plane.
+
+    Raises
+    ------
+    CalibrationMismatch
+        When the photo has another resolution than the board photo.
+    """
+    flip = np.array([1.0, -1.0])
+    cal = settings.calibration
+    if cal is None or cal.plane is None:
+        return line.centreline_px * flip, line.trimmed_px, settings
+    plane = cal.plane
+    check_size(plane, shape, scale, f"the board photo {Path(cal.boards[0]).name}")
+    pts = line.centreline_px
+    q = plane.to_plane(pts)
+    ends_img = _extended_ends(pts, line.trimmed_px)
+    ends_q = plane.to_plane(ends_img)
+    ends = (float(np.hypot(*(ends_q[0] - q[0]))), float(np.hypot(*(ends_q[1] - q[-1]))))
+    direction = settings.fixed_direction_deg
+    if direction is not None:
+        a = np.deg2rad(direction)
+        d = plane.to_plane([pts[0], pts[0] + 10.0 * np.array([np.cos(a), -np.sin(a)])])
+        direction = float(np.rad2deg(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0])))
+    return q * flip, ends, replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction)
+
 
 
 @functools.lru_cache(maxsize=4)
