@@ -8,7 +8,8 @@ folder-wide value for that row (``fixed_end`` becomes ``fixed_end_x`` / ``fixed_
 row into a :class:`~pipeline.measure.settings.MeasureSettings` -- or into the problems that
 prevent it, so one bad row is one ``failed`` measurement and the rest of the set is measured.
 Only a set that cannot be read at all (no folder, bad YAML, no manifest, missing columns) is
-refused.  :func:`validate_photoset` (``photoset check``) lists every problem, strictly.
+refused.  :func:`validate_photoset` lists every problem, strictly (``photoset check``, which for a
+video set also checks the videos: :mod:`pipeline.photoset_check`).
 
 A *video* photo set has the same two files, but ``manifest.csv`` lists videos instead of images
 (columns :data:`VIDEO_REQUIRED_COLUMNS`, optionally :data:`VIDEO_OPTIONAL_COLUMNS` and any
@@ -343,10 +344,65 @@ def _refuse(folder: Path, problems: list[Problem]) -> None:
     )
 
 
+def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[Problem]]:
+    """Load a photo set for checking: the set (None when it cannot be loaded) and its problems so far.
+
+    The problems are those of ``photoset.yaml`` (unknown keys are warnings), the refusal to load
+    when the set cannot be read at all, and every row's problems; :func:`file_problems` adds
+    those of the files.
+    """
+    folder = Path(folder)
+    settings, problems = _read_yaml(folder)
+    if settings is None:
+        return None, problems
+    try:
+        ps = load_photoset(folder)
+    except UserInputError as exc:
+        return None, problems + [Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")]
+    return ps, problems + list(ps.problems)
+
+
+def file_problems(ps: PhotoSet, *, decode_images: bool = True, require_images: bool = True) -> list[Problem]:
+    """Problems of a loaded set's images (missing, undecodable, settings outside the photo) and
+    calibrations, and the doubt of a set without a scale.
+
+    A video set's videos and pressure logs are not checked here but by
+    :func:`pipeline.video.clips.clip_problems` (:func:`pipeline.photoset_check.check_photoset`
+    does both).
+    """
+    folder, mpath = ps.folder, str(ps.folder / MANIFEST)
+    problems: list[Problem] = []
+    sizes: dict[str, tuple[int, int] | None] = {}
+    images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
+    for (line, image), settings_row in zip(images, ps.rows):
+        if is_missing(image):
+            continue
+        path = folder / str(image)
+        if not path.is_file():
+            if require_images:
+                problems.append(Problem(mpath, int(line), f"image {image!r} does not exist in {folder}", "copy the photo in or remove the row"))
+            continue
+        if not decode_images:
+            continue
+        size = sizes.get(str(image)) if str(image) in sizes else _image_size(path)
+        sizes[str(image)] = size
+        if size is None:
+            problems.append(Problem(mpath, int(line), f"image {image!r} cannot be decoded (corrupt, truncated or not an image)", "re-export or re-take the photo, or remove the row"))
+        elif settings_row is not None:
+            problems += geometry_problems(mpath, int(line), settings_row, size)
+    problems += _calibration_problems(ps)
+    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
+        problems.append(Problem(str(folder / SETTINGS), None, "no mm_per_px: psi will be the turning of the measured line, so a line cut short by the clamp or the border reads low", "measure the image scale (mm per pixel) and set mm_per_px", warning=True))
+    return problems
+
+
 def validate_photoset(
     folder: str | os.PathLike[str], *, decode_images: bool = True, require_images: bool = True, warnings: bool = False
 ) -> list[Problem]:
-    """Every problem of a photo set, each naming the file, the manifest line and the fix.
+    """Every problem of a photo set of images, each naming the file, the manifest line and the fix.
+
+    For a video set only its rows, settings and calibrations: ``photoset check``
+    (:func:`pipeline.photoset_check.check_photoset`) also checks its videos and pressure logs.
 
     Parameters
     ----------
@@ -365,43 +421,9 @@ def validate_photoset(
     list of Problem
         Empty when the photo set is valid (and, with ``warnings``, nothing is doubtful).
     """
-    folder = Path(folder)
-    settings, problems = _read_yaml(folder)
-    if settings is None:
-        return problems
-    if not warnings:
-        problems = [p for p in problems if not p.warning]
-    try:
-        ps = load_photoset(folder)
-    except UserInputError as exc:
-        return problems + [Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")]
-    problems += list(ps.problems)
-    mpath = str(folder / MANIFEST)
-    if ps.is_video:
-        from pipeline.video.clips import clip_problems
-
-        problems += clip_problems(ps, decode=decode_images, require_files=require_images)
-    sizes: dict[str, tuple[int, int] | None] = {}
-    images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
-    for (line, image), settings_row in zip(images, ps.rows):
-        if is_missing(image):
-            continue
-        path = folder / str(image)
-        if not path.is_file():
-            if require_images:
-                problems.append(Problem(mpath, int(line), f"image {image!r} does not exist in {folder}", "copy the photo in or remove the row"))
-            continue
-        if not decode_images:
-            continue
-        size = sizes.get(str(image)) if str(image) in sizes else _image_size(path)
-        sizes[str(image)] = size
-        if size is None:
-            problems.append(Problem(mpath, int(line), f"image {image!r} cannot be decoded (corrupt, truncated or not an image)", "re-export or re-take the photo, or remove the row"))
-        elif settings_row is not None:
-            problems += _geometry_problems(mpath, int(line), settings_row, size)
-    problems += _calibration_problems(ps)
-    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
-        problems.append(Problem(str(folder / SETTINGS), None, "no mm_per_px: psi will be the turning of the measured line, so a line cut short by the clamp or the border reads low", "measure the image scale (mm per pixel) and set mm_per_px", warning=True))
+    ps, problems = load_checked(folder)
+    if ps is not None:
+        problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
     return [p for p in problems if warnings or not p.warning]
 
 
@@ -433,7 +455,8 @@ def _calibration_problems(ps: PhotoSet) -> list[Problem]:
     return out
 
 
-def _geometry_problems(file: str, line: int, s: MeasureSettings, size: tuple[int, int]) -> list[Problem]:
+def geometry_problems(file: str, line: int, s: MeasureSettings, size: tuple[int, int]) -> list[Problem]:
+    """Settings of a row that do not fit its photo of ``size`` (width, height): calibration, roi, fixed end."""
     w, h = size
     out = []
     cal = s.calibration

@@ -169,7 +169,9 @@ def _pick(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    problems = photoset.validate_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
+    from pipeline.photoset_check import check_photoset
+
+    problems = check_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
     errors = [p for p in problems if not p.warning]
     manifest = photoset.read_manifest(args.folder) if (Path(args.folder) / photoset.MANIFEST).is_file() else None
     video = manifest is not None and photoset.is_video_manifest(manifest)

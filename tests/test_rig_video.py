@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.photoset import validate_photoset
+from pipeline.photoset_check import check_photoset
 from pipeline.photoset_measure import measure_photoset
 from pipeline.rig.emulator import Emulator, Faults, PlantParams
 
@@ -40,7 +40,7 @@ def test_a_continuous_ramp_is_recorded_as_a_video_photo_set_and_resumed(tmp_path
         again = run(video_cmd(emu.port, out, trials=2))  # trial 1 is kept, trial 2 recorded
         assert again.returncode == 0, again.stderr
     assert "1 trial(s) already recorded" in again.stdout
-    assert validate_photoset(out) == []
+    assert check_photoset(out) == []
     m = pd.read_csv(out / "manifest.csv")
     assert list(m["trial"]) == [1, 2] and (m["clock_offset_s"] == 0).all()
     log = pd.read_csv(out / m["pressure_log"].iloc[0])
@@ -73,7 +73,7 @@ def test_an_estop_vents_keeps_the_interrupted_recording_and_a_rerun_records_the_
         emu.release_estop()
         resumed = run(video_cmd(str(link), out))
         assert resumed.returncode == 0, resumed.stderr
-    assert len(pd.read_csv(out / "manifest.csv")) == 1 and validate_photoset(out) == []
+    assert len(pd.read_csv(out / "manifest.csv")) == 1 and check_photoset(out) == []
 
 
 def test_dry_run_and_cameras_that_cannot_record_video(tmp_path):

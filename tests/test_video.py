@@ -14,6 +14,7 @@ import pytest
 
 from pipeline import photoset
 from pipeline.errors import UserInputError
+from pipeline.photoset_check import check_photoset
 from pipeline.photoset_measure import measure_photoset
 from pipeline.synth.video import Dynamics, render_video, simulate, toy_actuator
 from pipeline.video import measure as video_measure
@@ -79,7 +80,7 @@ def test_truncated_video_keeps_the_frames_it_could_read_and_fails_the_rest(video
     # frames read after the unusable index (packets skipped from the start) are the same frames
     intact = measure_photoset(video_set, jobs=1).set_index("frame")
     assert np.allclose(read.set_index("frame")["psi_deg"], intact.loc[read["frame"], "psi_deg"])
-    text = "\n".join(map(str, photoset.validate_photoset(folder)))
+    text = "\n".join(map(str, check_photoset(folder)))
     assert f"only frames 0-{len(read) - 1} of the 135 of video {path.name} can be read" in text
 
 
@@ -103,7 +104,7 @@ def test_a_log_not_covering_the_video_is_refused_naming_both_spans(video_set, tm
     log_path = folder / pd.read_csv(folder / "manifest.csv")["pressure_log"].iloc[0]
     log = pd.read_csv(log_path)
     log[log["time_s"] <= 5.0].to_csv(log_path, index=False)
-    problems = [p for p in photoset.validate_photoset(folder) if not p.warning]
+    problems = [p for p in check_photoset(folder) if not p.warning]
     assert len(problems) == 1 and problems[0].line == 2
     assert "spans 0.70-14.10 s on the log clock" in problems[0].message
     assert "covers 0.00-5.00 s" in problems[0].message

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from pipeline.measure.settings import is_missing
-from pipeline.photoset import MANIFEST, PhotoSet, Problem, _geometry_problems
+from pipeline.photoset import MANIFEST, PhotoSet, Problem, geometry_problems
 from pipeline.video.reader import VideoInfo, probe_video, read_frames
 from pipeline.video.timeline import PressureLog, covers, read_frame_times, read_pressure_log, span_text
 
@@ -178,7 +178,7 @@ def clip_problems(ps: PhotoSet, *, decode: bool = True, require_files: bool = Tr
                                f"announces {clip.info.frame_count}", "use the frame-times file written with this video",
                                warning=len(clip.frame_times_s) < clip.info.frame_count))
         if settings is not None:
-            out += _geometry_problems(mpath, clip.line, settings, (clip.info.width, clip.info.height))
+            out += geometry_problems(mpath, clip.line, settings, (clip.info.width, clip.info.height))
         if decode:
             n = readable_frames(clip.info)
             if n < clip.n_frames:
