@@ -322,7 +322,7 @@ def test_preview_shows_the_rectified_photo(calibrated, tmp_path: Path) -> None:
 
 def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
     from pipeline.report.data import Dataset, ReportInputs, load_report_data
-    from pipeline.report.style import report_style
+    from pipeline.layout.style import report_style
     from pipeline.report.summary import calibration_summary, summary_page
 
     datasets = []

@@ -32,9 +32,9 @@ from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
 from pipeline.report.build import build_report, report_figures
 from pipeline.report.data import Dataset, ReportInputs, dataset_dates, load_report_data
 from pipeline.report.reasons import top_reasons, words
-from pipeline.report.style import FOOTER_PT, MIN_FONT_PT, report_style
+from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
 from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
-from pipeline.report.typeset import NA, fmt
+from pipeline.layout.typeset import NA, fmt
 
 #: rough p(psi=0) per material, only to make curves of the right shape
 P_ZERO = {"DS20": 65.0, "DS30": 105.0, "SS40": 215.0, "SS50": 600.0}
@@ -294,7 +294,7 @@ def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
 
 
 def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
-    from pipeline.report.style import page
+    from pipeline.layout.style import page
 
     with report_style():
         fig = page()
@@ -498,7 +498,7 @@ def test_each_material_has_one_colour_on_every_page(default):
 
     from pipeline.force import pages as force_pages
     from pipeline.report.pages import overview_page
-    from pipeline.report.style import material_colors
+    from pipeline.layout.style import material_colors
     from pipeline.report.summary import summary_page
 
     data = load_report_data(default[0])

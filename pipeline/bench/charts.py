@@ -10,7 +10,7 @@
   choices, typeset.
 * :func:`model_cost_figure`: model quadrature grid size against error and time, with its table.
 
-Every page uses the report's style (:mod:`pipeline.report.style`), so it is A4 with fonts of at
+Every page uses the report's style (:mod:`pipeline.layout.style`), so it is A4 with fonts of at
 least 7 pt whether it is printed in the report or saved alone by :func:`save`.
 """
 
@@ -27,8 +27,8 @@ from matplotlib.lines import Line2D
 
 from pipeline.bench.analysis import BREAKDOWN_P95_DEG, NOMINAL, SILENT_WRONG_DEG, breakdown
 from pipeline.bench.grids import GRIDS
-from pipeline.report.style import A4_LANDSCAPE_IN, FOOTER_PT, MARGIN_PT, page, report_style, text_page
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.style import A4_LANDSCAPE_IN, FOOTER_PT, MARGIN_PT, page, report_style, text_page
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
 #: axis label of every condition (from the grids)
 LABELS: dict[str, str] = {s.name: s.label for g in GRIDS.values() for s in g.sweeps}

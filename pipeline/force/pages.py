@@ -14,7 +14,7 @@ grasp_summary.csv          ``force grasp``: Fig. 8B heaviest mass held (g) again
 =========================  =====================================================================
 
 Every page is A4 in the report's style; each material has the same colour as on the report's
-own pages (:func:`pipeline.report.style.material_colors`).
+own pages (:func:`pipeline.layout.style.material_colors`).
 """
 
 from __future__ import annotations
@@ -30,8 +30,8 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import offset_copy
 
 from pipeline.fileio import read_table
-from pipeline.report.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
-from pipeline.report.typeset import Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
+from pipeline.layout.typeset import Column, Flow, Table, fmt, table_height_pt
 
 FORCE_SUMMARY = "force_summary.csv"
 ECCENTRICITY_SUMMARY = "eccentricity_summary.csv"
@@ -58,7 +58,7 @@ def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[
         Folder written by ``python -m pipeline force aggregate/grasp``.
     colors : mapping, optional
         Colour of each material (the report passes its own); others get
-        :func:`~pipeline.report.style.material_colors`.
+        :func:`~pipeline.layout.style.material_colors`.
 
     Returns
     -------

@@ -31,7 +31,7 @@ from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
 from pipeline.video import pages as video_pages
 from pipeline.report.provenance import provenance_pages
-from pipeline.report.style import FOOTER_PT, material_colors, report_style
+from pipeline.layout.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.summary import summary_page
 from pipeline.report.textcheck import FOOTER_GID
 

@@ -16,8 +16,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from pipeline.report.data import ReportData
-from pipeline.report.style import A4_LANDSCAPE_IN, MARGIN_PT, text_page
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt
+from pipeline.layout.style import A4_LANDSCAPE_IN, MARGIN_PT, text_page
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt
 
 #: what each ``rms_kind`` means, in words for the reader
 RMS_KIND_TEXT: dict[str, str] = {

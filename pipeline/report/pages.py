@@ -1,7 +1,7 @@
 """The report's own result pages: the Fig. 6 overview, one page per material, the comparison.
 
 Each function returns one A4 :class:`~matplotlib.figure.Figure` (call inside
-:func:`pipeline.report.style.report_style`).
+:func:`pipeline.layout.style.report_style`).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from matplotlib.patches import Patch
 from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
-from pipeline.report.style import (
+from pipeline.layout.style import (
     A4_PORTRAIT_IN,
     P_LABEL,
     PSI_LABEL,
@@ -28,7 +28,7 @@ from pipeline.report.style import (
     material_colors,
     page,
 )
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
 #: height kept for the legend under the overview panels (pt)
 LEGEND_BAND_PT = 44.0

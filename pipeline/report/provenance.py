@@ -10,9 +10,9 @@ from importlib import metadata
 from matplotlib.figure import Figure
 
 from pipeline.report.data import ReportData
-from pipeline.report.style import text_page
+from pipeline.layout.style import text_page
 from pipeline.report.summary import calibration_summary
-from pipeline.report.typeset import MONO, Column, Flow, Table, rows_that_fit
+from pipeline.layout.typeset import MONO, Column, Flow, Table, rows_that_fit
 
 #: libraries whose versions can change a number or a pixel of the report
 LIBRARIES: tuple[str, ...] = ("numpy", "pandas", "scipy", "opencv-python-headless", "opencv-python", "matplotlib")

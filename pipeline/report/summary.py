@@ -17,8 +17,8 @@ from matplotlib.figure import Figure
 from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.reasons import top_reasons
-from pipeline.report.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
 #: least height (pt) worth giving the overview plot on page 1
 MIN_PLOT_PT = 170.0

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.report.style import A4_PORTRAIT_IN, footer_fraction, text_page
+from pipeline.layout.style import A4_PORTRAIT_IN, footer_fraction, text_page
 
 #: step rows shown in the table (the rest are counted)
 MAX_TABLE_ROWS = 12

@@ -86,7 +86,7 @@ def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, to
         Name of the page (``Figure.get_label()``), e.g. ``"summary"``; tests find pages by it.
     bottom_pt, top_pt : float
         Extra bands (pt) kept free of axes at the bottom (above the footer) and at the top, for
-        text or tables placed with :class:`pipeline.report.typeset.Flow`.
+        text or tables placed with :class:`pipeline.layout.typeset.Flow`.
 
     Returns
     -------

@@ -8,7 +8,7 @@ missing (:func:`fmt`).
 
 Examples
 --------
->>> from pipeline.report.style import report_style, text_page
+>>> from pipeline.layout.style import report_style, text_page
 >>> with report_style():
 ...     fig = text_page()
 ...     flow = Flow(fig)
@@ -35,7 +35,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.transforms import Affine2D, Transform
 
-from pipeline.report.style import FOOTER_PT, MARGIN_PT, MIN_FONT_PT, Color
+from pipeline.layout.style import FOOTER_PT, MARGIN_PT, MIN_FONT_PT, Color
 
 #: what a missing value reads as, everywhere in the report
 NA = "n/a"
