@@ -38,7 +38,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "model": ("pipeline.model.cli", "analytical model of the paper: P(psi) curves, inverse, k_P calibration"),
     "compare": ("pipeline.compare_cli", "compare measured hysteresis with the model: RMS (deg), crossings (kPa), k_P"),
     "report": ("pipeline.report.cli", "write the PDF report from the results tables"),
-    "bench": ("pipeline.bench.cli", "speed/accuracy and stability study of the angle methods and the model"),
+    "bench": ("pipeline.bench.cli", "benchmarks that print figures: the speed/accuracy study (bench study), measure, video, ..."),
     "force": ("pipeline.force.cli", "blocked force, eccentricity and grasp-log analysis"),
 }
 

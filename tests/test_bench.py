@@ -1,4 +1,4 @@
-"""Tests of the speed/accuracy and stability study (pipeline.bench)."""
+"""Tests of the speed/accuracy and stability study (pipeline.study, run as ``bench study``)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.bench import analysis, grids
-from pipeline.bench.analysis import breakdown_point, pareto_front
+from pipeline.study import analysis, grids
+from pipeline.study.analysis import breakdown_point, pareto_front
 
 # ---------------------------------------------------------------------------------------------
 # Pareto front
@@ -195,7 +195,7 @@ TINY = grids.Grid(
 
 
 def test_run_is_deterministic_across_jobs():
-    from pipeline.bench.run import run_grid
+    from pipeline.study.run import run_grid
 
     cs = grids.cases(TINY)[:2]
     a = run_grid(cs, methods=["hyper", "turning"], jobs=1)
@@ -206,13 +206,14 @@ def test_run_is_deterministic_across_jobs():
 
 
 def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture):
-    from pipeline.bench import cli, pages
+    from pipeline.bench import study
+    from pipeline.study import pages
     from pipeline.measure import METHODS
 
     monkeypatch.setitem(grids.GRIDS, "default", TINY)
     out = tmp_path / "bench"
     args = argparse.Namespace(grid="default", jobs=2, out=out, methods=None, seed=1, no_model=False)
-    assert cli.run(args) == 0
+    assert study.run(args) == 0
     printed = capsys.readouterr().out
     assert "Nominal scenes" in printed and "Breakdown point" in printed and "grid_n" in printed
     n_images = len(grids.cases(TINY))
@@ -249,7 +250,7 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
 
 def _assert_same_as_measure_photoset(res: pd.DataFrame, folder: Path) -> None:
     """The bench's psi for the default method is what ``measure_photoset`` gives on the same JPEGs."""
-    from pipeline.bench.run import render_case
+    from pipeline.study.run import render_case
     from pipeline.measure import DEFAULT_METHOD
     from pipeline.photoset_measure import measure_photoset
     from pipeline.photoset import write_manifest, write_settings

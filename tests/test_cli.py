@@ -7,6 +7,7 @@ import sys
 
 import pytest
 
+from pipeline.bench.cli import BENCHES
 from pipeline.cli import SUBCOMMANDS
 
 REQUIRED = {"synth", "measure", "aggregate", "model", "compare", "report", "acquire", "bench", "photoset"}
@@ -44,3 +45,21 @@ def test_bad_input_is_one_line_without_traceback(tmp_path):
     out = _run("photoset", "init", str(tmp_path / "nope"), "--pattern", "{pressure_kpa}.jpg")
     assert out.returncode == 2
     assert "Traceback" not in out.stderr and "not a folder" in out.stderr
+
+
+@pytest.mark.parametrize("what", sorted(BENCHES))
+def test_every_benchmark_runs_from_the_one_entry_point(what, capsys):
+    from pipeline.cli import main
+
+    with pytest.raises(SystemExit) as stop:  # argparse exits 0 after --help
+        main(["bench", what, "--help"])
+    assert stop.value.code == 0
+    assert f"usage: python -m pipeline bench {what}" in capsys.readouterr().out
+
+
+def test_bench_model_prints_its_figures(capsys):
+    from pipeline.cli import main
+
+    assert main(["bench", "model", "--grid-sizes", "2", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "max_rel_error" in out and "default grid (grid_n=4)" in out

@@ -1,6 +1,6 @@
 """Bending-angle measurement: estimators, extraction, quality flags, photo sets and the CLI.
 
-Accuracy only (speed is in ``python -m pipeline.measure.bench``).  Synthetic photos come from
+Accuracy only (speed is in ``python -m pipeline bench measure``).  Synthetic photos come from
 :mod:`pipeline.synth` with exact ground truth; seeds are fixed.
 """
 
@@ -99,7 +99,7 @@ def test_grey_decode_coarse_extraction_refined(psi: float) -> None:
     """The photo-set path: grey decode, extraction on a halved copy, centre line refined."""
     from scipy.spatial import cKDTree
 
-    from pipeline.measure.core import COARSE_WIDTH_PX, _reduce
+    from pipeline.measure.core import COARSE_WIDTH_PX, reduce_image
     from pipeline.measure.colors import BLACK
     from pipeline.measure.extract import extract_centreline
     from pipeline.measure.refine import refine_centreline
@@ -114,7 +114,7 @@ def test_grey_decode_coarse_extraction_refined(psi: float) -> None:
     assert res.psi_deg == pytest.approx(psi, abs=0.5 if abs(psi) > 3 else 0.3)
     assert res.degree == 1
     # the refinement brings the coarse centre line much closer to the true one
-    line = extract_centreline(_reduce(img, 2), color=BLACK, fixed_end_px=r.fixed_end_px, scale=2.0 * f)
+    line = extract_centreline(reduce_image(img, 2), color=BLACK, fixed_end_px=r.fixed_end_px, scale=2.0 * f)
     fine = refine_centreline(img, line.centreline_px, scale=float(f), half_width_px=0.5 * line.width_px)
     tree = cKDTree(r.centreline_px)
     before, after = np.median(tree.query(line.centreline_px)[0]), np.median(tree.query(fine)[0])

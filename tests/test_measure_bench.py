@@ -1,4 +1,4 @@
-"""Tests of the speed / accuracy comparison in :mod:`pipeline.measure.bench` (issue 6's target).
+"""Tests of the speed / accuracy comparison in :mod:`pipeline.bench.measure` (issue 6's target).
 
 The comparison runs for real on a few small synthetic photos (scikit-image provides the
 skeletonize baseline); the verdict rule is checked as a pure function on made-up tables.
@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.measure import bench
+from pipeline.bench import measure as bench
 
 SPEED_COLUMNS = ["n", "imread_ms", "ours_ms", "ours/imread", "skeleton_ms", "skeleton/ours",
                  "decode_floor_ms", "bare_ms", "max_speedup"]

@@ -4,7 +4,7 @@ The committed photo set is measured as a lab runs it (``measure`` on the folder,
 photoset.yaml, a fixed end per row because the strips are free) and scored against labels.csv.
 What must hold: no row is ``ok`` outside its tolerance (a wrong number is flagged or failed, with a
 reason in words), and at least as many rows are within tolerance as today (5 of 10; the issue's
-target of 9 is not reached: see ``python -m pipeline.bench.realscenes``).
+target of 9 is not reached: see ``python -m pipeline bench realscenes``).
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ import pypdfium2 as pdfium
 import pytest
 from PIL import Image
 
-from pipeline.bench import analysis
+from pipeline.study import analysis
 from pipeline.cli import main
 from pipeline.errors import UserInputError
 from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure

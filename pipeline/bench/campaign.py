@@ -1,6 +1,6 @@
 """Accuracy of a finished run on its synthetic photo sets: angles.csv against truth.csv.
 
-``python -m pipeline.bench.campaign [RESULTS_DIR]`` prints, per dataset whose photo set has a
+``python -m pipeline bench campaign [RESULTS_DIR]`` prints, per dataset whose photo set has a
 ``truth.csv`` (synthetic sets under ``RESULTS_DIR/photosets/`` and committed sets such as
 ``sample_images/``), the status counts and the median / 95th-percentile / largest absolute error
 of the ``ok`` rows, against the angle seen in the image (``psi_image_deg``, which includes the
@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 import yaml
+
+from pipeline.errors import UserInputError
 
 
 def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
@@ -67,7 +70,10 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     A relative photo-set path in the config is relative to the run's working folder (the one
     holding ``results_dir``), wherever this is called from.
     """
-    config = yaml.safe_load((config_path or results_dir / "config.resolved.yaml").read_text())
+    path = config_path or Path(results_dir) / "config.resolved.yaml"
+    if not path.is_file():
+        raise UserInputError(f"{path}: not found; pass the results folder of a finished run (snakemake writes it there)")
+    config = yaml.safe_load(path.read_text())
     results_dir = Path(results_dir)
     configured = Path(config.get("results_dir", "results"))
     depth = len(configured.parts)
@@ -84,9 +90,9 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     return pd.DataFrame(rows)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Print the accuracy table of a finished run."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.bench.campaign", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench campaign", description=__doc__.splitlines()[0])
     parser.add_argument("results_dir", nargs="?", default="results", type=Path, help="results folder of a finished run")
     args = parser.parse_args(argv)
     table = run_accuracy(args.results_dir)

@@ -1,4 +1,4 @@
-"""``python -m pipeline.bench.realscenes``: the angle measurement on real-photo scenes.
+"""``python -m pipeline bench realscenes``: the angle measurement on real-photo scenes.
 
 Two parts, printed as tables:
 
@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
@@ -109,10 +110,10 @@ def dev_set(folder: Path, jobs: int = 1) -> pd.DataFrame:
     return m
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Print the real-photo and the synthetic-analogue tables."""
     here = Path(__file__).resolve().parents[2]
-    parser = argparse.ArgumentParser(prog="python -m pipeline.bench.realscenes", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench realscenes", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dev-set", type=Path, default=here / "tests" / "data" / "xia2023_strips",
                         help="a photo set with labels.csv (default: the committed real strips, tests/data/xia2023_strips)")
     parser.add_argument("--n", type=int, default=12, help="rendered photos per synthetic scene (default 12)")

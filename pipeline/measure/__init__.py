@@ -21,7 +21,7 @@ a background photo or a colour, its centre line between the two long edges) ->
 :mod:`pipeline.ramp_check` compares each photo with its ramp.
 
 Body mode (``target: body``) reads psi as the tip angle (:func:`~pipeline.measure.estimators.tangents`):
-on synthetic analogues of real scenes (``python -m pipeline.bench.realscenes``) the median error is
+on synthetic analogues of real scenes (``python -m pipeline bench realscenes``) the median error is
 1.3-1.8 deg and p95 3-6 deg; on the committed real strips 5 of 10 photos are within their label's
 tolerance and none is ``ok`` outside it.
 ``AngleResult.degree`` (angles.csv column ``degree``, after ``seconds``) is the complexity of the
@@ -37,7 +37,7 @@ Default method: ``auto``
 ------------------------
 ``auto`` is the Hyper circle fit, switching to ``turning`` only when a BIC-chosen tangent-angle
 fit says the curvature is not constant and the two disagree by more than 1.5 deg.  Measured
-with ``python -m pipeline.measure.bench`` (lab scenes: noise, blur, JPEG 90, textured table,
+with ``python -m pipeline bench measure`` (lab scenes: noise, blur, JPEG 90, textured table,
 uneven light, distractor marks, clamp, tube, tilt 0-3 deg; |error| in deg):
 
 ==================  ===========================  ===========================

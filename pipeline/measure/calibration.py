@@ -15,7 +15,7 @@ mm and turned to match the photo at the board's centre, so every downstream numb
 residuals, the ramp check) keeps its pixel meaning while psi, the curvature and ``length_mm``
 are those of the physical plane (psi = mean curvature in 1/mm times ``l0_mm``).
 
-Measured (``python -m pipeline.measure.calibration_bench``, 8 rendered poses with the camera
+Measured (``python -m pipeline bench calibration``, 8 rendered poses with the camera
 3-8 deg off nadir and |k1| <= 0.1, 106 lab photos at 1280x960, one board photo each): |psi
 error| against the physical angle, ok rows, median 0.042 deg and p95 0.18 deg calibrated,
 against 2.0 deg and 10.4 deg for the same photos measured in the image with ``mm_per_px``; the

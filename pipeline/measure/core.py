@@ -377,10 +377,10 @@ def measure_image(
     if image_bgr is None or image_bgr.ndim != 3:
         return measure_work_image(image_bgr, settings, scale=1.0, method=method)
     f = reduction_for(image_bgr.shape[1], work_width_px)
-    res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
+    res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
-        res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
+        res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
     return res
 
 
@@ -452,10 +452,11 @@ def decode_for_work(
     if img is None:
         return None, 1
     f = factor if factor is not None else reduction_for(img.shape[1], work_width_px)
-    return _reduce(img, f), f
+    return reduce_image(img, f), f
 
 
-def _reduce(image: np.ndarray, factor: int) -> np.ndarray:
+def reduce_image(image: np.ndarray, factor: int) -> np.ndarray:
+    """``image`` reduced ``factor`` times in each direction (INTER_AREA); itself for ``factor`` <= 1."""
     if factor <= 1:
         return image
     return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
@@ -508,7 +509,7 @@ def measure_decoded(
     decode, the usual photo only one small one.
     """
     if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
-        coarse = _reduce(img, 2)
+        coarse = reduce_image(img, 2)
         res = measure_work_image(coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor))
         # anything doubtful (gaps, rivals, border, ...) is measured again at the decoded size
         if res.status == "ok" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
@@ -517,7 +518,7 @@ def measure_decoded(
     while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
         factor //= 2
         if full is not None:
-            finer = _reduce(full, factor)
+            finer = reduce_image(full, factor)
         else:
             assert data is not None
             finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)

@@ -235,6 +235,27 @@ def _choose(cands: list[_Candidate], near_px: float) -> tuple[_Candidate, bool]:
     return max(cands, key=lambda c: c.length), False
 
 
+def line_component(
+    mask: np.ndarray, fixed_end_px: tuple[float, float] | None, near_px: float
+) -> tuple[int, int, np.ndarray]:
+    """The component of a line mask that :func:`extract_centreline` starts from.
+
+    The longest line-like component reaching ``fixed_end_px`` (within ``near_px``), else the
+    longest; as ``(x0, y0, sub)``: its 0/1 mask ``sub`` in its bounding box (1 px margin) at
+    ``(x0, y0)`` of ``mask``.  Pixels of the work image throughout.
+
+    Raises
+    ------
+    NoLineFound
+        When ``mask`` holds nothing line-like.
+    """
+    cands = _candidates(mask, fixed_end_px)
+    if not cands:
+        raise NoLineFound("no line found: nothing long and thin in the mask")
+    best, _ = _choose(cands, near_px)
+    return best.x0, best.y0, best.sub
+
+
 def _fill_small_holes(sub: np.ndarray, max_fraction: float = 0.1) -> np.ndarray:
     """Fill holes smaller than ``max_fraction`` of the box (a clamp's frame becomes a block).
 

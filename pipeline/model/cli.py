@@ -1,4 +1,5 @@
-"""``python -m pipeline model ...``: P(psi) curves, single values, anchor table, benchmark."""
+"""``python -m pipeline model ...``: P(psi) curves, single values, anchor table (its benchmark:
+``python -m pipeline bench model``)."""
 
 from __future__ import annotations
 
@@ -146,16 +147,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "snaps", parents=[parent], help="print snap-through regions of P(psi) per material"
     )
     p.add_argument("--material", default=None, help="one material (default: all)")
-    p = sub.add_parser(
-        "bench", help="print time (ms) per quadrature grid size and convergence error"
-    )
-    p.add_argument(
-        "--grid-sizes",
-        type=int,
-        nargs="+",
-        default=[2, 3, 4, 6, 8, 12],
-        help="grid sizes n (n_tau = n, n_phi = 2n nodes); default 2 3 4 6 8 12",
-    )
 
 
 def _material(args: argparse.Namespace, name: str) -> Material:
@@ -173,12 +164,6 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.model import model_curve, pressure_kpa, psi_deg, snap_regions
 
     cmd = args.model_command
-    if cmd == "bench":
-        from pipeline.model.bench import benchmark_model, format_benchmark
-
-        df = benchmark_model(grid_sizes=args.grid_sizes)
-        print(format_benchmark(df))
-        return 0
     opts = reading_options(args)
     if cmd == "curve":
         mat = _material(args, args.material)

@@ -23,7 +23,6 @@ from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from pipeline import __version__
-from pipeline.bench import pages as bench_pages
 from pipeline.fileio import atomic_write_bytes
 from pipeline.force import pages as force_pages
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
@@ -34,6 +33,7 @@ from pipeline.report.provenance import provenance_pages
 from pipeline.layout.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.summary import summary_page
 from pipeline.report.textcheck import FOOTER_GID
+from pipeline.study import pages as study_pages
 
 #: what each page is, for the contents list on page 1 (by figure label; first page of a run of pages)
 CONTENTS: dict[str, str] = {
@@ -133,7 +133,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     infos: list[str] = []
     extra: list[Figure] = []
     colors = material_colors(data.materials)
-    sources = [("--bench-dir", data.inputs.bench_dir, bench_pages.figures),
+    sources = [("--bench-dir", data.inputs.bench_dir, study_pages.figures),
                ("--force-dir", data.inputs.force_dir, lambda d: force_pages.figures(d, colors=colors))]
     sources += [("--video-dirs", d, video_pages.figures) for d in data.inputs.video_dirs]  # a page per video dataset
     for name, folder, build in sources:

@@ -43,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model-curves", nargs="+", type=Path, default=None, metavar="C.csv",
                         help="model curves from 'model curve' (columns material, psi_deg, pressure_kpa), drawn dashed")
     parser.add_argument("--bench-dir", type=Path, default=None, metavar="DIR",
-                        help="output folder of 'python -m pipeline bench'; adds its speed/accuracy, stability and table pages")
+                        help="output folder of 'python -m pipeline bench study'; adds its speed/accuracy, stability and table pages")
     parser.add_argument("--force-dir", type=Path, default=None, metavar="DIR",
                         help="output folder of 'python -m pipeline force'; adds the blocked-force, eccentricity and grasp pages")
     parser.add_argument("--video-dirs", nargs="+", type=Path, default=(), metavar="DIR",

@@ -25,7 +25,7 @@ from pipeline.aggregate import (
     read_angles,
 )
 from pipeline.compare import check_hysteresis
-from pipeline.bench.pages import TABLES as BENCH_TABLES
+from pipeline.study.pages import TABLES as BENCH_TABLES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 from pipeline.force.pages import FILES as FORCE_FILES

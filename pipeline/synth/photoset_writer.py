@@ -52,7 +52,7 @@ from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import Camera, camera_for, make_camera
 from pipeline.synth.centreline import actuator_centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
-from pipeline.synth.scene import _compose, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
+from pipeline.synth.scene import compose_photo, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
 
 #: seed streams (second key after the material)
 _TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND, _BOARD = range(8)
@@ -195,7 +195,7 @@ def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
     for row in task["rows"]:
         pts = actuator_centreline_mm(row["psi_deg"], task["l0_mm"], scene, bulge=row["bulge"])
         rng = np.random.default_rng(child_seed(*task["image_seed"], row["step"]))
-        r = _compose(pts, scene, camera, backdrop, scene.body_width_mm, rng)
+        r = compose_photo(pts, scene, camera, backdrop, scene.body_width_mm, rng)
         tmp = out_dir / f".{row['image']}.tmp"
         tmp.write_bytes(r.jpeg_bytes)
         os.replace(tmp, out_dir / row["image"])

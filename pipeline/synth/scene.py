@@ -276,11 +276,11 @@ def render_curve(
         backdrop = make_backdrop(scene, camera, seed=child_seed(seed, 0), keepout_mm=[pts])
     camera = backdrop.camera
     rng = np.random.default_rng(child_seed(seed, 1))
-    return _compose(pts, scene, camera, backdrop, body_w, rng)
+    return compose_photo(pts, scene, camera, backdrop, body_w, rng)
 
 
-def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
-             body_w: float, rng: np.random.Generator) -> RenderedImage:
+def compose_photo(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
+                  body_w: float, rng: np.random.Generator) -> RenderedImage:
     """One photo of the actuator whose layer is ``pts_mm`` over ``backdrop``, seen by ``camera``."""
     if scene.target == "body":
         check_body_fits(pts_mm, scene, body_w)

@@ -22,7 +22,7 @@ import numpy as np
 from pipeline.measure.core import (
     DEFAULT_METHOD,
     AngleResult,
-    _reduce,
+    reduce_image,
     decode_for_work,
     decodes_grey,
     failed,
@@ -75,7 +75,7 @@ def measure_frame(frame: Frame, settings: MeasureSettings, method: str, packets:
         return measure_decoded(frame.data, img, f, settings, method=method), img, f
     full = cv2.cvtColor(frame.data, cv2.COLOR_BGR2GRAY) if grey else frame.data
     f = reduction_for(full.shape[1])
-    img = _reduce(full, f)
+    img = reduce_image(full, f)
     return measure_decoded(None, img, f, settings, method=method, full=full), img, f
 
 

@@ -1,6 +1,6 @@
 """Benchmark of measuring on a calibrated plane (issue 17): accuracy against the physical psi, and cost.
 
-``python -m pipeline.measure.calibration_bench [--poses N] [--seed S] [--repeats R]``
+``python -m pipeline bench calibration [--poses N] [--seed S] [--repeats R]``
 
 Each camera pose is a rendered photo set (:func:`pipeline.synth.photoset_writer.render_photoset`,
 ``lab`` scene at 1280x960, one ramp of 20 kPa steps of a material, materials in turn) with the
@@ -29,6 +29,7 @@ import argparse
 import dataclasses
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -129,11 +130,11 @@ def summary(df: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Render, measure, print the tables and the verdicts."""
     import cv2
 
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench calibration", description=__doc__.split("\n\n")[0])
     parser.add_argument("--poses", type=int, default=8, help="camera poses (photo sets), default 8")
     parser.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per photo and mode (default 3)")

@@ -1,6 +1,6 @@
 """Render every scene of a grid and measure it with every angle method the way the pipeline does.
 
-For each :class:`~pipeline.bench.grids.Case` one worker renders the photo with
+For each :class:`~pipeline.study.grids.Case` one worker renders the photo with
 :func:`pipeline.synth.render_actuator`, writes its JPEG bytes (the scene's quality) to a file and
 measures that file once per method of :data:`pipeline.measure.METHODS` through
 :func:`pipeline.measure.worker.run_task` -- the very function
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.bench.grids import Case
+from pipeline.study.grids import Case
 
 #: columns of the per-image results table, in order
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -133,7 +133,7 @@ def run_grid(
     Parameters
     ----------
     cases : sequence of Case
-        From :func:`pipeline.bench.grids.cases`.
+        From :func:`pipeline.study.grids.cases`.
     methods : sequence of str, optional
         Methods to compare (default: every key of :data:`pipeline.measure.METHODS`).
     jobs : int

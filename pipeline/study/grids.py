@@ -1,7 +1,7 @@
 """The scenes of the study: sweeps of one condition at a time, the others nominal.
 
 A :class:`Grid` is a list of :class:`Sweep` (one per condition) plus a repeatability block;
-:func:`cases` expands it into the :class:`Case` list that :mod:`pipeline.bench.run` renders and
+:func:`cases` expands it into the :class:`Case` list that :mod:`pipeline.study.run` renders and
 measures.  Two grids are defined in :data:`GRIDS`:
 
 ``default``

@@ -25,8 +25,8 @@ from matplotlib import ticker, transforms
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from pipeline.bench.analysis import BREAKDOWN_P95_DEG, NOMINAL, SILENT_WRONG_DEG, breakdown
-from pipeline.bench.grids import GRIDS
+from pipeline.study.analysis import BREAKDOWN_P95_DEG, NOMINAL, SILENT_WRONG_DEG, breakdown
+from pipeline.study.grids import GRIDS
 from pipeline.layout.style import A4_LANDSCAPE_IN, FOOTER_PT, MARGIN_PT, page, report_style, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
@@ -112,7 +112,7 @@ def speed_accuracy_figure(table: pd.DataFrame) -> Figure:
     Parameters
     ----------
     table : DataFrame
-        ``speed_accuracy.csv`` (see :func:`pipeline.bench.analysis.speed_accuracy`).
+        ``speed_accuracy.csv`` (see :func:`pipeline.study.analysis.speed_accuracy`).
     """
     colours = method_colours(table["method"])
     nominal = table[table["condition"] == NOMINAL].copy()
@@ -258,7 +258,7 @@ def stability_figure(stab: pd.DataFrame, *, ncols: int = 4) -> Figure:
     Parameters
     ----------
     stab : DataFrame
-        ``stability.csv`` (see :func:`pipeline.bench.analysis.stability`).
+        ``stability.csv`` (see :func:`pipeline.study.analysis.stability`).
     """
     conditions = list(dict.fromkeys(stab["condition"]))
     colours = method_colours(stab["method"])
@@ -424,7 +424,7 @@ def model_cost_figure(cost: pd.DataFrame) -> Figure:
     flow.text("Model: accuracy against cost of the quadrature grid", size=12.0, weight="bold")
     flow.space(4.0)
     if cost.empty:
-        flow.text("The model benchmark was not run (bench --no-model).", size=8.5)
+        flow.text("The model benchmark was not run (bench study --no-model).", size=8.5)
         return fig
     c = cost.sort_values("grid_n")
     err = np.maximum(c["max_rel_error"].astype(float), 1e-16)

@@ -11,10 +11,10 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.bench import charts
+from pipeline.study import charts
 from pipeline.fileio import read_table
 
-#: the tables a bench directory holds (written by ``python -m pipeline bench``)
+#: the tables a bench directory holds (written by ``python -m pipeline bench study``)
 TABLES: tuple[str, ...] = (
     "speed_accuracy.csv", "stability.csv", "breakdown.csv", "repeatability.csv", "model_choice.csv",
     "model_cost.csv",
@@ -23,7 +23,7 @@ TABLES: tuple[str, ...] = (
 
 def _read(bench_dir: Path, name: str) -> pd.DataFrame | None:
     path = Path(bench_dir) / name
-    return read_table(path, f"the bench's {name} (rerun 'python -m pipeline bench')") if path.is_file() else None
+    return read_table(path, f"the bench's {name} (rerun 'python -m pipeline bench study')") if path.is_file() else None
 
 
 def figures(bench_dir: Path) -> list[Figure]:
@@ -33,7 +33,7 @@ def figures(bench_dir: Path) -> list[Figure]:
     Parameters
     ----------
     bench_dir : Path
-        Output directory of ``python -m pipeline bench``.
+        Output directory of ``python -m pipeline bench study``.
 
     Returns
     -------

@@ -1,6 +1,6 @@
 """Benchmark of the angle measurement: accuracy per method and speed, printed as tables.
 
-``python -m pipeline.measure.bench [--n N] [--seed S]``
+``python -m pipeline bench measure [--n N] [--seed S]``
 
 Accuracy, on synthetic photos with exact ground truth (:mod:`pipeline.synth`):
 
@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Sequence
 from functools import partial
 from pathlib import Path
 
@@ -47,7 +48,7 @@ from pipeline.measure.colors import BLACK
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work, measure_decoded, measure_file
 from pipeline.measure.settings import resolve_settings
 from pipeline.measure.estimators import METHODS, algebraic_circle, hyper
-from pipeline.measure.extract import _candidates, _choose, line_mask
+from pipeline.measure.extract import line_component, line_mask
 from pipeline.synth import render_actuator, scene_from
 
 L0_MM = 180.0
@@ -119,10 +120,9 @@ def _skeleton_psi(path: Path, mm_per_px: float, fixed_end: tuple[float, float]) 
     img = cv2.imread(str(path))
     mask, _ = line_mask(img, BLACK)
     skel = skeletonize(mask.astype(bool))  # the whole frame, as a straightforward pipeline does
-    cands = _candidates(mask, fixed_end)
-    best, _ = _choose(cands, 0.03 * float(np.hypot(*img.shape[:2])))
-    h, w = best.sub.shape
-    ys, xs = np.nonzero(skel[best.y0 : best.y0 + h, best.x0 : best.x0 + w] & (best.sub > 0))
+    x0, y0, sub = line_component(mask, fixed_end, 0.03 * float(np.hypot(*img.shape[:2])))
+    h, w = sub.shape
+    ys, xs = np.nonzero(skel[y0 : y0 + h, x0 : x0 + w] & (sub > 0))
     pts = np.c_[xs, -ys].astype(float)
     return float(abs(np.rad2deg(hyper(pts, np.random.default_rng(0)).kappa_per_px / mm_per_px * L0_MM)))
 
@@ -402,9 +402,9 @@ def scaling(n: int, seed: int, workdir: Path, copies: int = COPIES) -> dict[str,
     return out
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print its tables."""
-    ap = argparse.ArgumentParser(prog="python -m pipeline.measure.bench", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m pipeline bench measure", description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=60, help="nominal images for accuracy (half as many near-straight and bulged)")
     ap.add_argument("--n-speed", type=int, default=40, help="images per resolution for the speed and paired accuracy tables (40: the paired CI at 4000x3000 is then about +-0.007 deg; 16 leaves it too wide to decide)")
     ap.add_argument("--n-set", type=int, default=32, help="photos in the --jobs scaling set")

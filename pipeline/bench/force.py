@@ -1,4 +1,4 @@
-"""Accuracy benchmark of the eccentricity measurement: ``python -m pipeline.force.bench``.
+"""Accuracy benchmark of the eccentricity measurement: ``python -m pipeline bench force``.
 
 Prints (and with ``--out`` writes as CSV) the error ``e_measured - e_true`` of
 
@@ -111,7 +111,7 @@ def _summary(df: pd.DataFrame, by: list[str]) -> pd.DataFrame:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print the tables."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.force.bench", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench force", description=__doc__.split("\n")[0])
     parser.add_argument("--seeds", type=int, default=3, help="noise seeds per point-sweep case (default 3)")
     parser.add_argument("--noise-px", type=float, default=0.5, help="point noise sd in px (default 0.5)")
     parser.add_argument("--no-images", action="store_true", help="skip the rendered-photo sweep")

@@ -1,7 +1,7 @@
 """Tables of the speed/accuracy and stability study, from the per-image results of :mod:`run`.
 
 Every function here is pure: a DataFrame in, a DataFrame out.  The input is the long table
-written by :func:`pipeline.bench.run.run_grid` (one row per image and method) with at least the
+written by :func:`pipeline.study.run.run_grid` (one row per image and method) with at least the
 columns ``case_id, kind, condition, value, nominal, psi_true_deg, bulge, seed, method, psi_deg,
 abs_error_deg, status, degree, seconds, decode_seconds``.  ``seconds`` is the time per image
 as ``python -m pipeline measure`` spends it (file read + JPEG decode + measurement, one core);
@@ -386,12 +386,12 @@ def model_choice_summary(choice: pd.DataFrame) -> pd.DataFrame:
 
 
 def model_cost(**kwargs: object) -> pd.DataFrame:
-    """Model quadrature grid size against error and time, from ``pipeline.model.bench``.
+    """Model quadrature grid size against error and time (:mod:`pipeline.study.model_cost`).
 
     Parameters
     ----------
     **kwargs
-        Passed to :func:`pipeline.model.bench.benchmark_model` (grid sizes, repeats, ...).
+        Passed to :func:`pipeline.study.model_cost.benchmark_model` (grid sizes, repeats, ...).
 
     Returns
     -------
@@ -399,7 +399,7 @@ def model_cost(**kwargs: object) -> pd.DataFrame:
         Columns ``grid_n, seconds, max_rel_error`` first, then whatever else the model
         benchmark reports (node counts, forward/inverse split, inverse error in deg).
     """
-    from pipeline.model.bench import benchmark_model
+    from pipeline.study.model_cost import benchmark_model
 
     table = benchmark_model(**kwargs)  # type: ignore[arg-type]
     first = ["grid_n", "seconds", "max_rel_error"]

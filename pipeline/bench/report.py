@@ -1,6 +1,6 @@
 """Benchmark of aggregate -> compare -> report on synthetic angles tables; prints the timings.
 
-Run ``python -m pipeline.report.benchmark [--trials N]``.  The angles are drawn from the model
+Run ``python -m pipeline bench report [--trials N]``.  The angles are drawn from the model
 (loading branch, 4 deg noise, decreasing branch 10 % lower in pressure), 3 actuators per material,
 10 kPa steps as in the paper; no photos (the strip then says so).
 """
@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -44,11 +45,11 @@ def synthetic_angles(material: str, trials: int, seed: int) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main() -> None:
+def main(argv: Sequence[str] | None = None) -> int:
     """Time each stage and print one line per stage."""
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench report", description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=int, default=6, help="trials per actuator (default 6, as the paper)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         datasets, frames = [], []
@@ -77,7 +78,8 @@ def main() -> None:
     for r in table.itertuples():
         print(f"  {r.material}: RMS {r.rms_deg:.1f} deg, k_P {r.k_p_fit:.2f} [{r.k_p_ci_low:.2f}, {r.k_p_ci_high:.2f}]"
               f" (model k_P {r.k_p_paper})")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

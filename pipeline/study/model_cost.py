@@ -1,6 +1,6 @@
-"""Speed and accuracy of the model against the quadrature size (prints figures; not a timed test).
+"""Time and error of the model against its quadrature grid size: the study's ``model_cost.csv``.
 
-``python -m pipeline model bench`` or ``python -m pipeline.model.bench``.
+``python -m pipeline bench model`` prints the table (:mod:`pipeline.bench.model`).
 """
 
 from __future__ import annotations
@@ -131,32 +131,3 @@ def benchmark_model(
             }
         )
     return pd.DataFrame(rows)
-
-
-def format_benchmark(df: pd.DataFrame) -> str:
-    """Human-readable table of :func:`benchmark_model` (times in ms)."""
-    out = df.copy()
-    for col in ("forward_seconds", "inverse_seconds", "seconds", "cpu_seconds"):
-        out[col.replace("seconds", "ms")] = (out.pop(col) * 1e3).round(3)
-    return out.to_string(index=False, float_format=lambda v: f"{v:.3g}")
-
-
-def main() -> int:
-    """Print the benchmark (4 materials x 400 angles forward + 400 pressures inverse)."""
-    df = benchmark_model()
-    print(
-        "model benchmark: 4 materials x 400 angles (forward) + 400 pressures (loading inverse), "
-        "one process"
-    )
-    print(format_benchmark(df))
-    default = df[df.grid_n == 4]
-    if len(default):
-        print(
-            f"default grid (grid_n=4): {1e3 * float(default.seconds.iloc[0]):.2f} ms wall, "
-            f"{1e3 * float(default.cpu_seconds.iloc[0]):.2f} ms CPU in total (target < 10 ms)"
-        )
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,4 +1,4 @@
-"""Speed of the rig software against the emulator: ``python -m pipeline.rig.bench``.
+"""Speed of the rig software against the emulator: ``python -m pipeline bench rig``.
 
 Prints (never asserts) the figures that decide how long a real session costs besides the
 settle time: command round trips through the pty, the per-step overhead of the acquisition
@@ -69,39 +69,30 @@ def loop_overhead(trials: int, step_kpa: float, max_kpa: float, mode: str) -> di
 
 def synthetic_costs(n: int) -> dict[str, float]:
     """Time (ms) to render one synthetic photo and to measure psi on it (live psi0 stop)."""
-    out: dict[str, float] = {}
-    try:
-        from pipeline.rig.acquire import psi0_stop_criterion
-        from pipeline.rig.cameras import SyntheticCamera
-    except ImportError:
-        return out
-    try:
-        cam = SyntheticCamera("DS20", 270.0, preset="lab", seed=0)
-    except ImportError:
-        return out
-    settings = {**cam.photoset_settings(), "l0_mm": 270.0}
+    from pipeline.measure.settings import resolve_settings
+    from pipeline.model import load_materials
+    from pipeline.rig.acquire import psi0_stop_criterion
+    from pipeline.rig.cameras import SyntheticCamera
+
+    material = load_materials()["DS20"]
+    cam = SyntheticCamera(material.name, 270.0, preset="lab", seed=0)
+    settings = resolve_settings({**cam.photoset_settings(), "l0_mm": 270.0})
+    stop = psi0_stop_criterion(material.psi0_deg)
     render, measure = [], []
-    try:
-        stop = psi0_stop_criterion(210.0)
-    except ImportError:
-        stop = None
     for i in range(n):
         t0 = time.perf_counter()
         data, _ = cam.capture(Shot(10.0 * i, 10.0 * i, "up", 1, i))
         render.append((time.perf_counter() - t0) * 1e3)
-        if stop is not None:
-            t1 = time.perf_counter()
-            stop(data, settings)
-            measure.append((time.perf_counter() - t1) * 1e3)
-    out["synthetic_render_median_ms"] = float(np.median(render))
-    if measure:
-        out["live_psi_measure_median_ms"] = float(np.median(measure))
-    return out
+        t1 = time.perf_counter()
+        stop(data, settings)
+        measure.append((time.perf_counter() - t1) * 1e3)
+    return {"synthetic_render_median_ms": float(np.median(render)),
+            "live_psi_measure_median_ms": float(np.median(measure))}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print the figures."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.rig.bench", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench rig", description=__doc__)
     parser.add_argument("--round-trips", type=int, default=500, help="SET+GET pairs timed (default 500)")
     parser.add_argument("--synthetic", type=int, default=10, help="synthetic photos timed (default 10)")
     args = parser.parse_args(argv)

@@ -1,6 +1,6 @@
 """Camera-speed benchmark: a rendered video measured end to end, with accuracy, timing and memory.
 
-``python -m pipeline.video.bench`` renders (once; cached by its parameters) a synthetic video photo
+``python -m pipeline bench video`` renders (once; cached by its parameters) a synthetic video photo
 set -- by default 2 minutes of 1280x720 at 30 fps (3600 frames), SS40 on two pressure ramps, lab
 scene with the camera square to the table, MJPEG -- and a video of a sixth of its length with
 the same settings, then measures each with ``python -m pipeline measure --jobs N`` in a
@@ -32,6 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -184,9 +185,9 @@ def render_cached(cache: Path, params: dict[str, Any]) -> tuple[Path, float]:
     return folder, time.perf_counter() - t0
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Render, measure, print the figures."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.video.bench", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m pipeline bench video", description=__doc__.splitlines()[0])
     parser.add_argument("--duration-s", type=float, default=120.0, help="video length (s, default 120)")
     parser.add_argument("--fps", type=float, default=30.0, help="frame rate (default 30)")
     parser.add_argument("--width", type=int, default=1280, help="frame width (px, default 1280)")

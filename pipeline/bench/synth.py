@@ -1,7 +1,7 @@
 """Rendering benchmark: the default synthetic campaign, images per second; or one photo per scene.
 
-``python -m pipeline.synth.bench [--quick] [--jobs N] [--scene lab] [--out DIR]``
-``python -m pipeline.synth.bench --photos [--repeats R]``
+``python -m pipeline bench synth [--quick] [--jobs N] [--scene lab] [--out DIR]``
+``python -m pipeline bench synth --photos [--repeats R]``
 
 The default campaign is 4 materials x 3 actuators x 6 trials of full ramps (10 kPa steps up to
 260 kPa or psi = -psi0 and back) at 1280x960 JPEG; the target is under 2 minutes on 2 cores.
@@ -22,6 +22,7 @@ import os
 import shutil
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 MATERIALS = ("DS20", "DS30", "SS40", "SS50")
@@ -42,7 +43,7 @@ def photo_times(preset: str, width: int, height: int, repeats: int = 5) -> dict[
     from pipeline.synth.camera import make_camera
     from pipeline.synth.centreline import actuator_centreline_mm
     from pipeline.synth.presets import scene_from
-    from pipeline.synth.scene import _compose, world_extent_mm
+    from pipeline.synth.scene import compose_photo, world_extent_mm
 
     cv2.setNumThreads(1)
     scene = scene_from(preset, width=width, height=height)
@@ -54,7 +55,7 @@ def photo_times(preset: str, width: int, height: int, repeats: int = 5) -> dict[
         w0, c0 = time.perf_counter(), time.process_time()
         backdrop = make_backdrop(scene, camera, seed=child_seed(1, k), keepout_mm=curves)
         w1, c1 = time.perf_counter(), time.process_time()
-        r = _compose(curves[k % len(curves)], scene, camera, backdrop, scene.body_width_mm, np.random.default_rng(k))
+        r = compose_photo(curves[k % len(curves)], scene, camera, backdrop, scene.body_width_mm, np.random.default_rng(k))
         w2 = time.perf_counter()
         _ = r.jpeg_bytes
         w3, c3 = time.perf_counter(), time.process_time()
@@ -83,11 +84,11 @@ def photos_report(repeats: int) -> None:
           "target: a 1280x960 body photo < 0.2 s")
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print images/s per material and in total."""
     from pipeline.synth.photoset_writer import render_photoset
 
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python -m pipeline bench synth", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--quick", action="store_true", help="1 actuator x 1 trial per material instead of 3 x 6")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes (default: all cores)")
     p.add_argument("--scene", default="lab", help="scene preset (default lab)")
