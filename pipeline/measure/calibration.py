@@ -46,7 +46,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -463,9 +463,3 @@ def describe_problem(cal: Calibration, exc: Exception) -> tuple[str, str]:
     if "px but" in text:
         return text, "take every board photo with the camera and resolution of the actuator photos"
     return text, "re-take or re-export the board photo"
-
-
-def as_mapping(cal: Calibration) -> Mapping[str, Any]:
-    """The spec as a ``calibration:`` value (for messages and the CLI)."""
-    return {"board": [Path(b).name for b in cal.boards], "square_mm": cal.square_mm,
-            "inner_corners": list(cal.inner_corners)}

@@ -319,8 +319,3 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
         f"--camera {spec!r} is not understood; use a device index (0), a stream URL (rtsp://...), "
         "'cmd:COMMAND {path}', 'dir:FOLDER' or 'synthetic[:clean|lab|hard]'"
     )
-
-
-def is_synthetic(camera: Camera) -> bool:
-    """Whether ``camera`` renders synthetic images."""
-    return isinstance(camera, SyntheticCamera)

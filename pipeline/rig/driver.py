@@ -158,7 +158,6 @@ class PicoDriver:
         self.timeout_s = timeout_s
         self.info: DeviceInfo | None = None
         self.garbage_lines = 0
-        self.commands_sent = 0
         self._estop_seen = False
         self._watchdog_seen = False
         self._buf = b""
@@ -433,7 +432,6 @@ class PicoDriver:
                     f"serial port {self.link.port!r} lost while sending {command} ({exc}); "
                     "reconnect the rig and re-run the same command to resume"
                 ) from exc
-            self.commands_sent += 1
             reply = self._await_reply(command)
             if reply.kind == "ERR" and reply.command == "PARSE" and attempt < retries:
                 log.warning("device answered ERR PARSE to %s; sending it again", command)

@@ -25,7 +25,6 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -171,8 +170,3 @@ def run_grid(
                 if progress:
                     progress(min((i + 1) * size, len(cases)), len(cases))
     return pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
-
-
-def cases_table(cases: Sequence[Case]) -> pd.DataFrame:
-    """The cases as a table (what was rendered), for the record."""
-    return pd.DataFrame([{**asdict(c), "overrides": ";".join(f"{k}={v}" for k, v in c.overrides)} for c in cases])
