@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import DIRECTIONS, STATUSES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 
@@ -60,10 +61,8 @@ PER_ACTUATOR_COLUMNS: tuple[str, ...] = (
     "material", "actuator", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg",
     "n", "n_trials", "n_excluded", "pressure_mean_kpa",
 )
-DIRECTION_ORDER: tuple[str, ...] = ("up", "down")
 #: bin width (kPa) of the frames of a video when no bin width is asked for
 CONTINUOUS_BIN_KPA = 5.0
-STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 
 
 def read_angles(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
@@ -134,7 +133,7 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
     if bad_p.any():
         i = int(np.flatnonzero(bad_p)[0])
         raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint (kPa)")
-    for column, allowed in (("direction", DIRECTION_ORDER), ("status", STATUSES)):
+    for column, allowed in (("direction", DIRECTIONS), ("status", STATUSES)):
         bad = ~angles[column].isin(allowed).to_numpy()
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
@@ -246,7 +245,7 @@ def _summarise(df: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
     out = pd.DataFrame(rows)
     if out.empty:
         return out
-    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTIONS)})
     sort_keys = [k if k != "direction" else "_dir" for k in keys] + ["pressure_kpa"]
     out = out.sort_values(sort_keys, kind="stable").drop(columns="_dir").reset_index(drop=True)
     for c in ("n", "n_actuators", "n_trials", "n_excluded"):
@@ -427,6 +426,6 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
             row["pressure_mean_kpa"] = float(np.sum(n[used] * pm[used]) / total) if total else math.nan
         rows.append(row)
     out = pd.DataFrame(rows)
-    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTIONS)})
     out = out.sort_values(["material", "_dir", "pressure_kpa"], kind="stable").drop(columns="_dir")
     return out.reset_index(drop=True)

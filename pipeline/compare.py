@@ -56,6 +56,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.aggregate import actuator_keys, pool_hysteresis
+from pipeline.constants import DIRECTIONS, PSI0_DEG
 from pipeline.errors import UserInputError
 
 ModelPsi = Callable[[str, np.ndarray, "float | None"], np.ndarray]
@@ -116,7 +117,7 @@ def check_hysteresis(hyst: pd.DataFrame, where: str = "hysteresis.csv") -> None:
         raise UserInputError(
             f"{where}: missing column(s) {missing}; pass a hysteresis.csv written by 'aggregate'"
         )
-    bad = ~hyst["direction"].isin(("up", "down")).to_numpy()
+    bad = ~hyst["direction"].isin(DIRECTIONS).to_numpy()
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise UserInputError(
@@ -332,7 +333,7 @@ def compare_material(
         out["rms_deg"], _, out["n_model_nan"] = rms_deg(meas, model)
         out["rms_up_deg"] = rms_deg(meas[up], model[up])[0]
         out["rms_down_deg"] = rms_deg(meas[~up], model[~up])[0]
-    for direction in ("up", "down"):
+    for direction in DIRECTIONS:
         p_b, s_b = branch(h, direction)
         out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0)
         out[f"p_minus_psi0_{direction}_kpa"] = crossing_kpa(p_b, s_b, -psi0_deg)
@@ -517,7 +518,8 @@ def compare(
         the model does not know, or an l0 it refuses (the callable raises
         :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
-        Rest angle per material (deg); 210 deg (the paper's) for materials not listed.
+        Rest angle per material (deg); :data:`pipeline.constants.PSI0_DEG` (the paper's) for materials
+        not listed.
     default_l0_mm : mapping, optional
         The model's l0 per material for datasets without their own (materials not listed: the
         callables get ``l0_mm=None``, the model's own default).
@@ -559,7 +561,7 @@ def compare(
         usable = not group.mixed
         psi_fn = (lambda m, p, l0=l0: model_psi(m, p, l0)) if model_psi is not None and usable else None
         fit_fn = (lambda m, p, s, l0=l0: fit_k_p(m, p, s, l0)) if fit_k_p is not None and usable else None
-        kwargs = dict(psi0_deg=float(psi0.get(material, 210.0)), n_boot=n_boot, seed=seed)
+        kwargs = dict(psi0_deg=float(psi0.get(material, PSI0_DEG)), n_boot=n_boot, seed=seed)
         note = group.note
         try:
             rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)

@@ -103,7 +103,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="output CSV: material, psi_deg, pressure_kpa, reason",
     )
     p.add_argument(
-        "--psi-max", type=float, default=None, help="first angle (deg); default psi0 = 210"
+        "--psi-max", type=float, default=None, help="first angle (deg); default the material's psi0"
     )
     p.add_argument("--psi-min", type=float, default=-360.0, help="last angle (deg); default -360")
     p.add_argument("--n", type=int, default=400, help="number of angles (default 400)")

@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from pipeline.constants import DIRECTIONS
 from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
@@ -75,7 +76,7 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, 
     h = data.hysteresis[data.hysteresis["material"] == material]
     p_max = float(h["pressure_kpa"].max()) if len(h) else 1.0
     styles = {"up": (color, 0.35, "increasing P"), "down": (lighter(color), 0.35, "decreasing P")}
-    for direction in ("up", "down"):
+    for direction in DIRECTIONS:
         b = h[h["direction"] == direction].sort_values("pressure_kpa")
         if b.empty:
             continue

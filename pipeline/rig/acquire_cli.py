@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from pipeline.constants import PSI0_DEG
 from pipeline.errors import UserInputError
 from pipeline.rig.acquire import (
     EXIT_CODES,
@@ -54,7 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="turning direction on screen, from fixed to free end, counted as positive psi (default ccw)")
     parser.add_argument("--stop-at-psi0", action=argparse.BooleanOptionalAction, default=None,
                         help="end the up leg when the live-measured psi reaches -psi0 (default: on with the synthetic camera when pipeline.measure is available)")
-    parser.add_argument("--psi0-deg", type=float, help="rest bending angle psi0 for --stop-at-psi0 (deg; default: the material's, else 210)")
+    parser.add_argument("--psi0-deg", type=float, help="rest bending angle psi0 for --stop-at-psi0 (deg; default: the material's, else the paper's 210)")
     parser.add_argument("--watchdog-s", type=float,
                         help="the Pico vents by itself when the host sends nothing for this long, e.g. a pulled cable "
                              "(s; default 3 x settle + camera timeout + 10; 0 = off)")
@@ -142,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
     psi0 = args.psi0_deg
     if psi0 is None:
         mat = _material_defaults(args.material)
-        psi0 = mat.psi0_deg if mat is not None else 210.0
+        psi0 = mat.psi0_deg if mat is not None else PSI0_DEG
     stop_up = psi0_stop_criterion(psi0) if stop_at_psi0 else None
     try:
         return _acquire(args, cfg, calibration, stop_up, settings)

@@ -82,13 +82,13 @@ def benchmark_model(
     """
     table = load_materials()
     mats: list[Material] = [table[m] for m in materials]
-    psi = np.linspace(210.0, -360.0, n_angles)
+    psi = {m.name: np.linspace(m.psi0_deg, -360.0, n_angles) for m in mats}
     ref_kw = {**options, **grid_options(reference_n)}
     ref_p = {}
     pressures = {}
     ref_psi = {}
     for m in mats:
-        ref_p[m.name], _ = pressure_core(m, np.radians(psi), make_options(**ref_kw))
+        ref_p[m.name], _ = pressure_core(m, np.radians(psi[m.name]), make_options(**ref_kw))
         top = float(np.nanmax(ref_p[m.name])) if np.isfinite(ref_p[m.name]).any() else 0.0
         pressures[m.name] = np.linspace(0.0, top, n_pressures)
         ref_psi[m.name] = psi_deg(m, pressures[m.name], **ref_kw)
@@ -98,7 +98,7 @@ def benchmark_model(
 
         def forward(kw: dict[str, Any] = kw) -> None:
             for m in mats:
-                pressure_core(m, np.radians(psi), make_options(**kw))
+                pressure_core(m, np.radians(psi[m.name]), make_options(**kw))
 
         def inverse(kw: dict[str, Any] = kw) -> None:
             for m in mats:
@@ -108,7 +108,7 @@ def benchmark_model(
         t_inv, c_inv = _best_time(inverse, repeats)
         rel, dpsi = 0.0, 0.0
         for m in mats:
-            p, _ = pressure_core(m, np.radians(psi), make_options(**kw))
+            p, _ = pressure_core(m, np.radians(psi[m.name]), make_options(**kw))
             ok = np.isfinite(p) & np.isfinite(ref_p[m.name]) & (np.abs(ref_p[m.name]) > 1e-9)
             if ok.any():
                 rel = max(rel, float(np.max(np.abs(p[ok] / ref_p[m.name][ok] - 1.0))))

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import VACUUM_KPA
+from pipeline.constants import DIRECTIONS, VACUUM_KPA
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
@@ -219,7 +219,7 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
     # direction of each log interval: up until the first turning point, then alternating
     edges = log.time_s[tp]
     n_turns = np.searchsorted(edges, t, side="left")  # a frame at a peak's own time is still rising
-    out["direction"] = np.where(n_turns % 2 == 0, "up", "down")
+    out["direction"] = np.where(n_turns % 2 == 0, *DIRECTIONS)
     steps = step_times(log)
     k = np.searchsorted(steps, t, side="right")
     out["step"] = k.astype(int)
