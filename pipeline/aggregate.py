@@ -142,6 +142,35 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
             )
 
 
+def measured_pressure(angles: pd.DataFrame) -> pd.Series:
+    """The pressure each row was measured at (kPa): ``measured_pressure_kpa`` where present and
+    finite, else the setpoint ``pressure_kpa``.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"pressure_kpa": [10.0, 20.0], "measured_pressure_kpa": [9.5, None]})
+    >>> measured_pressure(df).tolist()
+    [9.5, 20.0]
+    """
+    nominal = pd.to_numeric(angles["pressure_kpa"], errors="coerce").astype(float)
+    if "measured_pressure_kpa" not in angles.columns:
+        return nominal
+    measured = pd.to_numeric(angles["measured_pressure_kpa"], errors="coerce").astype(float)
+    return measured.where(np.isfinite(measured), nominal)
+
+
+def is_used(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Series:
+    """Whether each row's psi may enter a curve by its status: ``ok``, and ``flagged`` if asked
+    (``failed`` never).
+
+    Examples
+    --------
+    >>> is_used(pd.DataFrame({"status": ["ok", "flagged", "failed"]}), include_flagged=True).tolist()
+    [True, True, False]
+    """
+    return angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
+
+
 def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Series:
     """Pressure level (kPa) of each row.
 
@@ -174,10 +203,7 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
         return nominal.where(~frames, pressure_levels(angles, CONTINUOUS_BIN_KPA))
     if not (math.isfinite(bin_kpa) and bin_kpa > 0):
         raise UserInputError(f"--bin-kpa must be a positive number of kPa, got {bin_kpa}")
-    measured = nominal
-    if "measured_pressure_kpa" in angles.columns:
-        m = pd.to_numeric(angles["measured_pressure_kpa"], errors="coerce").astype(float)
-        measured = m.where(np.isfinite(m), nominal)
+    measured = measured_pressure(angles)
     # floor(x / w + 0.5) rounds half up, unlike numpy's round-half-to-even
     return pd.Series(np.floor(measured.to_numpy() / bin_kpa + 0.5) * bin_kpa, index=angles.index)
 
@@ -189,16 +215,13 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
     df["trial"] = df["trial"].astype(str)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["_level"] = pressure_levels(df, bin_kpa)
-    pressure_used = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
     binned = pd.Series(bin_kpa is not None, index=df.index)
     if "frame" in df.columns:
         binned |= df["frame"].notna()
-    if "measured_pressure_kpa" in df.columns:
-        m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
-        pressure_used = m.where(np.isfinite(m) & binned, pressure_used)
-    df["_pressure"] = pressure_used
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df["_included"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
+    # binned rows average the measured pressure, setpoint levels the setpoint
+    setpoint = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
+    df["_pressure"] = measured_pressure(df).where(binned, setpoint)
+    df["_included"] = is_used(df, include_flagged) & np.isfinite(df["psi_deg"])
     df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
     if "frame" in df.columns and df["frame"].notna().any():
         df = _collapse_frames(df)

@@ -55,7 +55,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.aggregate import actuator_keys, pool_hysteresis
+from pipeline.aggregate import actuator_keys, is_used, measured_pressure, pool_hysteresis
 from pipeline.constants import DIRECTIONS, PSI0_DEG
 from pipeline.errors import UserInputError
 
@@ -363,13 +363,8 @@ def included_rows(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Dat
 
     The pressure used is ``measured_pressure_kpa`` where present and finite, else the setpoint.
     """
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df = angles[angles["status"].isin(allowed)].copy()
-    p = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
-    if "measured_pressure_kpa" in df.columns:
-        m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
-        p = m.where(np.isfinite(m), p)
-    df["pressure_kpa"] = p
+    df = angles[is_used(angles, include_flagged)].copy()
+    df["pressure_kpa"] = measured_pressure(df)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["actuator"] = actuator_keys(df)
     ok = np.isfinite(df["pressure_kpa"]) & np.isfinite(df["psi_deg"])

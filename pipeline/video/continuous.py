@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.aggregate import is_used, measured_pressure
 from pipeline.errors import UserInputError
 from pipeline.fileio import write_table
 
@@ -80,10 +81,8 @@ def _frames(angles: pd.DataFrame, include_flagged: bool) -> pd.DataFrame:
     for column in ("time_s", "psi_deg", "pressure_kpa", "measured_pressure_kpa", "since_step_s"):
         if column in df.columns:
             df[column] = pd.to_numeric(df[column], errors="coerce")
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df["_used"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
-    df["_pressure"] = (df["measured_pressure_kpa"] if "measured_pressure_kpa" in df.columns else df["pressure_kpa"])
-    df["_pressure"] = df["_pressure"].where(np.isfinite(df["_pressure"]), df["pressure_kpa"])
+    df["_used"] = is_used(df, include_flagged) & np.isfinite(df["psi_deg"])
+    df["_pressure"] = measured_pressure(df)
     return df.sort_values([*RAMP_KEYS, "time_s"], kind="stable")
 
 
