@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from pipeline.measure.calibration import CalibrationMismatch, check_size
 from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
-from pipeline.measure.quality import assess, assess_body
+from pipeline.measure.quality import Quality, assess, assess_body
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
 
@@ -92,6 +92,34 @@ def failed(method: str, reason: str) -> AngleResult:
     """An :class:`AngleResult` for a photo that could not be measured."""
     nan = float("nan")
     return AngleResult(nan, nan, nan, method, nan, "failed", reason, np.empty((0, 2)))
+
+
+def _measured(
+    psi: float,
+    est: CurveEstimate,
+    line: LineExtraction,
+    quality: Quality,
+    settings: MeasureSettings,
+    method: str,
+) -> AngleResult:
+    """The :class:`AngleResult` of a measured photo: psi, the fit ``est`` of ``line`` and its quality.
+
+    ``settings`` are those the fit used (on a calibrated plane: the plane's ``mm_per_px``).
+    """
+    mm_per_px = settings.mm_per_px
+    return AngleResult(
+        psi_deg=psi,
+        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
+        length_mm=float(est.length_px * mm_per_px) if mm_per_px else float("nan"),
+        method=method,
+        residual_px=est.residual_px,
+        status=quality.status,
+        reason=quality.reason,
+        centreline_px=line.centreline_px,
+        line_width_px=line.width_px,
+        degree=int(est.degree),
+        length_px=float(est.length_px),
+    )
 
 
 def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
@@ -183,19 +211,7 @@ def measure_work_image(
         psi_arc_deg=_psi_from(arc, sign, l0_mm, mm_per_px, length_px),
         turning_degree=trn.degree,
     )
-    return AngleResult(
-        psi_deg=psi,
-        kappa_per_mm=float(np.deg2rad(psi) / l0_mm),
-        length_mm=float(length_px * mm_per_px) if mm_per_px else float("nan"),
-        method=method,
-        residual_px=est.residual_px,
-        status=quality.status,
-        reason=quality.reason,
-        centreline_px=line.centreline_px,
-        line_width_px=line.width_px,
-        degree=int(est.degree),
-        length_px=float(est.length_px),
-    )
+    return _measured(psi, est, line, quality, settings, method)
 
 
 def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float]) -> NDArray[np.float64]:
@@ -318,20 +334,8 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
     )
-    mm = settings.mm_per_px
-    return AngleResult(
-        psi_deg=psi,
-        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
-        length_mm=float(est.length_px * mm) if mm else float("nan"),
-        method="tangents" if method == "auto" or base is not None else method,
-        residual_px=est.residual_px,
-        status=quality.status,
-        reason=quality.reason,
-        centreline_px=line.centreline_px,
-        line_width_px=line.width_px,
-        degree=int(est.degree),
-        length_px=float(est.length_px),
-    )
+    used = "tangents" if method == "auto" or base is not None else method
+    return _measured(psi, est, line, quality, settings, used)
 
 
 def measure_image(
