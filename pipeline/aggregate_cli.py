@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import io
 from pathlib import Path
 
-import pandas as pd
-
 from pipeline.aggregate import aggregate_hysteresis, aggregate_per_actuator, read_angles
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import write_table
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,21 +35,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _write_csv(frame: pd.DataFrame, path: Path) -> None:
-    buf = io.StringIO()
-    frame.to_csv(buf, index=False, float_format="%.6g", lineterminator="\n")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(path, buf.getvalue().encode("utf-8"))
-
-
 def run(args: argparse.Namespace) -> int:
     """Aggregate and write; print a one-line summary."""
     angles = read_angles(args.angles)
     hyst = aggregate_hysteresis(angles, bin_kpa=args.bin_kpa, include_flagged=args.include_flagged)
-    _write_csv(hyst, args.out)
+    write_table(hyst, args.out)
     if args.per_actuator_out is not None:
         per = aggregate_per_actuator(angles, bin_kpa=args.bin_kpa, include_flagged=args.include_flagged)
-        _write_csv(per, args.per_actuator_out)
+        write_table(per, args.per_actuator_out)
     n_used = int(hyst["n"].sum()) if len(hyst) else 0
     n_excl = int(hyst["n_excluded"].sum()) if len(hyst) else 0
     materials = ", ".join(sorted(map(str, hyst["material"].unique()))) if len(hyst) else "none"

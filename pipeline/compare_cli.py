@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import io
 import warnings
 from pathlib import Path
 
@@ -14,7 +13,7 @@ from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, model_callables
 from pipeline.errors import UserInputError
 from pipeline.model.cli import add_reading_arguments, reading_options
-from pipeline.fileio import atomic_write_bytes, read_table
+from pipeline.fileio import read_table, write_table
 from pipeline.photoset import TRUTH
 
 
@@ -120,14 +119,6 @@ def model_fit_text(options: dict[str, object]) -> str:
     return "none (derived reading; k_P and k_t are the paper's)"
 
 
-def write_csv(table: pd.DataFrame, path: Path) -> None:
-    """Write ``table`` atomically with 6 significant digits."""
-    buf = io.StringIO()
-    table.to_csv(buf, index=False, float_format="%.6g", lineterminator="\n")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(path, buf.getvalue().encode("utf-8"))
-
-
 def run(args: argparse.Namespace) -> int:
     """Compare and write rms.csv (and the model curves); print a one-line summary per row."""
     from pipeline import model
@@ -169,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
         )
     for w in caught:
         print(f"warning: {w.message}")
-    write_csv(table, args.out)
+    write_table(table, args.out)
     if args.curves is not None:
         readings = {k: v for k, v in options.items() if k != "l0_mm"}
         curves = [
@@ -179,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         ]
         columns = ["curve", "material", "l0_mm", "psi_deg", "pressure_kpa", "reason"]
         out = pd.concat(curves, ignore_index=True)[columns] if curves else pd.DataFrame(columns=columns)
-        write_csv(out, args.curves)
+        write_table(out, args.curves)
     for r in table.itertuples():
         print(f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; {r.rms_kind}]: RMS {r.rms_deg:.1f} deg")
     print(f"compare: {len(table)} comparison(s) -> {args.out}" + (f", curves -> {args.curves}" if args.curves else ""))

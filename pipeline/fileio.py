@@ -124,8 +124,12 @@ def table_bytes(table: pd.DataFrame, float_format: str | None = FLOAT_FORMAT) ->
     return table.to_csv(index=False, lineterminator="\n", float_format=float_format).encode()
 
 
-def write_table(table: pd.DataFrame, path: str | os.PathLike[str], float_format: str | None = FLOAT_FORMAT) -> None:
+def write_table(
+    table: pd.DataFrame, path: str | os.PathLike[str], float_format: str | None = FLOAT_FORMAT
+) -> None:
     """Write a table as CSV atomically (folder created, :data:`FLOAT_FORMAT` floats).
+
+    ``float_format=None`` keeps every digit (tables later stages compute on, inputs as given).
 
     Examples
     --------

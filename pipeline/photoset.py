@@ -41,7 +41,7 @@ import yaml
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.calibration import CalibrationCache
 from pipeline.measure.settings import KEYS, OVERRIDE_COLUMNS, MeasureSettings, is_missing, merge_calibration, settings_problems
 
@@ -500,7 +500,7 @@ def write_manifest(folder: str | os.PathLike[str], rows: pd.DataFrame) -> None:
     df = rows.drop(columns=["manifest_line"], errors="ignore")
     first = [c for c in (VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS) if c in df.columns]
     df = df[first + [c for c in df.columns if c not in first]]
-    atomic_write_bytes(Path(folder) / MANIFEST, df.to_csv(index=False, lineterminator="\n").encode())
+    write_table(df, Path(folder) / MANIFEST, float_format=None)  # the input as given: every digit
 
 
 def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:

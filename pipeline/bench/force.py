@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from pipeline.fileio import write_table
 from pipeline.force.ellipse import ellipse_points, fit_ellipse
 
 TARGET = 0.02
@@ -127,7 +128,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     sel = pts[(pts["refine"] == "auto") & (pts["arc_fraction"] >= 0.4)]
     print(_summary(sel, ["e_true"]).to_string())
     if args.out:
-        pts.to_csv(f"{args.out}_points.csv", index=False)
+        write_table(pts, f"{args.out}_points.csv", float_format=None)
     if not args.no_images:
         imgs = image_sweep(seeds=max(1, args.seeds - 1))
         print("\n== rendered photos (render -> extract -> fit), by scene and arc fraction")
@@ -140,7 +141,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if len(flagged):
             print("most common flag/fail reasons:\n" + flagged.to_string())
         if args.out:
-            imgs.to_csv(f"{args.out}_images.csv", index=False)
+            write_table(imgs, f"{args.out}_images.csv", float_format=None)
     return 0
 
 

@@ -18,6 +18,7 @@ import pandas as pd
 
 from pipeline.aggregate import aggregate_hysteresis
 from pipeline.compare import compare, model_callables
+from pipeline.fileio import write_table
 from pipeline.report.build import build_report
 from pipeline.report.data import Dataset, ReportInputs
 
@@ -55,7 +56,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         datasets, frames = [], []
         for i, m in enumerate(P_MAX_KPA):
             a = synthetic_angles(m, args.trials, seed=i)
-            a.to_csv(root / f"{m}.csv", index=False)
+            write_table(a, root / f"{m}.csv", float_format=None)
             datasets.append(Dataset(m, root / f"{m}.csv"))
             frames.append(a)
         angles = pd.concat(frames, ignore_index=True)
@@ -65,8 +66,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         model_psi, fit_k_p, psi0 = model_callables()
         table = compare(hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, n_boot=200, seed=0)
         t2 = time.perf_counter()
-        hyst.to_csv(root / "h.csv", index=False)
-        table.to_csv(root / "rms.csv", index=False)
+        write_table(hyst, root / "h.csv", float_format=None)
+        write_table(table, root / "rms.csv", float_format=None)
         result = build_report(ReportInputs(datasets=tuple(datasets), hysteresis=(root / "h.csv",),
                                            rms=(root / "rms.csv",)), root / "report.pdf")
         t3 = time.perf_counter()

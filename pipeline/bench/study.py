@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import write_table
 from pipeline.folders import staged_folder
 
 if TYPE_CHECKING:
@@ -129,7 +130,7 @@ def _run_into(out: Path, args: argparse.Namespace, grid: Grid, methods: list[str
     tables = {"results.csv": results, "speed_accuracy.csv": sa, "stability.csv": stab, "breakdown.csv": bd,
               "repeatability.csv": rep, "model_choice.csv": choice, "model_cost.csv": cost}
     for name, table in tables.items():
-        table.to_csv(out / name, index=False, float_format="%.8g")
+        write_table(table, out / name, float_format="%.8g")
     figs = {"speed_accuracy": charts.speed_accuracy_figure(sa), "stability": charts.stability_figure(stab),
             "tables": charts.tables_figure(bd, choice, rep), "model_cost": charts.model_cost_figure(cost)}
     for stem, fig in figs.items():

@@ -23,12 +23,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from pipeline.errors import UserInputError
-
-if TYPE_CHECKING:
-    import pandas as pd
+from pipeline.fileio import write_table
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -98,13 +95,6 @@ def run(args: argparse.Namespace) -> int:
     }[args.force_command](args)
 
 
-def _write_csv(df: pd.DataFrame, path: Path) -> None:
-    from pipeline.fileio import atomic_write_bytes
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(path, df.to_csv(index=False, lineterminator="\n").encode())
-
-
 def _scene_overrides(pairs: list[str]) -> dict[str, str]:
     out = {}
     for pair in pairs:
@@ -148,7 +138,7 @@ def _measure(args: argparse.Namespace) -> int:
         max_eccentricity_sd=args.max_eccentricity_sd,
         max_residual_px=args.max_residual_px,
     )
-    _write_csv(table, args.out)
+    write_table(table, args.out, float_format=None)
     counts = table["status"].value_counts()
     print(
         f"force measure: {len(table)} photos, {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} flagged, "
@@ -168,8 +158,8 @@ def _aggregate(args: argparse.Namespace) -> int:
     force = force_vs_pressure(table)
     ecc = eccentricity_at_max_pressure(table)
     ecc_out = args.eccentricity_out or args.out.with_name("eccentricity_summary.csv")
-    _write_csv(force, args.out)
-    _write_csv(ecc, ecc_out)
+    write_table(force, args.out, float_format=None)
+    write_table(ecc, ecc_out, float_format=None)
     parts = [
         f"{r.material} e={r.eccentricity_mean:.3f} at {r.pressure_kpa:g} kPa" for r in ecc.itertuples()
     ]
@@ -190,7 +180,7 @@ def _grasp(args: argparse.Namespace) -> int:
     path = EXAMPLE_LOG if args.example else args.log
     log = read_grasp_log(path)
     summary = heaviest_held(log)
-    _write_csv(summary, args.out)
+    write_table(summary, args.out, float_format=None)
     if args.figure is not None:
         args.figure.parent.mkdir(parents=True, exist_ok=True)
         grasp_figure(summary).savefig(args.figure)

@@ -330,7 +330,7 @@ def render_blocked_photoset(
     pandas.DataFrame
         The manifest written.
     """
-    from pipeline.fileio import atomic_write_bytes
+    from pipeline.fileio import atomic_write_bytes, write_table
     from pipeline.folders import staged_folder
     from pipeline.photoset import TRUTH, write_manifest, write_settings
     from pipeline.synth import child_seed, render_curve, scene_from
@@ -382,6 +382,6 @@ def render_blocked_photoset(
             },
         )
         truth = pd.DataFrame(truth_rows, columns=list(TRUTH_COLUMNS))
-        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n").encode())
+        write_table(truth, tmp / TRUTH, float_format=None)
     return manifest
 

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import write_table
 from pipeline.model.materials import Material, load_materials
 from pipeline.model.options import CHOICES, ModelOptions, make_options
 
@@ -171,8 +172,7 @@ def run(args: argparse.Namespace) -> int:
             raise UserInputError("--n must be at least 2")
         top = mat.psi0_deg if args.psi_max is None else args.psi_max
         df = model_curve(mat, np.linspace(top, args.psi_min, args.n), **opts)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(args.out, index=False)
+        write_table(df, args.out, float_format=None)
         print(
             f"wrote {len(df)} angles to {args.out} ({int(df.pressure_kpa.isna().sum())} undefined)"
         )

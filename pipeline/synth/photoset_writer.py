@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.folders import staged_folder
 from pipeline.photoset import MANIFEST, TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
@@ -359,5 +359,5 @@ def render_photoset(
             settings["calibration"] = write_board_photo(tmp / BOARD_PHOTO, sc, make_camera(
                 sc, rotation_deg=base_rot, fixed_end_px=tasks[0]["fixed_end_px"]), seed=child_seed(seed, mk, _BOARD))
         write_settings(tmp, settings)
-        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+        write_table(truth, tmp / TRUTH)
     return truth

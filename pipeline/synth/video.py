@@ -46,7 +46,7 @@ import pandas as pd
 from scipy.signal import lfilter
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import write_table
 from pipeline.photoset import TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
@@ -275,7 +275,7 @@ def render_video(
                         "pressure_kpa": np.interp(log_t, sim["time_s"], sim["setpoint_kpa"]),
                         "measured_kpa": np.interp(log_t, sim["time_s"], sim["pressure_kpa"]) + noise})
     log_name = f"{Path(name).stem}_pressure.csv"
-    atomic_write_bytes(out / log_name, log.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+    write_table(log, out / log_name)
     write_manifest(out, pd.DataFrame([{"video": name, "pressure_log": log_name, "clock_offset_s": f"{clock_offset_s:g}",
                                        "material": material, "actuator": actuator, "trial": trial}]))
     write_settings(out, {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
@@ -290,7 +290,7 @@ def render_video(
               tau_pressure_s=dyn.tau_pressure_s, tau_psi_s=dyn.tau_psi_s, psi0_deg=trial_actuator.psi0_deg,
               stiffness=trial_actuator.stiffness, hysteresis=trial_actuator.behaviour.hysteresis, l0_mm=l0,
               mm_per_px=sc.mm_per_px, width=sc.width, height=sc.height, seed=seed)
-    atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+    write_table(truth, out / TRUTH)
     return truth
 
 
