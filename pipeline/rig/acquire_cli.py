@@ -54,7 +54,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--positive-turn", choices=("ccw", "cw"), default="ccw",
                         help="turning direction on screen, from fixed to free end, counted as positive psi (default ccw)")
     parser.add_argument("--stop-at-psi0", action=argparse.BooleanOptionalAction, default=None,
-                        help="end the up leg when the live-measured psi reaches -psi0 (default: on with the synthetic camera when pipeline.measure is available)")
+                        help="end the up leg when the live-measured psi reaches -psi0 (default: on with the synthetic camera)")
     parser.add_argument("--psi0-deg", type=float, help="rest bending angle psi0 for --stop-at-psi0 (deg; default: the material's, else the paper's 210)")
     parser.add_argument("--watchdog-s", type=float,
                         help="the Pico vents by itself when the host sends nothing for this long, e.g. a pulled cable "

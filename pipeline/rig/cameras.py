@@ -298,7 +298,7 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
     Raises
     ------
     UserInputError
-        On a spec that names no backend, or ``synthetic`` when :mod:`pipeline.synth` is missing.
+        On a spec that names no backend.
     """
     spec = spec.strip()
     if spec.startswith("cmd:"):
@@ -307,10 +307,7 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
         return FolderCamera(spec[4:], timeout_s=timeout_s)
     if spec == "synthetic" or spec.startswith("synthetic:"):
         preset = spec.partition(":")[2] or "lab"
-        try:
-            return SyntheticCamera(material, l0_mm, preset=preset, seed=seed, mode=mode)
-        except ImportError as exc:
-            raise UserInputError(f"--camera synthetic needs pipeline.synth, pipeline.model (and pipeline.force in blocked mode): {exc}") from exc
+        return SyntheticCamera(material, l0_mm, preset=preset, seed=seed, mode=mode)
     if spec.isdigit():
         return OpenCVCamera(int(spec))
     if "://" in spec:

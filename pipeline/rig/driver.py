@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 import time
 from dataclasses import dataclass
 from types import TracebackType
@@ -37,12 +38,12 @@ from pipeline.rig.protocol import BAUDRATE, EXTENSIONS, Reply, encode, parse_rep
 
 log = logging.getLogger(__name__)
 
-try:  # POSIX: a hung-up tty raises termios.error (not an OSError) from tcdrain/tcsetattr
+_PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+# POSIX: a hung-up tty raises termios.error (not an OSError) from tcdrain/tcsetattr
+if sys.platform != "win32":
     import termios
 
-    _PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, termios.error)
-except ImportError:  # pragma: no cover - Windows
-    _PORT_ERRORS = (serial.SerialException, OSError)
+    _PORT_ERRORS = (*_PORT_ERRORS, termios.error)
 
 #: garbage lines tolerated while waiting for one reply
 MAX_GARBAGE_PER_REPLY = 20

@@ -126,10 +126,8 @@ class LoadingCurve:
 
 
 def _model_psi_fn() -> PsiFunction:
-    try:
-        from pipeline.model import psi_deg
-    except ImportError as exc:  # pragma: no cover - the model ships with the package
-        raise UserInputError("pipeline.model is not available; pass psi_fn= to the synthetic renderer") from exc
+    from pipeline.model import psi_deg  # imported when first needed: the model loads its tables
+
     return psi_deg
 
 

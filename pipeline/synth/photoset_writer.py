@@ -77,13 +77,10 @@ def image_name(material: str, actuator: str, trial: str, step: int, direction: s
 
 def default_l0_mm(material: str) -> float:
     """l0 of the material from ``pipeline.model.load_materials`` (195 mm if unknown)."""
-    try:
-        from pipeline.model import load_materials
+    from pipeline.model import load_materials
 
-        mats = load_materials()
-        return float(mats[material].l0_mm) if material in mats else DEFAULT_L0_MM
-    except ImportError:  # pragma: no cover
-        return DEFAULT_L0_MM
+    mats = load_materials()
+    return float(mats[material].l0_mm) if material in mats else DEFAULT_L0_MM
 
 
 def plan_photoset(
