@@ -116,7 +116,8 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
     missing = [c for c in REQUIRED_ANGLE_COLUMNS if c not in angles.columns]
     if missing:
         raise UserInputError(
-            f"{where}: missing column(s) {missing}; an angles.csv needs {list(REQUIRED_ANGLE_COLUMNS)}"
+            f"{where}: missing column(s) {missing}; an angles.csv needs "
+            f"{list(REQUIRED_ANGLE_COLUMNS)}"
         )
     for column in ("pressure_kpa", "psi_deg") + (
         ("measured_pressure_kpa",) if "measured_pressure_kpa" in angles.columns else ()
@@ -126,19 +127,27 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
         if bad.any():
             i = int(np.flatnonzero(bad.to_numpy())[0])
             raise UserInputError(
-                f"{where} line {i + 2}: column '{column}' must be a number, got {angles[column].iloc[i]!r}"
+                f"{where} line {i + 2}: column '{column}' must be a number, got "
+                f"{angles[column].iloc[i]!r}"
             )
     # a failed row may have no pressure (a bad manifest pressure, a frame outside its pressure log)
-    bad_p = (pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna() & (angles["status"] != "failed")).to_numpy()
+    bad_p = (
+        pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna()
+        & (angles["status"] != "failed")
+    ).to_numpy()
     if bad_p.any():
         i = int(np.flatnonzero(bad_p)[0])
-        raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint (kPa)")
+        raise UserInputError(
+            f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint "
+            "(kPa)"
+        )
     for column, allowed in (("direction", DIRECTIONS), ("status", STATUSES)):
         bad = ~angles[column].isin(allowed).to_numpy()
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise UserInputError(
-                f"{where} line {i + 2}: '{column}' is {angles[column].iloc[i]!r}; use one of {list(allowed)}"
+                f"{where} line {i + 2}: '{column}' is {angles[column].iloc[i]!r}; use one of "
+                f"{list(allowed)}"
             )
 
 
@@ -165,7 +174,8 @@ def is_used(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Series:
 
     Examples
     --------
-    >>> is_used(pd.DataFrame({"status": ["ok", "flagged", "failed"]}), include_flagged=True).tolist()
+    >>> status = pd.DataFrame({"status": ["ok", "flagged", "failed"]})
+    >>> is_used(status, include_flagged=True).tolist()
     [True, True, False]
     """
     return angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
@@ -238,7 +248,14 @@ def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:
     keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
     inc = frames[frames["_included"]]
     mean = inc.groupby(keys, sort=False)[["psi_deg", "_pressure"]].mean()
-    rows = frames.groupby(keys, sort=False).size().rename("_frames").to_frame().join(mean).reset_index()
+    rows = (
+        frames.groupby(keys, sort=False)
+        .size()
+        .rename("_frames")
+        .to_frame()
+        .join(mean)
+        .reset_index()
+    )
     rows["_included"] = rows["psi_deg"].notna()
     rows["status"] = np.where(rows["_included"], "ok", "failed")
     rows["_pressure"] = rows["_pressure"].where(rows["_included"], np.nan)
@@ -339,7 +356,8 @@ def reason_kind(reason: str) -> str:
     >>> reason_kind("")
     '(no reason given)'
     """
-    text = re.sub(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?", "#", reason.strip())  # keeps names like l0
+    # keeps names like l0
+    text = re.sub(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?", "#", reason.strip())
     return text or "(no reason given)"
 
 
@@ -368,11 +386,20 @@ def status_counts(angles: pd.DataFrame, max_kinds: int = 6) -> pd.DataFrame:
     rows = []
     for (dataset, material), g in df.groupby(["dataset", "material"], sort=False):
         bad = g[g["status"] != "ok"]
-        kinds = [reason_kind(part) for r in bad["reason"].fillna("").astype(str) for part in (r.split(";") or [""])]
+        kinds = [
+            reason_kind(part)
+            for r in bad["reason"].fillna("").astype(str)
+            for part in (r.split(";") or [""])
+        ]
         counts = pd.Series(kinds, dtype=str).value_counts(sort=False)
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
         if len(ordered) > max_kinds:
-            ordered = ordered[:max_kinds] + [(f"{len(ordered) - max_kinds} other kind(s)", sum(c for _, c in ordered[max_kinds:]))]
+            ordered = ordered[:max_kinds] + [
+                (
+                    f"{len(ordered) - max_kinds} other kind(s)",
+                    sum(c for _, c in ordered[max_kinds:]),
+                )
+            ]
         rows.append(
             {
                 "dataset": dataset,
@@ -384,7 +411,9 @@ def status_counts(angles: pd.DataFrame, max_kinds: int = 6) -> pd.DataFrame:
                 "reasons": "; ".join(f"{r} x{c}" for r, c in ordered),
             }
         )
-    return pd.DataFrame(rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"])
+    return pd.DataFrame(
+        rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"]
+    )
 
 
 def actuator_keys(angles: pd.DataFrame) -> pd.Series:
@@ -417,7 +446,8 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
     Examples
     --------
     >>> import pandas as pd
-    >>> a = dict(material="DS20", direction="up", pressure_kpa=0.0, n_actuators=1, n_trials=2, n_excluded=0)
+    >>> a = dict(material="DS20", direction="up", pressure_kpa=0.0, n_actuators=1, n_trials=2,
+    ...          n_excluded=0)
     >>> h = pd.DataFrame([dict(a, psi_mean_deg=1.0, psi_sd_deg=2 ** 0.5, n=2),
     ...                   dict(a, psi_mean_deg=4.0, psi_sd_deg=float("nan"), n=1)])
     >>> pool_hysteresis(h)[["psi_mean_deg", "psi_sd_deg", "n"]].to_numpy().tolist()  # of 0, 2, 4
@@ -434,7 +464,11 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
         used = n > 0
         total = float(n[used].sum())
         mean = float(np.sum(n[used] * m[used]) / total) if total else math.nan
-        ss = float(np.sum((n[used] - 1) * sd[used] ** 2) + np.sum(n[used] * (m[used] - mean) ** 2)) if total else 0.0
+        ss = (
+            float(np.sum((n[used] - 1) * sd[used] ** 2) + np.sum(n[used] * (m[used] - mean) ** 2))
+            if total
+            else 0.0
+        )
         row = dict(zip(keys, key, strict=True))
         row.update(
             psi_mean_deg=mean,
@@ -446,7 +480,9 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
         )
         if "pressure_mean_kpa" in g:
             pm = g["pressure_mean_kpa"].to_numpy(float)
-            row["pressure_mean_kpa"] = float(np.sum(n[used] * pm[used]) / total) if total else math.nan
+            row["pressure_mean_kpa"] = (
+                float(np.sum(n[used] * pm[used]) / total) if total else math.nan
+            )
         rows.append(row)
     out = pd.DataFrame(rows)
     out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTIONS)})

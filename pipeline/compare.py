@@ -62,7 +62,14 @@ from pipeline.errors import UserInputError
 ModelPsi = Callable[[str, np.ndarray, "float | None"], np.ndarray]
 FitKp = Callable[[str, np.ndarray, np.ndarray, "float | None"], tuple[float, Any]]
 
-HYSTERESIS_REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n")
+HYSTERESIS_REQUIRED: tuple[str, ...] = (
+    "material",
+    "direction",
+    "pressure_kpa",
+    "psi_mean_deg",
+    "psi_sd_deg",
+    "n",
+)
 
 
 @dataclass(frozen=True)
@@ -111,7 +118,8 @@ RMS_COLUMNS: tuple[str, ...] = (
 
 
 def check_hysteresis(hyst: pd.DataFrame, where: str = "hysteresis.csv") -> None:
-    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has a bad direction."""
+    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has a bad
+    direction."""
     missing = [c for c in HYSTERESIS_REQUIRED if c not in hyst.columns]
     if missing:
         raise UserInputError(
@@ -195,19 +203,22 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
 
 
 def branch(hyst_material: pd.DataFrame, direction: str) -> tuple[np.ndarray, np.ndarray]:
-    """Pressure and mean psi of one direction in ramp order (ascending for up, descending for down)."""
+    """Pressure and mean psi of one direction in ramp order (ascending for up, descending for
+    down)."""
     b = hyst_material[hyst_material["direction"] == direction]
     b = b.sort_values("pressure_kpa", ascending=(direction == "up"), kind="stable")
     return b["pressure_kpa"].to_numpy(dtype=float), b["psi_mean_deg"].to_numpy(dtype=float)
 
 
 def hysteresis_width(hyst_material: pd.DataFrame) -> tuple[float, float]:
-    """Largest |psi_up - psi_down| (deg) over levels present in both directions, and its pressure (kPa).
+    """Largest |psi_up - psi_down| (deg) over levels in both directions, and its pressure (kPa).
 
     Returns ``(nan, nan)`` when no level has finite means in both directions.
     """
     up = hyst_material[hyst_material["direction"] == "up"].set_index("pressure_kpa")["psi_mean_deg"]
-    down = hyst_material[hyst_material["direction"] == "down"].set_index("pressure_kpa")["psi_mean_deg"]
+    down = hyst_material[hyst_material["direction"] == "down"].set_index("pressure_kpa")[
+        "psi_mean_deg"
+    ]
     both = pd.concat([up.rename("up"), down.rename("down")], axis=1, join="inner").dropna()
     if both.empty:
         return math.nan, math.nan
@@ -257,7 +268,9 @@ def bootstrap_k_p(
     """
     if rows.empty:
         return math.nan, math.nan, math.nan, 0
-    k_p = float(fit_k_p(material, rows["pressure_kpa"].to_numpy(float), rows["psi_deg"].to_numpy(float))[0])
+    k_p = float(
+        fit_k_p(material, rows["pressure_kpa"].to_numpy(float), rows["psi_deg"].to_numpy(float))[0]
+    )
     actuators = sorted(rows["actuator"].astype(str).unique())
     if len(actuators) < 2 or n_boot <= 0:
         return k_p, math.nan, math.nan, 0
@@ -266,12 +279,18 @@ def bootstrap_k_p(
     fits = []
     memo: dict[tuple[int, ...], float] = {}  # a resample is a multiset of actuators: fit each once
     for _ in range(n_boot):
-        pick = tuple(sorted(int(i) for i in rng.choice(len(actuators), size=len(actuators), replace=True)))
+        pick = tuple(
+            sorted(int(i) for i in rng.choice(len(actuators), size=len(actuators), replace=True))
+        )
         if pick not in memo:
             sample = pd.concat([by_act[actuators[i]] for i in pick], ignore_index=True)
             try:
                 memo[pick] = float(
-                    fit_k_p(material, sample["pressure_kpa"].to_numpy(float), sample["psi_deg"].to_numpy(float))[0]
+                    fit_k_p(
+                        material,
+                        sample["pressure_kpa"].to_numpy(float),
+                        sample["psi_deg"].to_numpy(float),
+                    )[0]
                 )
             except UserInputError:  # e.g. too few finite pairs in this resample
                 memo[pick] = math.nan
@@ -437,14 +456,19 @@ def comparison_groups(
     for dataset, material in pairs.itertuples(index=False):
         l0s: list[float] = []
         if have_l0:
-            sel = angles[(angles["dataset"].astype(str) == dataset) & (angles["material"].astype(str) == material)]
+            sel = angles[
+                (angles["dataset"].astype(str) == dataset)
+                & (angles["material"].astype(str) == material)
+            ]
             values = pd.to_numeric(sel["l0_mm"], errors="coerce").to_numpy(float)
             l0s = sorted({float(v) for v in values[np.isfinite(values)]})
         if len(l0s) > 1:
             note = (
                 f"dataset {dataset!r} holds {material} actuators of several l0 "
-                f"({', '.join(f'{v:g}' for v in l0s)} mm) pooled in one hysteresis.csv: no single model "
-                "curve fits them; split the photo set into one dataset per l0 to compare with the model"
+                f"({', '.join(f'{v:g}' for v in l0s)} mm) pooled in one hysteresis.csv: no single "
+                "model "
+                "curve fits them; split the photo set into one dataset per l0 to compare with the "
+                "model"
             )
             found[(material, "several", dataset)] = Group(
                 material, None, "several l0 in one dataset", (dataset,), mixed=True, note=note
@@ -513,8 +537,8 @@ def compare(
         the model does not know, or an l0 it refuses (the callable raises
         :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
-        Rest angle per material (deg); :data:`pipeline.constants.PSI0_DEG` (the paper's) for materials
-        not listed.
+        Rest angle per material (deg); :data:`pipeline.constants.PSI0_DEG` (the paper's) for
+        materials not listed.
     default_l0_mm : mapping, optional
         The model's l0 per material for datasets without their own (materials not listed: the
         callables get ``l0_mm=None``, the model's own default).
@@ -552,25 +576,41 @@ def compare(
         hm = pool_hysteresis(hyst[in_group].drop(columns="dataset"))
         rows = None
         if rows_all is not None:
-            rows = rows_all[rows_all["dataset"].isin(group.datasets) & (rows_all["material"].astype(str) == material)]
+            rows = rows_all[
+                rows_all["dataset"].isin(group.datasets)
+                & (rows_all["material"].astype(str) == material)
+            ]
         usable = not group.mixed
-        psi_fn = (lambda m, p, l0=l0: model_psi(m, p, l0)) if model_psi is not None and usable else None
-        fit_fn = (lambda m, p, s, l0=l0: fit_k_p(m, p, s, l0)) if fit_k_p is not None and usable else None
-        kwargs = dict(psi0_deg=float(psi0.get(material, PSI0_DEG)), n_boot=n_boot, seed=seed)
+        psi_fn = (
+            (lambda m, p, l0=l0: model_psi(m, p, l0)) if model_psi is not None and usable else None
+        )
+        fit_fn = (
+            (lambda m, p, s, l0=l0: fit_k_p(m, p, s, l0))
+            if fit_k_p is not None and usable
+            else None
+        )
+        kwargs = {"psi0_deg": float(psi0.get(material, PSI0_DEG)), "n_boot": n_boot, "seed": seed}
         note = group.note
         try:
             rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)
         except UserInputError as exc:
-            warnings.warn(f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2)
+            warnings.warn(
+                f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2
+            )
             note = f"model unavailable: {exc}"
             rec = compare_material(material, hm, rows, model_psi=None, fit_k_p=None, **kwargs)
         if note and group.note:
             warnings.warn(f"{group.curve}: {note}", stacklevel=2)
         data = [sources.get(d, "unknown") for d in group.datasets]
         rec.update(
-            curve=group.curve, datasets=" + ".join(group.datasets), l0_mm=math.nan if l0 is None else l0,
+            curve=group.curve,
+            datasets=" + ".join(group.datasets),
+            l0_mm=math.nan if l0 is None else l0,
             l0_source=group.l0_source,
-            data_source=" + ".join(sorted(set(data))), rms_kind=rms_kind(data), model_fit=model_fit, note=note,
+            data_source=" + ".join(sorted(set(data))),
+            rms_kind=rms_kind(data),
+            model_fit=model_fit,
+            note=note,
         )
         records.append(rec)
     return pd.DataFrame(records, columns=list(RMS_COLUMNS))
@@ -619,7 +659,9 @@ def model_callables(
                           **readings)
         )
 
-    def fit(name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray, l0_mm: float | None) -> tuple[float, Any]:
+    def fit(
+        name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray, l0_mm: float | None
+    ) -> tuple[float, Any]:
         l0 = default_l0 if l0_mm is None else l0_mm
         return model.fit_k_p(_material(name), pressure_kpa, psi_deg, l0_mm=l0, **readings)
 

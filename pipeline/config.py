@@ -103,7 +103,11 @@ def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list
         hint = err.schema.get("description", "") if isinstance(err.schema, Mapping) else ""
         if err.validator == "required":
             # a conditional requirement (an if/then block) says why in its description
-            why = err.schema.get("description") if set(err.schema) <= {"required", "description"} else None
+            why = (
+                err.schema.get("description")
+                if set(err.schema) <= {"required", "description"}
+                else None
+            )
             name = str(err.message).split("'")[1]  # "'port' is a required property"
             where = f"{key}.{name}" if err.absolute_path else name
             messages.append(f"{where}: required" + (f" {why}" if why else ""))
@@ -113,7 +117,9 @@ def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list
         elif err.validator == "enum":
             messages.append(f"{key}: {err.instance!r} is not one of {err.validator_value}")
         else:
-            messages.append(f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else ""))
+            messages.append(
+                f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else "")
+            )
     return list(dict.fromkeys(messages))
 
 
@@ -125,26 +131,50 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
             key = f"{section}[{i}]"
             name = ds.get("name")
             if name in names:
-                messages.append(f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give each dataset a unique name")
+                messages.append(
+                    f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give "
+                    "each dataset a unique name"
+                )
             names.setdefault(name, i)
             source = ds.get("source")
             if source == "folder" and not (workdir / ds["path"]).is_dir():
-                messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
-            if source in ("synthetic", "synthetic_video", "rig") and ds["material"] not in materials:
-                messages.append(f"{key}.material: unknown material {ds['material']!r}; use one of {sorted(materials)} or add it to a materials file (model.materials_file)")
+                messages.append(
+                    f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to "
+                    f"{workdir}); fix the path or copy the photo set there"
+                )
+            if (
+                source in ("synthetic", "synthetic_video", "rig")
+                and ds["material"] not in materials
+            ):
+                messages.append(
+                    f"{key}.material: unknown material {ds['material']!r}; use one of "
+                    f"{sorted(materials)} or add it to a materials file (model.materials_file)"
+                )
             if source == "rig" and not ds["port"]:
-                messages.append(f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. /dev/ttyACM0)")
+                messages.append(
+                    f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. "
+                    "/dev/ttyACM0)"
+                )
     for i, ds in enumerate(config.get("force", {}).get("datasets", [])):
         if ds.get("source") == "folder" and not (workdir / ds["path"]).is_dir():
-            messages.append(f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist")
+            messages.append(
+                f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist"
+            )
         elif ds.get("source") == "synthetic" and ds.get("material") not in materials:
-            messages.append(f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; use one of {sorted(materials)}")
+            messages.append(
+                f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; use one "
+                f"of {sorted(materials)}"
+            )
     grasp = config.get("force", {}).get("grasp_log")
     if grasp and not (workdir / grasp).is_file():
-        messages.append(f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null")
+        messages.append(
+            f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null"
+        )
     mfile = config.get("model", {}).get("materials_file")
     if mfile and not (workdir / mfile).is_file():
-        messages.append(f"model.materials_file: file {mfile!r} does not exist; fix the path or set it to null")
+        messages.append(
+            f"model.materials_file: file {mfile!r} does not exist; fix the path or set it to null"
+        )
     return messages
 
 
@@ -186,7 +216,9 @@ def validate_config(
     if not problems:
         workdir = Path(workdir)
         mfile = filled["model"]["materials_file"]
-        materials = known_materials(workdir / mfile if mfile and (workdir / mfile).is_file() else None)
+        materials = known_materials(
+            workdir / mfile if mfile and (workdir / mfile).is_file() else None
+        )
         problems = _semantic_errors(filled, workdir, materials)
     if problems:
         raise UserInputError(
@@ -207,4 +239,6 @@ def write_resolved_config(config: Mapping[str, Any], path: str | Path) -> None:
     """Write the validated configuration (defaults filled in) as YAML, with its digest."""
     data = {"config_digest": config_digest(config), **dict(config)}
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(yaml.safe_dump(json.loads(json.dumps(data, default=str)), sort_keys=False))
+    Path(path).write_text(
+        yaml.safe_dump(json.loads(json.dumps(data, default=str)), sort_keys=False)
+    )

@@ -20,7 +20,12 @@ from pipeline.errors import UserInputError
 
 
 def read_table(
-    path: str | os.PathLike[str], what: str, *, required: Sequence[str] = (), hint: str = "", **read_csv: Any
+    path: str | os.PathLike[str],
+    what: str,
+    *,
+    required: Sequence[str] = (),
+    hint: str = "",
+    **read_csv: Any,
 ) -> pd.DataFrame:
     """Read a CSV table, refusing a missing, unreadable or incomplete file with a clear message.
 
@@ -59,10 +64,14 @@ def read_table(
     except FileNotFoundError:
         raise UserInputError(f"{path}: file not found; pass {what}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise UserInputError(f"{path}: not a readable CSV ({exc}); fix or regenerate {what}") from None
+        raise UserInputError(
+            f"{path}: not a readable CSV ({exc}); fix or regenerate {what}"
+        ) from None
     missing = [c for c in required if c not in df.columns]
     if missing:
-        raise UserInputError(f"{path}: missing column(s) {missing}; pass {what}" + (f" ({hint})" if hint else ""))
+        raise UserInputError(
+            f"{path}: missing column(s) {missing}; pass {what}" + (f" ({hint})" if hint else "")
+        )
     return df
 
 

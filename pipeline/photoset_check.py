@@ -14,7 +14,11 @@ from pipeline.video.clips import clip_problems
 
 
 def check_photoset(
-    folder: str | os.PathLike[str], *, decode_images: bool = True, require_images: bool = True, warnings: bool = False
+    folder: str | os.PathLike[str],
+    *,
+    decode_images: bool = True,
+    require_images: bool = True,
+    warnings: bool = False,
 ) -> list[Problem]:
     """Every problem of a photo set (of images or videos), each naming the file, line and fix.
 

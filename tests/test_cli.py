@@ -10,11 +10,23 @@ import pytest
 from pipeline.bench.cli import BENCHES
 from pipeline.cli import SUBCOMMANDS
 
-REQUIRED = {"synth", "measure", "aggregate", "model", "compare", "report", "acquire", "bench", "photoset"}
+REQUIRED = {
+    "synth",
+    "measure",
+    "aggregate",
+    "model",
+    "compare",
+    "report",
+    "acquire",
+    "bench",
+    "photoset",
+}
 
 
 def _run(*args):
-    return subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "pipeline", *args], capture_output=True, text=True, check=False
+    )
 
 
 def test_help_lists_the_subcommands():
@@ -33,12 +45,21 @@ def test_every_subcommand_has_help(name):
 
 
 def test_photoset_init_then_check(photo_folder):
-    out = _run("photoset", "init", str(photo_folder), "--pattern", "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200")
+    out = _run(
+        "photoset",
+        "init",
+        str(photo_folder),
+        "--pattern",
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        "--l0-mm",
+        "200",
+    )
     assert out.returncode == 0, out.stderr
     assert "8 photos (6 up, 2 down)" in out.stdout
     out = _run("photoset", "check", str(photo_folder))
     assert out.returncode == 0, out.stderr
-    assert "OK (8 photos" in out.stdout  # warnings (no mm_per_px, an empty first photo) do not fail the check
+    # warnings (no mm_per_px, an empty first photo) do not fail the check
+    assert "OK (8 photos" in out.stdout
 
 
 def test_bad_input_is_one_line_without_traceback(tmp_path):

@@ -24,9 +24,22 @@ def _hyst() -> pd.DataFrame:
     # up: 200, 100, -50 at 0, 10, 20 kPa; down: 190, 20, -50
     rows = [("up", 0, 200.0), ("up", 10, 100.0), ("up", 20, -50.0),
             ("down", 0, 190.0), ("down", 10, 20.0), ("down", 20, -50.0)]
-    return pd.DataFrame([{"material": "DS20", "direction": d, "pressure_kpa": p, "psi_mean_deg": s,
-                          "psi_sd_deg": 1.0, "n": 3, "n_actuators": 3, "n_trials": 3, "n_excluded": 0}
-                         for d, p, s in rows])
+    return pd.DataFrame(
+        [
+            {
+                "material": "DS20",
+                "direction": d,
+                "pressure_kpa": p,
+                "psi_mean_deg": s,
+                "psi_sd_deg": 1.0,
+                "n": 3,
+                "n_actuators": 3,
+                "n_trials": 3,
+                "n_excluded": 0,
+            }
+            for d, p, s in rows
+        ]
+    )
 
 
 def linear_model(material: str, pressure_kpa: np.ndarray, l0_mm=None) -> np.ndarray:
@@ -71,7 +84,12 @@ def test_crossings_both_branches():
 
 def test_range_and_hysteresis_width():
     out = compare(_hyst(), model_psi=None, fit_k_p=None).iloc[0]
-    assert (out["range_deg"], out["psi_max_deg"], out["psi_min_deg"], out["range_kpa"]) == (250.0, 200.0, -50.0, 20.0)
+    assert (out["range_deg"], out["psi_max_deg"], out["psi_min_deg"], out["range_kpa"]) == (
+        250.0,
+        200.0,
+        -50.0,
+        20.0,
+    )
     assert hysteresis_width(_hyst()) == (80.0, 10.0)
     up_only = _hyst()[_hyst()["direction"] == "up"]
     w, at = hysteresis_width(up_only)
@@ -121,7 +139,9 @@ def test_compare_fits_k_p_from_angles_rows():
     angles = rows.assign(status="ok", material="DS20", direction="up", trial=1)
     angles.loc[0, "status"] = "failed"
     angles.loc[0, "psi_deg"] = np.nan
-    out = compare(_hyst(), angles, model_psi=linear_model, fit_k_p=ls_fit, n_boot=20, seed=1).iloc[0]
+    out = compare(_hyst(), angles, model_psi=linear_model, fit_k_p=ls_fit, n_boot=20, seed=1).iloc[
+        0
+    ]
     assert out["k_p_fit"] == pytest.approx(2.0)
     assert out["k_p_ci_low"] == pytest.approx(2.0) and out["k_p_ci_high"] == pytest.approx(2.0)
     assert out["n_actuators"] == 2
@@ -134,7 +154,11 @@ def test_unknown_material_keeps_data_metrics():
     h = _hyst().assign(material="EcoFlex")
     with pytest.warns(UserWarning, match="EcoFlex"):
         out = compare(h, model_psi=model, fit_k_p=None).iloc[0]
-    assert math.isnan(out["rms_deg"]) and out["range_deg"] == 250.0 and math.isnan(out["paper_rms_deg"])
+    assert (
+        math.isnan(out["rms_deg"])
+        and out["range_deg"] == 250.0
+        and math.isnan(out["paper_rms_deg"])
+    )
 
 
 def test_bad_hysteresis_table():
@@ -165,14 +189,26 @@ def test_cli_with_the_real_model(tmp_path, capsys):
             for direction, order in (("up", p), ("down", p[::-1])):
                 for pk in order:
                     psi = float(truth[p == pk][0] + rng.normal(0.0, 2.0))
-                    rows.append({"image": f"{actuator}_{trial}_{direction}_{pk:g}.jpg", "psi_deg": psi,
-                                 "status": "ok", "reason": "", "pressure_kpa": pk, "direction": direction,
-                                 "material": "SS40", "actuator": actuator, "trial": trial})
+                    rows.append(
+                        {
+                            "image": f"{actuator}_{trial}_{direction}_{pk:g}.jpg",
+                            "psi_deg": psi,
+                            "status": "ok",
+                            "reason": "",
+                            "pressure_kpa": pk,
+                            "direction": direction,
+                            "material": "SS40",
+                            "actuator": actuator,
+                            "trial": trial,
+                        }
+                    )
     angles = tmp_path / "angles.csv"
     pd.DataFrame(rows).to_csv(angles, index=False)
     hyst, rms = tmp_path / "h.csv", tmp_path / "rms.csv"
     assert main(["aggregate", str(angles), "--out", str(hyst)]) == 0
-    assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(rms), "--seed", "3"]) == 0
+    assert (
+        main(["compare", str(hyst), "--angles", str(angles), "--out", str(rms), "--seed", "3"]) == 0
+    )
     assert "compare: SS40, l0 255 mm [" in capsys.readouterr().out
     out = pd.read_csv(rms).iloc[0]
     finite = np.isfinite(truth)
@@ -191,38 +227,69 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     assert printed["k_p_fit"] > out["k_p_fit"] * 1.1 and printed["rms_deg"] > out["rms_deg"]
     assert main(["compare", str(hyst), "--out", str(other), "--eq12-scale", "-1"]) == 2
     # no l0_mm in this angles.csv: the model's default l0, and rms.csv says where it came from
-    assert out["l0_mm"] == model.load_materials()["SS40"].l0_mm and out["l0_source"] == "materials file"
+    assert (
+        out["l0_mm"] == model.load_materials()["SS40"].l0_mm
+        and out["l0_source"] == "materials file"
+    )
     assert out["rms_kind"] == "unknown" and out["model_fit"].startswith("none")
 
 
 def _angles(dataset: str, material: str, l0_mm, psi_offset: float = 0.0) -> pd.DataFrame:
     p = np.array([0.0, 10.0, 20.0])
-    rows = [{"dataset": dataset, "image": f"{dataset}_{a}_{d}_{pk:g}.jpg", "status": "ok", "material": material,
-             "actuator": a, "trial": "1", "direction": d, "pressure_kpa": pk, "l0_mm": l0_mm,
-             "psi_deg": 200.0 - 10.0 * pk + psi_offset}
-            for a in ("A1", "A2") for d in ("up", "down") for pk in p]
+    rows = [
+        {
+            "dataset": dataset,
+            "image": f"{dataset}_{a}_{d}_{pk:g}.jpg",
+            "status": "ok",
+            "material": material,
+            "actuator": a,
+            "trial": "1",
+            "direction": d,
+            "pressure_kpa": pk,
+            "l0_mm": l0_mm,
+            "psi_deg": 200.0 - 10.0 * pk + psi_offset,
+        }
+        for a in ("A1", "A2")
+        for d in ("up", "down")
+        for pk in p
+    ]
     return pd.DataFrame(rows)
 
 
 def _hyst_of(angles: pd.DataFrame) -> pd.DataFrame:
     from pipeline.aggregate import aggregate_hysteresis
 
-    return pd.concat([aggregate_hysteresis(g).assign(dataset=d) for d, g in angles.groupby("dataset")],
-                     ignore_index=True)
+    return pd.concat(
+        [aggregate_hysteresis(g).assign(dataset=d) for d, g in angles.groupby("dataset")],
+        ignore_index=True,
+    )
 
 
 def test_each_dataset_is_compared_at_its_own_l0():
     """Datasets of one material pool only when they share l0; each row says which l0 and why."""
-    angles = pd.concat([_angles("a", "SS50", 255.0), _angles("b", "SS50", 220.0, psi_offset=5.0),
-                        _angles("c", "SS50", 255.0), _angles("d", "SS50", np.nan)], ignore_index=True)
+    angles = pd.concat(
+        [
+            _angles("a", "SS50", 255.0),
+            _angles("b", "SS50", 220.0, psi_offset=5.0),
+            _angles("c", "SS50", 255.0),
+            _angles("d", "SS50", np.nan),
+        ],
+        ignore_index=True,
+    )
     calls = []
 
     def model(material, p, l0_mm):
         calls.append(l0_mm)
         return 200.0 - 10.0 * np.asarray(p, float) + (5.0 if l0_mm == 220.0 else 0.0)
 
-    out = compare(_hyst_of(angles), angles, model_psi=model, fit_k_p=None, default_l0_mm={"SS50": 250.0},
-                  data_sources={"a": "synthetic", "b": "measured", "c": "synthetic", "d": "measured"})
+    out = compare(
+        _hyst_of(angles),
+        angles,
+        model_psi=model,
+        fit_k_p=None,
+        default_l0_mm={"SS50": 250.0},
+        data_sources={"a": "synthetic", "b": "measured", "c": "synthetic", "d": "measured"},
+    )
     assert list(out["curve"]) == ["SS50, l0 250 mm", "SS50, l0 220 mm", "SS50, l0 255 mm"]
     rows = out.set_index("curve")
     assert rows.loc["SS50, l0 255 mm", "datasets"] == "a + c"
@@ -241,8 +308,10 @@ def test_each_dataset_is_compared_at_its_own_l0():
 
 
 def test_a_dataset_mixing_l0_keeps_its_data_figures_and_says_why_no_model():
-    one = pd.concat([_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
-                    ignore_index=True)
+    one = pd.concat(
+        [_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
+        ignore_index=True,
+    )
     with pytest.warns(UserWarning, match="several l0 .200, 220 mm"):
         out = compare(_hyst_of(one), one, model_psi=linear_model, fit_k_p=ls_fit).iloc[0]
     assert out["curve"] == "DS20, x (several l0)" and math.isnan(out["l0_mm"])
@@ -259,16 +328,32 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
     for name, l0 in (("short", 220.0), ("long", None)):
         p = np.arange(0.0, 241.0, 40.0)
         psi = model.psi_deg("SS50", p, l0_mm=l0)
-        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
-                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1, "l0_mm": l0}
-                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        rows = [
+            {
+                "image": f"{d}_{pk:g}.jpg",
+                "psi_deg": s,
+                "status": "ok",
+                "reason": "",
+                "pressure_kpa": pk,
+                "direction": d,
+                "material": "SS50",
+                "actuator": "A1",
+                "trial": 1,
+                "l0_mm": l0,
+            }
+            for d in ("up", "down")
+            for pk, s in zip(p, psi, strict=True)
+        ]
         folder = tmp_path / name
         folder.mkdir()
         frame = pd.DataFrame(rows)
         if l0 is None:
             frame = frame.drop(columns="l0_mm")
         frame.to_csv(folder / "angles.csv", index=False)
-        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        assert (
+            main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")])
+            == 0
+        )
         folders.append(folder)
     (folders[0] / "truth.csv").write_text("image,psi_deg\n")  # 'short' was rendered by synth
     rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
@@ -281,15 +366,22 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
     out = pd.read_csv(rms).set_index("datasets")
     default = model.load_materials()["SS50"].l0_mm
     assert out.loc["short", "l0_mm"] == 220.0 and out.loc["long", "l0_mm"] == default
-    assert out.loc["long", "l0_source"] == "materials file" and out.loc["long", "rms_kind"] == "prediction"
+    assert (
+        out.loc["long", "l0_source"] == "materials file"
+        and out.loc["long", "rms_kind"] == "prediction"
+    )
     assert (out["rms_deg"] < 1e-3).all()  # each set was drawn from the model at its own l0
     c = pd.read_csv(curves)
     assert set(c["curve"]) == set(out["curve"])
     short = c[c["curve"] == "SS50, l0 220 mm"]
     assert (short["l0_mm"] == 220.0).all() and len(short) == 400
     expected = model.model_curve("SS50", l0_mm=220.0)
-    np.testing.assert_allclose(short["pressure_kpa"], expected["pressure_kpa"], rtol=1e-5, atol=1e-9)
-    assert not np.allclose(expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3)
+    np.testing.assert_allclose(
+        short["pressure_kpa"], expected["pressure_kpa"], rtol=1e-5, atol=1e-9
+    )
+    assert not np.allclose(
+        expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3
+    )
     assert main(["compare", str(folders[0] / "hysteresis.csv"), "--photosets", "a", "b",
                  "--out", str(rms)]) == 2
 
@@ -314,16 +406,38 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
                  "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
     config = {
         "datasets": [
-            {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
-             "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
+            {
+                "name": "std",
+                "source": "synthetic",
+                "material": "SS50",
+                "actuators": 1,
+                "trials": 1,
+                "step_kpa": 80,
+                "max_kpa": 240,
+                "scene": "clean",
+                "scene_set": {"width": 400, "height": 300},
+            },
             {"name": "short", "source": "folder", "path": str(short)},
         ],
         "compare": {"bootstrap": 5},
         "bench": {"in_report": False},
     }
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
-    run = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
-                          str(tmp_path), "--cores", "2"], capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(repo / "Snakefile"),
+            "--directory",
+            str(tmp_path),
+            "--cores",
+            "2",
+        ],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-5000:]
     res = tmp_path / "results"
     angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
@@ -345,13 +459,20 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     curves = pd.read_csv(res / "compare_curves.csv")
     c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
     assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
-    np.testing.assert_allclose(c220["pressure_kpa"], model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
-                               rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(
+        c220["pressure_kpa"],
+        model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
+        rtol=1e-5,
+        atol=1e-9,
+    )
     doc = pdfium.PdfDocument(str(res / "report.pdf"))
     pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
     doc.close()
     comparison = next(t for t in pages if "Model versus measurements, beside" in t)
-    assert "photos rendered from this package's model, so the RMS is a self-check, not a validation" in comparison
+    assert (
+        "photos rendered from this package's model, so the RMS is a self-check, not a validation"
+        in comparison
+    )
     provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
     assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
     assert f"SS50, l0 {default:g} mm" in provenance

@@ -8,14 +8,14 @@ import subprocess
 import sys
 
 import pytest
-import yaml
 
 from pipeline.config import config_digest, load_schema, validate_config
 from pipeline.errors import UserInputError
 
 
 def _walk(schema, path="config", required=frozenset()):
-    """Every (path, sub-schema, required-here) of the schema; conditional (if/then) requirements count."""
+    """Every (path, sub-schema, required-here) of the schema; conditional (if/then) requirements
+    count."""
     yield path, schema, path.rsplit(".", 1)[-1] in required
     needed = set(schema.get("required", []))
     for block in schema.get("allOf", []):
@@ -44,15 +44,19 @@ def test_the_schema_ships_in_the_package_and_repeats_no_model_choice(repo):
 
     raw = _yaml.safe_load((repo / "pipeline" / "config.schema.yaml").read_text())
     readings = raw["properties"]["model"]["properties"]["readings"]["properties"]
-    assert not [key for key, sub in readings.items() if "enum" in sub]  # only pipeline.model's CHOICES
+    # only pipeline.model's CHOICES
+    assert not [key for key, sub in readings.items() if "enum" in sub]
     assert not (repo / "rules" / "config.schema.yaml").exists()  # one schema, not two
 
 
 def test_schema_defaults_alone_make_a_valid_config(repo):
     cfg = validate_config({}, workdir=repo)
-    assert [(d["name"], d["source"], d["path"]) for d in cfg["datasets"]] == [("sample", "folder", "sample_images")]
+    assert [(d["name"], d["source"], d["path"]) for d in cfg["datasets"]] == [
+        ("sample", "folder", "sample_images")
+    ]
     assert cfg["measure"] == {"method": "default", "jobs": 2, "overlays": True}
-    assert cfg["model"] == {"materials_file": None, "readings": {}}  # readings stay what the user gave
+    # readings stay what the user gave
+    assert cfg["model"] == {"materials_file": None, "readings": {}}
     assert cfg["force"] == {"datasets": [], "grasp_log": None} and cfg["results_dir"] == "results"
 
 
@@ -68,14 +72,29 @@ def test_scene_presets_in_the_schema_are_the_renderers():
 @pytest.mark.parametrize(
     "datasets, message",
     [
-        ([{"name": "a", "source": "synthetic", "material": "DS25"}], "datasets[0].material: unknown material 'DS25'"),
-        ([{"name": "a", "source": "folder", "path": "no/such/folder"}], "datasets[0].path: photo-set folder 'no/such/folder' does not exist"),
-        ([{"name": "a", "source": "synthetic", "material": "DS20", "trials": "six"}], "datasets[0].trials: 'six' is not of type 'integer'"),
+        (
+            [{"name": "a", "source": "synthetic", "material": "DS25"}],
+            "datasets[0].material: unknown material 'DS25'",
+        ),
+        (
+            [{"name": "a", "source": "folder", "path": "no/such/folder"}],
+            "datasets[0].path: photo-set folder 'no/such/folder' does not exist",
+        ),
+        (
+            [{"name": "a", "source": "synthetic", "material": "DS20", "trials": "six"}],
+            "datasets[0].trials: 'six' is not of type 'integer'",
+        ),
         ([{"name": "a", "source": "camera"}], "datasets[0].source: 'camera' is not one of"),
         ([{"name": "a", "source": "synthetic", "material": "DS20"}] * 2, "'a' is used twice"),
-        ([{"name": "a", "source": "rig", "path": "x", "material": "DS20"}], "datasets[0].port: required for source 'rig'"),
+        (
+            [{"name": "a", "source": "rig", "path": "x", "material": "DS20"}],
+            "datasets[0].port: required for source 'rig'",
+        ),
         ([{"name": "a", "source": "folder"}], "datasets[0].path: required for source 'folder'"),
-        ([{"name": "a", "source": "synthetic"}], "datasets[0].material: required for source 'synthetic'"),
+        (
+            [{"name": "a", "source": "synthetic"}],
+            "datasets[0].material: required for source 'synthetic'",
+        ),
         ([{"source": "synthetic", "material": "DS20"}], "datasets[0].name: required"),
     ],
 )
@@ -112,25 +131,50 @@ def test_a_bad_model_reading_is_refused(tmp_path):
         validate_config({"model": {"readings": {"l0_factor": "inches"}}}, workdir=tmp_path)
     assert "model.readings.l0_factor: 'inches' is not one of" in str(exc.value)
     synthetic = [{"name": "a", "source": "synthetic", "material": "SS50"}]
-    cfg = validate_config({"datasets": synthetic, "model": {"readings": {"l0_factor": "metres"}}}, workdir=tmp_path)
+    cfg = validate_config(
+        {"datasets": synthetic, "model": {"readings": {"l0_factor": "metres"}}}, workdir=tmp_path
+    )
     assert cfg["model"] == {"materials_file": None, "readings": {"l0_factor": "metres"}}
 
 
 def test_the_built_package_ships_the_schema_and_validates_without_the_workflow(repo, tmp_path):
-    """setuptools' build_py (what a wheel holds) from a copy of the sources; validate with that alone."""
+    """setuptools' build_py (what a wheel holds) from a copy of the sources; validate with that
+    alone."""
     src = tmp_path / "src"
-    shutil.copytree(repo / "pipeline", src / "pipeline", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(
+        repo / "pipeline", src / "pipeline", ignore=shutil.ignore_patterns("__pycache__")
+    )
     for name in ("pyproject.toml", "README.md"):
         shutil.copy(repo / name, src / name)
     lib = tmp_path / "lib"
-    build = subprocess.run([sys.executable, "-c", "import setuptools; setuptools.setup()", "-q", "build_py", "-d", str(lib)],
-                           cwd=src, capture_output=True, text=True)
+    build = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import setuptools; setuptools.setup()",
+            "-q",
+            "build_py",
+            "-d",
+            str(lib),
+        ],
+        cwd=src,
+        capture_output=True,
+        text=True, check=False,
+    )
     assert build.returncode == 0, build.stderr[-2000:]
     assert (lib / "pipeline" / "config.schema.yaml").is_file()
     check = subprocess.run(
-        [sys.executable, "-c", "from pipeline.config import validate_config; "
-         "print(validate_config({'datasets': [{'name': 'a', 'source': 'synthetic', 'material': 'DS20'}]})['datasets'][0]['scene'])"],
-        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(lib)}, capture_output=True, text=True,
+        [
+            sys.executable,
+            "-c",
+            ("from pipeline.config import validate_config; "
+            "print(validate_config({'datasets': [{'name': 'a', 'source': 'synthetic', 'material': "
+            "'DS20'}]})['datasets'][0]['scene'])"),
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(lib)},
+        capture_output=True,
+        text=True, check=False,
     )
     assert check.returncode == 0 and check.stdout.strip() == "lab", check.stderr[-2000:]
 

@@ -37,4 +37,5 @@ def test_real_photos_within_tolerance(measured):
 def test_every_doubtful_real_photo_says_why(measured):
     doubtful = measured[measured["status"] != "ok"]
     assert len(doubtful) and doubtful["reason"].str.len().min() > 10
-    assert not doubtful["reason"].str.contains(r"\(\(\(|array\(|np\.", regex=True).any()  # words, not reprs
+    # words, not reprs
+    assert not doubtful["reason"].str.contains(r"\(\(\(|array\(|np\.", regex=True).any()

@@ -33,8 +33,8 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
     Returns
     -------
     dict
-        n, n_ok, n_flagged, n_failed, median/p95/max absolute error vs the image angle and median/p95
-        vs the physical angle (deg), and n_ok_over_5deg.
+        n, n_ok, n_flagged, n_failed, median/p95/max absolute error vs the image angle and
+        median/p95 vs the physical angle (deg), and n_ok_over_5deg.
 
     Examples
     --------
@@ -44,8 +44,15 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
     0.5
     """
     seen = "psi_image_deg" if "psi_image_deg" in truth.columns else "psi_deg"
-    keys = ["image", "frame"] if "frame" in truth.columns and "frame" in angles.columns else ["image"]  # a video: per frame
-    m = angles.merge(truth[keys + ["psi_deg"] + ([seen] if seen != "psi_deg" else [])], on=keys, suffixes=("", "_true"))
+    # a video: per frame
+    keys = (
+        ["image", "frame"] if "frame" in truth.columns and "frame" in angles.columns else ["image"]
+    )
+    m = angles.merge(
+        truth[keys + ["psi_deg"] + ([seen] if seen != "psi_deg" else [])],
+        on=keys,
+        suffixes=("", "_true"),
+    )
     ok = m[m["status"] == "ok"]
     err = (ok["psi_deg"] - ok[seen if seen != "psi_deg" else "psi_deg_true"]).abs()
     err_phys = (ok["psi_deg"] - ok["psi_deg_true"]).abs()
@@ -72,7 +79,10 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     """
     path = config_path or Path(results_dir) / "config.resolved.yaml"
     if not path.is_file():
-        raise UserInputError(f"{path}: not found; pass the results folder of a finished run (snakemake writes it there)")
+        raise UserInputError(
+            f"{path}: not found; pass the results folder of a finished run (snakemake writes it "
+            "there)"
+        )
     config = yaml.safe_load(path.read_text())
     results_dir = Path(results_dir)
     configured = Path(config.get("results_dir", "results"))
@@ -82,7 +92,9 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     rows = []
     for ds in config["datasets"]:
         synthetic = ds["source"] in ("synthetic", "synthetic_video")
-        folder = results_dir / "photosets" / ds["name"] if synthetic else workdir / ds.get("path", "")
+        folder = (
+            results_dir / "photosets" / ds["name"] if synthetic else workdir / ds.get("path", "")
+        )
         angles = results_dir / "datasets" / ds["name"] / "angles.csv"
         if (folder / "truth.csv").is_file() and angles.is_file():
             stats = campaign_errors(pd.read_csv(angles), pd.read_csv(folder / "truth.csv"))
@@ -92,8 +104,16 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Print the accuracy table of a finished run."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline bench campaign", description=__doc__.splitlines()[0])
-    parser.add_argument("results_dir", nargs="?", default="results", type=Path, help="results folder of a finished run")
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench campaign", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "results_dir",
+        nargs="?",
+        default="results",
+        type=Path,
+        help="results folder of a finished run",
+    )
     args = parser.parse_args(argv)
     table = run_accuracy(args.results_dir)
     if table.empty:

@@ -25,12 +25,17 @@ def format_benchmark(df: pd.DataFrame) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Print the benchmark (4 materials x 400 angles forward + 400 pressures inverse)."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline bench model", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench model", description=__doc__.splitlines()[0]
+    )
     parser.add_argument("--grid-sizes", type=int, nargs="+", default=[2, 3, 4, 6, 8, 12],
                         help="grid sizes n (n_tau = n, n_phi = 2n nodes); default 2 3 4 6 8 12")
     args = parser.parse_args(argv)
     df = benchmark_model(grid_sizes=args.grid_sizes)
-    print("model benchmark: 4 materials x 400 angles (forward) + 400 pressures (loading inverse), one process")
+    print(
+        "model benchmark: 4 materials x 400 angles (forward) + 400 pressures (loading inverse), "
+        "one process"
+    )
     print(format_benchmark(df))
     default = df[df.grid_n == 4]
     if len(default):

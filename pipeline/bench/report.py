@@ -39,17 +39,30 @@ def synthetic_angles(material: str, trials: int, seed: int) -> pd.DataFrame:
                 psi = model.psi_deg(material, order * scale) + rng.normal(0.0, 4.0, order.size)
                 for p, s in zip(order, psi, strict=True):
                     ok = bool(np.isfinite(s))
-                    rows.append({"image": f"{material}_{actuator}_{trial}_{direction}_{p:g}.jpg", "psi_deg": s,
-                                 "status": "ok" if ok else "failed", "reason": "" if ok else "beyond model",
-                                 "pressure_kpa": p, "direction": direction, "material": material,
-                                 "actuator": actuator, "trial": trial})
+                    rows.append(
+                        {
+                            "image": f"{material}_{actuator}_{trial}_{direction}_{p:g}.jpg",
+                            "psi_deg": s,
+                            "status": "ok" if ok else "failed",
+                            "reason": "" if ok else "beyond model",
+                            "pressure_kpa": p,
+                            "direction": direction,
+                            "material": material,
+                            "actuator": actuator,
+                            "trial": trial,
+                        }
+                    )
     return pd.DataFrame(rows)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Time each stage and print one line per stage."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline bench report", description=__doc__.splitlines()[0])
-    parser.add_argument("--trials", type=int, default=6, help="trials per actuator (default 6, as the paper)")
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench report", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "--trials", type=int, default=6, help="trials per actuator (default 6, as the paper)"
+    )
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
@@ -64,7 +77,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         hyst = aggregate_hysteresis(angles)
         t1 = time.perf_counter()
         model_psi, fit_k_p, psi0 = model_callables()
-        table = compare(hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, n_boot=200, seed=0)
+        table = compare(
+            hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, n_boot=200, seed=0
+        )
         t2 = time.perf_counter()
         write_table(hyst, root / "h.csv", float_format=None)
         write_table(table, root / "rms.csv", float_format=None)
@@ -72,13 +87,19 @@ def main(argv: Sequence[str] | None = None) -> int:
                                            rms=(root / "rms.csv",)), root / "report.pdf")
         t3 = time.perf_counter()
         size_kb = (root / "report.pdf").stat().st_size / 1024
-    print(f"rows: {len(angles)} angles, {len(hyst)} hysteresis levels, 4 materials x 3 actuators x {args.trials} trials")
+    print(
+        f"rows: {len(angles)} angles, {len(hyst)} hysteresis levels, 4 materials x 3 actuators x "
+        f"{args.trials} trials"
+    )
     print(f"aggregate: {1e3 * (t1 - t0):.1f} ms")
     print(f"compare (RMS, crossings, k_P + 200 bootstrap resamples per material): {t2 - t1:.2f} s")
     print(f"report: {t3 - t2:.2f} s for {result.pages} pages, {size_kb:.0f} kB")
     for r in table.itertuples():
-        print(f"  {r.material}: RMS {r.rms_deg:.1f} deg, k_P {r.k_p_fit:.2f} [{r.k_p_ci_low:.2f}, {r.k_p_ci_high:.2f}]"
-              f" (model k_P {r.k_p_paper})")
+        print(
+            f"  {r.material}: RMS {r.rms_deg:.1f} deg, k_P {r.k_p_fit:.2f} [{r.k_p_ci_low:.2f}, "
+            f"{r.k_p_ci_high:.2f}]"
+            f" (model k_P {r.k_p_paper})"
+        )
     return 0
 
 

@@ -9,6 +9,7 @@ of that overhead with the manifest length, and the synthetic camera / live psi m
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from collections.abc import Sequence
@@ -34,8 +35,12 @@ def round_trips(n: int) -> dict[str, float]:
             t2 = time.perf_counter()
             set_ms.append((t1 - t0) * 1e3)
             get_ms.append((t2 - t1) * 1e3)
-    return {"set_median_ms": float(np.median(set_ms)), "set_p95_ms": float(np.percentile(set_ms, 95)),
-            "get_median_ms": float(np.median(get_ms)), "get_p95_ms": float(np.percentile(get_ms, 95))}
+    return {
+        "set_median_ms": float(np.median(set_ms)),
+        "set_p95_ms": float(np.percentile(set_ms, 95)),
+        "get_median_ms": float(np.median(get_ms)),
+        "get_p95_ms": float(np.percentile(get_ms, 95)),
+    }
 
 
 def loop_overhead(trials: int, step_kpa: float, max_kpa: float, mode: str) -> dict[str, float]:
@@ -47,24 +52,49 @@ def loop_overhead(trials: int, step_kpa: float, max_kpa: float, mode: str) -> di
         img = np.full((960, 1280, 3), 200, np.uint8)
         cv2.line(img, (100, 480), (1180, 480), (0, 0, 0), 6)
         photo.write_bytes(cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 90])[1].tobytes())
-        cfg = SessionConfig(out_dir=Path(tmp) / "set", material="DS20", actuator="A1", trials=trials,
-                            step_kpa=step_kpa, max_kpa=max_kpa, settle_s=0.0, settings={"l0_mm": 270.0},
-                            mode=mode, force_samples=10)
+        cfg = SessionConfig(
+            out_dir=Path(tmp) / "set",
+            material="DS20",
+            actuator="A1",
+            trials=trials,
+            step_kpa=step_kpa,
+            max_kpa=max_kpa,
+            settle_s=0.0,
+            settings={"l0_mm": 270.0},
+            mode=mode,
+            force_samples=10,
+        )
         camera = CommandCamera(f"cp {photo} {{path}}")
         with Emulator(seed=0) as emu, PicoDriver.open(emu.port, max_kpa=max_kpa) as rig:
             t0 = time.perf_counter()
-            result = run_session(rig, camera, cfg, progress=False, stream=open("/dev/null", "w"))
+            with open(os.devnull, "w") as devnull:
+                result = run_session(rig, camera, cfg, progress=False, stream=devnull)
             seconds = time.perf_counter() - t0
         camera.close()
         # cost of one more row once the manifest holds every row of the session
         from pipeline.photoset import append_manifest_rows
 
         t1 = time.perf_counter()
-        append_manifest_rows(cfg.out_dir, [{"image": "extra.jpg", "pressure_kpa": "0", "direction": "up", "material": "DS20",
-                                            "actuator": "A9", "trial": "1", "step": "0"}])
+        append_manifest_rows(
+            cfg.out_dir,
+            [
+                {
+                    "image": "extra.jpg",
+                    "pressure_kpa": "0",
+                    "direction": "up",
+                    "material": "DS20",
+                    "actuator": "A9",
+                    "trial": "1",
+                    "step": "0",
+                }
+            ],
+        )
         append_ms = (time.perf_counter() - t1) * 1e3
-    return {"photos": result.photos_taken, "per_photo_ms": seconds / max(result.photos_taken, 1) * 1e3,
-            "append_row_at_end_ms": append_ms}
+    return {
+        "photos": result.photos_taken,
+        "per_photo_ms": seconds / max(result.photos_taken, 1) * 1e3,
+        "append_row_at_end_ms": append_ms,
+    }
 
 
 def synthetic_costs(n: int) -> dict[str, float]:
@@ -108,22 +138,43 @@ def synthetic_costs(n: int) -> dict[str, float]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print the figures."""
     parser = argparse.ArgumentParser(prog="python -m pipeline bench rig", description=__doc__)
-    parser.add_argument("--round-trips", type=int, default=500, help="SET+GET pairs timed (default 500)")
-    parser.add_argument("--synthetic", type=int, default=10, help="synthetic photos timed (default 10)")
+    parser.add_argument(
+        "--round-trips", type=int, default=500, help="SET+GET pairs timed (default 500)"
+    )
+    parser.add_argument(
+        "--synthetic", type=int, default=10, help="synthetic photos timed (default 10)"
+    )
     args = parser.parse_args(argv)
     print("rig benchmark (emulator over a pty; times in ms)")
     for key, value in round_trips(args.round_trips).items():
         print(f"  {key:32s} {value:8.3f}")
-    for label, kwargs in (("paper ramp, 1 trial (53 photos)", dict(trials=1, step_kpa=10, max_kpa=260, mode="bending")),
-                          ("paper ramp, 6 trials (318 photos)", dict(trials=6, step_kpa=10, max_kpa=260, mode="bending")),
-                          ("blocked, 1 trial, 10 samples/step", dict(trials=1, step_kpa=10, max_kpa=260, mode="blocked"))):
+    for label, kwargs in (
+        (
+            "paper ramp, 1 trial (53 photos)",
+            {"trials": 1, "step_kpa": 10, "max_kpa": 260, "mode": "bending"},
+        ),
+        (
+            "paper ramp, 6 trials (318 photos)",
+            {"trials": 6, "step_kpa": 10, "max_kpa": 260, "mode": "bending"},
+        ),
+        (
+            "blocked, 1 trial, 10 samples/step",
+            {"trials": 1, "step_kpa": 10, "max_kpa": 260, "mode": "blocked"},
+        ),
+    ):
         r = loop_overhead(**kwargs)  # type: ignore[arg-type]
-        print(f"  {label}: {r['photos']} photos, {r['per_photo_ms']:.1f} ms per photo besides settling; "
-              f"one more manifest row at the end {r['append_row_at_end_ms']:.1f} ms")
+        print(
+            f"  {label}: {r['photos']} photos, {r['per_photo_ms']:.1f} ms per photo besides "
+            "settling; "
+            f"one more manifest row at the end {r['append_row_at_end_ms']:.1f} ms"
+        )
     costs = synthetic_costs(args.synthetic)
     if costs["live_psi_measured"] < args.synthetic:
-        print(f"  live psi measured on {costs['live_psi_measured']:.0f} of {args.synthetic} synthetic photos: "
-              "the timing would be of the failure path; not reported")
+        print(
+            f"  live psi measured on {costs['live_psi_measured']:.0f} of {args.synthetic} "
+            "synthetic photos: "
+            "the timing would be of the failure path; not reported"
+        )
         return 1
     for key in ("synthetic_render_median_ms", "live_psi_measure_median_ms"):
         print(f"  {key:32s} {costs[key]:8.1f}")

@@ -57,7 +57,12 @@ RC: dict[str, object] = {
 }
 
 #: material -> colour (the paper's four silicones; others get the colours below in name order)
-MATERIAL_COLORS: dict[str, str] = {"DS20": "#1f77b4", "DS30": "#ff7f0e", "SS40": "#2ca02c", "SS50": "#d62728"}
+MATERIAL_COLORS: dict[str, str] = {
+    "DS20": "#1f77b4",
+    "DS30": "#ff7f0e",
+    "SS40": "#2ca02c",
+    "SS50": "#d62728",
+}
 _OTHER_COLORS = ("#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
 
 Color = tuple[float, float, float]
@@ -75,7 +80,9 @@ def footer_fraction(size_in: tuple[float, float]) -> float:
     return FOOTER_PT / (72.0 * size_in[1])
 
 
-def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, top_pt: float = 0.0) -> Figure:
+def page(
+    landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, top_pt: float = 0.0
+) -> Figure:
     """A new A4 page; constrained layout places its axes above the footer band.
 
     Parameters
@@ -96,7 +103,9 @@ def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, to
     height_pt = 72.0 * size[1]
     bottom = (FOOTER_PT + bottom_pt) / height_pt
     top = top_pt / height_pt
-    fig = Figure(figsize=size, layout=ConstrainedLayoutEngine(rect=(0.0, bottom, 1.0, 1.0 - bottom - top)))
+    fig = Figure(
+        figsize=size, layout=ConstrainedLayoutEngine(rect=(0.0, bottom, 1.0, 1.0 - bottom - top))
+    )
     fig.set_label(label)
     return fig
 

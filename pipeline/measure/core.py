@@ -22,7 +22,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pipeline.measure.calibration import CalibrationMismatch, check_size
-from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
+from pipeline.measure.estimators import (
+    METHODS,
+    CurveEstimate,
+    auto_choice,
+    hyper,
+    tangents,
+    turning_quick,
+)
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.quality import Quality, assess, assess_body
 from pipeline.measure.refine import refine_centreline
@@ -102,7 +109,8 @@ def _measured(
     settings: MeasureSettings,
     method: str,
 ) -> AngleResult:
-    """The :class:`AngleResult` of a measured photo: psi, the fit ``est`` of ``line`` and its quality.
+    """The :class:`AngleResult` of a measured photo: psi, the fit ``est`` of ``line`` and its
+    quality.
 
     ``settings`` are those the fit used (on a calibrated plane: the plane's ``mm_per_px``).
     """
@@ -136,7 +144,9 @@ def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
     return f
 
 
-def _psi_from(est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | None, length_px: float) -> float:
+def _psi_from(
+    est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | None, length_px: float
+) -> float:
     if mm_per_px:
         return float(np.rad2deg(sign * est.kappa_per_px / mm_per_px * l0_mm))
     return float(np.rad2deg(sign * est.kappa_per_px * length_px))
@@ -165,15 +175,25 @@ def measure_work_image(
         return measure_body(image_bgr, settings, scale=scale, method=method)
     l0_mm, mm_per_px = settings.l0_mm, settings.mm_per_px
     assert settings.color is not None
-    region = None if image_bgr is None else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    region = (
+        None
+        if image_bgr is None
+        else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    )
     try:
         line: LineExtraction = extract_centreline(
-            image_bgr, color=settings.color, fixed_end_px=settings.fixed_end_px, scale=scale, region=region
+            image_bgr,
+            color=settings.color,
+            fixed_end_px=settings.fixed_end_px,
+            scale=scale,
+            region=region,
         )
     except NoLineFound as exc:
         return failed(method, str(exc))
     if fine is not None:
-        refined = refine_centreline(fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px)
+        refined = refine_centreline(
+            fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px
+        )
         line = replace(line, centreline_px=refined)
     try:  # y-up: on-screen ccw is positive; calibrated: undistorted, on the plane (plane px)
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
@@ -183,7 +203,8 @@ def measure_work_image(
     rng = np.random.default_rng(SEED)
     sign = settings.sign
     try:
-        arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
+        # the arc and quick turning fits serve the quality check
+        arc = hyper(pts, rng, ends_px=ends)
         trn = turning_quick(pts, rng, ends_px=ends)
         if method == "hyper":
             est = arc
@@ -199,7 +220,11 @@ def measure_work_image(
         # the full turning fit was run: its quick linear proxy is too crude a check (it
         # extrapolates a polynomial to the ends); the fit with one term more or less is the check
         trn = CurveEstimate(
-            est.neighbour_turning_rad / est.length_px, est.neighbour_turning_rad, est.length_px, est.residual_px, est.degree
+            est.neighbour_turning_rad / est.length_px,
+            est.neighbour_turning_rad,
+            est.length_px,
+            est.residual_px,
+            est.degree,
         )
     quality = assess(
         line,
@@ -214,7 +239,9 @@ def measure_work_image(
     return _measured(psi, est, line, quality, settings, method)
 
 
-def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float]) -> NDArray[np.float64]:
+def _extended_ends(
+    points: NDArray[np.float64], trimmed_px: tuple[float, float]
+) -> NDArray[np.float64]:
     """The two ends of the measured line: the first/last point carried on by the trimmed lengths."""
     out = []
     for end, nxt, trim in ((points[0], points[min(3, len(points) - 1)], trimmed_px[0]),
@@ -228,7 +255,8 @@ def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float])
 def plane_centreline(
     line: LineExtraction, settings: MeasureSettings, shape: Sequence[int], scale: float
 ) -> tuple[NDArray[np.float64], tuple[float, float], MeasureSettings]:
-    """The centre line as the estimators take it: y up, and on the plane when the photo is calibrated.
+    """The centre line as the estimators take it: y up, and on the plane when the photo is
+    calibrated.
 
     Parameters
     ----------
@@ -272,8 +300,11 @@ def plane_centreline(
         a = np.deg2rad(direction)
         d = plane.to_plane([pts[0], pts[0] + 10.0 * np.array([np.cos(a), -np.sin(a)])])
         direction = float(np.rad2deg(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0])))
-    return q * flip, ends, replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction)
-
+    return (
+        q * flip,
+        ends,
+        replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction),
+    )
 
 
 @functools.lru_cache(maxsize=4)
@@ -285,7 +316,9 @@ def _background(path: str, shape: tuple[int, int]) -> np.ndarray | None:
     return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
 
 
-def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD) -> AngleResult:
+def measure_body(
+    image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD
+) -> AngleResult:
     """psi of the actuator's body (``target: body``): its centre line's total turning.
 
     ``auto`` is :func:`~pipeline.measure.estimators.tangents` here (the tip angle: a body is
@@ -298,22 +331,32 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     if settings.background_path is not None and image_bgr is not None:
         background = _background(settings.background_path, image_bgr.shape[:2])
         if background is None:
-            return failed(method, f"background photo {Path(settings.background_path).name} cannot be decoded")
+            return failed(
+                method, f"background photo {Path(settings.background_path).name} cannot be decoded"
+            )
     try:
         body = extract_body(image_bgr, settings, scale=scale, background_bgr=background)
     except NoLineFound as exc:
         return failed(method, str(exc))
     line = body.line
-    try:  # ends: the tangents are carried to the clamp face and to the tip (not over a cap); calibrated: on the plane
+    # ends: the tangents are carried to the clamp face and to the tip (not over a cap); calibrated:
+    # on the plane
+    try:
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
     rng = np.random.default_rng(SEED)
-    base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    base = (
+        None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    )
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
-        est = tip if method in ("auto", "tangents") or base is not None else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+        est = (
+            tip
+            if method in ("auto", "tangents") or base is not None
+            else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+        )
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
@@ -322,7 +365,9 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     quality = assess_body(
         line,
         psi_deg=psi,
-        psi_check_deg=float(np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))),
+        psi_check_deg=float(
+            np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))
+        ),
         widths_px=body.widths_px,
         expected_length_px=settings.l0_mm / settings.mm_per_px if settings.mm_per_px else None,
         length_px=est.length_px,
@@ -372,7 +417,8 @@ def measure_image(
     >>> img = np.full((480, 640, 3), 200, np.uint8)
     >>> t = np.linspace(0, np.pi, 200)                      # half circle, radius 150 px
     >>> pts = np.c_[320 + 150 * np.cos(t), 300 - 150 * np.sin(t)]
-    >>> _ = cv2.polylines(img, [np.round(pts * 16).astype(np.int32)], False, (20, 20, 20), 5, cv2.LINE_AA, 4)
+    >>> line = [np.round(pts * 16).astype(np.int32)]
+    >>> _ = cv2.polylines(img, line, False, (20, 20, 20), 5, cv2.LINE_AA, 4)
     >>> s = resolve_settings(l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end=[470, 300])
     >>> r = measure_image(img, s)
     >>> print(round(r.psi_deg), r.status)
@@ -384,11 +430,18 @@ def measure_image(
     res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
-        res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
+        res = measure_work_image(
+            reduce_image(image_bgr, f), settings, scale=float(f), method=method
+        )
     return res
 
 
-_REDUCED = {1: cv2.IMREAD_COLOR, 2: cv2.IMREAD_REDUCED_COLOR_2, 4: cv2.IMREAD_REDUCED_COLOR_4, 8: cv2.IMREAD_REDUCED_COLOR_8}
+_REDUCED = {
+    1: cv2.IMREAD_COLOR,
+    2: cv2.IMREAD_REDUCED_COLOR_2,
+    4: cv2.IMREAD_REDUCED_COLOR_4,
+    8: cv2.IMREAD_REDUCED_COLOR_8,
+}
 _REDUCED_GREY = {
     1: cv2.IMREAD_GRAYSCALE, 2: cv2.IMREAD_REDUCED_GRAYSCALE_2, 4: cv2.IMREAD_REDUCED_GRAYSCALE_4,
     8: cv2.IMREAD_REDUCED_GRAYSCALE_8,
@@ -426,7 +479,10 @@ def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
 
 
 def decode_for_work(
-    data: np.ndarray, work_width_px: int = WORK_WIDTH_PX, factor: int | None = None, grey: bool = False
+    data: np.ndarray,
+    work_width_px: int = WORK_WIDTH_PX,
+    factor: int | None = None,
+    grey: bool = False,
 ) -> tuple[np.ndarray | None, int]:
     """Decode image bytes, directly at reduced size for large JPEGs (DCT scaling: much faster).
 
@@ -460,10 +516,13 @@ def decode_for_work(
 
 
 def reduce_image(image: np.ndarray, factor: int) -> np.ndarray:
-    """``image`` reduced ``factor`` times in each direction (INTER_AREA); itself for ``factor`` <= 1."""
+    """``image`` reduced ``factor`` times in each direction (INTER_AREA); itself for ``factor`` <=
+    1."""
     if factor <= 1:
         return image
-    return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
+    return cv2.resize(
+        image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA
+    )
 
 
 def decodes_grey(settings: MeasureSettings) -> bool:
@@ -491,14 +550,25 @@ def measure_file(
         data = np.fromfile(str(path), dtype=np.uint8)
     except OSError as exc:
         return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
-    img, f = decode_for_work(data, work_width_px, grey=decodes_grey(settings)) if data.size else (None, 1)
+    img, f = (
+        decode_for_work(data, work_width_px, grey=decodes_grey(settings))
+        if data.size
+        else (None, 1)
+    )
     if img is None:
-        return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
+        return failed(
+            method, f"unreadable image: {Path(path).name} cannot be decoded"
+        ), time.perf_counter() - t0
     return measure_decoded(data, img, f, settings, method=method), time.perf_counter() - t0
 
 
 def measure_decoded(
-    data: np.ndarray | None, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD,
+    data: np.ndarray | None,
+    img: np.ndarray,
+    factor: int,
+    settings: MeasureSettings,
+    *,
+    method: str = DEFAULT_METHOD,
     full: np.ndarray | None = None,
 ) -> AngleResult:
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
@@ -514,12 +584,16 @@ def measure_decoded(
     """
     if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
         coarse = reduce_image(img, 2)
-        res = measure_work_image(coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor))
+        res = measure_work_image(
+            coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor)
+        )
         # anything doubtful (gaps, rivals, border, ...) is measured again at the decoded size
         if res.status == "ok" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
             return res
     res = measure_work_image(img, settings, scale=float(factor), method=method)
-    while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
+    while factor > 1 and (
+        res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX
+    ):
         factor //= 2
         if full is not None:
             finer = reduce_image(full, factor)

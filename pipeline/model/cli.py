@@ -336,8 +336,8 @@ def format_calibration(
         fixed = {k: v for k, v in options.items() if k not in keys and k != "l0_mm"}
         res = search_readings(keys, materials=table, **fixed)
         passing = res[res["passes"]]
-        out += ["", f"Search (steps 1-4): {len(res)} derived readings, {len(passing)} meet "
-                f"+-{MODEL_BAR_PCT:g} % on both model results at their l0:"]
+        out += ["", (f"Search (steps 1-4): {len(res)} derived readings, {len(passing)} meet "
+                     f"+-{MODEL_BAR_PCT:g} % on both model results at their l0:")]
         cols = [*keys, "departures", "l0_fit_mm", "ss50_pct", "ss40_pct",
                 "exp_pressure_rms_pct", "exp_psi_rms_deg", "exp_range_rms_pct"]
         shown = (passing if len(passing) else res.head(5))[cols]

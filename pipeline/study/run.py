@@ -102,12 +102,26 @@ def measure_case(case: Case, methods: Sequence[str], workdir: str | Path) -> lis
             row = run_task(Task(str(path), settings, method))
             err = row["psi_deg"] - case.psi_deg
             out[method] = {
-                "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,
-                "nominal": case.nominal, "psi_true_deg": case.psi_deg, "bulge": case.bulge, "seed": case.seed,
-                "width_px": scene.width, "line_length_px": case.l0_mm / scene.mm_per_px, "method": method,
-                "psi_deg": row["psi_deg"], "error_deg": err, "abs_error_deg": abs(err), "status": row["status"],
-                "reason": row["reason"], "degree": np.nan if row["degree"] is None else float(row["degree"]),
-                "residual_px": row["residual_px"], "seconds": row["seconds"], "decode_seconds": decode_s,
+                "case_id": case.case_id,
+                "kind": case.kind,
+                "condition": case.condition,
+                "value": case.value,
+                "nominal": case.nominal,
+                "psi_true_deg": case.psi_deg,
+                "bulge": case.bulge,
+                "seed": case.seed,
+                "width_px": scene.width,
+                "line_length_px": case.l0_mm / scene.mm_per_px,
+                "method": method,
+                "psi_deg": row["psi_deg"],
+                "error_deg": err,
+                "abs_error_deg": abs(err),
+                "status": row["status"],
+                "reason": row["reason"],
+                "degree": np.nan if row["degree"] is None else float(row["degree"]),
+                "residual_px": row["residual_px"],
+                "seconds": row["seconds"],
+                "decode_seconds": decode_s,
                 "render_seconds": render_s,
             }
     finally:
