@@ -40,8 +40,15 @@ BODY_SCENES: dict[str, dict[str, object]] = {
 _PRESET = {"lab_body": "lab"}
 
 
-def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 960,
-               fixed_direction: bool = False, scenes: tuple[str, ...] | None = None) -> pd.DataFrame:
+def body_cases(
+    n: int = 12,
+    *,
+    seed: int = 30,
+    width: int = 1280,
+    height: int = 960,
+    fixed_direction: bool = False,
+    scenes: tuple[str, ...] | None = None,
+) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
     Parameters
