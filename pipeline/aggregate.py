@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import DIRECTIONS, STATUSES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 
@@ -60,10 +61,8 @@ PER_ACTUATOR_COLUMNS: tuple[str, ...] = (
     "material", "actuator", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg",
     "n", "n_trials", "n_excluded", "pressure_mean_kpa",
 )
-DIRECTION_ORDER: tuple[str, ...] = ("up", "down")
 #: bin width (kPa) of the frames of a video when no bin width is asked for
 CONTINUOUS_BIN_KPA = 5.0
-STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 
 
 def read_angles(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
@@ -117,7 +116,8 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
     missing = [c for c in REQUIRED_ANGLE_COLUMNS if c not in angles.columns]
     if missing:
         raise UserInputError(
-            f"{where}: missing column(s) {missing}; an angles.csv needs {list(REQUIRED_ANGLE_COLUMNS)}"
+            f"{where}: missing column(s) {missing}; an angles.csv needs "
+            f"{list(REQUIRED_ANGLE_COLUMNS)}"
         )
     for column in ("pressure_kpa", "psi_deg") + (
         ("measured_pressure_kpa",) if "measured_pressure_kpa" in angles.columns else ()
@@ -127,20 +127,58 @@ def check_angles(angles: pd.DataFrame, where: str = "angles.csv") -> None:
         if bad.any():
             i = int(np.flatnonzero(bad.to_numpy())[0])
             raise UserInputError(
-                f"{where} line {i + 2}: column '{column}' must be a number, got {angles[column].iloc[i]!r}"
+                f"{where} line {i + 2}: column '{column}' must be a number, got "
+                f"{angles[column].iloc[i]!r}"
             )
     # a failed row may have no pressure (a bad manifest pressure, a frame outside its pressure log)
-    bad_p = (pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna() & (angles["status"] != "failed")).to_numpy()
+    bad_p = (
+        pd.to_numeric(angles["pressure_kpa"], errors="coerce").isna()
+        & (angles["status"] != "failed")
+    ).to_numpy()
     if bad_p.any():
         i = int(np.flatnonzero(bad_p)[0])
-        raise UserInputError(f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint (kPa)")
-    for column, allowed in (("direction", DIRECTION_ORDER), ("status", STATUSES)):
+        raise UserInputError(
+            f"{where} line {i + 2}: 'pressure_kpa' is empty; every measured row needs its setpoint "
+            "(kPa)"
+        )
+    for column, allowed in (("direction", DIRECTIONS), ("status", STATUSES)):
         bad = ~angles[column].isin(allowed).to_numpy()
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise UserInputError(
-                f"{where} line {i + 2}: '{column}' is {angles[column].iloc[i]!r}; use one of {list(allowed)}"
+                f"{where} line {i + 2}: '{column}' is {angles[column].iloc[i]!r}; use one of "
+                f"{list(allowed)}"
             )
+
+
+def measured_pressure(angles: pd.DataFrame) -> pd.Series:
+    """The pressure each row was measured at (kPa): ``measured_pressure_kpa`` where present and
+    finite, else the setpoint ``pressure_kpa``.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"pressure_kpa": [10.0, 20.0], "measured_pressure_kpa": [9.5, None]})
+    >>> measured_pressure(df).tolist()
+    [9.5, 20.0]
+    """
+    nominal = pd.to_numeric(angles["pressure_kpa"], errors="coerce").astype(float)
+    if "measured_pressure_kpa" not in angles.columns:
+        return nominal
+    measured = pd.to_numeric(angles["measured_pressure_kpa"], errors="coerce").astype(float)
+    return measured.where(np.isfinite(measured), nominal)
+
+
+def is_used(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Series:
+    """Whether each row's psi may enter a curve by its status: ``ok``, and ``flagged`` if asked
+    (``failed`` never).
+
+    Examples
+    --------
+    >>> status = pd.DataFrame({"status": ["ok", "flagged", "failed"]})
+    >>> is_used(status, include_flagged=True).tolist()
+    [True, True, False]
+    """
+    return angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
 
 
 def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Series:
@@ -175,10 +213,7 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
         return nominal.where(~frames, pressure_levels(angles, CONTINUOUS_BIN_KPA))
     if not (math.isfinite(bin_kpa) and bin_kpa > 0):
         raise UserInputError(f"--bin-kpa must be a positive number of kPa, got {bin_kpa}")
-    measured = nominal
-    if "measured_pressure_kpa" in angles.columns:
-        m = pd.to_numeric(angles["measured_pressure_kpa"], errors="coerce").astype(float)
-        measured = m.where(np.isfinite(m), nominal)
+    measured = measured_pressure(angles)
     # floor(x / w + 0.5) rounds half up, unlike numpy's round-half-to-even
     return pd.Series(np.floor(measured.to_numpy() / bin_kpa + 0.5) * bin_kpa, index=angles.index)
 
@@ -190,16 +225,13 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
     df["trial"] = df["trial"].astype(str)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["_level"] = pressure_levels(df, bin_kpa)
-    pressure_used = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
     binned = pd.Series(bin_kpa is not None, index=df.index)
     if "frame" in df.columns:
         binned |= df["frame"].notna()
-    if "measured_pressure_kpa" in df.columns:
-        m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
-        pressure_used = m.where(np.isfinite(m) & binned, pressure_used)
-    df["_pressure"] = pressure_used
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df["_included"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
+    # binned rows average the measured pressure, setpoint levels the setpoint
+    setpoint = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
+    df["_pressure"] = measured_pressure(df).where(binned, setpoint)
+    df["_included"] = is_used(df, include_flagged) & np.isfinite(df["psi_deg"])
     df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
     if "frame" in df.columns and df["frame"].notna().any():
         df = _collapse_frames(df)
@@ -216,7 +248,14 @@ def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:
     keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
     inc = frames[frames["_included"]]
     mean = inc.groupby(keys, sort=False)[["psi_deg", "_pressure"]].mean()
-    rows = frames.groupby(keys, sort=False).size().rename("_frames").to_frame().join(mean).reset_index()
+    rows = (
+        frames.groupby(keys, sort=False)
+        .size()
+        .rename("_frames")
+        .to_frame()
+        .join(mean)
+        .reset_index()
+    )
     rows["_included"] = rows["psi_deg"].notna()
     rows["status"] = np.where(rows["_included"], "ok", "failed")
     rows["_pressure"] = rows["_pressure"].where(rows["_included"], np.nan)
@@ -246,7 +285,7 @@ def _summarise(df: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
     out = pd.DataFrame(rows)
     if out.empty:
         return out
-    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTIONS)})
     sort_keys = [k if k != "direction" else "_dir" for k in keys] + ["pressure_kpa"]
     out = out.sort_values(sort_keys, kind="stable").drop(columns="_dir").reset_index(drop=True)
     for c in ("n", "n_actuators", "n_trials", "n_excluded"):
@@ -317,7 +356,8 @@ def reason_kind(reason: str) -> str:
     >>> reason_kind("")
     '(no reason given)'
     """
-    text = re.sub(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?", "#", reason.strip())  # keeps names like l0
+    # keeps names like l0
+    text = re.sub(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?", "#", reason.strip())
     return text or "(no reason given)"
 
 
@@ -346,11 +386,20 @@ def status_counts(angles: pd.DataFrame, max_kinds: int = 6) -> pd.DataFrame:
     rows = []
     for (dataset, material), g in df.groupby(["dataset", "material"], sort=False):
         bad = g[g["status"] != "ok"]
-        kinds = [reason_kind(part) for r in bad["reason"].fillna("").astype(str) for part in (r.split(";") or [""])]
+        kinds = [
+            reason_kind(part)
+            for r in bad["reason"].fillna("").astype(str)
+            for part in (r.split(";") or [""])
+        ]
         counts = pd.Series(kinds, dtype=str).value_counts(sort=False)
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
         if len(ordered) > max_kinds:
-            ordered = ordered[:max_kinds] + [(f"{len(ordered) - max_kinds} other kind(s)", sum(c for _, c in ordered[max_kinds:]))]
+            ordered = ordered[:max_kinds] + [
+                (
+                    f"{len(ordered) - max_kinds} other kind(s)",
+                    sum(c for _, c in ordered[max_kinds:]),
+                )
+            ]
         rows.append(
             {
                 "dataset": dataset,
@@ -362,7 +411,9 @@ def status_counts(angles: pd.DataFrame, max_kinds: int = 6) -> pd.DataFrame:
                 "reasons": "; ".join(f"{r} x{c}" for r, c in ordered),
             }
         )
-    return pd.DataFrame(rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"])
+    return pd.DataFrame(
+        rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"]
+    )
 
 
 def actuator_keys(angles: pd.DataFrame) -> pd.Series:
@@ -395,7 +446,8 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
     Examples
     --------
     >>> import pandas as pd
-    >>> a = dict(material="DS20", direction="up", pressure_kpa=0.0, n_actuators=1, n_trials=2, n_excluded=0)
+    >>> a = dict(material="DS20", direction="up", pressure_kpa=0.0, n_actuators=1, n_trials=2,
+    ...          n_excluded=0)
     >>> h = pd.DataFrame([dict(a, psi_mean_deg=1.0, psi_sd_deg=2 ** 0.5, n=2),
     ...                   dict(a, psi_mean_deg=4.0, psi_sd_deg=float("nan"), n=1)])
     >>> pool_hysteresis(h)[["psi_mean_deg", "psi_sd_deg", "n"]].to_numpy().tolist()  # of 0, 2, 4
@@ -412,7 +464,11 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
         used = n > 0
         total = float(n[used].sum())
         mean = float(np.sum(n[used] * m[used]) / total) if total else math.nan
-        ss = float(np.sum((n[used] - 1) * sd[used] ** 2) + np.sum(n[used] * (m[used] - mean) ** 2)) if total else 0.0
+        ss = (
+            float(np.sum((n[used] - 1) * sd[used] ** 2) + np.sum(n[used] * (m[used] - mean) ** 2))
+            if total
+            else 0.0
+        )
         row = dict(zip(keys, key, strict=True))
         row.update(
             psi_mean_deg=mean,
@@ -424,9 +480,11 @@ def pool_hysteresis(hyst: pd.DataFrame) -> pd.DataFrame:
         )
         if "pressure_mean_kpa" in g:
             pm = g["pressure_mean_kpa"].to_numpy(float)
-            row["pressure_mean_kpa"] = float(np.sum(n[used] * pm[used]) / total) if total else math.nan
+            row["pressure_mean_kpa"] = (
+                float(np.sum(n[used] * pm[used]) / total) if total else math.nan
+            )
         rows.append(row)
     out = pd.DataFrame(rows)
-    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTION_ORDER)})
+    out["_dir"] = out["direction"].map({d: i for i, d in enumerate(DIRECTIONS)})
     out = out.sort_values(["material", "_dir", "pressure_kpa"], kind="stable").drop(columns="_dir")
     return out.reset_index(drop=True)

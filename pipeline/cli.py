@@ -28,17 +28,50 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "pipeline.photoset_cli",
         "create (init) or validate (check) a photo set folder: manifest.csv + photoset.yaml",
     ),
-    "synth": ("pipeline.synth.cli", "render a synthetic pressure-ramp photo set with exact ground truth"),
-    "synth-video": ("pipeline.synth.video_cli", "render a synthetic video photo set (video + pressure log) with exact truth"),
-    "acquire": ("pipeline.rig.acquire_cli", "run the pressure ramp on a rig (real or emulated) and photograph it"),
-    "rig": ("pipeline.rig.cli", "rig utilities: emulate the Pico over a pseudo-terminal, calibrate the regulator"),
-    "measure": ("pipeline.measure_cli", "measure the bending angle psi (deg) of every photo of a photo set"),
-    "aggregate": ("pipeline.aggregate_cli", "aggregate angles.csv into mean/sd hysteresis curves per pressure (kPa)"),
-    "continuous": ("pipeline.video.continuous_cli", "a video's loops, settling curves and step responses (s, deg, kPa)"),
-    "model": ("pipeline.model.cli", "analytical model of the paper: P(psi) curves, inverse, k_P calibration"),
-    "compare": ("pipeline.compare_cli", "compare measured hysteresis with the model: RMS (deg), crossings (kPa), k_P"),
+    "synth": (
+        "pipeline.synth.cli",
+        "render a synthetic pressure-ramp photo set with exact ground truth",
+    ),
+    "synth-video": (
+        "pipeline.synth.video_cli",
+        "render a synthetic video photo set (video + pressure log) with exact truth",
+    ),
+    "acquire": (
+        "pipeline.rig.acquire_cli",
+        "run the pressure ramp on a rig (real or emulated) and photograph it",
+    ),
+    "rig": (
+        "pipeline.rig.cli",
+        "rig utilities: emulate the Pico over a pseudo-terminal, calibrate the regulator",
+    ),
+    "measure": (
+        "pipeline.measure_cli",
+        "measure the bending angle psi (deg) of every photo of a photo set",
+    ),
+    "aggregate": (
+        "pipeline.aggregate_cli",
+        "aggregate angles.csv into mean/sd hysteresis curves per pressure (kPa)",
+    ),
+    "continuous": (
+        "pipeline.video.continuous_cli",
+        "a video's loops, settling curves and step responses (s, deg, kPa)",
+    ),
+    "model": (
+        "pipeline.model.cli",
+        "analytical model of the paper: P(psi) curves, inverse, k_P calibration",
+    ),
+    "compare": (
+        "pipeline.compare_cli",
+        "compare measured hysteresis with the model: RMS (deg), crossings (kPa), k_P",
+    ),
     "report": ("pipeline.report.cli", "write the PDF report from the results tables"),
-    "bench": ("pipeline.bench.cli", "speed/accuracy and stability study of the angle methods and the model"),
+    "bench": (
+        "pipeline.bench.cli",
+        (
+            "benchmarks that print figures: the speed/accuracy study (bench study), measure, "
+            "video, ..."
+        ),
+    ),
     "force": ("pipeline.force.cli", "blocked force, eccentricity and grasp-log analysis"),
 }
 

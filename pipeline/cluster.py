@@ -69,7 +69,9 @@ def resolve_resource(raw: object, environ: Mapping[str, str]) -> str:
     return text
 
 
-def slurm_problems(default_resources: Mapping[str, object], environ: Mapping[str, str]) -> list[Problem]:
+def slurm_problems(
+    default_resources: Mapping[str, object], environ: Mapping[str, str]
+) -> list[Problem]:
     """Every empty or unset SLURM account/partition among a run's default resources.
 
     Parameters
@@ -114,7 +116,9 @@ def slurm_problems(default_resources: Mapping[str, object], environ: Mapping[str
     return problems
 
 
-def check_slurm_resources(default_resources: Mapping[str, object], environ: Mapping[str, str]) -> None:
+def check_slurm_resources(
+    default_resources: Mapping[str, object], environ: Mapping[str, str]
+) -> None:
     """Refuse a run whose SLURM account or partition is empty, listing every problem.
 
     Raises

@@ -60,13 +60,21 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.aggregate import actuator_keys, pool_hysteresis
+from pipeline.aggregate import actuator_keys, is_used, measured_pressure, pool_hysteresis
+from pipeline.constants import DIRECTIONS, PSI0_DEG
 from pipeline.errors import UserInputError
 
 ModelPsi = Callable[[str, np.ndarray, "float | None"], np.ndarray]
 FitKp = Callable[[str, np.ndarray, np.ndarray, "float | None"], tuple[float, Any]]
 
-HYSTERESIS_REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n")
+HYSTERESIS_REQUIRED: tuple[str, ...] = (
+    "material",
+    "direction",
+    "pressure_kpa",
+    "psi_mean_deg",
+    "psi_sd_deg",
+    "n",
+)
 
 
 @dataclass(frozen=True)
@@ -104,24 +112,54 @@ PAPER_VALUES: dict[str, PaperValues] = {
 
 #: rms.csv columns, in order
 RMS_COLUMNS: tuple[str, ...] = (
-    "material", "curve", "datasets", "l0_mm", "l0_source", "materials_file", "data_source", "rms_kind", "model_fit",
-    "note", "rms_deg", "rms_up_deg", "rms_down_deg", "n_levels", "n_model_nan",
-    "p_zero_up_kpa", "p_zero_down_kpa", "p_minus_psi0_up_kpa", "p_minus_psi0_down_kpa", "psi0_deg",
-    "range_deg", "psi_max_deg", "psi_min_deg", "range_kpa",
-    "hysteresis_width_deg", "hysteresis_width_at_kpa",
-    "k_p_fit", "k_p_ci_low", "k_p_ci_high", "k_p_boot_n", "n_actuators",
-    "k_p_paper", "paper_rms_deg", "paper_p_zero_kpa", "paper_range_deg", "paper_range_kpa",
+    "material",
+    "curve",
+    "datasets",
+    "l0_mm",
+    "l0_source",
+    "materials_file",
+    "data_source",
+    "rms_kind",
+    "model_fit",
+    "note",
+    "rms_deg",
+    "rms_up_deg",
+    "rms_down_deg",
+    "n_levels",
+    "n_model_nan",
+    "p_zero_up_kpa",
+    "p_zero_down_kpa",
+    "p_minus_psi0_up_kpa",
+    "p_minus_psi0_down_kpa",
+    "psi0_deg",
+    "range_deg",
+    "psi_max_deg",
+    "psi_min_deg",
+    "range_kpa",
+    "hysteresis_width_deg",
+    "hysteresis_width_at_kpa",
+    "k_p_fit",
+    "k_p_ci_low",
+    "k_p_ci_high",
+    "k_p_boot_n",
+    "n_actuators",
+    "k_p_paper",
+    "paper_rms_deg",
+    "paper_p_zero_kpa",
+    "paper_range_deg",
+    "paper_range_kpa",
 )
 
 
 def check_hysteresis(hyst: pd.DataFrame, where: str = "hysteresis.csv") -> None:
-    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has a bad direction."""
+    """Raise :class:`UserInputError` if ``hyst`` lacks hysteresis.csv columns or has a bad
+    direction."""
     missing = [c for c in HYSTERESIS_REQUIRED if c not in hyst.columns]
     if missing:
         raise UserInputError(
             f"{where}: missing column(s) {missing}; pass a hysteresis.csv written by 'aggregate'"
         )
-    bad = ~hyst["direction"].isin(("up", "down")).to_numpy()
+    bad = ~hyst["direction"].isin(DIRECTIONS).to_numpy()
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise UserInputError(
@@ -199,19 +237,22 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
 
 
 def branch(hyst_material: pd.DataFrame, direction: str) -> tuple[np.ndarray, np.ndarray]:
-    """Pressure and mean psi of one direction in ramp order (ascending for up, descending for down)."""
+    """Pressure and mean psi of one direction in ramp order (ascending for up, descending for
+    down)."""
     b = hyst_material[hyst_material["direction"] == direction]
     b = b.sort_values("pressure_kpa", ascending=(direction == "up"), kind="stable")
     return b["pressure_kpa"].to_numpy(dtype=float), b["psi_mean_deg"].to_numpy(dtype=float)
 
 
 def hysteresis_width(hyst_material: pd.DataFrame) -> tuple[float, float]:
-    """Largest |psi_up - psi_down| (deg) over levels present in both directions, and its pressure (kPa).
+    """Largest |psi_up - psi_down| (deg) over levels in both directions, and its pressure (kPa).
 
     Returns ``(nan, nan)`` when no level has finite means in both directions.
     """
     up = hyst_material[hyst_material["direction"] == "up"].set_index("pressure_kpa")["psi_mean_deg"]
-    down = hyst_material[hyst_material["direction"] == "down"].set_index("pressure_kpa")["psi_mean_deg"]
+    down = hyst_material[hyst_material["direction"] == "down"].set_index("pressure_kpa")[
+        "psi_mean_deg"
+    ]
     both = pd.concat([up.rename("up"), down.rename("down")], axis=1, join="inner").dropna()
     if both.empty:
         return math.nan, math.nan
@@ -261,7 +302,9 @@ def bootstrap_k_p(
     """
     if rows.empty:
         return math.nan, math.nan, math.nan, 0
-    k_p = float(fit_k_p(material, rows["pressure_kpa"].to_numpy(float), rows["psi_deg"].to_numpy(float))[0])
+    k_p = float(
+        fit_k_p(material, rows["pressure_kpa"].to_numpy(float), rows["psi_deg"].to_numpy(float))[0]
+    )
     actuators = sorted(rows["actuator"].astype(str).unique())
     if len(actuators) < 2 or n_boot <= 0:
         return k_p, math.nan, math.nan, 0
@@ -270,12 +313,18 @@ def bootstrap_k_p(
     fits = []
     memo: dict[tuple[int, ...], float] = {}  # a resample is a multiset of actuators: fit each once
     for _ in range(n_boot):
-        pick = tuple(sorted(int(i) for i in rng.choice(len(actuators), size=len(actuators), replace=True)))
+        pick = tuple(
+            sorted(int(i) for i in rng.choice(len(actuators), size=len(actuators), replace=True))
+        )
         if pick not in memo:
             sample = pd.concat([by_act[actuators[i]] for i in pick], ignore_index=True)
             try:
                 memo[pick] = float(
-                    fit_k_p(material, sample["pressure_kpa"].to_numpy(float), sample["psi_deg"].to_numpy(float))[0]
+                    fit_k_p(
+                        material,
+                        sample["pressure_kpa"].to_numpy(float),
+                        sample["psi_deg"].to_numpy(float),
+                    )[0]
                 )
             except UserInputError:  # e.g. too few finite pairs in this resample
                 memo[pick] = math.nan
@@ -337,7 +386,7 @@ def compare_material(
         out["rms_deg"], _, out["n_model_nan"] = rms_deg(meas, model)
         out["rms_up_deg"] = rms_deg(meas[up], model[up])[0]
         out["rms_down_deg"] = rms_deg(meas[~up], model[~up])[0]
-    for direction in ("up", "down"):
+    for direction in DIRECTIONS:
         p_b, s_b = branch(h, direction)
         out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0)
         out[f"p_minus_psi0_{direction}_kpa"] = crossing_kpa(p_b, s_b, -psi0_deg)
@@ -356,8 +405,11 @@ def compare_material(
     paper = PAPER_VALUES.get(material)
     if paper is not None:
         out.update(
-            k_p_paper=paper.k_p, paper_rms_deg=paper.rms_deg, paper_p_zero_kpa=paper.p_zero_kpa,
-            paper_range_deg=paper.range_deg, paper_range_kpa=paper.range_kpa,
+            k_p_paper=paper.k_p,
+            paper_rms_deg=paper.rms_deg,
+            paper_p_zero_kpa=paper.p_zero_kpa,
+            paper_range_deg=paper.range_deg,
+            paper_range_kpa=paper.range_kpa,
         )
     return out
 
@@ -367,13 +419,8 @@ def included_rows(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Dat
 
     The pressure used is ``measured_pressure_kpa`` where present and finite, else the setpoint.
     """
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df = angles[angles["status"].isin(allowed)].copy()
-    p = pd.to_numeric(df["pressure_kpa"], errors="coerce").astype(float)
-    if "measured_pressure_kpa" in df.columns:
-        m = pd.to_numeric(df["measured_pressure_kpa"], errors="coerce").astype(float)
-        p = m.where(np.isfinite(m), p)
-    df["pressure_kpa"] = p
+    df = angles[is_used(angles, include_flagged)].copy()
+    df["pressure_kpa"] = measured_pressure(df)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)
     df["actuator"] = actuator_keys(df)
     ok = np.isfinite(df["pressure_kpa"]) & np.isfinite(df["psi_deg"])
@@ -485,17 +532,27 @@ def comparison_groups(
         mfile = fm.materials_file if fm else ""
         l0s: list[float] = []
         if have_l0:
-            sel = angles[(angles["dataset"].astype(str) == dataset) & (angles["material"].astype(str) == material)]
+            sel = angles[
+                (angles["dataset"].astype(str) == dataset)
+                & (angles["material"].astype(str) == material)
+            ]
             values = pd.to_numeric(sel["l0_mm"], errors="coerce").to_numpy(float)
             l0s = sorted({float(v) for v in values[np.isfinite(values)]})
         if len(l0s) > 1:
             note = (
                 f"dataset {dataset!r} holds {material} actuators of several l0 "
-                f"({', '.join(f'{v:g}' for v in l0s)} mm) pooled in one hysteresis.csv: no single model "
-                "curve fits them; split the photo set into one dataset per l0 to compare with the model"
+                f"({', '.join(f'{v:g}' for v in l0s)} mm) pooled in one hysteresis.csv: no single "
+                "model "
+                "curve fits them; split the photo set into one dataset per l0 to compare with the "
+                "model"
             )
             found[(material, "several", dataset)] = Group(
-                material, None, "several l0 in one dataset", (dataset,), mixed=True, note=note,
+                material,
+                None,
+                "several l0 in one dataset",
+                (dataset,),
+                mixed=True,
+                note=note,
                 materials_file=mfile,
             )
             continue
@@ -514,14 +571,21 @@ def comparison_groups(
         else:
             sources = prev.l0_source.split(" + ")
             merged = " + ".join(sources + ([source] if source not in sources else []))
-            found[key] = Group(material, l0, merged, prev.datasets + (dataset,), materials_file=mfile)
+            found[key] = Group(
+                material, l0, merged, prev.datasets + (dataset,), materials_file=mfile
+            )
     file_l0 = {fm.materials_file: fm.l0_mm for fm in own.values()}
 
     def order(g: Group) -> tuple[str, int, str, int, float]:
         l0 = math.inf if g.l0_mm is None else g.l0_mm
         default = file_l0.get(g.materials_file, {}) if g.materials_file else defaults
-        return (g.material, 1 if g.materials_file else 0, g.materials_file,
-                0 if (g.l0_mm is None or g.l0_mm == default.get(g.material)) else 1, l0)
+        return (
+            g.material,
+            1 if g.materials_file else 0,
+            g.materials_file,
+            0 if (g.l0_mm is None or g.l0_mm == default.get(g.material)) else 1,
+            l0,
+        )
 
     return sorted(found.values(), key=order)
 
@@ -569,7 +633,8 @@ def compare(
         the model does not know, or an l0 it refuses (the callable raises
         :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
-        Rest angle per material (deg); 210 deg (the paper's) for materials not listed.
+        Rest angle per material (deg); :data:`pipeline.constants.PSI0_DEG` (the paper's) for
+        materials not listed.
     default_l0_mm : mapping, optional
         The model's l0 per material for datasets without their own (materials not listed: the
         callables get ``l0_mm=None``, the model's own default).
@@ -611,30 +676,53 @@ def compare(
     for group in comparison_groups(hyst, angles, dict(default_l0_mm or {}), default_l0_source, own):
         material, l0 = group.material, group.l0_mm
         fm = by_file.get(group.materials_file)
-        run_psi, run_fit, run_psi0 = (fm.model_psi, fm.fit_k_p, fm.psi0_deg) if fm else (model_psi, fit_k_p, psi0)
+        run_psi, run_fit, run_psi0 = (
+            (fm.model_psi, fm.fit_k_p, fm.psi0_deg) if fm else (model_psi, fit_k_p, psi0)
+        )
         in_group = hyst["dataset"].isin(group.datasets) & (hyst["material"].astype(str) == material)
         hm = pool_hysteresis(hyst[in_group].drop(columns="dataset"))
         rows = None
         if rows_all is not None:
-            rows = rows_all[rows_all["dataset"].isin(group.datasets) & (rows_all["material"].astype(str) == material)]
+            rows = rows_all[
+                rows_all["dataset"].isin(group.datasets)
+                & (rows_all["material"].astype(str) == material)
+            ]
         usable = not group.mixed
-        psi_fn = (lambda m, p, l0=l0, f=run_psi: f(m, p, l0)) if run_psi is not None and usable else None
-        fit_fn = (lambda m, p, s, l0=l0, f=run_fit: f(m, p, s, l0)) if run_fit is not None and usable else None
-        kwargs = dict(psi0_deg=float(run_psi0.get(material, 210.0)), n_boot=n_boot, seed=seed)
+        psi_fn = (
+            (lambda m, p, l0=l0, f=run_psi: f(m, p, l0)) if run_psi is not None and usable else None
+        )
+        fit_fn = (
+            (lambda m, p, s, l0=l0, f=run_fit: f(m, p, s, l0))
+            if run_fit is not None and usable
+            else None
+        )
+        kwargs = {
+            "psi0_deg": float(run_psi0.get(material, PSI0_DEG)),
+            "n_boot": n_boot,
+            "seed": seed,
+        }
         note = group.note
         try:
             rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)
         except UserInputError as exc:
-            warnings.warn(f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2)
+            warnings.warn(
+                f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2
+            )
             note = f"model unavailable: {exc}"
             rec = compare_material(material, hm, rows, model_psi=None, fit_k_p=None, **kwargs)
         if note and group.note:
             warnings.warn(f"{group.curve}: {note}", stacklevel=2)
         data = [sources.get(d, "unknown") for d in group.datasets]
         rec.update(
-            curve=group.curve, datasets=" + ".join(group.datasets), l0_mm=math.nan if l0 is None else l0,
-            l0_source=group.l0_source, materials_file=group.materials_file or materials_file,
-            data_source=" + ".join(sorted(set(data))), rms_kind=rms_kind(data), model_fit=model_fit, note=note,
+            curve=group.curve,
+            datasets=" + ".join(group.datasets),
+            l0_mm=math.nan if l0 is None else l0,
+            l0_source=group.l0_source,
+            materials_file=group.materials_file or materials_file,
+            data_source=" + ".join(sorted(set(data))),
+            rms_kind=rms_kind(data),
+            model_fit=model_fit,
+            note=note,
         )
         records.append(rec)
     return pd.DataFrame(records, columns=list(RMS_COLUMNS))
@@ -678,12 +766,18 @@ def model_callables(
 
     def model_psi(name: str, pressure_kpa: np.ndarray, l0_mm: float | None) -> np.ndarray:
         return np.asarray(
-            model.psi_deg(_material(name), np.asarray(pressure_kpa, float), branch="loading",
-                          l0_mm=default_l0 if l0_mm is None else l0_mm,
-                          **readings)
+            model.psi_deg(
+                _material(name),
+                np.asarray(pressure_kpa, float),
+                branch="loading",
+                l0_mm=default_l0 if l0_mm is None else l0_mm,
+                **readings,
+            )
         )
 
-    def fit(name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray, l0_mm: float | None) -> tuple[float, Any]:
+    def fit(
+        name: str, pressure_kpa: np.ndarray, psi_deg: np.ndarray, l0_mm: float | None
+    ) -> tuple[float, Any]:
         l0 = default_l0 if l0_mm is None else l0_mm
         return model.fit_k_p(_material(name), pressure_kpa, psi_deg, l0_mm=l0, **readings)
 
@@ -710,4 +804,6 @@ def file_model(materials_path: str, **options: Any) -> DatasetModel:
 
     table = model.load_materials(materials_path)
     model_psi, fit, psi0 = model_callables(materials_path, **options)
-    return DatasetModel(materials_path, model_psi, fit, psi0, {n: float(m.l0_mm) for n, m in table.items()})
+    return DatasetModel(
+        materials_path, model_psi, fit, psi0, {n: float(m.l0_mm) for n, m in table.items()}
+    )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import io
 import warnings
 from pathlib import Path
 
@@ -13,64 +12,107 @@ import pandas as pd
 from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, file_model, model_callables
 from pipeline.errors import UserInputError
+from pipeline.fileio import read_table, write_table
 from pipeline.model.cli import add_reading_arguments, reading_options
-from pipeline.fileio import atomic_write_bytes, read_table
 from pipeline.photoset import TRUTH
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define the ``compare`` options."""
     parser.add_argument(
-        "hysteresis", nargs="+", type=Path, metavar="HYSTERESIS.csv",
-        help="hysteresis.csv file(s) from 'aggregate' (psi in deg per pressure level in kPa); pooled",
+        "hysteresis",
+        nargs="+",
+        type=Path,
+        metavar="HYSTERESIS.csv",
+        help="hysteresis.csv file(s) from 'aggregate' (psi in deg per pressure level in kPa); "
+        "pooled",
     )
     parser.add_argument(
-        "--angles", nargs="+", type=Path, default=None, metavar="ANGLES.csv",
-        help="angles.csv file(s) from 'measure' used to fit k_P (dimensionless) with a bootstrap CI over "
+        "--angles",
+        nargs="+",
+        type=Path,
+        default=None,
+        metavar="ANGLES.csv",
+        help="angles.csv file(s) from 'measure' used to fit k_P (dimensionless) with a bootstrap "
+        "CI over "
         "actuators; omit to skip the fit",
     )
     parser.add_argument(
-        "--out", type=Path, required=True, metavar="FILE",
-        help="rms.csv to write: per material RMS model error (deg; both directions, up, down), pressures "
-        "(kPa) at psi=0 and psi=-psi0, range of motion (deg), hysteresis width (deg), k_P fit + CI, paper values",
+        "--out",
+        type=Path,
+        required=True,
+        metavar="FILE",
+        help="rms.csv to write: per material RMS model error (deg; both directions, up, down), "
+        "pressures "
+        "(kPa) at psi=0 and psi=-psi0, range of motion (deg), hysteresis width (deg), k_P fit + "
+        "CI, paper values",
     )
     parser.add_argument(
-        "--materials", type=str, default=None, metavar="PATH",
+        "--materials",
+        type=str,
+        default=None,
+        metavar="PATH",
         help="materials YAML for the model (default: the packaged DS20/DS30/SS40/SS50 file)",
     )
     parser.add_argument(
-        "--dataset-materials", nargs="+", default=None, metavar="PATH",
-        help="each dataset's own materials YAML, same order as --datasets ('-' for --materials): that "
-        "dataset is compared against its file's model (Ogden terms, k_P, k_t, geometry; l0 unless its "
-        "angles.csv has l0_mm), in rows of its own",
-    )
-    parser.add_argument("--seed", type=int, default=0, help="seed of the k_P bootstrap (integer; default 0)")
-    parser.add_argument(
-        "--bootstrap", "--n-boot", dest="n_boot", type=int, default=200, metavar="N",
-        help="bootstrap resamples of actuators for the k_P 95%% interval (default 200; 0 = no interval)",
+        "--dataset-materials",
+        nargs="+",
+        default=None,
+        metavar="PATH",
+        help="each dataset's own materials YAML, same order as --datasets ('-' for --materials): "
+        "that dataset is compared against its file's model (Ogden terms, k_P, k_t, geometry; l0 "
+        "unless its angles.csv has l0_mm), in rows of its own",
     )
     parser.add_argument(
-        "--datasets", nargs="+", default=None, metavar="NAME",
-        help="dataset names, one per HYSTERESIS.csv in the same order (default: each file's folder name); "
+        "--seed", type=int, default=0, help="seed of the k_P bootstrap (integer; default 0)"
+    )
+    parser.add_argument(
+        "--bootstrap",
+        "--n-boot",
+        dest="n_boot",
+        type=int,
+        default=200,
+        metavar="N",
+        help="bootstrap resamples of actuators for the k_P 95%% interval (default 200; 0 = no "
+        "interval)",
+    )
+    parser.add_argument(
+        "--datasets",
+        nargs="+",
+        default=None,
+        metavar="NAME",
+        help="dataset names, one per HYSTERESIS.csv in the same order (default: each file's folder "
+        "name); "
         "with as many ANGLES.csv, the i-th angles file belongs to the i-th dataset",
     )
     parser.add_argument(
-        "--photosets", nargs="+", default=None, metavar="DIR",
-        help="photo-set folder of each dataset, same order ('-' for unknown): a set holding truth.csv was "
+        "--photosets",
+        nargs="+",
+        default=None,
+        metavar="DIR",
+        help="photo-set folder of each dataset, same order ('-' for unknown): a set holding "
+        "truth.csv was "
         "rendered by 'synth' from this model, so its RMS is a self-check, not a validation",
     )
     parser.add_argument(
-        "--curves", type=Path, default=None, metavar="FILE",
-        help="also write the model curve of every rms.csv row (curve, material, l0_mm in mm, materials_file, "
-        "psi_deg, pressure_kpa in kPa, reason): the curve each RMS was computed against",
+        "--curves",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="also write the model curve of every rms.csv row (curve, material, l0_mm in mm, "
+        "materials_file, psi_deg, pressure_kpa in kPa, reason): the curve each RMS was computed "
+        "against",
     )
     parser.add_argument(
-        "--include-flagged", action="store_true",
+        "--include-flagged",
+        action="store_true",
         help="also fit k_P on rows with status 'flagged' (default: only 'ok')",
     )
     model_group = parser.add_argument_group(
-        "model readings (as in 'python -m pipeline model'; default: the derived reading of docs/model.md). "
-        "--l0-mm is the model's l0 for datasets whose angles.csv has no l0_mm; a dataset's own l0_mm wins"
+        "model readings (as in 'python -m pipeline model'; default: the derived reading of "
+        "docs/model.md). "
+        "--l0-mm is the model's l0 for datasets whose angles.csv has no l0_mm; a dataset's own "
+        "l0_mm wins"
     )
     add_reading_arguments(model_group)
 
@@ -105,7 +147,8 @@ def dataset_names(paths: list[Path], given: list[str] | None) -> list[str]:
 
 
 def data_source(folder: str) -> str:
-    """``synthetic`` if the photo set was rendered by ``synth`` (it holds truth.csv), else ``measured``.
+    """``synthetic`` if the photo set was rendered by ``synth`` (it holds truth.csv), else
+    ``measured``.
 
     Only the file's presence is checked (truth.csv itself is for tests and benchmarks);
     ``"-"`` or a missing folder give ``unknown``.
@@ -121,17 +164,13 @@ def model_fit_text(options: dict[str, object]) -> str:
 
     opts = make_options(**options)
     if opts.l0_factor == "fitted_scale":
-        how = f"given as {opts.eq12_scale:g}" if opts.eq12_scale is not None else "fitted for these readings"
+        how = (
+            f"given as {opts.eq12_scale:g}"
+            if opts.eq12_scale is not None
+            else "fitted for these readings"
+        )
         return f"eq12_scale fitted to the paper's two model results (l0_factor=fitted_scale, {how})"
     return "none (derived reading; k_P and k_t are the paper's)"
-
-
-def write_csv(table: pd.DataFrame, path: Path) -> None:
-    """Write ``table`` atomically with 6 significant digits."""
-    buf = io.StringIO()
-    table.to_csv(buf, index=False, float_format="%.6g", lineterminator="\n")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(path, buf.getvalue().encode("utf-8"))
 
 
 #: ``materials_file`` of rows compared against the packaged materials (no machine path in rms.csv)
@@ -145,8 +184,9 @@ def own_files(args: argparse.Namespace, names: list[str], pooled: bool) -> dict[
         return {}
     if len(given) != len(names):
         raise UserInputError(
-            f"--dataset-materials has {len(given)} file(s) but {len(names)} HYSTERESIS.csv file(s) were "
-            "given; pass one per dataset in the same order ('-' for the run's --materials)"
+            f"--dataset-materials has {len(given)} file(s) but {len(names)} HYSTERESIS.csv "
+            "file(s) were given; pass one per dataset in the same order ('-' for the run's "
+            "--materials)"
         )
     out = {n: f for n, f in zip(names, given, strict=True) if f != "-"}
     if out and pooled:
@@ -166,7 +206,8 @@ def run(args: argparse.Namespace) -> int:
         raise UserInputError(f"--bootstrap must be >= 0 resamples, got {args.n_boot}")
     if args.photosets is not None and len(args.photosets) != len(names):
         raise UserInputError(
-            f"--photosets has {len(args.photosets)} folder(s) but {len(names)} HYSTERESIS.csv file(s) were "
+            f"--photosets has {len(args.photosets)} folder(s) but {len(names)} HYSTERESIS.csv "
+            "file(s) were "
             "given; pass one per dataset in the same order ('-' for unknown)"
         )
     frames = []
@@ -178,8 +219,13 @@ def run(args: argparse.Namespace) -> int:
     own = own_files(args, names, pooled)
     if args.angles:
         if len(args.angles) == len(names):  # the i-th angles.csv belongs to the i-th dataset
-            angles = pd.concat([read_angles([a]).assign(dataset=n) for a, n in zip(args.angles, names, strict=True)],
-                               ignore_index=True)
+            angles = pd.concat(
+                [
+                    read_angles([a]).assign(dataset=n)
+                    for a, n in zip(args.angles, names, strict=True)
+                ],
+                ignore_index=True,
+            )
         else:  # cannot tell which angles belong to which hysteresis: one pool
             angles = read_angles(args.angles)
             hyst["dataset"] = "all"
@@ -188,36 +234,72 @@ def run(args: argparse.Namespace) -> int:
     model_psi, fit_k_p, psi0 = model_callables(args.materials, **options)
     table_m = model.load_materials(args.materials)
     given_l0 = options.get("l0_mm")
-    default_l0 = {n: float(given_l0) if given_l0 is not None else m.l0_mm for n, m in table_m.items()}
-    sources = dict(zip(names, [data_source(f) for f in args.photosets], strict=True)) if args.photosets else {}
+    default_l0 = {
+        n: float(given_l0) if given_l0 is not None else m.l0_mm for n, m in table_m.items()
+    }
+    sources = (
+        dict(zip(names, [data_source(f) for f in args.photosets], strict=True))
+        if args.photosets
+        else {}
+    )
     files = {f: file_model(f, **options) for f in sorted(set(own.values()))}
     tables = {"": table_m, **{f: model.load_materials(f) for f in files}}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         table = compare(
-            hyst, angles, model_psi=model_psi, fit_k_p=fit_k_p, psi0_deg=psi0, default_l0_mm=default_l0,
-            default_l0_source="--l0-mm" if given_l0 is not None else "materials file", data_sources=sources,
-            model_fit=model_fit_text(options), n_boot=args.n_boot, seed=args.seed,
-            include_flagged=args.include_flagged, materials_file=args.materials or PACKAGED,
+            hyst,
+            angles,
+            model_psi=model_psi,
+            fit_k_p=fit_k_p,
+            psi0_deg=psi0,
+            default_l0_mm=default_l0,
+            default_l0_source="--l0-mm" if given_l0 is not None else "materials file",
+            data_sources=sources,
+            model_fit=model_fit_text(options),
+            n_boot=args.n_boot,
+            seed=args.seed,
+            include_flagged=args.include_flagged,
+            materials_file=args.materials or PACKAGED,
             dataset_models={n: files[f] for n, f in own.items()},
         )
     for w in caught:
         print(f"warning: {w.message}")
-    write_csv(table, args.out)
+    write_table(table, args.out)
     if args.curves is not None:
         readings = {k: v for k, v in options.items() if k != "l0_mm"}
-        own_file = {r.curve: r.materials_file if r.materials_file in files else "" for r in table.itertuples()}
+        own_file = {
+            r.curve: r.materials_file if r.materials_file in files else ""
+            for r in table.itertuples()
+        }
         curves = [
-            model.model_curve(tables[own_file[r.curve]][r.material], l0_mm=r.l0_mm, **readings).assign(
-                curve=r.curve, materials_file=r.materials_file)
+            model.model_curve(
+                tables[own_file[r.curve]][r.material], l0_mm=r.l0_mm, **readings
+            ).assign(curve=r.curve, materials_file=r.materials_file)
             for r in table.itertuples()
             if r.material in tables[own_file[r.curve]] and np.isfinite(r.l0_mm)
         ]
-        columns = ["curve", "material", "l0_mm", "materials_file", "psi_deg", "pressure_kpa", "reason"]
-        out = pd.concat(curves, ignore_index=True)[columns] if curves else pd.DataFrame(columns=columns)
-        write_csv(out, args.curves)
+        columns = [
+            "curve",
+            "material",
+            "l0_mm",
+            "materials_file",
+            "psi_deg",
+            "pressure_kpa",
+            "reason",
+        ]
+        out = (
+            pd.concat(curves, ignore_index=True)[columns]
+            if curves
+            else pd.DataFrame(columns=columns)
+        )
+        write_table(out, args.curves)
     for r in table.itertuples():
-        print(f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; materials {r.materials_file}; {r.rms_kind}]: "
-              f"RMS {r.rms_deg:.1f} deg")
-    print(f"compare: {len(table)} comparison(s) -> {args.out}" + (f", curves -> {args.curves}" if args.curves else ""))
+        print(
+            f"compare: {r.curve} [{r.datasets}; l0 from {r.l0_source}; "
+            f"materials {r.materials_file}; {r.rms_kind}]: RMS {r.rms_deg:.1f} deg"
+        )
+    print(
+        f"compare: {len(table)} comparison(s) -> {args.out}"
+        + (f", curves -> {args.curves}" if args.curves else "")
+    )
     return 0

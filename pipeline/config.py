@@ -103,7 +103,11 @@ def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list
         hint = err.schema.get("description", "") if isinstance(err.schema, Mapping) else ""
         if err.validator == "required":
             # a conditional requirement (an if/then block) says why in its description
-            why = err.schema.get("description") if set(err.schema) <= {"required", "description"} else None
+            why = (
+                err.schema.get("description")
+                if set(err.schema) <= {"required", "description"}
+                else None
+            )
             name = str(err.message).split("'")[1]  # "'port' is a required property"
             where = f"{key}.{name}" if err.absolute_path else name
             messages.append(f"{where}: required" + (f" {why}" if why else ""))
@@ -113,16 +117,23 @@ def _schema_errors(config: Mapping[str, Any], schema: Mapping[str, Any]) -> list
         elif err.validator == "enum":
             messages.append(f"{key}: {err.instance!r} is not one of {err.validator_value}")
         else:
-            messages.append(f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else ""))
+            messages.append(
+                f"{key}: {err.message}" + (f" (expected: {hint.strip()})" if hint else "")
+            )
     return list(dict.fromkeys(messages))
 
 
-def _materials_problem(key: str, path: str, workdir: Path, instead: str) -> tuple[set[str] | None, str | None]:
-    """The material names a config's materials file holds, or the problem that stops it being read."""
+def _materials_problem(
+    key: str, path: str, workdir: Path, instead: str
+) -> tuple[set[str] | None, str | None]:
+    """The material names a config's materials file holds, or the problem that stops it being
+    read."""
     file = workdir / path
     if not file.is_file():
-        return None, (f"{key}: materials file {path!r} does not exist (relative to {workdir}); fix the path, "
-                      f"or set it to null for {instead}")
+        return None, (
+            f"{key}: materials file {path!r} does not exist (relative to {workdir}); fix the path, "
+            f"or set it to null for {instead}"
+        )
     try:
         return set(load_materials(file)), None
     except UserInputError as exc:
@@ -130,7 +141,8 @@ def _materials_problem(key: str, path: str, workdir: Path, instead: str) -> tupl
 
 
 def _folder_materials(folder: Path) -> list[str]:
-    """Materials a folder photo set's manifest names ([] when it cannot be read: measure says why)."""
+    """Materials a folder photo set's manifest names ([] when it cannot be read: measure says
+    why)."""
     from pipeline.photoset import read_manifest  # imported here: the measurement stack is heavy
 
     try:
@@ -139,8 +151,11 @@ def _folder_materials(folder: Path) -> list[str]:
         return []
 
 
-def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[str] | None) -> list[str]:
-    """Problems only the file system shows; ``materials``: model.materials_file's (None: it is unreadable)."""
+def _semantic_errors(
+    config: Mapping[str, Any], workdir: Path, materials: set[str] | None
+) -> list[str]:
+    """Problems only the file system shows; ``materials``: model.materials_file's (None: it is
+    unreadable)."""
     messages = []
     names: dict[str, int] = {}
     packaged = known_materials()
@@ -149,39 +164,83 @@ def _semantic_errors(config: Mapping[str, Any], workdir: Path, materials: set[st
             key = f"{section}[{i}]"
             name = ds.get("name")
             if name in names:
-                messages.append(f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give each dataset a unique name")
+                messages.append(
+                    f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give "
+                    "each dataset a unique name"
+                )
             names.setdefault(name, i)
             source = ds.get("source")
             folder_ok = source != "folder" or (workdir / ds["path"]).is_dir()
             if not folder_ok:
-                messages.append(f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to {workdir}); fix the path or copy the photo set there")
+                messages.append(
+                    f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to "
+                    f"{workdir}); fix the path or copy the photo set there"
+                )
             own = ds.get("materials_file")  # replaces model.materials_file for this dataset
             where, model_materials = "model.materials_file", materials
             if own:
                 where = f"{key}.materials_file (dataset {name!r})"
-                model_materials, problem = _materials_problem(where, own, workdir, "model.materials_file")
+                model_materials, problem = _materials_problem(
+                    where, own, workdir, "model.materials_file"
+                )
                 messages += [problem] if problem else []
-            named = [ds["material"]] if ds.get("material") else (
-                _folder_materials(workdir / ds["path"]) if own and source == "folder" and folder_ok else [])
+            named = (
+                [ds["material"]]
+                if ds.get("material")
+                else (
+                    _folder_materials(workdir / ds["path"])
+                    if own and source == "folder" and folder_ok
+                    else []
+                )
+            )
             missing = [m for m in named if model_materials is not None and m not in model_materials]
             for m in missing:
                 if own:
-                    messages.append(f"{where}: material {m!r} (named by the dataset) is not in {own!r}, which holds "
-                                    f"{sorted(model_materials or ())}; add {m!r} to that file or point materials_file at one holding it")
+                    messages.append(
+                        f"{where}: material {m!r} (named by the dataset) is not in {own!r}, "
+                        f"which holds {sorted(model_materials or ())}; add {m!r} to that file "
+                        "or point materials_file at one holding it"
+                    )
                 else:
-                    messages.append(f"{key}.material: unknown material {m!r}; use one of {sorted(model_materials or ())} or add it to a materials file (model.materials_file, or the dataset's own materials_file)")
-            if source in ("synthetic", "synthetic_video") and not missing and ds["material"] not in packaged:
-                messages.append(f"{key}.material: synthetic photos are rendered from the packaged model, which has no material {ds['material']!r}; use one of {sorted(packaged)} (a materials file changes the comparison, not the rendering)")
+                    messages.append(
+                        f"{key}.material: unknown material {m!r}; use one of "
+                        f"{sorted(model_materials or ())} or add it to a materials file "
+                        "(model.materials_file, or the dataset's own materials_file)"
+                    )
+            if (
+                source in ("synthetic", "synthetic_video")
+                and not missing
+                and ds["material"] not in packaged
+            ):
+                messages.append(
+                    f"{key}.material: synthetic photos are rendered from the packaged model, "
+                    f"which has no material {ds['material']!r}; use one of {sorted(packaged)} "
+                    "(a materials file changes the comparison, not the rendering)"
+                )
             if source == "rig" and not ds["port"]:
-                messages.append(f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. /dev/ttyACM0)")
+                messages.append(
+                    f"{key}.port: required for source 'rig' (the Pico's serial port, e.g. "
+                    "/dev/ttyACM0)"
+                )
     for i, ds in enumerate(config.get("force", {}).get("datasets", [])):
         if ds.get("source") == "folder" and not (workdir / ds["path"]).is_dir():
-            messages.append(f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist")
-        elif ds.get("source") == "synthetic" and materials is not None and ds.get("material") not in materials:
-            messages.append(f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; use one of {sorted(materials)}")
+            messages.append(
+                f"force.datasets[{i}].path: photo-set folder {ds.get('path')!r} does not exist"
+            )
+        elif (
+            ds.get("source") == "synthetic"
+            and materials is not None
+            and ds.get("material") not in materials
+        ):
+            messages.append(
+                f"force.datasets[{i}].material: unknown material {ds.get('material')!r}; "
+                f"use one of {sorted(materials)}"
+            )
     grasp = config.get("force", {}).get("grasp_log")
     if grasp and not (workdir / grasp).is_file():
-        messages.append(f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null")
+        messages.append(
+            f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null"
+        )
     return messages
 
 
@@ -225,7 +284,8 @@ def validate_config(
         mfile = filled["model"]["materials_file"]
         materials, problem = (
             _materials_problem("model.materials_file", mfile, workdir, "the packaged materials")
-            if mfile else (known_materials(), None)
+            if mfile
+            else (known_materials(), None)
         )
         problems = ([problem] if problem else []) + _semantic_errors(filled, workdir, materials)
     if problems:
@@ -247,4 +307,6 @@ def write_resolved_config(config: Mapping[str, Any], path: str | Path) -> None:
     """Write the validated configuration (defaults filled in) as YAML, with its digest."""
     data = {"config_digest": config_digest(config), **dict(config)}
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(yaml.safe_dump(json.loads(json.dumps(data, default=str)), sort_keys=False))
+    Path(path).write_text(
+        yaml.safe_dump(json.loads(json.dumps(data, default=str)), sort_keys=False)
+    )

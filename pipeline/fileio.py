@@ -20,7 +20,12 @@ from pipeline.errors import UserInputError
 
 
 def read_table(
-    path: str | os.PathLike[str], what: str, *, required: Sequence[str] = (), hint: str = "", **read_csv: Any
+    path: str | os.PathLike[str],
+    what: str,
+    *,
+    required: Sequence[str] = (),
+    hint: str = "",
+    **read_csv: Any,
 ) -> pd.DataFrame:
     """Read a CSV table, refusing a missing, unreadable or incomplete file with a clear message.
 
@@ -59,10 +64,14 @@ def read_table(
     except FileNotFoundError:
         raise UserInputError(f"{path}: file not found; pass {what}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise UserInputError(f"{path}: not a readable CSV ({exc}); fix or regenerate {what}") from None
+        raise UserInputError(
+            f"{path}: not a readable CSV ({exc}); fix or regenerate {what}"
+        ) from None
     missing = [c for c in required if c not in df.columns]
     if missing:
-        raise UserInputError(f"{path}: missing column(s) {missing}; pass {what}" + (f" ({hint})" if hint else ""))
+        raise UserInputError(
+            f"{path}: missing column(s) {missing}; pass {what}" + (f" ({hint})" if hint else "")
+        )
     return df
 
 
@@ -124,8 +133,12 @@ def table_bytes(table: pd.DataFrame, float_format: str | None = FLOAT_FORMAT) ->
     return table.to_csv(index=False, lineterminator="\n", float_format=float_format).encode()
 
 
-def write_table(table: pd.DataFrame, path: str | os.PathLike[str], float_format: str | None = FLOAT_FORMAT) -> None:
+def write_table(
+    table: pd.DataFrame, path: str | os.PathLike[str], float_format: str | None = FLOAT_FORMAT
+) -> None:
     """Write a table as CSV atomically (folder created, :data:`FLOAT_FORMAT` floats).
+
+    ``float_format=None`` keeps every digit (tables later stages compute on, inputs as given).
 
     Examples
     --------

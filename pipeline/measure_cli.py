@@ -1,4 +1,5 @@
-"""``python -m pipeline measure PHOTOSET_DIR --out angles.csv [--method NAME] [--overlays DIR] [--jobs N]``."""
+"""``python -m pipeline measure PHOTOSET_DIR --out angles.csv [--method NAME] [--overlays DIR]
+[--jobs N]``."""
 
 from __future__ import annotations
 
@@ -12,16 +13,44 @@ from pipeline.measure.estimators import METHODS
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of the ``measure`` subcommand."""
-    parser.add_argument("photoset", metavar="PHOTOSET_DIR", help="photo-set folder (manifest.csv + photoset.yaml + images, or videos with their pressure logs: one row per frame)")
-    parser.add_argument("--out", required=True, help="angles.csv to write: psi_deg (deg), kappa_per_mm (1/mm), length_mm (mm), status per photo")
     parser.add_argument(
-        "--method", default=DEFAULT_METHOD, choices=sorted(METHODS),
-        help=f"curvature estimator (default {DEFAULT_METHOD}); 'paper' is the paper's biased unsigned average, kept for comparison",
+        "photoset",
+        metavar="PHOTOSET_DIR",
+        help="photo-set folder (manifest.csv + photoset.yaml + images, or videos with their "
+             "pressure logs: one row per frame)",
     )
-    parser.add_argument("--overlays", metavar="DIR", default=None, help="also write per-photo overlays (<= 640 px wide) and contact sheets per ramp into DIR")
-    parser.add_argument("--jobs", type=int, default=1, help="worker processes (photos measured in parallel; default 1)")
-    parser.add_argument("--no-ramp-check", dest="ramp_check", action="store_false",
-                        help="do not check each photo's psi against its ramp's trend (flagging jumps, re-trusting cosmetic flags)")
+    parser.add_argument(
+        "--out",
+        required=True,
+        help="angles.csv to write: psi_deg (deg), kappa_per_mm (1/mm), length_mm (mm), status per "
+             "photo",
+    )
+    parser.add_argument(
+        "--method",
+        default=DEFAULT_METHOD,
+        choices=sorted(METHODS),
+        help=f"curvature estimator (default {DEFAULT_METHOD}); 'paper' is the paper's biased "
+             "unsigned average, kept for comparison",
+    )
+    parser.add_argument(
+        "--overlays",
+        metavar="DIR",
+        default=None,
+        help="also write per-photo overlays (<= 640 px wide) and contact sheets per ramp into DIR",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        help="worker processes (photos measured in parallel; default 1)",
+    )
+    parser.add_argument(
+        "--no-ramp-check",
+        dest="ramp_check",
+        action="store_false",
+        help="do not check each photo's psi against its ramp's trend (flagging jumps, re-trusting "
+             "cosmetic flags)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -29,12 +58,14 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
-    kw = dict(method=args.method, jobs=args.jobs, ramp_check=args.ramp_check)
+    kw = {"method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check}
     if args.overlays is None:
         angles = measure_photoset(args.photoset, **kw)
     else:  # the overlay folder appears only when complete
         with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
             angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
-    print(f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}")
+    print(
+        f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}"
+    )
     return 0

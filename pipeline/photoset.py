@@ -8,7 +8,8 @@ folder-wide value for that row (``fixed_end`` becomes ``fixed_end_x`` / ``fixed_
 row into a :class:`~pipeline.measure.settings.MeasureSettings` -- or into the problems that
 prevent it, so one bad row is one ``failed`` measurement and the rest of the set is measured.
 Only a set that cannot be read at all (no folder, bad YAML, no manifest, missing columns) is
-refused.  :func:`validate_photoset` (``photoset check``) lists every problem, strictly.
+refused.  :func:`validate_photoset` lists every problem, strictly (``photoset check``, which for a
+video set also checks the videos: :mod:`pipeline.photoset_check`).
 
 A *video* photo set has the same two files, but ``manifest.csv`` lists videos instead of images
 (columns :data:`VIDEO_REQUIRED_COLUMNS`, optionally :data:`VIDEO_OPTIONAL_COLUMNS` and any
@@ -40,15 +41,29 @@ import yaml
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.calibration import CalibrationCache
-from pipeline.measure.settings import KEYS, OVERRIDE_COLUMNS, MeasureSettings, is_missing, merge_calibration, settings_problems
+from pipeline.measure.settings import (
+    KEYS,
+    OVERRIDE_COLUMNS,
+    MeasureSettings,
+    is_missing,
+    merge_calibration,
+    settings_problems,
+)
 
 MANIFEST = "manifest.csv"
 SETTINGS = "photoset.yaml"
 TRUTH = "truth.csv"
 
-REQUIRED_COLUMNS: tuple[str, ...] = ("image", "pressure_kpa", "direction", "material", "actuator", "trial")
+REQUIRED_COLUMNS: tuple[str, ...] = (
+    "image",
+    "pressure_kpa",
+    "direction",
+    "material",
+    "actuator",
+    "trial",
+)
 OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa")
 #: manifest columns of a video photo set (one row per video; see :mod:`pipeline.video`)
 VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", "actuator", "trial")
@@ -56,10 +71,31 @@ VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", 
 #: CSV of the frames' timestamps on the video's clock (default: the container's presentation times)
 VIDEO_OPTIONAL_COLUMNS: tuple[str, ...] = ("clock_offset_s", "frame_times")
 #: folder-wide settings written by default (the other keys are optional, see KEYS)
-SETTING_DEFAULTS: dict[str, Any] = {"l0_mm": None, "mm_per_px": None, "fixed_end": "auto", "positive_turn": "ccw"}
+SETTING_DEFAULTS: dict[str, Any] = {
+    "l0_mm": None,
+    "mm_per_px": None,
+    "fixed_end": "auto",
+    "positive_turn": "ccw",
+}
 #: manifest columns read as text
-_TEXT_COLUMNS = ("image", "material", "actuator", "direction", "trial", "line_color", "positive_turn", "target",
-                 "background", "roi", "exclude", "method", "calibration", "video", "pressure_log", "frame_times")
+_TEXT_COLUMNS = (
+    "image",
+    "material",
+    "actuator",
+    "direction",
+    "trial",
+    "line_color",
+    "positive_turn",
+    "target",
+    "background",
+    "roi",
+    "exclude",
+    "method",
+    "calibration",
+    "video",
+    "pressure_log",
+    "frame_times",
+)
 
 IMAGE_SUFFIXES: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp")
 
@@ -131,7 +167,11 @@ class PhotoSet:
     def row_reason(self, position: int) -> str:
         """Why row ``position`` (0-based) cannot be measured, in words ('' when it can)."""
         line = int(self.manifest["manifest_line"].iloc[position])
-        return "; ".join(f"manifest line {line}: {p.message} (fix: {p.fix})" for p in self.problems if p.line == line)
+        return "; ".join(
+            f"manifest line {line}: {p.message} (fix: {p.fix})"
+            for p in self.problems
+            if p.line == line
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -142,18 +182,41 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
     path = folder / SETTINGS
     name = str(path)
     if not folder.is_dir():
-        return None, [Problem(str(folder), None, "photo-set folder does not exist", "check the path in the config or command")]
+        return None, [
+            Problem(
+                str(folder),
+                None,
+                "photo-set folder does not exist",
+                "check the path in the config or command",
+            )
+        ]
     if not path.is_file():
-        return None, [Problem(name, None, "missing", f"create it (python -m pipeline photoset init {folder}) with at least l0_mm")]
+        return None, [
+            Problem(
+                name,
+                None,
+                "missing",
+                f"create it (python -m pipeline photoset init {folder}) with at least l0_mm",
+            )
+        ]
     try:
         raw = yaml.safe_load(path.read_text()) or {}
     except yaml.YAMLError as exc:
         return None, [Problem(name, None, f"not valid YAML ({exc})", "fix the YAML syntax")]
     if not isinstance(raw, dict):
-        return None, [Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")]
+        return None, [
+            Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")
+        ]
     problems = [
-        Problem(name, None, f"unknown key {key!r} is ignored", f"use only {', '.join(KEYS)}", warning=True)
-        for key in raw if key not in KEYS
+        Problem(
+            name,
+            None,
+            f"unknown key {key!r} is ignored",
+            f"use only {', '.join(KEYS)}",
+            warning=True,
+        )
+        for key in raw
+        if key not in KEYS
     ]
     return {**SETTING_DEFAULTS, **raw}, problems
 
@@ -193,7 +256,10 @@ def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """
     path = Path(folder) / MANIFEST
     if not path.is_file():
-        raise UserInputError(f"{path}: missing; create it with 'python -m pipeline photoset init {folder} --pattern ...'")
+        raise UserInputError(
+            f"{path}: missing; create it with 'python -m pipeline photoset init {folder} --pattern "
+            "...'"
+        )
     try:
         df = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
@@ -201,9 +267,14 @@ def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     required = VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS
     missing = [c for c in required if c not in df.columns]
     if missing:
-        raise UserInputError(f"{path}: missing column(s) {missing}; the header must contain {list(required)}"
-                             + ("" if "video" in df.columns else " (or, for videos, "
-                                f"{list(VIDEO_REQUIRED_COLUMNS)})"))
+        raise UserInputError(
+            f"{path}: missing column(s) {missing}; the header must contain {list(required)}"
+            + (
+                ""
+                if "video" in df.columns
+                else f" (or, for videos, {list(VIDEO_REQUIRED_COLUMNS)})"
+            )
+        )
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
     return df
 
@@ -213,28 +284,76 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
     out: list[Problem] = []
     pressure = pd.to_numeric(df["pressure_kpa"], errors="coerce")
     first_line: dict[str, int] = {}
-    for i, (line, image, direction) in enumerate(zip(df["manifest_line"], df["image"], df["direction"])):
+    for i, (line, image, direction) in enumerate(
+        zip(df["manifest_line"], df["image"], df["direction"])
+    ):
         line = int(line)
         if is_missing(image):
-            out.append(Problem(mpath, line, "image name is empty", "put the image file name in the 'image' column"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    "image name is empty",
+                    "put the image file name in the 'image' column",
+                )
+            )
         elif image in first_line:
-            out.append(Problem(mpath, line, f"image {image!r} is listed twice (also line {first_line[image]})", "remove the duplicate row"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"image {image!r} is listed twice (also line {first_line[image]})",
+                    "remove the duplicate row",
+                )
+            )
         else:
             first_line[image] = line
         p = pressure.iloc[i]
         if not np.isfinite(p):
-            out.append(Problem(mpath, line, f"pressure_kpa {df['pressure_kpa'].iloc[i]!r} is not a number", "write the gauge pressure in kPa, e.g. 40"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"pressure_kpa {df['pressure_kpa'].iloc[i]!r} is not a number",
+                    "write the gauge pressure in kPa, e.g. 40",
+                )
+            )
         elif p < VACUUM_KPA:
-            out.append(Problem(mpath, line, f"pressure_kpa {p:g} is below absolute vacuum ({VACUUM_KPA:g} kPa gauge)", "write the gauge pressure in kPa (>= -101.3)"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"pressure_kpa {p:g} is below absolute vacuum ({VACUUM_KPA:g} kPa gauge)",
+                    "write the gauge pressure in kPa (>= -101.3)",
+                )
+            )
         if direction not in DIRECTIONS:
-            out.append(Problem(mpath, line, f"direction {direction!r} is unknown", "use 'up' (increasing pressure) or 'down' (decreasing)"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"direction {direction!r} is unknown",
+                    "use 'up' (increasing pressure) or 'down' (decreasing)",
+                )
+            )
         for key in ("material", "actuator", "trial"):
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
     if "step" in df.columns:
-        dup = df[df["step"].notna() & df.duplicated(["material", "actuator", "trial", "step"], keep="first")]
+        dup = df[
+            df["step"].notna()
+            & df.duplicated(["material", "actuator", "trial", "step"], keep="first")
+        ]
         for _, row in dup.iterrows():
-            out.append(Problem(mpath, int(row["manifest_line"]), f"step {row['step']} repeats for material {row['material']}, actuator {row['actuator']}, trial {row['trial']}", "renumber the steps or remove the duplicate row"))
+            out.append(
+                Problem(
+                    mpath,
+                    int(row["manifest_line"]),
+                    f"step {row['step']} repeats for material {row['material']}, actuator "
+                    f"{row['actuator']}, trial {row['trial']}",
+                    "renumber the steps or remove the duplicate row",
+                )
+            )
     return out
 
 
@@ -243,27 +362,70 @@ def _video_row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
     out: list[Problem] = []
     first: dict[str, int] = {}
     ramps: dict[tuple[str, str, str], int] = {}
-    offsets = df["clock_offset_s"] if "clock_offset_s" in df.columns else pd.Series([None] * len(df), index=df.index)
-    for i, (line, video, log, offset) in enumerate(zip(df["manifest_line"], df["video"], df["pressure_log"], offsets)):
+    offsets = (
+        df["clock_offset_s"]
+        if "clock_offset_s" in df.columns
+        else pd.Series([None] * len(df), index=df.index)
+    )
+    for i, (line, video, log, offset) in enumerate(
+        zip(df["manifest_line"], df["video"], df["pressure_log"], offsets)
+    ):
         line = int(line)
         if is_missing(video):
-            out.append(Problem(mpath, line, "video name is empty", "put the video file name in the 'video' column"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    "video name is empty",
+                    "put the video file name in the 'video' column",
+                )
+            )
         elif video in first:
-            out.append(Problem(mpath, line, f"video {video!r} is listed twice (also line {first[video]})", "remove the duplicate row"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"video {video!r} is listed twice (also line {first[video]})",
+                    "remove the duplicate row",
+                )
+            )
         else:
             first[video] = line
         if is_missing(log):
-            out.append(Problem(mpath, line, "pressure_log is empty", "name the CSV (time_s, pressure_kpa[, measured_kpa]) logged with this video"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    "pressure_log is empty",
+                    "name the CSV (time_s, pressure_kpa[, measured_kpa]) logged with this video",
+                )
+            )
         if not is_missing(offset):
             value = pd.to_numeric(pd.Series([offset]), errors="coerce").iloc[0]
             if not np.isfinite(value):
-                out.append(Problem(mpath, line, f"clock_offset_s {offset!r} is not a number", "give the log time (s) of the video's first instant, e.g. 1.25, or leave it empty for 0"))
+                out.append(
+                    Problem(
+                        mpath,
+                        line,
+                        f"clock_offset_s {offset!r} is not a number",
+                        "give the log time (s) of the video's first instant, e.g. 1.25, or leave "
+                        "it empty for 0",
+                    )
+                )
         for key in ("material", "actuator", "trial"):
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
         key3 = tuple(str(df[k].iloc[i]) for k in ("material", "actuator", "trial"))
         if key3 in ramps:
-            out.append(Problem(mpath, line, f"material {key3[0]}, actuator {key3[1]}, trial {key3[2]} is also line {ramps[key3]}", "give each video its own trial number"))
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"material {key3[0]}, actuator {key3[1]}, trial {key3[2]} is also line "
+                    f"{ramps[key3]}",
+                    "give each video its own trial number",
+                )
+            )
         else:
             ramps[key3] = line
     return out
@@ -278,7 +440,11 @@ def _resolve_rows(
     calibrations = CalibrationCache(folder)  # each board photo set is calibrated (or read) once
     _, folder_problems = settings_problems(folder_raw, folder=folder, calibrations=calibrations)
     # a folder-wide l0_mm may be missing when every row has its own
-    folder_bad = [Problem(sname, None, p.message, p.fix) for p in folder_problems if p.key != "l0_mm" or "missing" not in p.message]
+    folder_bad = [
+        Problem(sname, None, p.message, p.fix)
+        for p in folder_problems
+        if p.key != "l0_mm" or "missing" not in p.message
+    ]
     overrides = [c for c in OVERRIDE_COLUMNS if c in df.columns]
     rows: list[MeasureSettings | None] = []
     problems: list[Problem] = []
@@ -322,9 +488,21 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
     if folder_bad:
         _refuse(folder, folder_bad)
     if len(df) == 0:
-        _refuse(folder, [Problem(str(folder / MANIFEST), None, "has no rows", "add one row per image")])
+        _refuse(
+            folder, [Problem(str(folder / MANIFEST), None, "has no rows", "add one row per image")]
+        )
     if all(r is None for r in rows) and any("l0_mm is missing" in p.message for p in row_problems):
-        _refuse(folder, [Problem(str(folder / SETTINGS), None, "l0_mm is missing", "add 'l0_mm: <length of the marked layer in mm>' (or an l0_mm manifest column)")])
+        _refuse(
+            folder,
+            [
+                Problem(
+                    str(folder / SETTINGS),
+                    None,
+                    "l0_mm is missing",
+                    "add 'l0_mm: <length of the marked layer in mm>' (or an l0_mm manifest column)",
+                )
+            ],
+        )
     if is_video_manifest(df):
         problems = _video_row_problems(df, str(folder / MANIFEST)) + row_problems
     else:
@@ -333,20 +511,110 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
     bad_lines = {p.line for p in problems}
     rows = tuple(None if line in bad_lines else r for line, r in zip(df["manifest_line"], rows))
     problems.sort(key=lambda p: p.line or 0)
-    return PhotoSet(folder=folder, settings=settings, manifest=df, rows=rows, problems=tuple(problems))
+    return PhotoSet(
+        folder=folder, settings=settings, manifest=df, rows=rows, problems=tuple(problems)
+    )
 
 
 def _refuse(folder: Path, problems: list[Problem]) -> None:
     errors = [p for p in problems if not p.warning]
     raise UserInputError(
-        f"photo set {folder} is not valid ({len(errors)} problem(s)):\n  " + "\n  ".join(map(str, errors))
+        f"photo set {folder} is not valid ({len(errors)} problem(s)):\n  "
+        + "\n  ".join(map(str, errors))
     )
 
 
-def validate_photoset(
-    folder: str | os.PathLike[str], *, decode_images: bool = True, require_images: bool = True, warnings: bool = False
+def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[Problem]]:
+    """Load a photo set for checking: the set (None when it cannot be loaded) and its problems so
+    far.
+
+    The problems are those of ``photoset.yaml`` (unknown keys are warnings), the refusal to load
+    when the set cannot be read at all, and every row's problems; :func:`file_problems` adds
+    those of the files.
+    """
+    folder = Path(folder)
+    settings, problems = _read_yaml(folder)
+    if settings is None:
+        return None, problems
+    try:
+        ps = load_photoset(folder)
+    except UserInputError as exc:
+        return None, problems + [
+            Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")
+        ]
+    return ps, problems + list(ps.problems)
+
+
+def file_problems(
+    ps: PhotoSet, *, decode_images: bool = True, require_images: bool = True
 ) -> list[Problem]:
-    """Every problem of a photo set, each naming the file, the manifest line and the fix.
+    """Problems of a loaded set's images (missing, undecodable, settings outside the photo) and
+    calibrations, and the doubt of a set without a scale.
+
+    A video set's videos and pressure logs are not checked here but by
+    :func:`pipeline.video.clips.clip_problems` (:func:`pipeline.photoset_check.check_photoset`
+    does both).
+    """
+    folder, mpath = ps.folder, str(ps.folder / MANIFEST)
+    problems: list[Problem] = []
+    sizes: dict[str, tuple[int, int] | None] = {}
+    images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
+    for (line, image), settings_row in zip(images, ps.rows):
+        if is_missing(image):
+            continue
+        path = folder / str(image)
+        if not path.is_file():
+            if require_images:
+                problems.append(
+                    Problem(
+                        mpath,
+                        int(line),
+                        f"image {image!r} does not exist in {folder}",
+                        "copy the photo in or remove the row",
+                    )
+                )
+            continue
+        if not decode_images:
+            continue
+        size = sizes.get(str(image)) if str(image) in sizes else _image_size(path)
+        sizes[str(image)] = size
+        if size is None:
+            problems.append(
+                Problem(
+                    mpath,
+                    int(line),
+                    f"image {image!r} cannot be decoded (corrupt, truncated or not an image)",
+                    "re-export or re-take the photo, or remove the row",
+                )
+            )
+        elif settings_row is not None:
+            problems += geometry_problems(mpath, int(line), settings_row, size)
+    problems += _calibration_problems(ps)
+    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
+        problems.append(
+            Problem(
+                str(folder / SETTINGS),
+                None,
+                "no mm_per_px: psi will be the turning of the measured line, so a line cut short "
+                "by the clamp or the border reads low",
+                "measure the image scale (mm per pixel) and set mm_per_px",
+                warning=True,
+            )
+        )
+    return problems
+
+
+def validate_photoset(
+    folder: str | os.PathLike[str],
+    *,
+    decode_images: bool = True,
+    require_images: bool = True,
+    warnings: bool = False,
+) -> list[Problem]:
+    """Every problem of a photo set of images, each naming the file, the manifest line and the fix.
+
+    For a video set only its rows, settings and calibrations: ``photoset check``
+    (:func:`pipeline.photoset_check.check_photoset`) also checks its videos and pressure logs.
 
     Parameters
     ----------
@@ -365,48 +633,15 @@ def validate_photoset(
     list of Problem
         Empty when the photo set is valid (and, with ``warnings``, nothing is doubtful).
     """
-    folder = Path(folder)
-    settings, problems = _read_yaml(folder)
-    if settings is None:
-        return problems
-    if not warnings:
-        problems = [p for p in problems if not p.warning]
-    try:
-        ps = load_photoset(folder)
-    except UserInputError as exc:
-        return problems + [Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")]
-    problems += list(ps.problems)
-    mpath = str(folder / MANIFEST)
-    if ps.is_video:
-        from pipeline.video.clips import clip_problems
-
-        problems += clip_problems(ps, decode=decode_images, require_files=require_images)
-    sizes: dict[str, tuple[int, int] | None] = {}
-    images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
-    for (line, image), settings_row in zip(images, ps.rows):
-        if is_missing(image):
-            continue
-        path = folder / str(image)
-        if not path.is_file():
-            if require_images:
-                problems.append(Problem(mpath, int(line), f"image {image!r} does not exist in {folder}", "copy the photo in or remove the row"))
-            continue
-        if not decode_images:
-            continue
-        size = sizes.get(str(image)) if str(image) in sizes else _image_size(path)
-        sizes[str(image)] = size
-        if size is None:
-            problems.append(Problem(mpath, int(line), f"image {image!r} cannot be decoded (corrupt, truncated or not an image)", "re-export or re-take the photo, or remove the row"))
-        elif settings_row is not None:
-            problems += _geometry_problems(mpath, int(line), settings_row, size)
-    problems += _calibration_problems(ps)
-    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
-        problems.append(Problem(str(folder / SETTINGS), None, "no mm_per_px: psi will be the turning of the measured line, so a line cut short by the clamp or the border reads low", "measure the image scale (mm per pixel) and set mm_per_px", warning=True))
+    ps, problems = load_checked(folder)
+    if ps is not None:
+        problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
     return [p for p in problems if warnings or not p.warning]
 
 
 def _calibration_problems(ps: PhotoSet) -> list[Problem]:
-    """Doubts about the calibrations: a large reprojection error (every row using it), not stored, mm_per_px unused."""
+    """Doubts about the calibrations: a large reprojection error (every row using it), not stored,
+    mm_per_px unused."""
     from pipeline.measure.calibration import MAX_RMS_PX
 
     mpath, sname = str(ps.folder / MANIFEST), str(ps.folder / SETTINGS)
@@ -418,36 +653,87 @@ def _calibration_problems(ps: PhotoSet) -> list[Problem]:
             continue
         board = Path(cal.boards[0]).name
         if cal.plane.doubtful:
-            out.append(Problem(mpath, int(line), f"calibration {board}: reprojection error {cal.plane.rms_px:.2f} px is above "
-                               f"{MAX_RMS_PX:g} px: the row's psi is flagged", "re-take the board photo flat, sharp and evenly lit, "
-                               "check square_mm and inner_corners, or add board photos in other poses", warning=True))
+            out.append(
+                Problem(
+                    mpath,
+                    int(line),
+                    f"calibration {board}: reprojection error {cal.plane.rms_px:.2f} px is above "
+                    f"{MAX_RMS_PX:g} px: the row's psi is flagged",
+                    "re-take the board photo flat, sharp and evenly lit, "
+                    "check square_mm and inner_corners, or add board photos in other poses",
+                    warning=True,
+                )
+            )
         if cal.key not in seen:
             seen.add(cal.key)
             if not cal.stored:
-                out.append(Problem(sname, None, f"calibration {board} is not stored (computed each time the set is read)",
-                                   f"run 'python -m pipeline photoset calibrate {ps.folder}'", warning=True))
+                out.append(
+                    Problem(
+                        sname,
+                        None,
+                        f"calibration {board} is not stored (computed each time the set is read)",
+                        f"run 'python -m pipeline photoset calibrate {ps.folder}'",
+                        warning=True,
+                    )
+                )
         if s is not None and s.mm_per_px is not None and ("mm_per_px", cal.key) not in seen:
             seen.add(("mm_per_px", cal.key))
-            out.append(Problem(sname, None, f"mm_per_px is not used where calibration {board} applies (the plane gives the scale)",
-                               "remove mm_per_px, or keep it for the uncalibrated rows", warning=True))
+            out.append(
+                Problem(
+                    sname,
+                    None,
+                    f"mm_per_px is not used where calibration {board} applies (the plane gives the "
+                    "scale)",
+                    "remove mm_per_px, or keep it for the uncalibrated rows",
+                    warning=True,
+                )
+            )
     return out
 
 
-def _geometry_problems(file: str, line: int, s: MeasureSettings, size: tuple[int, int]) -> list[Problem]:
+def geometry_problems(
+    file: str, line: int, s: MeasureSettings, size: tuple[int, int]
+) -> list[Problem]:
+    """Settings of a row that do not fit its photo of ``size`` (width, height): calibration, roi,
+    fixed end."""
     w, h = size
     out = []
     cal = s.calibration
     if cal is not None and cal.plane is not None and tuple(cal.plane.image_size) != (w, h):
         cw, ch = cal.plane.image_size
-        out.append(Problem(file, line, f"the photo is {w}x{h} px but calibration board photo {Path(cal.boards[0]).name} is "
-                           f"{cw}x{ch} px", "take the board photo with the camera and resolution of the actuator photos "
-                           "(or give this row its own calibration)"))
+        out.append(
+            Problem(
+                file,
+                line,
+                f"the photo is {w}x{h} px but calibration board photo {Path(cal.boards[0]).name} "
+                "is "
+                f"{cw}x{ch} px",
+                "take the board photo with the camera and resolution of the actuator photos "
+                "(or give this row its own calibration)",
+            )
+        )
     if s.roi is not None:
         xs, ys = [p[0] for p in s.roi], [p[1] for p in s.roi]
         if max(xs) <= 0 or max(ys) <= 0 or min(xs) >= w or min(ys) >= h:
-            out.append(Problem(file, line, f"roi {list(s.roi)} lies outside the {w}x{h} photo", "give roi in pixels of this photo (x right, y down)"))
-    if s.fixed_end_px is not None and not (0 <= s.fixed_end_px[0] < w and 0 <= s.fixed_end_px[1] < h):
-        out.append(Problem(file, line, f"fixed_end {list(s.fixed_end_px)} lies outside the {w}x{h} photo", "give the pixel near the clamped end (x right, y down)"))
+            out.append(
+                Problem(
+                    file,
+                    line,
+                    f"roi {list(s.roi)} lies outside the {w}x{h} photo",
+                    "give roi in pixels of this photo (x right, y down)",
+                )
+            )
+    if s.fixed_end_px is not None and not (
+        0 <= s.fixed_end_px[0] < w and 0 <= s.fixed_end_px[1] < h
+    ):
+        out.append(
+            Problem(
+                file,
+                line,
+                f"fixed_end {list(s.fixed_end_px)} lies outside the {w}x{h} photo",
+                "give the pixel near the clamped end (x right, y down)",
+            )
+        )
     return out
 
 
@@ -460,7 +746,11 @@ def _image_size(path: Path) -> tuple[int, int] | None:
     img = cv2.imdecode(data, cv2.IMREAD_REDUCED_GRAYSCALE_8)
     if img is None:
         return None
-    full = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if path.suffix.lower() not in (".jpg", ".jpeg") else None
+    full = (
+        cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
+        if path.suffix.lower() not in (".jpg", ".jpeg")
+        else None
+    )
     if full is not None:
         return full.shape[1], full.shape[0]
     from pipeline.measure.core import jpeg_size
@@ -475,13 +765,20 @@ def _image_size(path: Path) -> tuple[int, int] | None:
 def write_manifest(folder: str | os.PathLike[str], rows: pd.DataFrame) -> None:
     """Write ``manifest.csv`` atomically (required columns first, ``manifest_line`` dropped)."""
     df = rows.drop(columns=["manifest_line"], errors="ignore")
-    first = [c for c in (VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS) if c in df.columns]
+    first = [
+        c
+        for c in (VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS)
+        if c in df.columns
+    ]
     df = df[first + [c for c in df.columns if c not in first]]
-    atomic_write_bytes(Path(folder) / MANIFEST, df.to_csv(index=False, lineterminator="\n").encode())
+    write_table(df, Path(folder) / MANIFEST, float_format=None)  # the input as given: every digit
 
 
-def append_manifest_rows(folder: str | os.PathLike[str], rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
-    """Append rows to ``manifest.csv`` atomically; rows whose image (video) is already listed are replaced.
+def append_manifest_rows(
+    folder: str | os.PathLike[str], rows: Iterable[Mapping[str, Any]]
+) -> pd.DataFrame:
+    """Append rows to ``manifest.csv`` atomically; rows whose image (video) is already listed are
+    replaced.
 
     Returns
     -------

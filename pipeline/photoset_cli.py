@@ -1,4 +1,5 @@
-"""``python -m pipeline photoset {init,check,calibrate,preview,pick-color}``: start, validate, calibrate or preview a photo set."""
+"""``python -m pipeline photoset {init,check,calibrate,preview,pick-color}``: start, validate,
+calibrate or preview a photo set."""
 
 from __future__ import annotations
 
@@ -13,71 +14,139 @@ from pipeline.measure.settings import POSITIVE_TURNS
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Define ``photoset init`` and ``photoset check``."""
-    sub = parser.add_subparsers(dest="photoset_command", metavar="{init,check,calibrate,preview,pick-color}", required=True)
+    sub = parser.add_subparsers(
+        dest="photoset_command", metavar="{init,check,calibrate,preview,pick-color}", required=True
+    )
     init = sub.add_parser(
         "init",
         help="write a starter manifest.csv and photoset.yaml from the image file names",
         description=(
-            "Write manifest.csv (and photoset.yaml when absent) from the names of the photos in DIR. "
+            "Write manifest.csv (and photoset.yaml when absent) from the names of the photos in "
+            "DIR. "
             "Fields: {pressure_kpa} (kPa; '12p5' means 12.5), {direction} (up/down, inc/dec), "
             "{trial}, {actuator}, {material}, {step}, {_} or * (ignored). Without {direction}, "
             "photos before the highest pressure of each ramp are 'up', after it 'down'."
         ),
     )
     init.add_argument("folder", metavar="DIR", help="folder holding the photos")
-    init.add_argument("--pattern", required=True, help="file-name pattern, e.g. '{material}_{actuator}_t{trial}_{step}_{pressure_kpa}kPa.jpg'")
-    init.add_argument("--material", help="material for every photo when the pattern has no {material}")
-    init.add_argument("--actuator", help="actuator label when the pattern has no {actuator} (default A1)")
+    init.add_argument(
+        "--pattern",
+        required=True,
+        help="file-name pattern, e.g. "
+             "'{material}_{actuator}_t{trial}_{step}_{pressure_kpa}kPa.jpg'",
+    )
+    init.add_argument(
+        "--material", help="material for every photo when the pattern has no {material}"
+    )
+    init.add_argument(
+        "--actuator", help="actuator label when the pattern has no {actuator} (default A1)"
+    )
     init.add_argument("--trial", help="trial label when the pattern has no {trial} (default 1)")
-    init.add_argument("--l0-mm", type=float, help="length of the marked inextensible layer, mm (written to photoset.yaml)")
-    init.add_argument("--mm-per-px", type=float, help="image scale, mm per pixel (recommended: without it psi relies on the measured line length)")
-    init.add_argument("--fixed-end", metavar="X,Y", help="pixel near the clamped end, e.g. 812,455 (recommended; default: guessed per photo)")
-    init.add_argument("--target", choices=("line", "body"), default="line", help="measure a drawn line (default) or the actuator's body")
-    init.add_argument("--line-color", default=None, help="colour of the line or body: a name (black, white, grey, red, orange, yellow, green, cyan, blue, purple, magenta), 'h,s,v-h,s,v', or several joined by ';' (default: black for a line, none for a body)")
-    init.add_argument("--positive-turn", choices=POSITIVE_TURNS, default="ccw", help="turning direction on screen, fixed end to free end, that counts as positive psi (default ccw)")
+    init.add_argument(
+        "--l0-mm",
+        type=float,
+        help="length of the marked inextensible layer, mm (written to photoset.yaml)",
+    )
+    init.add_argument(
+        "--mm-per-px",
+        type=float,
+        help="image scale, mm per pixel (recommended: without it psi relies on the measured line "
+             "length)",
+    )
+    init.add_argument(
+        "--fixed-end",
+        metavar="X,Y",
+        help="pixel near the clamped end, e.g. 812,455 (recommended; default: guessed per photo)",
+    )
+    init.add_argument(
+        "--target",
+        choices=("line", "body"),
+        default="line",
+        help="measure a drawn line (default) or the actuator's body",
+    )
+    init.add_argument(
+        "--line-color",
+        default=None,
+        help="colour of the line or body: a name (black, white, grey, red, orange, yellow, green, "
+             "cyan, blue, purple, magenta), 'h,s,v-h,s,v', or several joined by ';' (default: "
+             "black for a line, none for a body)",
+    )
+    init.add_argument(
+        "--positive-turn",
+        choices=POSITIVE_TURNS,
+        default="ccw",
+        help="turning direction on screen, fixed end to free end, that counts as positive psi "
+             "(default ccw)",
+    )
     init.add_argument("--overwrite", action="store_true", help="replace an existing manifest.csv")
     check = sub.add_parser(
         "check",
         help="validate a photo set and list every bad row with its fix",
-        description="Validate manifest.csv, photoset.yaml and every image (decoded with OpenCV). Exit 1 if anything is wrong.",
+        description="Validate manifest.csv, photoset.yaml and every image (decoded with OpenCV). "
+                    "Exit 1 if anything is wrong.",
     )
     check.add_argument("folder", metavar="DIR", help="photo-set folder")
-    check.add_argument("--no-decode", action="store_true", help="only check that images exist (faster)")
+    check.add_argument(
+        "--no-decode", action="store_true", help="only check that images exist (faster)"
+    )
     calibrate = sub.add_parser(
         "calibrate",
-        help="compute the camera calibration from the set's checkerboard photo(s) and store it (calibration.json)",
-        description="For every calibration the photo set uses (photoset.yaml 'calibration: {board: ..., square_mm: ..., "
-        "inner_corners: [columns, rows]}' or a manifest column): find the board, fit the lens and the plane, print "
-        "the reprojection error in px and mm and store the result in DIR/calibration.json, which measuring then reads. "
+        help="compute the camera calibration from the set's checkerboard photo(s) and store it "
+             "(calibration.json)",
+        description="For every calibration the photo set uses (photoset.yaml 'calibration: {board: "
+                    "..., square_mm: ..., "
+        "inner_corners: [columns, rows]}' or a manifest column): find the board, fit the lens and "
+        "the plane, print "
+        "the reprojection error in px and mm and store the result in DIR/calibration.json, which "
+        "measuring then reads. "
         "Exit 1 if a calibration cannot be computed.",
     )
     calibrate.add_argument("folder", metavar="DIR", help="photo-set folder")
-    calibrate.add_argument("--max-error-px", type=float, default=None,
-                           help="warn above this reprojection error, px (default 1; rows using such a calibration are flagged when measured)")
+    calibrate.add_argument(
+        "--max-error-px",
+        type=float,
+        default=None,
+        help="warn above this reprojection error, px (default 1; rows using such a calibration are "
+             "flagged when measured)",
+    )
     preview = sub.add_parser(
         "preview",
-        help="write one contact sheet showing what the settings select and measure, first and last photo of every ramp",
-        description="For the first and last photo of every ramp: the photo with the selection tinted, roi/exclude, "
-        "candidates, the chosen line or body centre line, the fixed end and psi, beside the selection mask.",
+        help="write one contact sheet showing what the settings select and measure, first and last "
+             "photo of every ramp",
+        description="For the first and last photo of every ramp: the photo with the selection "
+                    "tinted, roi/exclude, "
+        "candidates, the chosen line or body centre line, the fixed end and psi, beside the "
+        "selection mask.",
     )
     preview.add_argument("folder", metavar="DIR", help="photo-set folder")
-    preview.add_argument("--out", help="JPEG to write (default: <DIR name>_preview.jpg in the current folder)")
-    preview.add_argument("--all", action="store_true", help="every photo, not only the first and last of each ramp")
+    preview.add_argument(
+        "--out", help="JPEG to write (default: <DIR name>_preview.jpg in the current folder)"
+    )
+    preview.add_argument(
+        "--all", action="store_true", help="every photo, not only the first and last of each ramp"
+    )
     pick = sub.add_parser(
         "pick-color",
         help="print an HSV range (ready for photoset.yaml) for the colour around a pixel",
-        description="Sample the colour around X,Y and print a line_color value that selects it (red's hue wrap handled).",
+        description="Sample the colour around X,Y and print a line_color value that selects it "
+                    "(red's hue wrap handled).",
     )
     pick.add_argument("image", metavar="IMAGE", help="a photo")
-    pick.add_argument("--at", required=True, metavar="X,Y", help="pixel (x right, y down) on the line or body")
-    pick.add_argument("--radius", type=float, default=4.0, help="radius of the sampled disc, px (default 4)")
+    pick.add_argument(
+        "--at", required=True, metavar="X,Y", help="pixel (x right, y down) on the line or body"
+    )
+    pick.add_argument(
+        "--radius", type=float, default=4.0, help="radius of the sampled disc, px (default 4)"
+    )
 
 
 def _xy(text: str, option: str) -> tuple[float, float]:
     try:
         x, y = (float(v) for v in text.split(","))
     except ValueError:
-        raise UserInputError(f"{option} {text!r}: write two pixel numbers as X,Y, e.g. 812,455") from None
+        raise UserInputError(
+            f"{option} {text!r}: write two pixel numbers as X,Y, e.g. 812,455"
+        ) from None
     return x, y
 
 
@@ -90,7 +159,10 @@ def run(args: argparse.Namespace) -> int:
 
         out = args.out or f"{Path(args.folder).resolve().name}_preview.jpg"
         path, n = write_preview(args.folder, out, every=args.all)
-        print(f"wrote {path}: {n} photo(s); green = ok, orange = flagged, tinted = what the settings select")
+        print(
+            f"wrote {path}: {n} photo(s); green = ok, orange = flagged, tinted = what the settings "
+            "select"
+        )
         return 0
     if args.photoset_command == "pick-color":
         return _pick(args)
@@ -103,7 +175,8 @@ def _calibrate(args: argparse.Namespace) -> int:
     from pipeline.measure.calibration import MAX_RMS_PX, write_store
 
     limit = MAX_RMS_PX if args.max_error_px is None else args.max_error_px
-    ps = photoset.load_photoset(args.folder)  # a folder-wide calibration that fails refuses the set, naming the file
+    # a folder-wide calibration that fails refuses the set, naming the file
+    ps = photoset.load_photoset(args.folder)
     used: dict[object, tuple[object, list[int]]] = {}
     for line, row in zip(ps.manifest["manifest_line"], ps.rows):
         if row is not None and row.calibration is not None:
@@ -113,41 +186,68 @@ def _calibrate(args: argparse.Namespace) -> int:
         print(f"  {p}", file=sys.stderr)
     if not used:
         if not failed:
-            print(f"{args.folder}: no calibration in {photoset.SETTINGS} or the manifest (fix: add 'calibration: "
-                  "{board: board.jpg, square_mm: 25, inner_corners: [9, 6]}' naming a photo of a checkerboard "
-                  "lying where the actuator lies)", file=sys.stderr)
+            print(
+                f"{args.folder}: no calibration in {photoset.SETTINGS} or the manifest (fix: add "
+                "'calibration: "
+                "{board: board.jpg, square_mm: 25, inner_corners: [9, 6]}' naming a photo of a "
+                "checkerboard "
+                "lying where the actuator lies)",
+                file=sys.stderr,
+            )
         return 1
     path = write_store(args.folder, [c for c, _ in used.values()])  # type: ignore[misc]
     for cal, lines in used.values():
         plane = cal.plane  # type: ignore[attr-defined]
         boards = ", ".join(Path(b).name for b in cal.boards)  # type: ignore[attr-defined]
         f = plane.camera_matrix[0]
-        print(f"{boards}: {cal.board_size}, {cal.square_mm:g} mm squares; {plane.views} photo(s), {plane.corners} corners; "  # type: ignore[attr-defined]
-              f"{len(lines)} row(s)")
-        print(f"  reprojection error {plane.rms_px:.3f} px, {plane.rms_mm:.4f} mm on the plane; "
-              f"{plane.mm_per_px:.4f} mm per px at the board centre; focal {f:.0f} px, k1 {plane.k1:+.4f}"
-              + (f", k2 {plane.dist_coeffs[1]:+.4f}" if plane.views >= 3 else ""))
+        print(
+            f"{boards}: {cal.board_size}, {cal.square_mm:g} mm squares; {plane.views} photo(s), "
+            f"{plane.corners} corners; "  # type: ignore[attr-defined]
+            f"{len(lines)} row(s)"
+        )
+        print(
+            f"  reprojection error {plane.rms_px:.3f} px, {plane.rms_mm:.4f} mm on the plane; "
+            f"{plane.mm_per_px:.4f} mm per px at the board centre; focal {f:.0f} px, k1 "
+            f"{plane.k1:+.4f}"
+            + (f", k2 {plane.dist_coeffs[1]:+.4f}" if plane.views >= 3 else "")
+        )
         if plane.rms_px > limit:
-            print(f"  warning: reprojection error above {limit:g} px: the rows using it are flagged (fix: re-take the board "
-                  "photo flat, sharp and evenly lit, check square_mm and inner_corners, or add board photos in other poses)")
+            print(
+                f"  warning: reprojection error above {limit:g} px: the rows using it are flagged "
+                "(fix: re-take the board "
+                "photo flat, sharp and evenly lit, check square_mm and inner_corners, or add board "
+                "photos in other poses)"
+            )
     print(f"stored {len(used)} calibration(s) in {path}")
     return 1 if failed else 0
 
 
 def _init(args: argparse.Namespace) -> int:
     defaults = {k: getattr(args, k) for k in ("material", "actuator", "trial") if getattr(args, k)}
-    settings: dict[str, object] = {"l0_mm": args.l0_mm, "mm_per_px": args.mm_per_px, "positive_turn": args.positive_turn}
+    settings: dict[str, object] = {
+        "l0_mm": args.l0_mm,
+        "mm_per_px": args.mm_per_px,
+        "positive_turn": args.positive_turn,
+    }
     if args.target != "line":
         settings["target"] = args.target
     if args.line_color is not None or args.target == "line":
         settings["line_color"] = args.line_color or "black"
     if args.fixed_end:
         settings["fixed_end"] = list(_xy(args.fixed_end, "--fixed-end"))
-    df = photoset_init.init_photoset(args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite)
+    df = photoset_init.init_photoset(
+        args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite
+    )
     n_up = int((df["direction"] == "up").sum())
-    print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} down)")
+    print(
+        f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
+        "down)"
+    )
     if args.l0_mm is None:
-        print(f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline photoset check {args.folder}'")
+        print(
+            f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline "
+            f"photoset check {args.folder}'"
+        )
     return 0
 
 
@@ -169,20 +269,30 @@ def _pick(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    problems = photoset.validate_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
+    from pipeline.photoset_check import check_photoset
+
+    problems = check_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
     errors = [p for p in problems if not p.warning]
-    manifest = photoset.read_manifest(args.folder) if (Path(args.folder) / photoset.MANIFEST).is_file() else None
+    manifest = (
+        photoset.read_manifest(args.folder)
+        if (Path(args.folder) / photoset.MANIFEST).is_file()
+        else None
+    )
     video = manifest is not None and photoset.is_video_manifest(manifest)
     if not errors and not args.no_decode and not video:  # previews read photos, not videos
         from pipeline.preview import empty_first_photos
 
         for r in empty_first_photos(args.folder).itertuples():
-            problems.append(photoset.Problem(
-                str(Path(args.folder) / photoset.MANIFEST), r.manifest_line,
-                f"the first photo of its ramp ({r.image}) shows nothing that {r.what}",
-                f"check line_color / background / roi with 'python -m pipeline photoset preview {args.folder}'",
-                warning=True,
-            ))
+            problems.append(
+                photoset.Problem(
+                    str(Path(args.folder) / photoset.MANIFEST),
+                    r.manifest_line,
+                    f"the first photo of its ramp ({r.image}) shows nothing that {r.what}",
+                    "check line_color / background / roi with 'python -m pipeline photoset "
+                    f"preview {args.folder}'",
+                    warning=True,
+                )
+            )
     for p in problems:
         print(f"  {p}", file=sys.stderr)
     if errors:
@@ -190,5 +300,8 @@ def _check(args: argparse.Namespace) -> int:
         return 1
     n = len(photoset.read_manifest(args.folder))
     warn = len(problems) - len(errors)
-    print(f"{args.folder}: OK ({n} {'videos' if video else 'photos'}{f', {warn} warning(s)' if warn else ''})")
+    print(
+        f"{args.folder}: OK ({n} "
+        f"{'videos' if video else 'photos'}{f', {warn} warning(s)' if warn else ''})"
+    )
     return 0

@@ -1,7 +1,8 @@
 """Start a photo set from a folder of photos: a manifest built from the image file names.
 
-``python -m pipeline photoset init DIR --pattern '{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'``
-writes ``manifest.csv`` (and a starter ``photoset.yaml``); see :func:`init_photoset`.
+``python -m pipeline photoset init DIR --pattern
+'{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'`` writes ``manifest.csv`` (and a starter
+``photoset.yaml``); see :func:`init_photoset`.
 """
 
 from __future__ import annotations
@@ -18,7 +19,6 @@ import pandas as pd
 from pipeline.errors import UserInputError
 from pipeline.photoset import IMAGE_SUFFIXES, MANIFEST, SETTINGS, write_manifest, write_settings
 
-
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.p]\d+)?",
     "measured_pressure_kpa": r"[-+]?\d+(?:[.p]\d+)?",
@@ -31,13 +31,25 @@ _FIELD_PATTERNS: dict[str, str] = {
 }
 
 _DIRECTION_WORDS: dict[str, str] = {
-    "up": "up", "u": "up", "inc": "up", "increasing": "up", "load": "up", "loading": "up",
-    "down": "down", "d": "down", "dn": "down", "dec": "down", "decreasing": "down", "unload": "down", "unloading": "down",
+    "up": "up",
+    "u": "up",
+    "inc": "up",
+    "increasing": "up",
+    "load": "up",
+    "loading": "up",
+    "down": "down",
+    "d": "down",
+    "dn": "down",
+    "dec": "down",
+    "decreasing": "down",
+    "unload": "down",
+    "unloading": "down",
 }
 
 
 def pattern_to_regex(pattern: str) -> re.Pattern[str]:
-    """Compile a file-name pattern such as ``'{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'``.
+    """Compile a file-name pattern such as
+    ``'{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'``.
 
     Fields: ``pressure_kpa``, ``direction``, ``trial``, ``actuator``, ``material``, ``step``,
     ``measured_pressure_kpa`` and ``_`` (anything, ignored); ``*`` matches anything too.
@@ -54,7 +66,9 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
         out.append(re.escape(pattern[pos : m.start()]).replace(r"\*", ".*?"))
         name = m.group(1)
         if name not in _FIELD_PATTERNS:
-            raise UserInputError(f"pattern field {{{name}}} is unknown; use {sorted(_FIELD_PATTERNS)}")
+            raise UserInputError(
+                f"pattern field {{{name}}} is unknown; use {sorted(_FIELD_PATTERNS)}"
+            )
         if name == "_":
             out.append(_FIELD_PATTERNS["_"])
         else:
@@ -65,7 +79,10 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
         pos = m.end()
     out.append(re.escape(pattern[pos:]).replace(r"\*", ".*?"))
     if "pressure_kpa" not in names:
-        raise UserInputError(f"pattern {pattern!r} has no {{pressure_kpa}} field; the pressure must come from the file name")
+        raise UserInputError(
+            f"pattern {pattern!r} has no {{pressure_kpa}} field; the pressure must come from the "
+            "file name"
+        )
     return re.compile("".join(out) + r"\Z")
 
 
@@ -125,7 +142,9 @@ def init_photoset(
         for key in ("material", "actuator", "trial"):
             row[key] = fields.get(key) or defaults.get(key)
             if row[key] is None:
-                raise UserInputError(f"{path.name}: no {key} in the file name and no default; pass --{key}")
+                raise UserInputError(
+                    f"{path.name}: no {key} in the file name and no default; pass --{key}"
+                )
         row["pressure_kpa"] = float(fields["pressure_kpa"].replace("p", "."))
         if fields.get("step") is not None:
             row["step"] = int(fields["step"])
@@ -134,7 +153,10 @@ def init_photoset(
         if fields.get("direction") is not None:
             word = fields["direction"].lower()
             if word not in _DIRECTION_WORDS:
-                raise UserInputError(f"{path.name}: direction {fields['direction']!r} unknown; use up/down (or inc/dec)")
+                raise UserInputError(
+                    f"{path.name}: direction {fields['direction']!r} unknown; use up/down (or "
+                    "inc/dec)"
+                )
             row["direction"] = _DIRECTION_WORDS[word]
         rows.append(row)
     if not rows:

@@ -25,27 +25,51 @@ from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
-#: (``degree``: curve-model complexity the estimator used, see :class:`~pipeline.measure.AngleResult`;
+#: (``degree``: curve-model complexity the estimator used, see
+#: :class:`~pipeline.measure.AngleResult`;
 #: empty on failed rows; ``l0_mm``: the length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
-    "image", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px", "status", "reason",
-    "seconds", "degree", "l0_mm", "calibration_px", "calibration_mm",
+    "image",
+    "psi_deg",
+    "kappa_per_mm",
+    "length_mm",
+    "length_px",
+    "method",
+    "residual_px",
+    "status",
+    "reason",
+    "seconds",
+    "degree",
+    "l0_mm",
+    "calibration_px",
+    "calibration_mm",
 )
 #: manifest columns carried over first (when present), then any others
-CARRIED_FIRST: tuple[str, ...] = ("pressure_kpa", "direction", "material", "actuator", "trial", "step")
+CARRIED_FIRST: tuple[str, ...] = (
+    "pressure_kpa",
+    "direction",
+    "material",
+    "actuator",
+    "trial",
+    "step",
+)
 
 
 def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
     tasks = []
-    for i, (image, pressure, direction) in enumerate(zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])):
+    for i, (image, pressure, direction) in enumerate(
+        zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])
+    ):
         image = str(image)
         overlay = None if overlays_dir is None else str(overlays_dir / f"{Path(image).stem}.jpg")
         title = f"{image}  {pressure:g} kPa {direction}"
         cal = None if ps.rows[i] is None else ps.rows[i].calibration
         if cal is not None and cal.plane is not None:
             title += f"  calibrated ({cal.plane.rms_px:.2f} px)"
-        tasks.append(Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i)))
+        tasks.append(
+            Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i))
+        )
     return tasks
 
 
@@ -115,7 +139,9 @@ def measure_photoset(
 def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> pd.DataFrame:
     """The angles.csv table of a photo set of images (one row per manifest row)."""
     manifest = ps.manifest
-    rows = map_photos(run_task, _tasks(ps, method, odir), jobs=jobs, preload=["pipeline.measure.worker"])
+    rows = map_photos(
+        run_task, _tasks(ps, method, odir), jobs=jobs, preload=["pipeline.measure.worker"]
+    )
     result = pd.DataFrame(rows, index=manifest.index)
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
@@ -126,7 +152,9 @@ def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> 
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
-    return pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(drop=True)
+    return pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
+        drop=True
+    )
 
 
 def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
@@ -137,7 +165,9 @@ def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
     if not bad.any():
         return angles
     out = angles.copy()
-    note = out.loc[bad, "calibration_px"].map(lambda e: f"calibration reprojection error {e:.2f} px > {MAX_RMS_PX:g} px")
+    note = out.loc[bad, "calibration_px"].map(
+        lambda e: f"calibration reprojection error {e:.2f} px > {MAX_RMS_PX:g} px"
+    )
     old = out.loc[bad, "reason"].fillna("").astype(str)
     out.loc[bad, "reason"] = [f"{r}; {n}" if r else n for r, n in zip(old, note)]
     out.loc[bad, "status"] = "flagged"
@@ -147,14 +177,22 @@ def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:
 def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]:
     """One ``contact_<material>_<actuator>_<trial>.jpg`` per ramp, photos in manifest order
     (for a video: the frames that have an overlay, in time order)."""
-    from pipeline.measure.overlay import contact_sheet  # cv2 drawing only when overlays are asked for
+    from pipeline.measure.overlay import (
+        contact_sheet,  # cv2 drawing only when overlays are asked for
+    )
 
     written = []
-    for (material, actuator, trial), g in angles.groupby(["material", "actuator", "trial"], sort=False):
+    for (material, actuator, trial), g in angles.groupby(
+        ["material", "actuator", "trial"], sort=False
+    ):
         if "frame" in g.columns:
             from pipeline.video.measure import frame_overlay_name
 
-            paths = [overlays_dir / frame_overlay_name(str(i), int(k)) for i, k in zip(g["image"], g["frame"]) if pd.notna(k)]
+            paths = [
+                overlays_dir / frame_overlay_name(str(i), int(k))
+                for i, k in zip(g["image"], g["frame"])
+                if pd.notna(k)
+            ]
             paths = [p for p in paths if p.is_file()]
             if not paths:
                 continue
@@ -180,6 +218,7 @@ def summary(angles: pd.DataFrame) -> str:
     sec = float(np.nansum(angles["seconds"]))
     unit = "frames" if "frame" in angles.columns else "photos"
     return (
-        f"measured {len(angles)} {unit}: {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} flagged, "
+        f"measured {len(angles)} {unit}: {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} "
+        "flagged, "
         f"{counts.get('failed', 0)} failed ({sec:.1f} s of work)"
     )

@@ -25,7 +25,12 @@ def init_worker() -> None:
 
 
 def map_photos(
-    func: Callable[[T], R], tasks: Sequence[T], *, jobs: int = 1, preload: Sequence[str] = (), desc: str = "photos"
+    func: Callable[[T], R],
+    tasks: Sequence[T],
+    *,
+    jobs: int = 1,
+    preload: Sequence[str] = (),
+    desc: str = "photos",
 ) -> list[R]:
     """``[func(t) for t in tasks]``, in ``jobs`` worker processes when ``jobs > 1``.
 
@@ -54,7 +59,7 @@ def map_photos(
     """
     from tqdm import tqdm
 
-    bar = dict(total=len(tasks), desc=desc, unit="photo", disable=None, leave=False)
+    bar = {"total": len(tasks), "desc": desc, "unit": "photo", "disable": None, "leave": False}
     if jobs <= 1 or len(tasks) <= 1:
         return [func(t) for t in tqdm(tasks, **bar)]  # type: ignore[call-overload]
     methods = multiprocessing.get_all_start_methods()

@@ -32,7 +32,12 @@ TILE_WIDTH_PX = 480
 _STATUS_BGR = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
 
 
-def selection(image_bgr: np.ndarray, settings: MeasureSettings, scale: float, background: np.ndarray | None = None) -> np.ndarray:
+def selection(
+    image_bgr: np.ndarray,
+    settings: MeasureSettings,
+    scale: float,
+    background: np.ndarray | None = None,
+) -> np.ndarray:
     """0/1 mask of what the settings select in a (reduced) photo, before any candidate is chosen."""
     if settings.target == "body":
         return body_mask(image_bgr, settings, scale=scale, background_bgr=background)[0]
@@ -46,61 +51,135 @@ def _background(settings: MeasureSettings, shape: tuple[int, ...]) -> np.ndarray
     if settings.background_path is None:
         return None
     img = cv2.imread(settings.background_path, cv2.IMREAD_COLOR)
-    return None if img is None else cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+    return (
+        None if img is None else cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+    )
 
 
 def _poly(points: tuple[tuple[float, float], ...], k: float) -> np.ndarray:
     return np.round(np.asarray(points, float) * k * 16).astype(np.int32)
 
 
-def preview_tile(path: str | os.PathLike[str], settings: MeasureSettings | None, *, method: str = "auto", title: str = "", reason: str = "") -> np.ndarray:
+def preview_tile(
+    path: str | os.PathLike[str],
+    settings: MeasureSettings | None,
+    *,
+    method: str = "auto",
+    title: str = "",
+    reason: str = "",
+) -> np.ndarray:
     """The preview of one photo: annotated photo beside its selection mask (BGR)."""
     data = np.fromfile(str(path), dtype=np.uint8) if Path(path).is_file() else np.empty(0, np.uint8)
     img, f = decode_for_work(data) if data.size else (None, 1)
     if img is None or settings is None:
         blank = np.full((TILE_WIDTH_PX * 3 // 4, 2 * TILE_WIDTH_PX, 3), 60, np.uint8)
-        why = reason or (f"{Path(path).name} cannot be read" if img is None else "row cannot be measured")
+        why = reason or (
+            f"{Path(path).name} cannot be read" if img is None else "row cannot be measured"
+        )
         for i, t in enumerate((title, "failed", why[:110])):
-            cv2.putText(blank, t, (10, 30 + 26 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.55, (255, 255, 255), 1, cv2.LINE_AA)
+            cv2.putText(
+                blank,
+                t,
+                (10, 30 + 26 * i),
+                cv2.FONT_HERSHEY_SIMPLEX,
+                0.55,
+                (255, 255, 255),
+                1,
+                cv2.LINE_AA,
+            )
         return blank
     res: AngleResult = measure_decoded(data, img, f, settings, method=method)
     sel = selection(img, settings, float(f), _background(settings, img.shape))
     k = TILE_WIDTH_PX / img.shape[1]
-    small = cv2.resize(img, (TILE_WIDTH_PX, int(round(img.shape[0] * k))), interpolation=cv2.INTER_AREA)
-    mask_small = cv2.resize(sel * 255, (small.shape[1], small.shape[0]), interpolation=cv2.INTER_AREA)
+    small = cv2.resize(
+        img, (TILE_WIDTH_PX, round(img.shape[0] * k)), interpolation=cv2.INTER_AREA
+    )
+    mask_small = cv2.resize(
+        sel * 255, (small.shape[1], small.shape[0]), interpolation=cv2.INTER_AREA
+    )
     tint = small.copy()
-    tint[mask_small > 127] = (0.45 * tint[mask_small > 127] + 0.55 * np.array([255, 0, 255])).astype(np.uint8)
+    tint[mask_small > 127] = (
+        0.45 * tint[mask_small > 127] + 0.55 * np.array([255, 0, 255])
+    ).astype(np.uint8)
     kk = k / f  # original px -> tile px
-    contours, _ = cv2.findContours((mask_small > 127).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-    cv2.drawContours(tint, [c for c in contours if cv2.arcLength(c, True) > 30], -1, (160, 160, 160), 1, cv2.LINE_AA)
+    contours, _ = cv2.findContours(
+        (mask_small > 127).astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE
+    )
+    cv2.drawContours(
+        tint,
+        [c for c in contours if cv2.arcLength(c, True) > 30],
+        -1,
+        (160, 160, 160),
+        1,
+        cv2.LINE_AA,
+    )
     if settings.roi is not None:
         cv2.polylines(tint, [_poly(settings.roi, kk)], True, (0, 230, 255), 2, cv2.LINE_AA, 4)
     for poly in settings.exclude:
         cv2.polylines(tint, [_poly(poly, kk)], True, (40, 40, 230), 2, cv2.LINE_AA, 4)
     colour = _STATUS_BGR.get(res.status, (255, 255, 255))
     if len(res.centreline_px):
-        cv2.polylines(tint, [np.round(res.centreline_px * kk * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
+        cv2.polylines(
+            tint,
+            [np.round(res.centreline_px * kk * 16).astype(np.int32)],
+            False,
+            colour,
+            2,
+            cv2.LINE_AA,
+            4,
+        )
     if settings.fixed_end_px is not None:
         fe = np.asarray(settings.fixed_end_px) * kk
         cv2.circle(tint, (int(fe[0]), int(fe[1])), 7, (255, 80, 0), 2, cv2.LINE_AA)
         if settings.fixed_direction_deg is not None:
             a = np.deg2rad(settings.fixed_direction_deg)
             tip = fe + 40 * np.array([np.cos(a), -np.sin(a)])
-            cv2.arrowedLine(tint, (int(fe[0]), int(fe[1])), (int(tip[0]), int(tip[1])), (255, 80, 0), 2, cv2.LINE_AA)
-    text = [title, f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed", res.reason[:80], res.reason[80:160]]
+            cv2.arrowedLine(
+                tint,
+                (int(fe[0]), int(fe[1])),
+                (int(tip[0]), int(tip[1])),
+                (255, 80, 0),
+                2,
+                cv2.LINE_AA,
+            )
+    text = [
+        title,
+        f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",
+        res.reason[:80],
+        res.reason[80:160],
+    ]
     box = tint[: 12 + 20 * len(text)]
     box[:] = (box * 0.35).astype(np.uint8)
     for i, t in enumerate(text):
-        cv2.putText(tint, t, (8, 20 + 20 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.48, colour if i else (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(
+            tint,
+            t,
+            (8, 20 + 20 * i),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.48,
+            colour if i else (255, 255, 255),
+            1,
+            cv2.LINE_AA,
+        )
     right = cv2.cvtColor(mask_small, cv2.COLOR_GRAY2BGR)
-    cv2.putText(right, f"selected: {settings.describe_color()}"[:60], (8, right.shape[0] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 200, 255), 1, cv2.LINE_AA)
+    cv2.putText(
+        right,
+        f"selected: {settings.describe_color()}"[:60],
+        (8, right.shape[0] - 10),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.45,
+        (0, 200, 255),
+        1,
+        cv2.LINE_AA,
+    )
     rectified = rectified_panel(img, float(f), settings, res, (small.shape[1], small.shape[0]))
     return np.hstack([tint, right] + ([] if rectified is None else [rectified]))
 
 
 def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, res: AngleResult,
                     size: tuple[int, int]) -> np.ndarray | None:
-    """A calibrated photo on the plane, with the centre line mapped there (None when uncalibrated)."""
+    """A calibrated photo on the plane, with the centre line mapped there (None when
+    uncalibrated)."""
     from pipeline.measure.calibration import CalibrationMismatch, check_size, rectify
 
     cal = settings.calibration
@@ -111,7 +190,16 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
         check_size(cal.plane, base.shape, scale)
     except CalibrationMismatch as exc:
         panel = np.full((size[1], size[0], 3), 60, np.uint8)
-        cv2.putText(panel, str(exc)[:60], (8, 24), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (40, 40, 230), 1, cv2.LINE_AA)
+        cv2.putText(
+            panel,
+            str(exc)[:60],
+            (8, 24),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.45,
+            (40, 40, 230),
+            1,
+            cv2.LINE_AA,
+        )
         return panel
     panel = rectify(base, cal.plane, scale)
     k = size[0] / panel.shape[1]
@@ -120,11 +208,23 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
         q = cal.plane.to_plane(res.centreline_px) / scale * k
         colour = _STATUS_BGR.get(res.status, (255, 255, 255))
         cv2.polylines(panel, [np.round(q * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
-    text = [f"on the plane ({Path(cal.boards[0]).name})", f"reprojection error {cal.plane.rms_px:.2f} px, {cal.plane.rms_mm:.3f} mm",
-            f"{cal.plane.mm_per_px:.4f} mm/px, k1 {cal.plane.k1:+.3f}"]
+    text = [
+        f"on the plane ({Path(cal.boards[0]).name})",
+        f"reprojection error {cal.plane.rms_px:.2f} px, {cal.plane.rms_mm:.3f} mm",
+        f"{cal.plane.mm_per_px:.4f} mm/px, k1 {cal.plane.k1:+.3f}",
+    ]
     warn = cal.plane.doubtful
     for i, t in enumerate(text):
-        cv2.putText(panel, t, (8, 20 + 20 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.48, (0, 165, 255) if warn else (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(
+            panel,
+            t,
+            (8, 20 + 20 * i),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.48,
+            (0, 165, 255) if warn else (255, 255, 255),
+            1,
+            cv2.LINE_AA,
+        )
     return panel
 
 
@@ -142,22 +242,59 @@ def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
     return rows
 
 
-def write_preview(folder: str | os.PathLike[str], out: str | os.PathLike[str], *, method: str = "auto", every: bool = False) -> tuple[Path, int]:
+def write_preview(
+    folder: str | os.PathLike[str],
+    out: str | os.PathLike[str],
+    *,
+    method: str = "auto",
+    every: bool = False,
+) -> tuple[Path, int]:
     """Write the preview contact sheet of a photo set (JPEG); return its path and the tile count."""
     ps = load_photoset(folder)
     if ps.is_video:
-        raise UserInputError(f"{folder}: lists videos; preview reads photos. Measure the set with --overlays DIR: it "
-                             "draws 24 frames of each video and a contact sheet")
+        raise UserInputError(
+            f"{folder}: lists videos; preview reads photos. Measure the set with --overlays DIR: "
+            "it "
+            "draws 24 frames of each video and a contact sheet"
+        )
     tiles = []
     for i in preview_rows(ps, every):
         row = ps.manifest.iloc[i]
-        title = f"{row['image']}  {row['material']} {row['actuator']} t{row['trial']}  {row['pressure_kpa']:g} kPa {row['direction']}"
-        tiles.append(preview_tile(ps.image_path(str(row["image"])), ps.rows[i], method=method, title=title, reason=ps.row_reason(i)))
+        title = (
+            f"{row['image']}  {row['material']} {row['actuator']} t{row['trial']}  "
+            f"{row['pressure_kpa']:g} kPa {row['direction']}"
+        )
+        tiles.append(
+            preview_tile(
+                ps.image_path(str(row["image"])),
+                ps.rows[i],
+                method=method,
+                title=title,
+                reason=ps.row_reason(i),
+            )
+        )
     height, width = max(t.shape[0] for t in tiles), max(t.shape[1] for t in tiles)
-    tiles = [cv2.copyMakeBorder(t, 0, height - t.shape[0] + 4, 0, width - t.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30))
-             for t in tiles]
-    sheet = np.vstack([np.hstack(tiles[i : i + 2]) if i + 1 < len(tiles) else np.hstack([tiles[i], np.zeros_like(tiles[i])]) for i in range(0, len(tiles), 2)])
-    ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 88])
+    tiles = [
+        cv2.copyMakeBorder(
+            t,
+            0,
+            height - t.shape[0] + 4,
+            0,
+            width - t.shape[1],
+            cv2.BORDER_CONSTANT,
+            value=(30, 30, 30),
+        )
+        for t in tiles
+    ]
+    sheet = np.vstack(
+        [
+            np.hstack(tiles[i : i + 2])
+            if i + 1 < len(tiles)
+            else np.hstack([tiles[i], np.zeros_like(tiles[i])])
+            for i in range(0, len(tiles), 2)
+        ]
+    )
+    _ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 88])
     path = Path(out)
     atomic_write_bytes(path, buf.tobytes())
     return path, len(tiles)
@@ -187,6 +324,12 @@ def empty_first_photos(folder: str | os.PathLike[str]) -> pd.DataFrame:
             continue
         sel = selection(img, s, float(f), _background(s, img.shape))
         if int(sel.sum()) < 25:
-            out.append({"manifest_line": int(m["manifest_line"].iloc[i]), "image": str(m["image"].iloc[i]), "what": s.describe_color()})
+            out.append(
+                {
+                    "manifest_line": int(m["manifest_line"].iloc[i]),
+                    "image": str(m["image"].iloc[i]),
+                    "what": s.describe_color(),
+                }
+            )
     return pd.DataFrame(out, columns=["manifest_line", "image", "what"])
 

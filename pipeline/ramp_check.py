@@ -24,7 +24,8 @@ Examples
 >>> import pandas as pd
 >>> df = pd.DataFrame({"image": list("abcde"), "psi_deg": [200.0, 150.0, -210.0, 50.0, 0.0],
 ...     "status": ["ok"] * 5, "reason": [""] * 5, "pressure_kpa": [0, 10, 20, 30, 40],
-...     "direction": ["up"] * 5, "material": ["DS20"] * 5, "actuator": ["A1"] * 5, "trial": ["1"] * 5})
+...     "direction": ["up"] * 5, "material": ["DS20"] * 5, "actuator": ["A1"] * 5,
+...     "trial": ["1"] * 5})
 >>> out = check_ramps(df)
 >>> out["status"].tolist()
 ['ok', 'ok', 'flagged', 'ok', 'ok']
@@ -90,7 +91,10 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
     out = angles.copy()
     if out.empty or not set(RAMP_KEYS) <= set(out.columns):
         return out
-    status, reason = out["status"].astype(str).to_numpy(copy=True), out["reason"].fillna("").astype(str).to_numpy(copy=True)
+    status, reason = (
+        out["status"].astype(str).to_numpy(copy=True),
+        out["reason"].fillna("").astype(str).to_numpy(copy=True),
+    )
     keys = [c for c in ("step", "time_s") if c in out.columns]  # frames of a video: over time
     order = out.sort_values(keys, kind="stable").index if keys else out.index
     position = {ix: k for k, ix in enumerate(out.index)}
@@ -100,10 +104,18 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
             lengths = measured["length_px"].to_numpy(float)
             med = float(np.nanmedian(lengths)) if np.isfinite(lengths).any() else np.nan
             for ix, length in zip(measured.index, lengths):
-                if np.isfinite(med) and np.isfinite(length) and not LENGTH_LOW <= length / med <= LENGTH_HIGH:
+                if (
+                    np.isfinite(med)
+                    and np.isfinite(length)
+                    and not LENGTH_LOW <= length / med <= LENGTH_HIGH
+                ):
                     k = position[ix]
                     status[k] = "flagged"
-                    reason[k] = _join(reason[k], f"line length {100 * length / med:.0f}% of its ramp's median: part of it may be missing or extra")
+                    reason[k] = _join(
+                        reason[k],
+                        f"line length {100 * length / med:.0f}% of its ramp's median: part of it "
+                        "may be missing or extra",
+                    )
         legs = (measured["direction"] != measured["direction"].shift()).cumsum()
         for _, leg in measured.groupby(legs, sort=False):
             _check_leg(leg, position, status, reason)
@@ -112,17 +124,24 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
 
 
 def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np.ndarray) -> None:
-    """Flag the leg's outliers one at a time (worst first, then check again without it); re-trust."""
+    """Flag the leg's outliers one at a time (worst first, then check again without it);
+    re-trust."""
     keep = list(range(len(leg)))
     psi_all = leg["psi_deg"].to_numpy(float)
     while len(keep) >= 3:
         psi = psi_all[keep]
-        worst, i, lo, hi = max((_outside(psi[i], *_allowed(psi, i)), i, *_allowed(psi, i)) for i in range(len(keep)))
+        worst, i, lo, hi = max(
+            (_outside(psi[i], *_allowed(psi, i)), i, *_allowed(psi, i)) for i in range(len(keep))
+        )
         if worst <= SLACK_DEG:
             break
         k = position[leg.index[keep[i]]]
         status[k] = "flagged"
-        reason[k] = _join(f"breaks its ramp: psi {psi[i]:+.0f} deg where its neighbours allow {lo:+.0f} to {hi:+.0f}", reason[k])
+        reason[k] = _join(
+            f"breaks its ramp: psi {psi[i]:+.0f} deg where its neighbours allow {lo:+.0f} to "
+            f"{hi:+.0f}",
+            reason[k],
+        )
         del keep[i]
     if len(keep) < 3:
         return
@@ -134,4 +153,6 @@ def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np
         if (status[k] == "flagged" and off <= AGREE_DEG and _is_cosmetic(reason[k])
                 and all(status[n] == "ok" for n in neighbours)):
             status[k] = "ok"
-            reason[k] = f"psi agrees with its ramp (between its neighbours) (was flagged: {reason[k]})"
+            reason[k] = (
+                f"psi agrees with its ramp (between its neighbours) (was flagged: {reason[k]})"
+            )

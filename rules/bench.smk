@@ -15,7 +15,7 @@ rule bench_default:
     conda:
         CONDA_ENV
     shell:
-        logged("python -m pipeline bench --grid default --jobs {threads} --out {output:q}")
+        logged("python -m pipeline bench study --grid default --jobs {threads} --out {output:q}")
 
 
 rule bench_full:
@@ -32,7 +32,7 @@ rule bench_full:
     conda:
         CONDA_ENV
     shell:
-        logged("python -m pipeline bench --grid full --jobs {threads} --out {output:q}")
+        logged("python -m pipeline bench study --grid full --jobs {threads} --out {output:q}")
 
 
 rule bench:

@@ -36,9 +36,17 @@ def video_set(tmp_path_factory) -> Path:
     from pipeline.video.profile import PressureProfile
 
     folder = tmp_path_factory.mktemp("video") / "steps"
-    render_video(folder, "SS40", profile=PressureProfile("steps", max_kpa=80, step_kpa=40, hold_s=2.5), fps=10,
-                 rest_s=0.5, clock_offset_s=0.7, scene="lab", scene_overrides={"width": 320, "height": 240, "tilt_deg": 0.0},
-                 seed=3)
+    render_video(
+        folder,
+        "SS40",
+        profile=PressureProfile("steps", max_kpa=80, step_kpa=40, hold_s=2.5),
+        fps=10,
+        rest_s=0.5,
+        clock_offset_s=0.7,
+        scene="lab",
+        scene_overrides={"width": 320, "height": 240, "tilt_deg": 0.0},
+        seed=3,
+    )
     return folder
 
 

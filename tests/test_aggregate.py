@@ -20,25 +20,56 @@ from pipeline.aggregate import (
 from pipeline.cli import main
 from pipeline.errors import UserInputError
 
-COLUMNS = ["image", "psi_deg", "kappa_per_mm", "length_mm", "method", "residual_px", "status", "reason",
-           "seconds", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+COLUMNS = [
+    "image",
+    "psi_deg",
+    "kappa_per_mm",
+    "length_mm",
+    "method",
+    "residual_px",
+    "status",
+    "reason",
+    "seconds",
+    "pressure_kpa",
+    "direction",
+    "material",
+    "actuator",
+    "trial",
+    "step",
+]
 
 
 def _row(psi, status, p, direction, actuator, trial, material="DS20", reason=""):
-    return {"image": f"{material}_{actuator}_{trial}_{direction}_{p}.jpg", "psi_deg": psi, "kappa_per_mm": 0.0,
-            "length_mm": 195.0, "method": "paper", "residual_px": 0.5, "status": status, "reason": reason,
-            "seconds": 0.01, "pressure_kpa": p, "direction": direction, "material": material,
-            "actuator": actuator, "trial": trial, "step": 0}
+    return {
+        "image": f"{material}_{actuator}_{trial}_{direction}_{p}.jpg",
+        "psi_deg": psi,
+        "kappa_per_mm": 0.0,
+        "length_mm": 195.0,
+        "method": "paper",
+        "residual_px": 0.5,
+        "status": status,
+        "reason": reason,
+        "seconds": 0.01,
+        "pressure_kpa": p,
+        "direction": direction,
+        "material": material,
+        "actuator": actuator,
+        "trial": trial,
+        "step": 0,
+    }
 
 
 @pytest.fixture()
 def crafted() -> pd.DataFrame:
     rows = [
         # up, 0 kPa: 200, 210, 220 ok (mean 210, sd 10); one flagged 999
-        _row(200.0, "ok", 0, "up", 1, 1), _row(210.0, "ok", 0, "up", 1, 2),
-        _row(220.0, "ok", 0, "up", 2, 1), _row(999.0, "flagged", 0, "up", 2, 2, reason="short line"),
+        _row(200.0, "ok", 0, "up", 1, 1),
+        _row(210.0, "ok", 0, "up", 1, 2),
+        _row(220.0, "ok", 0, "up", 2, 1),
+        _row(999.0, "flagged", 0, "up", 2, 2, reason="short line"),
         # up, 10 kPa: 100, 120 ok (mean 110, sd sqrt(200)); one failed
-        _row(100.0, "ok", 10, "up", 1, 1), _row(math.nan, "failed", 10, "up", 1, 2, reason="no line"),
+        _row(100.0, "ok", 10, "up", 1, 1),
+        _row(math.nan, "failed", 10, "up", 1, 2, reason="no line"),
         _row(120.0, "ok", 10, "up", 2, 1),
         # down, 10 kPa: a single value (sd undefined)
         _row(50.0, "ok", 10, "down", 1, 1),
@@ -60,7 +91,12 @@ def test_means_sds_and_counts(crafted):
     h = aggregate_hysteresis(crafted)
     assert list(h.columns) == list(HYSTERESIS_COLUMNS)
     assert list(zip(h["material"], h["direction"], h["pressure_kpa"])) == [
-        ("DS20", "up", 0), ("DS20", "up", 10), ("DS20", "down", 0), ("DS20", "down", 10), ("SS50", "up", 0)]
+        ("DS20", "up", 0),
+        ("DS20", "up", 10),
+        ("DS20", "down", 0),
+        ("DS20", "down", 10),
+        ("SS50", "up", 0),
+    ]
     r = _level(h, "DS20", "up", 0)
     assert r["psi_mean_deg"] == pytest.approx(210.0)
     assert r["psi_sd_deg"] == pytest.approx(10.0)
@@ -97,10 +133,18 @@ def test_per_actuator(crafted):
 
 
 def test_binning_uses_measured_pressure():
-    df = pd.DataFrame({"pressure_kpa": [10.0, 10.0, 10.0, 20.0], "measured_pressure_kpa": [8.1, 12.6, np.nan, 17.4]})
+    df = pd.DataFrame(
+        {
+            "pressure_kpa": [10.0, 10.0, 10.0, 20.0],
+            "measured_pressure_kpa": [8.1, 12.6, np.nan, 17.4],
+        }
+    )
     assert pressure_levels(df, 5.0).tolist() == [10.0, 15.0, 10.0, 15.0]
     assert pressure_levels(df).tolist() == [10.0, 10.0, 10.0, 20.0]
-    rows = [_row(v, "ok", p, "up", 1, i) for i, (v, p) in enumerate([(10.0, 10), (20.0, 10), (30.0, 20)])]
+    rows = [
+        _row(v, "ok", p, "up", 1, i)
+        for i, (v, p) in enumerate([(10.0, 10), (20.0, 10), (30.0, 20)])
+    ]
     angles = pd.DataFrame(rows, columns=COLUMNS)
     angles["measured_pressure_kpa"] = [9.0, 13.0, 16.0]
     h = aggregate_hysteresis(angles, bin_kpa=5.0)
@@ -153,9 +197,24 @@ def test_pooling_two_datasets_equals_aggregating_their_union(crafted):
 
 
 def test_reasons_grouped_by_kind():
-    rows = [_row(np.nan, "failed", 0, "up", 1, i, reason=r) for i, r in enumerate(
-        ["line partly hidden: 65% of l0 visible; touches border", "line partly hidden: 80% of l0 visible", "", "a",
-         "b", "c", "d", "e"])]
+    rows = [
+        _row(np.nan, "failed", 0, "up", 1, i, reason=r)
+        for i, r in enumerate(
+            [
+                "line partly hidden: 65% of l0 visible; touches border",
+                "line partly hidden: 80% of l0 visible",
+                "",
+                "a",
+                "b",
+                "c",
+                "d",
+                "e",
+            ]
+        )
+    ]
     s = status_counts(pd.DataFrame(rows, columns=COLUMNS), max_kinds=3).iloc[0]
     assert s["failed"] == 8
-    assert s["reasons"] == "line partly hidden: #% of l0 visible x2; (no reason given) x1; a x1; 5 other kind(s) x5"
+    assert (
+        s["reasons"]
+        == "line partly hidden: #% of l0 visible x2; (no reason given) x1; a x1; 5 other kind(s) x5"
+    )

@@ -1,4 +1,4 @@
-"""Tests of the speed/accuracy and stability study (pipeline.bench)."""
+"""Tests of the speed/accuracy and stability study (pipeline.study, run as ``bench study``)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.bench import analysis, grids
-from pipeline.bench.analysis import breakdown_point, pareto_front
+from pipeline.study import analysis, grids
+from pipeline.study.analysis import breakdown_point, pareto_front
 
 # ---------------------------------------------------------------------------------------------
 # Pareto front
@@ -25,7 +25,12 @@ def test_pareto_front_known_answer():
 
 def test_pareto_front_ties_and_nan():
     # identical points do not dominate each other; NaN points are never on the front
-    assert pareto_front([1.0, 1.0, np.nan, 0.5], [2.0, 2.0, 0.1, np.nan]).tolist() == [True, True, False, False]
+    assert pareto_front([1.0, 1.0, np.nan, 0.5], [2.0, 2.0, 0.1, np.nan]).tolist() == [
+        True,
+        True,
+        False,
+        False,
+    ]
     assert pareto_front([], []).tolist() == []
     with pytest.raises(ValueError):
         pareto_front([1.0, 2.0], [1.0])
@@ -44,11 +49,15 @@ def test_pareto_front_single_best_point_dominates_all():
 
 
 def test_breakdown_point_ascending_sweep():
-    assert breakdown_point([0, 1, 2, 4, 8], [0.2, 0.4, 1.0, 3.0, 9.0], [0, 0, 0, 0, 0], nominal=0) == (4.0, "p95 > 2 deg")
+    assert breakdown_point(
+        [0, 1, 2, 4, 8], [0.2, 0.4, 1.0, 3.0, 9.0], [0, 0, 0, 0, 0], nominal=0
+    ) == (4.0, "p95 > 2 deg")
 
 
 def test_breakdown_point_failure_counts_even_if_accurate():
-    assert breakdown_point([100, 80, 60, 40], [0.1, 0.1, 0.1, 0.1], [0, 0, 0.05, 0], nominal=100) == (60.0, "failure")
+    assert breakdown_point(
+        [100, 80, 60, 40], [0.1, 0.1, 0.1, 0.1], [0, 0, 0.05, 0], nominal=100
+    ) == (60.0, "failure")
 
 
 def test_breakdown_point_outward_from_nominal_both_sides():
@@ -73,8 +82,16 @@ def test_breakdown_point_none_and_nan():
 
 
 def _results(rows: list[dict]) -> pd.DataFrame:
-    base = {"kind": "sweep", "nominal": 0.0, "bulge": 0.0, "seed": 0, "status": "ok", "degree": np.nan,
-            "seconds": 0.01, "decode_seconds": 0.002}
+    base = {
+        "kind": "sweep",
+        "nominal": 0.0,
+        "bulge": 0.0,
+        "seed": 0,
+        "status": "ok",
+        "degree": np.nan,
+        "seconds": 0.01,
+        "decode_seconds": 0.002,
+    }
     df = pd.DataFrame([{**base, **r} for r in rows])
     df["abs_error_deg"] = (df["psi_deg"] - df["psi_true_deg"]).abs()
     return df
@@ -87,10 +104,29 @@ def test_speed_accuracy_stats_exclude_failures_and_mark_pareto():
                      "method": "fast", "psi_deg": 10.0 * i + err, "seconds": 0.001})
         rows.append({"case_id": i, "condition": "psi", "value": 10.0 * i, "psi_true_deg": 10.0 * i,
                      "method": "slow", "psi_deg": 10.0 * i + 2 * err, "seconds": 0.010})
-    rows.append({"case_id": 9, "condition": "psi", "value": 90.0, "psi_true_deg": 90.0, "method": "fast",
-                 "psi_deg": np.nan, "status": "failed", "seconds": 0.001})
-    rows.append({"case_id": 9, "condition": "psi", "value": 90.0, "psi_true_deg": 90.0, "method": "slow",
-                 "psi_deg": 90.0 + 7.0, "seconds": 0.010})
+    rows.append(
+        {
+            "case_id": 9,
+            "condition": "psi",
+            "value": 90.0,
+            "psi_true_deg": 90.0,
+            "method": "fast",
+            "psi_deg": np.nan,
+            "status": "failed",
+            "seconds": 0.001,
+        }
+    )
+    rows.append(
+        {
+            "case_id": 9,
+            "condition": "psi",
+            "value": 90.0,
+            "psi_true_deg": 90.0,
+            "method": "slow",
+            "psi_deg": 90.0 + 7.0,
+            "seconds": 0.010,
+        }
+    )
     sa = analysis.speed_accuracy(_results(rows)).set_index(["condition", "method"])
     fast, slow = sa.loc[("nominal", "fast")], sa.loc[("nominal", "slow")]
     assert fast["n"] == 5 and fast["failure_rate"] == pytest.approx(0.2)
@@ -107,8 +143,17 @@ def test_stability_breakdown_and_repeatability_tables():
     for i, noise in enumerate([0.0, 1.0, 2.0, 4.0]):
         for rep in range(3):
             err = [0.1, 0.5, 3.0, 8.0][i]
-            rows.append({"case_id": 10 * i + rep, "condition": "noise", "value": noise, "nominal": 1.0,
-                         "psi_true_deg": 60.0, "method": "m", "psi_deg": 60.0 + err})
+            rows.append(
+                {
+                    "case_id": 10 * i + rep,
+                    "condition": "noise",
+                    "value": noise,
+                    "nominal": 1.0,
+                    "psi_true_deg": 60.0,
+                    "method": "m",
+                    "psi_deg": 60.0 + err,
+                }
+            )
     for k, psi in enumerate([119.0, 121.0, 120.0, 120.0]):
         rows.append({"case_id": 100 + k, "kind": "repeat", "condition": "repeat", "value": 120.0,
                      "psi_true_deg": 120.0, "method": "m", "psi_deg": psi})
@@ -128,8 +173,18 @@ def test_stability_breakdown_and_repeatability_tables():
 def test_model_choice_consistency():
     rows = []
     for i, (bulge, deg) in enumerate([(0.0, 1), (0.0, 1), (0.0, 3), (0.5, 3), (0.5, 4), (0.5, 1)]):
-        rows.append({"case_id": i, "condition": "bulge", "value": bulge, "bulge": bulge, "psi_true_deg": 90.0,
-                     "method": "turning", "psi_deg": 90.0, "degree": deg})
+        rows.append(
+            {
+                "case_id": i,
+                "condition": "bulge",
+                "value": bulge,
+                "bulge": bulge,
+                "psi_true_deg": 90.0,
+                "method": "turning",
+                "psi_deg": 90.0,
+                "degree": deg,
+            }
+        )
     choice = analysis.model_choice(_results(rows))
     flat = choice.set_index("bulge")
     assert flat.loc[0.0, "share_richer"] == pytest.approx(1 / 3)
@@ -137,7 +192,11 @@ def test_model_choice_consistency():
     assert flat.loc[0.5, "consistent"] == pytest.approx(2 / 3)
     assert flat.loc[0.0, "degree_counts"] == "1:2;3:1"
     s = analysis.model_choice_summary(choice).iloc[0]
-    assert s["method"] == "turning" and s["richer_on_constant"] == pytest.approx(1 / 3) and s["richer_on_bulged"] == pytest.approx(2 / 3)
+    assert (
+        s["method"] == "turning"
+        and s["richer_on_constant"] == pytest.approx(1 / 3)
+        and s["richer_on_bulged"] == pytest.approx(2 / 3)
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -147,8 +206,19 @@ def test_model_choice_consistency():
 def test_grids_cover_the_issue_conditions():
     for name, grid in grids.GRIDS.items():
         names = {s.name for s in grid.sweeps}
-        assert {"psi", "noise", "blur", "jpeg", "contrast", "resolution", "width", "occlusion", "clutter",
-                "tilt", "bulge"} <= names, name
+        assert {
+            "psi",
+            "noise",
+            "blur",
+            "jpeg",
+            "contrast",
+            "resolution",
+            "width",
+            "occlusion",
+            "clutter",
+            "tilt",
+            "bulge",
+        } <= names, name
         for s in grid.sweeps:
             assert s.nominal in s.values, (name, s.name)
         psi = next(s for s in grid.sweeps if s.name == "psi").values
@@ -195,7 +265,7 @@ TINY = grids.Grid(
 
 
 def test_run_is_deterministic_across_jobs():
-    from pipeline.bench.run import run_grid
+    from pipeline.study.run import run_grid
 
     cs = grids.cases(TINY)[:2]
     a = run_grid(cs, methods=["hyper", "turning"], jobs=1)
@@ -205,14 +275,17 @@ def test_run_is_deterministic_across_jobs():
     assert (a["seconds"] > 0).all() and (a["decode_seconds"] > 0).all()
 
 
-def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture):
-    from pipeline.bench import cli, pages
+def test_bench_cli_end_to_end(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+):
+    from pipeline.bench import study
     from pipeline.measure import METHODS
+    from pipeline.study import pages
 
     monkeypatch.setitem(grids.GRIDS, "default", TINY)
     out = tmp_path / "bench"
     args = argparse.Namespace(grid="default", jobs=2, out=out, methods=None, seed=1, no_model=False)
-    assert cli.run(args) == 0
+    assert study.run(args) == 0
     printed = capsys.readouterr().out
     assert "Nominal scenes" in printed and "Breakdown point" in printed and "grid_n" in printed
     n_images = len(grids.cases(TINY))
@@ -220,7 +293,9 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
     assert len(res) == n_images * len(METHODS)
     assert set(res["method"]) == set(METHODS)
     ok = res["psi_deg"].notna()
-    assert np.allclose(res.loc[ok, "error_deg"], res.loc[ok, "psi_deg"] - res.loc[ok, "psi_true_deg"], atol=1e-4)
+    assert np.allclose(
+        res.loc[ok, "error_deg"], res.loc[ok, "psi_deg"] - res.loc[ok, "psi_true_deg"], atol=1e-4
+    )
     # the adaptive method's model choice is recorded for every image it measured
     for method in ("turning", "auto"):
         trn = res[(res["method"] == method) & ok]
@@ -248,11 +323,12 @@ def test_bench_cli_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, c
 
 
 def _assert_same_as_measure_photoset(res: pd.DataFrame, folder: Path) -> None:
-    """The bench's psi for the default method is what ``measure_photoset`` gives on the same JPEGs."""
-    from pipeline.bench.run import render_case
+    """The bench's psi for the default method is what ``measure_photoset`` gives on the same
+    JPEGs."""
     from pipeline.measure import DEFAULT_METHOD
-    from pipeline.photoset_measure import measure_photoset
     from pipeline.photoset import write_manifest, write_settings
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.study.run import render_case
 
     cases = grids.cases(TINY)
     folder.mkdir()
@@ -261,15 +337,31 @@ def _assert_same_as_measure_photoset(res: pd.DataFrame, folder: Path) -> None:
         scene, rendered = render_case(case)
         image = f"case_{case.case_id:03d}.jpg"
         (folder / image).write_bytes(rendered.jpeg_bytes)
-        rows.append({"image": image, "pressure_kpa": float(case.case_id), "direction": "up", "material": "synthetic",
-                     "actuator": "A1", "trial": "1", "step": case.case_id, "mm_per_px": scene.mm_per_px,
-                     "line_color": scene.line_color, "fixed_end_x": rendered.fixed_end_px[0],
-                     "fixed_end_y": rendered.fixed_end_px[1]})
+        rows.append(
+            {
+                "image": image,
+                "pressure_kpa": float(case.case_id),
+                "direction": "up",
+                "material": "synthetic",
+                "actuator": "A1",
+                "trial": "1",
+                "step": case.case_id,
+                "mm_per_px": scene.mm_per_px,
+                "line_color": scene.line_color,
+                "fixed_end_x": rendered.fixed_end_px[0],
+                "fixed_end_y": rendered.fixed_end_px[1],
+            }
+        )
     write_settings(folder, {"l0_mm": TINY.l0_mm, "positive_turn": "ccw"})
     write_manifest(folder, pd.DataFrame(rows))
-    angles = measure_photoset(folder, method=DEFAULT_METHOD, ramp_check=False)  # bench cases are no ramp
-    bench = res[res["method"] == DEFAULT_METHOD].set_index("case_id").loc[[c.case_id for c in cases]]
+    # bench cases are no ramp
+    angles = measure_photoset(folder, method=DEFAULT_METHOD, ramp_check=False)
+    bench = (
+        res[res["method"] == DEFAULT_METHOD].set_index("case_id").loc[[c.case_id for c in cases]]
+    )
     assert angles["status"].tolist() == bench["status"].tolist()
     assert angles["degree"].astype(float).tolist() == bench["degree"].tolist()
     # results.csv holds 8 significant digits
-    np.testing.assert_allclose(angles["psi_deg"].to_numpy(float), bench["psi_deg"].to_numpy(float), rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(
+        angles["psi_deg"].to_numpy(float), bench["psi_deg"].to_numpy(float), rtol=1e-7, atol=1e-9
+    )

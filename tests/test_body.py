@@ -12,8 +12,21 @@ from pipeline.measure.settings import resolve_settings
 W, H = 1280, 960
 
 
-def body_photo(psi_deg, *, length=600.0, width=46.0, clamp=True, backdrop=(190, 196, 200), body=(90, 140, 200),
-               noise=2.0, texture=False, seed=0, shift=(0.0, 0.0), tip_width=None, lost_side_from=None):
+def body_photo(
+    psi_deg,
+    *,
+    length=600.0,
+    width=46.0,
+    clamp=True,
+    backdrop=(190, 196, 200),
+    body=(90, 140, 200),
+    noise=2.0,
+    texture=False,
+    seed=0,
+    shift=(0.0, 0.0),
+    tip_width=None,
+    lost_side_from=None,
+):
     """A thick arc-shaped body (square ends) leaving a dark clamp along +x, with its exact psi.
 
     The inextensible layer is the body's lower edge (walking from the clamp); the body lies on
@@ -44,19 +57,33 @@ def body_photo(psi_deg, *, length=600.0, width=46.0, clamp=True, backdrop=(190, 
     if texture:  # fibre winding: thin darker strands across the body
         for t in np.arange(0.0, length, 14.0):
             i = int(t / length * (len(s) - 1))
-            a, b = to_px(pts[i : i + 1])[0], to_px((pts + n * width)[min(i + 40, len(s) - 1) : min(i + 40, len(s) - 1) + 1])[0]
-            cv2.line(img, tuple(np.round(a).astype(int)), tuple(np.round(b).astype(int)), tuple(int(0.7 * c) for c in body), 2, cv2.LINE_AA)
-    clamp_px = to_px(np.array([[-60.0, -20.0], [0.0, -20.0], [0.0, width + 20.0], [-60.0, width + 20.0]]))
+            a, b = (
+                to_px(pts[i : i + 1])[0],
+                to_px((pts + n * width)[min(i + 40, len(s) - 1) : min(i + 40, len(s) - 1) + 1])[0],
+            )
+            cv2.line(
+                img,
+                tuple(np.round(a).astype(int)),
+                tuple(np.round(b).astype(int)),
+                tuple(int(0.7 * c) for c in body),
+                2,
+                cv2.LINE_AA,
+            )
+    clamp_px = to_px(
+        np.array([[-60.0, -20.0], [0.0, -20.0], [0.0, width + 20.0], [-60.0, width + 20.0]])
+    )
     if clamp:
         cv2.fillPoly(img, [np.round(clamp_px * 16).astype(np.int32)], (60, 60, 66), cv2.LINE_AA, 4)
     img = np.clip(img + rng.normal(0.0, noise, img.shape), 0, 255).astype(np.uint8)
-    ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 90])
+    _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 90])
     img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
     return img, tuple(to_px(pts[:1])[0]), [tuple(map(float, p)) for p in clamp_px]
 
 
 def settings_for(fixed_end, **kw):
-    return resolve_settings(l0_mm=180.0, target="body", fixed_end=[float(v) for v in fixed_end], **kw)
+    return resolve_settings(
+        l0_mm=180.0, target="body", fixed_end=[float(v) for v in fixed_end], **kw
+    )
 
 
 @pytest.mark.parametrize("psi", [210.0, 120.0, 45.0, 3.0, -60.0, -150.0, -225.0])
@@ -108,7 +135,8 @@ def test_a_body_leaving_the_photo_is_flagged():
 
 def test_roi_restricts_the_search():
     img, fe, _ = body_photo(60.0)
-    cv2.rectangle(img, (20, 20), (400, 90), (90, 140, 200), -1)  # a second thing of the body's colour
+    # a second thing of the body's colour
+    cv2.rectangle(img, (20, 20), (400, 90), (90, 140, 200), -1)
     plain = measure_image(img, settings_for(fe))
     boxed = measure_image(img, settings_for(fe, roi=[0, 120, W, H]))
     assert boxed.status == "ok" and boxed.psi_deg == pytest.approx(60.0, abs=2.5)
@@ -160,7 +188,7 @@ def test_a_long_thin_tube_through_the_clamp_does_not_set_the_body_width(psi):
     # along its own ridge, not over the whole component (where the tube's would win)
     img, fe, clamp = body_photo(psi, length=500.0, width=46.0, seed=5)
     (x0, y0), (x3, y3) = clamp[0], clamp[3]
-    y_mid = int(round((y0 + y3) / 2))
+    y_mid = round((y0 + y3) / 2)
     x_clamp = int(min(x0, x3))
     cv2.line(img, (x_clamp, y_mid), (x_clamp - TUBE_PX, y_mid), (90, 140, 200), 9, cv2.LINE_AA)
     res = measure_image(img, settings_for(fe))
@@ -172,7 +200,7 @@ def test_a_tube_longer_than_the_body_is_never_an_ok_psi():
     # the farthest point from the fixed end is then the tube's end: flagged, not measured as psi
     img, fe, clamp = body_photo(120.0, length=300.0, width=46.0, seed=5, shift=(250.0, 0.0))
     (x0, y0), (x3, y3) = clamp[0], clamp[3]
-    y_mid = int(round((y0 + y3) / 2))
+    y_mid = round((y0 + y3) / 2)
     cv2.line(img, (int(min(x0, x3)), y_mid), (0, y_mid), (90, 140, 200), 12, cv2.LINE_AA)
     res = measure_image(img, settings_for(fe))
     assert res.status != "ok" or res.psi_deg == pytest.approx(120.0, abs=5.0), res.reason

@@ -1,5 +1,6 @@
-"""Issue 17: a checkerboard photo in the photo set makes psi the physical angle under a tilted camera
-and a real lens; bad board photos are refused or flagged; calibrate / check / preview / report."""
+"""Issue 17: a checkerboard photo in the photo set makes psi the physical angle under a tilted
+camera and a real lens; bad board photos are refused or flagged; calibrate / check / preview /
+report."""
 
 from __future__ import annotations
 
@@ -23,10 +24,9 @@ from pipeline.measure.calibration import (
     PlaneCalibration,
     calibrate_views,
     find_board,
-    plane_centreline,
     read_store,
 )
-from pipeline.measure.core import measure_image
+from pipeline.measure.core import measure_image, plane_centreline
 from pipeline.measure.extract import LineExtraction
 from pipeline.measure.settings import SettingsError, resolve_settings
 from pipeline.photoset import load_photoset, validate_photoset, write_settings
@@ -40,15 +40,26 @@ POSE = {"width": 640, "height": 480, "tilt_deg": 7.0, "lens_k1": -0.1, "tilt_azi
 
 
 def _run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "pipeline", *args], capture_output=True, text=True, check=False
+    )
 
 
 @pytest.fixture(scope="module")
 def calibrated(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, pd.DataFrame]:
     """A rendered ramp (7 photos) with its board photo: camera tilted 7 deg, k1 = -0.1."""
     folder = tmp_path_factory.mktemp("calibrated")
-    truth = render_photoset(folder, "DS20", actuators=1, trials=1, seed=4, scene="lab", step_kpa=40.0,
-                            scene_overrides=POSE, board=True)
+    truth = render_photoset(
+        folder,
+        "DS20",
+        actuators=1,
+        trials=1,
+        seed=4,
+        scene="lab",
+        step_kpa=40.0,
+        scene_overrides=POSE,
+        board=True,
+    )
     return folder, truth
 
 
@@ -69,7 +80,8 @@ def _yaml(folder: Path) -> dict:
 def test_lens_distortion_is_exact_and_invertible() -> None:
     scene = scene_from("clean", width=640, height=480, tilt_deg=6.0, lens_k1=0.1)
     cam = make_camera(scene, rotation_deg=30.0, fixed_end_px=(200.0, 300.0))
-    assert np.allclose(cam.fixed_end_px, (200.0, 300.0), atol=1e-6)  # the fixed end is where it was asked, as seen
+    # the fixed end is where it was asked, as seen
+    assert np.allclose(cam.fixed_end_px, (200.0, 300.0), atol=1e-6)
     world = np.array([[0.0, 0.0], [50.0, 20.0], [-80.0, 60.0], [120.0, -40.0]])
     assert np.allclose(cam.from_px(cam.to_px(world)), world, atol=1e-6)
     ideal = dataclasses.replace(cam, k1=0.0).to_px(world)
@@ -82,10 +94,15 @@ def test_lens_distortion_is_exact_and_invertible() -> None:
 
 def test_board_photo_corners_are_found_where_they_were_drawn() -> None:
     scene = scene_from("lab", **POSE)
-    board = render_board(scene, make_camera(scene, rotation_deg=10.0, fixed_end_px=(300.0, 250.0)), seed=2)
+    board = render_board(
+        scene, make_camera(scene, rotation_deg=10.0, fixed_end_px=(300.0, 250.0)), seed=2
+    )
     found = find_board(cv2.cvtColor(board.image, cv2.COLOR_BGR2GRAY), board.inner_corners)
     assert found is not None and found.shape == (54, 2)
-    err = min(np.hypot(*(found - board.corners_px).T).max(), np.hypot(*(found[::-1] - board.corners_px).T).max())
+    err = min(
+        np.hypot(*(found - board.corners_px).T).max(),
+        np.hypot(*(found[::-1] - board.corners_px).T).max(),
+    )
     assert err < 0.3
 
 
@@ -98,11 +115,14 @@ def test_calibration_maps_the_image_to_the_physical_plane() -> None:
     assert cal.rms_px < 0.2 and not cal.doubtful
     assert abs(cal.k1 - scene.lens_k1) < 0.02
     # distances on the plane are the world's, anywhere in the frame (not only on the board)
-    world = cam.from_px([[40.0, 40.0], [600.0, 60.0], [620.0, 450.0], [30.0, 440.0], [320.0, 240.0]])
+    world = cam.from_px(
+        [[40.0, 40.0], [600.0, 60.0], [620.0, 450.0], [30.0, 440.0], [320.0, 240.0]]
+    )
     mm = cal.to_mm(cam.to_px(world))
     d_true = np.hypot(*(world[:, None] - world[None]).transpose(2, 0, 1))
     d_cal = np.hypot(*(mm[:, None] - mm[None]).transpose(2, 0, 1))
-    assert np.abs(d_cal - d_true).max() < 0.5  # mm, over up to 440 mm (the frame corners lie beyond the board)
+    # mm, over up to 440 mm (the frame corners lie beyond the board)
+    assert np.abs(d_cal - d_true).max() < 0.5
     assert np.allclose(cal.to_image(cal.to_plane(board.corners_px)), board.corners_px, atol=1e-4)
     # and without the lens model the corners of the frame would be millimetres off
     flat = dataclasses.replace(cal, dist_coeffs=(0.0,) * 5).to_mm(cam.to_px(world))
@@ -111,7 +131,9 @@ def test_calibration_maps_the_image_to_the_physical_plane() -> None:
 
 def test_noisy_corners_give_a_doubtful_calibration() -> None:
     scene = scene_from("lab", **POSE)
-    board = render_board(scene, make_camera(scene, rotation_deg=0.0, fixed_end_px=(320.0, 240.0)), seed=3)
+    board = render_board(
+        scene, make_camera(scene, rotation_deg=0.0, fixed_end_px=(320.0, 240.0)), seed=3
+    )
     noisy = board.corners_px + np.random.default_rng(0).normal(0, 2.0, board.corners_px.shape)
     cal = calibrate_views([noisy], (640, 480), board.inner_corners, board.square_mm)
     assert cal.rms_px > 1.0 and cal.doubtful
@@ -133,14 +155,22 @@ def test_calibrated_psi_is_the_physical_angle(calibrated) -> None:
     assert err.max() < 0.5 and err.median() < 0.2, err.tolist()
     l0 = _yaml(folder)["l0_mm"]
     assert ((angles["length_mm"] - l0).abs() < l0 * 0.02).all()  # plane mm
-    assert np.allclose(angles["calibration_px"], cal.plane.rms_px) and (angles["calibration_mm"] > 0).all()
+    assert (
+        np.allclose(angles["calibration_px"], cal.plane.rms_px)
+        and (angles["calibration_mm"] > 0).all()
+    )
     from pipeline.photoset_measure import _tasks
 
-    assert all(f"calibrated ({cal.plane.rms_px:.2f} px)" in t.title for t in _tasks(ps, "auto", None))  # overlays say so
+    # overlays say so
+    assert all(
+        f"calibrated ({cal.plane.rms_px:.2f} px)" in t.title for t in _tasks(ps, "auto", None)
+    )
     # the same photos measured in the image (today's way) are degrees off the physical angle
     plain = []
     for i, image in enumerate(ps.manifest["image"]):
-        s = dataclasses.replace(ps.rows[i], calibration=None, mm_per_px=float(truth["mm_per_px"].iloc[0]))
+        s = dataclasses.replace(
+            ps.rows[i], calibration=None, mm_per_px=float(truth["mm_per_px"].iloc[0])
+        )
         plain.append(measure_image(cv2.imread(str(folder / image)), s).psi_deg)
     plain_err = (np.asarray(plain) - truth["psi_deg"]).abs()
     assert plain_err.median() > 1.0 and plain_err.median() > 5 * err.median()
@@ -152,11 +182,17 @@ def test_calibrate_stores_and_measuring_reads_it(calibrated, tmp_path: Path) -> 
     assert any("not stored" in p.message for p in before)
     run = _run("photoset", "calibrate", str(folder))
     assert run.returncode == 0, run.stderr
-    assert "reprojection error" in run.stdout and " px, " in run.stdout and " mm on the plane" in run.stdout
+    assert (
+        "reprojection error" in run.stdout
+        and " px, " in run.stdout
+        and " mm on the plane" in run.stdout
+    )
     stored = read_store(folder)
     assert len(stored) == 1
     ps = load_photoset(folder)
-    assert ps.rows[0].calibration.stored and ps.rows[0].calibration.plane == next(iter(stored.values()))
+    assert ps.rows[0].calibration.stored and ps.rows[0].calibration.plane == next(
+        iter(stored.values())
+    )
     assert not any("not stored" in p.message for p in validate_photoset(folder, warnings=True))
     assert _run("photoset", "check", str(folder)).returncode == 0
     # a warning above the threshold
@@ -168,7 +204,9 @@ def test_calibrate_stores_and_measuring_reads_it(calibrated, tmp_path: Path) -> 
     assert not load_photoset(folder).rows[0].calibration.stored
 
 
-def test_board_not_found_is_refused_naming_the_file_and_the_board_size(calibrated, tmp_path: Path) -> None:
+def test_board_not_found_is_refused_naming_the_file_and_the_board_size(
+    calibrated, tmp_path: Path
+) -> None:
     folder = _copy(calibrated[0], tmp_path / "set")
     first = str(pd.read_csv(folder / "manifest.csv")["image"].iloc[0])
     shutil.copy(folder / first, folder / "board.jpg")  # a photo without a board
@@ -192,15 +230,23 @@ def test_wrong_inner_corner_count_is_refused(calibrated, tmp_path: Path) -> None
     assert "board.jpg" in text and "7x5 inner corners" in text
 
 
-def test_board_of_another_resolution_is_refused_and_its_rows_fail(calibrated, tmp_path: Path) -> None:
+def test_board_of_another_resolution_is_refused_and_its_rows_fail(
+    calibrated, tmp_path: Path
+) -> None:
     folder = _copy(calibrated[0], tmp_path / "set")
     img = cv2.imread(str(folder / "board.jpg"))
-    cv2.imwrite(str(folder / "board.jpg"), cv2.resize(img, (800, 600), interpolation=cv2.INTER_CUBIC))
+    cv2.imwrite(
+        str(folder / "board.jpg"), cv2.resize(img, (800, 600), interpolation=cv2.INTER_CUBIC)
+    )
     problems = [p for p in validate_photoset(folder) if "800x600" in p.message]
     n = len(pd.read_csv(folder / "manifest.csv"))
-    assert len(problems) == n and all(p.line is not None and "640x480" in p.message for p in problems)
+    assert len(problems) == n and all(
+        p.line is not None and "640x480" in p.message for p in problems
+    )
     angles = measure_photoset(folder)  # never a silently wrong number: each photo is a failed row
-    assert (angles["status"] == "failed").all() and angles["reason"].str.contains("800x600 px").all()
+    assert (angles["status"] == "failed").all() and angles["reason"].str.contains(
+        "800x600 px"
+    ).all()
 
 
 def test_a_large_reprojection_error_flags_every_row_using_it(calibrated, tmp_path: Path) -> None:
@@ -222,9 +268,17 @@ def test_per_row_calibration_for_sets_of_several_sessions(calibrated, tmp_path: 
     """Two sessions with different camera poses in one set, each row naming its own board photo."""
     folder = _copy(calibrated[0], tmp_path / "set")
     other = tmp_path / "other"
-    truth2 = render_photoset(other, "DS20", actuators=1, trials=1, seed=9, scene="lab", step_kpa=80.0,
-                             scene_overrides={**POSE, "tilt_deg": 4.0, "lens_k1": 0.08, "tilt_azimuth_deg": 140.0},
-                             board=True)
+    truth2 = render_photoset(
+        other,
+        "DS20",
+        actuators=1,
+        trials=1,
+        seed=9,
+        scene="lab",
+        step_kpa=80.0,
+        scene_overrides={**POSE, "tilt_deg": 4.0, "lens_k1": 0.08, "tilt_azimuth_deg": 140.0},
+        board=True,
+    )
     m1 = pd.read_csv(folder / "manifest.csv", dtype=str)
     m2 = pd.read_csv(other / "manifest.csv", dtype=str)
     m2["trial"] = "2"
@@ -233,9 +287,11 @@ def test_per_row_calibration_for_sets_of_several_sessions(calibrated, tmp_path: 
         shutil.copy(other / name, folder / f"s2_{name}")
     shutil.copy(other / "board.jpg", folder / "board_s2.jpg")
     m1["calibration"] = "board.jpg"  # a name only: square size and corners from photoset.yaml
-    square = _yaml(other)["calibration"]["square_mm"]  # that print's squares; corners from photoset.yaml
+    # that print's squares; corners from photoset.yaml
+    square = _yaml(other)["calibration"]["square_mm"]
     m2["calibration"] = f"{{board: board_s2.jpg, square_mm: {square}}}"
-    for m, f in ((m1, folder), (m2, other)):  # the clamp is elsewhere in the second session's photos
+    # the clamp is elsewhere in the second session's photos
+    for m, f in ((m1, folder), (m2, other)):
         m["fixed_end_x"], m["fixed_end_y"] = _yaml(f)["fixed_end"]
     pd.concat([m1, m2]).to_csv(folder / "manifest.csv", index=False)
     ps = load_photoset(folder)
@@ -259,7 +315,8 @@ def test_without_calibration_the_line_is_measured_in_the_image() -> None:
 def test_the_plane_turns_the_fixed_direction_and_scales_the_line() -> None:
     """A plane rotated 30 deg ccw (on screen) against the photo at 0.5 mm per plane px."""
     a = np.deg2rad(30.0)
-    rot = np.array([[np.cos(a), np.sin(a), 0.0], [-np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])  # y down
+    # y down
+    rot = np.array([[np.cos(a), np.sin(a), 0.0], [-np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
     plane = PlaneCalibration((640, 480), (600.0, 0, 319.5, 0, 600.0, 239.5, 0, 0, 1), (0.0,) * 5,
                              tuple(rot.ravel()), 0.5, 0.1, 0.05, 1, 54)
     from pipeline.measure.calibration import Calibration
@@ -272,7 +329,9 @@ def test_the_plane_turns_the_fixed_direction_and_scales_the_line() -> None:
     assert s2.mm_per_px == 0.5 and abs(s2.fixed_direction_deg - 40.0) < 1e-6
     np.testing.assert_allclose(ends, (4.0, 6.0), atol=1e-6)
     np.testing.assert_allclose(np.hypot(*np.diff(q, axis=0).T), 10.0, atol=1e-6)
-    with pytest.raises(ValueError, match="the photo is 640x360 px but the board photo b.jpg is 640x480 px"):
+    with pytest.raises(
+        ValueError, match="the photo is 640x360 px but the board photo b.jpg is 640x480 px"
+    ):
         plane_centreline(line, s, (180, 320), 2.0)
 
 
@@ -283,18 +342,30 @@ def test_the_plane_turns_the_fixed_direction_and_scales_the_line() -> None:
 def test_calibration_settings_are_validated_once_with_every_problem(tmp_path: Path) -> None:
     (tmp_path / "b.jpg").write_bytes(b"")
     with pytest.raises(SettingsError) as err:
-        resolve_settings(l0_mm=100, calibration={"board": "nope.jpg", "inner_corners": [9], "colour": 1}, folder=tmp_path)
+        resolve_settings(
+            l0_mm=100,
+            calibration={"board": "nope.jpg", "inner_corners": [9], "colour": 1},
+            folder=tmp_path,
+        )
     text = str(err.value)
     assert "'nope.jpg' does not exist" in text and "square_mm is missing" in text
     assert "inner_corners = [9]" in text and "['colour'] unknown" in text
     with pytest.raises(SettingsError, match="must be a positive number"):
-        resolve_settings(l0_mm=100, calibration={"board": "b.jpg", "square_mm": -2, "inner_corners": "9x6"}, folder=tmp_path)
+        resolve_settings(
+            l0_mm=100,
+            calibration={"board": "b.jpg", "square_mm": -2, "inner_corners": "9x6"},
+            folder=tmp_path,
+        )
     with pytest.raises(SettingsError, match="cannot be decoded"):
-        resolve_settings(l0_mm=100, calibration={"board": "b.jpg", "square_mm": 20, "inner_corners": "9x6"}, folder=tmp_path)
+        resolve_settings(
+            l0_mm=100,
+            calibration={"board": "b.jpg", "square_mm": 20, "inner_corners": "9x6"},
+            folder=tmp_path,
+        )
 
 
 def test_one_board_is_calibrated_once_per_load(calibrated, monkeypatch) -> None:
-    import pipeline.measure.calibration as calibration
+    from pipeline.measure import calibration
 
     calls = []
     real = calibration.calibrate_files
@@ -316,28 +387,50 @@ def test_preview_shows_the_rectified_photo(calibrated, tmp_path: Path) -> None:
     tile = preview_tile(image, ps.rows[0], title="t")
     plain = preview_tile(image, dataclasses.replace(ps.rows[0], calibration=None), title="t")
     assert tile.shape[1] == 3 * TILE_WIDTH_PX and plain.shape[1] == 2 * TILE_WIDTH_PX
-    assert not np.array_equal(tile[:, 2 * TILE_WIDTH_PX:], tile[:, :TILE_WIDTH_PX])  # the rectified photo differs
+    # the rectified photo differs
+    assert not np.array_equal(tile[:, 2 * TILE_WIDTH_PX:], tile[:, :TILE_WIDTH_PX])
     run = _run("photoset", "preview", str(folder), "--out", str(tmp_path / "p.jpg"))
     assert run.returncode == 0 and cv2.imread(str(tmp_path / "p.jpg")).shape[1] >= 6 * TILE_WIDTH_PX
 
 
 def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
+    from pipeline.layout.style import report_style
     from pipeline.report.data import Dataset, ReportInputs, load_report_data
-    from pipeline.report.style import report_style
     from pipeline.report.summary import calibration_summary, summary_page
 
     datasets = []
     for name, err in (("bench", 0.05), ("old", None), ("shaky", 1.4)):
-        rows = [{"image": f"{name}{i}.jpg", "psi_deg": 200.0 - 30 * i, "kappa_per_mm": 0.01, "length_mm": 195.0,
-                 "method": "auto", "residual_px": 0.3, "status": "ok", "reason": "", "seconds": 0.1,
-                 "pressure_kpa": 10.0 * i, "direction": "up", "material": "DS20", "actuator": "A1", "trial": "1",
-                 "step": i, "calibration_px": err, "calibration_mm": None if err is None else err / 3} for i in range(4)]
+        rows = [
+            {
+                "image": f"{name}{i}.jpg",
+                "psi_deg": 200.0 - 30 * i,
+                "kappa_per_mm": 0.01,
+                "length_mm": 195.0,
+                "method": "auto",
+                "residual_px": 0.3,
+                "status": "ok",
+                "reason": "",
+                "seconds": 0.1,
+                "pressure_kpa": 10.0 * i,
+                "direction": "up",
+                "material": "DS20",
+                "actuator": "A1",
+                "trial": "1",
+                "step": i,
+                "calibration_px": err,
+                "calibration_mm": None if err is None else err / 3,
+            }
+            for i in range(4)
+        ]
         path = tmp_path / f"{name}.csv"
         pd.DataFrame(rows).to_csv(path, index=False)
         datasets.append(Dataset(name, path))
     data = load_report_data(ReportInputs(datasets=tuple(datasets)))
     lines = calibration_summary(data)  # page 1's "Camera calibration" lines
-    assert lines[0] == ("b", "bench: calibrated, 4 of 4 photos; reprojection error 0.05 px (0.017 mm on the plane)")
+    assert lines[0] == (
+        "b",
+        "bench: calibrated, 4 of 4 photos; reprojection error 0.05 px (0.017 mm on the plane)",
+    )
     assert lines[1][1].startswith("old: not calibrated")
     assert lines[2][0] == "w" and "1.40 px" in lines[2][1] and "flagged" in lines[2][1]
     with report_style():
@@ -346,12 +439,16 @@ def test_report_states_which_sets_are_calibrated(tmp_path: Path) -> None:
 
 
 def test_body_mode_on_a_calibrated_plane_keeps_the_clamp_direction() -> None:
-    """Body mode's one hook: the centre line and ``fixed_direction_deg`` are both taken to the plane."""
-    from pipeline.measure.calibration import Calibration
+    """Body mode's one hook: the centre line and ``fixed_direction_deg`` are both taken to the
+    plane."""
     from test_body import body_photo
 
+    from pipeline.measure.calibration import Calibration
+
     img, fe, _ = body_photo(100.0, seed=5)
-    base = resolve_settings(l0_mm=180.0, target="body", fixed_end=[float(v) for v in fe], fixed_direction_deg=0.0)
+    base = resolve_settings(
+        l0_mm=180.0, target="body", fixed_end=[float(v) for v in fe], fixed_direction_deg=0.0
+    )
     a = np.deg2rad(30.0)  # the plane turned 30 deg against the photo, 0.3 mm per plane px
     rot = np.array([[np.cos(a), np.sin(a), 0.0], [-np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
     plane = PlaneCalibration((1280, 960), (1500.0, 0, 639.5, 0, 1500.0, 479.5, 0, 0, 1), (0.0,) * 5,
@@ -364,6 +461,9 @@ def test_body_mode_on_a_calibrated_plane_keeps_the_clamp_direction() -> None:
     cv2.setRNGSeed(0)
     cal = measure_image(img, calibrated)
     assert plain.status == cal.status == "ok", (plain.reason, cal.reason)
-    assert cal.psi_deg == pytest.approx(plain.psi_deg, abs=0.05) and cal.psi_deg == pytest.approx(100.0, abs=2.5)
+    assert cal.psi_deg == pytest.approx(plain.psi_deg, abs=0.05) and cal.psi_deg == pytest.approx(
+        100.0, abs=2.5
+    )
     assert cal.length_mm == pytest.approx(0.3 * plain.length_px, rel=0.01)  # plane mm
-    np.testing.assert_array_equal(cal.centreline_px, plain.centreline_px)  # overlays stay in the photo's pixels
+    # overlays stay in the photo's pixels
+    np.testing.assert_array_equal(cal.centreline_px, plain.centreline_px)

@@ -7,13 +7,26 @@ import sys
 
 import pytest
 
+from pipeline.bench.cli import BENCHES
 from pipeline.cli import SUBCOMMANDS
 
-REQUIRED = {"synth", "measure", "aggregate", "model", "compare", "report", "acquire", "bench", "photoset"}
+REQUIRED = {
+    "synth",
+    "measure",
+    "aggregate",
+    "model",
+    "compare",
+    "report",
+    "acquire",
+    "bench",
+    "photoset",
+}
 
 
 def _run(*args):
-    return subprocess.run([sys.executable, "-m", "pipeline", *args], capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "pipeline", *args], capture_output=True, text=True, check=False
+    )
 
 
 def test_help_lists_the_subcommands():
@@ -32,15 +45,42 @@ def test_every_subcommand_has_help(name):
 
 
 def test_photoset_init_then_check(photo_folder):
-    out = _run("photoset", "init", str(photo_folder), "--pattern", "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200")
+    out = _run(
+        "photoset",
+        "init",
+        str(photo_folder),
+        "--pattern",
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        "--l0-mm",
+        "200",
+    )
     assert out.returncode == 0, out.stderr
     assert "8 photos (6 up, 2 down)" in out.stdout
     out = _run("photoset", "check", str(photo_folder))
     assert out.returncode == 0, out.stderr
-    assert "OK (8 photos" in out.stdout  # warnings (no mm_per_px, an empty first photo) do not fail the check
+    # warnings (no mm_per_px, an empty first photo) do not fail the check
+    assert "OK (8 photos" in out.stdout
 
 
 def test_bad_input_is_one_line_without_traceback(tmp_path):
     out = _run("photoset", "init", str(tmp_path / "nope"), "--pattern", "{pressure_kpa}.jpg")
     assert out.returncode == 2
     assert "Traceback" not in out.stderr and "not a folder" in out.stderr
+
+
+@pytest.mark.parametrize("what", sorted(BENCHES))
+def test_every_benchmark_runs_from_the_one_entry_point(what, capsys):
+    from pipeline.cli import main
+
+    with pytest.raises(SystemExit) as stop:  # argparse exits 0 after --help
+        main(["bench", what, "--help"])
+    assert stop.value.code == 0
+    assert f"usage: python -m pipeline bench {what}" in capsys.readouterr().out
+
+
+def test_bench_model_prints_its_figures(capsys):
+    from pipeline.cli import main
+
+    assert main(["bench", "model", "--grid-sizes", "2", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "max_rel_error" in out and "default grid (grid_n=4)" in out

@@ -23,11 +23,30 @@ from pipeline.errors import UserInputError
 
 def _hyst() -> pd.DataFrame:
     # up: 200, 100, -50 at 0, 10, 20 kPa; down: 190, 20, -50
-    rows = [("up", 0, 200.0), ("up", 10, 100.0), ("up", 20, -50.0),
-            ("down", 0, 190.0), ("down", 10, 20.0), ("down", 20, -50.0)]
-    return pd.DataFrame([{"material": "DS20", "direction": d, "pressure_kpa": p, "psi_mean_deg": s,
-                          "psi_sd_deg": 1.0, "n": 3, "n_actuators": 3, "n_trials": 3, "n_excluded": 0}
-                         for d, p, s in rows])
+    rows = [
+        ("up", 0, 200.0),
+        ("up", 10, 100.0),
+        ("up", 20, -50.0),
+        ("down", 0, 190.0),
+        ("down", 10, 20.0),
+        ("down", 20, -50.0),
+    ]
+    return pd.DataFrame(
+        [
+            {
+                "material": "DS20",
+                "direction": d,
+                "pressure_kpa": p,
+                "psi_mean_deg": s,
+                "psi_sd_deg": 1.0,
+                "n": 3,
+                "n_actuators": 3,
+                "n_trials": 3,
+                "n_excluded": 0,
+            }
+            for d, p, s in rows
+        ]
+    )
 
 
 def linear_model(material: str, pressure_kpa: np.ndarray, l0_mm=None) -> np.ndarray:
@@ -72,7 +91,12 @@ def test_crossings_both_branches():
 
 def test_range_and_hysteresis_width():
     out = compare(_hyst(), model_psi=None, fit_k_p=None).iloc[0]
-    assert (out["range_deg"], out["psi_max_deg"], out["psi_min_deg"], out["range_kpa"]) == (250.0, 200.0, -50.0, 20.0)
+    assert (out["range_deg"], out["psi_max_deg"], out["psi_min_deg"], out["range_kpa"]) == (
+        250.0,
+        200.0,
+        -50.0,
+        20.0,
+    )
     assert hysteresis_width(_hyst()) == (80.0, 10.0)
     up_only = _hyst()[_hyst()["direction"] == "up"]
     w, at = hysteresis_width(up_only)
@@ -94,8 +118,13 @@ def ls_fit(material, p, psi, l0_mm=None):
 
 def _rows(k_by_actuator):
     psi = np.array([200.0, 150.0, 100.0, 50.0, 0.0, -50.0])
-    return pd.concat([pd.DataFrame({"actuator": a, "pressure_kpa": k * _g(psi), "psi_deg": psi})
-                      for a, k in k_by_actuator.items()], ignore_index=True)
+    return pd.concat(
+        [
+            pd.DataFrame({"actuator": a, "pressure_kpa": k * _g(psi), "psi_deg": psi})
+            for a, k in k_by_actuator.items()
+        ],
+        ignore_index=True,
+    )
 
 
 def test_bootstrap_k_p_over_actuators():
@@ -122,7 +151,9 @@ def test_compare_fits_k_p_from_angles_rows():
     angles = rows.assign(status="ok", material="DS20", direction="up", trial=1)
     angles.loc[0, "status"] = "failed"
     angles.loc[0, "psi_deg"] = np.nan
-    out = compare(_hyst(), angles, model_psi=linear_model, fit_k_p=ls_fit, n_boot=20, seed=1).iloc[0]
+    out = compare(_hyst(), angles, model_psi=linear_model, fit_k_p=ls_fit, n_boot=20, seed=1).iloc[
+        0
+    ]
     assert out["k_p_fit"] == pytest.approx(2.0)
     assert out["k_p_ci_low"] == pytest.approx(2.0) and out["k_p_ci_high"] == pytest.approx(2.0)
     assert out["n_actuators"] == 2
@@ -135,7 +166,11 @@ def test_unknown_material_keeps_data_metrics():
     h = _hyst().assign(material="EcoFlex")
     with pytest.warns(UserWarning, match="EcoFlex"):
         out = compare(h, model_psi=model, fit_k_p=None).iloc[0]
-    assert math.isnan(out["rms_deg"]) and out["range_deg"] == 250.0 and math.isnan(out["paper_rms_deg"])
+    assert (
+        math.isnan(out["rms_deg"])
+        and out["range_deg"] == 250.0
+        and math.isnan(out["paper_rms_deg"])
+    )
 
 
 def test_bad_hysteresis_table():
@@ -166,14 +201,26 @@ def test_cli_with_the_real_model(tmp_path, capsys):
             for direction, order in (("up", p), ("down", p[::-1])):
                 for pk in order:
                     psi = float(truth[p == pk][0] + rng.normal(0.0, 2.0))
-                    rows.append({"image": f"{actuator}_{trial}_{direction}_{pk:g}.jpg", "psi_deg": psi,
-                                 "status": "ok", "reason": "", "pressure_kpa": pk, "direction": direction,
-                                 "material": "SS40", "actuator": actuator, "trial": trial})
+                    rows.append(
+                        {
+                            "image": f"{actuator}_{trial}_{direction}_{pk:g}.jpg",
+                            "psi_deg": psi,
+                            "status": "ok",
+                            "reason": "",
+                            "pressure_kpa": pk,
+                            "direction": direction,
+                            "material": "SS40",
+                            "actuator": actuator,
+                            "trial": trial,
+                        }
+                    )
     angles = tmp_path / "angles.csv"
     pd.DataFrame(rows).to_csv(angles, index=False)
     hyst, rms = tmp_path / "h.csv", tmp_path / "rms.csv"
     assert main(["aggregate", str(angles), "--out", str(hyst)]) == 0
-    assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(rms), "--seed", "3"]) == 0
+    assert (
+        main(["compare", str(hyst), "--angles", str(angles), "--out", str(rms), "--seed", "3"]) == 0
+    )
     assert "compare: SS40, l0 255 mm [" in capsys.readouterr().out
     out = pd.read_csv(rms).iloc[0]
     finite = np.isfinite(truth)
@@ -186,44 +233,90 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     # another reading of the model reaches the comparison: the printed Jacobian (jacobian=none)
     # is about 15 % softer, so data drawn from the default model need a larger k_P
     other = tmp_path / "rms_printed.csv"
-    assert main(["compare", str(hyst), "--angles", str(angles), "--out", str(other), "--seed", "3",
-                 "--jacobian", "none"]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                str(hyst),
+                "--angles",
+                str(angles),
+                "--out",
+                str(other),
+                "--seed",
+                "3",
+                "--jacobian",
+                "none",
+            ]
+        )
+        == 0
+    )
     printed = pd.read_csv(other).iloc[0]
     assert printed["k_p_fit"] > out["k_p_fit"] * 1.1 and printed["rms_deg"] > out["rms_deg"]
     assert main(["compare", str(hyst), "--out", str(other), "--eq12-scale", "-1"]) == 2
     # no l0_mm in this angles.csv: the model's default l0, and rms.csv says where it came from
-    assert out["l0_mm"] == model.load_materials()["SS40"].l0_mm and out["l0_source"] == "materials file"
+    assert (
+        out["l0_mm"] == model.load_materials()["SS40"].l0_mm
+        and out["l0_source"] == "materials file"
+    )
     assert out["rms_kind"] == "unknown" and out["model_fit"].startswith("none")
 
 
 def _angles(dataset: str, material: str, l0_mm, psi_offset: float = 0.0) -> pd.DataFrame:
     p = np.array([0.0, 10.0, 20.0])
-    rows = [{"dataset": dataset, "image": f"{dataset}_{a}_{d}_{pk:g}.jpg", "status": "ok", "material": material,
-             "actuator": a, "trial": "1", "direction": d, "pressure_kpa": pk, "l0_mm": l0_mm,
-             "psi_deg": 200.0 - 10.0 * pk + psi_offset}
-            for a in ("A1", "A2") for d in ("up", "down") for pk in p]
+    rows = [
+        {
+            "dataset": dataset,
+            "image": f"{dataset}_{a}_{d}_{pk:g}.jpg",
+            "status": "ok",
+            "material": material,
+            "actuator": a,
+            "trial": "1",
+            "direction": d,
+            "pressure_kpa": pk,
+            "l0_mm": l0_mm,
+            "psi_deg": 200.0 - 10.0 * pk + psi_offset,
+        }
+        for a in ("A1", "A2")
+        for d in ("up", "down")
+        for pk in p
+    ]
     return pd.DataFrame(rows)
 
 
 def _hyst_of(angles: pd.DataFrame) -> pd.DataFrame:
     from pipeline.aggregate import aggregate_hysteresis
 
-    return pd.concat([aggregate_hysteresis(g).assign(dataset=d) for d, g in angles.groupby("dataset")],
-                     ignore_index=True)
+    return pd.concat(
+        [aggregate_hysteresis(g).assign(dataset=d) for d, g in angles.groupby("dataset")],
+        ignore_index=True,
+    )
 
 
 def test_each_dataset_is_compared_at_its_own_l0():
     """Datasets of one material pool only when they share l0; each row says which l0 and why."""
-    angles = pd.concat([_angles("a", "SS50", 255.0), _angles("b", "SS50", 220.0, psi_offset=5.0),
-                        _angles("c", "SS50", 255.0), _angles("d", "SS50", np.nan)], ignore_index=True)
+    angles = pd.concat(
+        [
+            _angles("a", "SS50", 255.0),
+            _angles("b", "SS50", 220.0, psi_offset=5.0),
+            _angles("c", "SS50", 255.0),
+            _angles("d", "SS50", np.nan),
+        ],
+        ignore_index=True,
+    )
     calls = []
 
     def model(material, p, l0_mm):
         calls.append(l0_mm)
         return 200.0 - 10.0 * np.asarray(p, float) + (5.0 if l0_mm == 220.0 else 0.0)
 
-    out = compare(_hyst_of(angles), angles, model_psi=model, fit_k_p=None, default_l0_mm={"SS50": 250.0},
-                  data_sources={"a": "synthetic", "b": "measured", "c": "synthetic", "d": "measured"})
+    out = compare(
+        _hyst_of(angles),
+        angles,
+        model_psi=model,
+        fit_k_p=None,
+        default_l0_mm={"SS50": 250.0},
+        data_sources={"a": "synthetic", "b": "measured", "c": "synthetic", "d": "measured"},
+    )
     assert list(out["curve"]) == ["SS50, l0 250 mm", "SS50, l0 220 mm", "SS50, l0 255 mm"]
     rows = out.set_index("curve")
     assert rows.loc["SS50, l0 255 mm", "datasets"] == "a + c"
@@ -236,14 +329,21 @@ def test_each_dataset_is_compared_at_its_own_l0():
     # every comparison meets its own model exactly (b's data are 5 deg up, so is its 220 mm model)
     np.testing.assert_allclose(out["rms_deg"], 0.0, atol=1e-12)
     assert (out["n_actuators"] == [2, 2, 4]).all()
-    mixed = compare(_hyst_of(angles), angles, model_psi=model, fit_k_p=None,
-                    data_sources={"a": "synthetic", "b": "measured"})
+    mixed = compare(
+        _hyst_of(angles),
+        angles,
+        model_psi=model,
+        fit_k_p=None,
+        data_sources={"a": "synthetic", "b": "measured"},
+    )
     assert "unknown" in set(mixed["rms_kind"])  # c and d have no stated source
 
 
 def test_a_dataset_mixing_l0_keeps_its_data_figures_and_says_why_no_model():
-    one = pd.concat([_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
-                    ignore_index=True)
+    one = pd.concat(
+        [_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
+        ignore_index=True,
+    )
     with pytest.warns(UserWarning, match="several l0 .200, 220 mm"):
         out = compare(_hyst_of(one), one, model_psi=linear_model, fit_k_p=ls_fit).iloc[0]
     assert out["curve"] == "DS20, x (several l0)" and math.isnan(out["l0_mm"])
@@ -260,49 +360,108 @@ def test_cli_curves_are_the_ones_each_rms_used(tmp_path, capsys):
     for name, l0 in (("short", 220.0), ("long", None)):
         p = np.arange(0.0, 241.0, 40.0)
         psi = model.psi_deg("SS50", p, l0_mm=l0)
-        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
-                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1, "l0_mm": l0}
-                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        rows = [
+            {
+                "image": f"{d}_{pk:g}.jpg",
+                "psi_deg": s,
+                "status": "ok",
+                "reason": "",
+                "pressure_kpa": pk,
+                "direction": d,
+                "material": "SS50",
+                "actuator": "A1",
+                "trial": 1,
+                "l0_mm": l0,
+            }
+            for d in ("up", "down")
+            for pk, s in zip(p, psi, strict=True)
+        ]
         folder = tmp_path / name
         folder.mkdir()
         frame = pd.DataFrame(rows)
         if l0 is None:
             frame = frame.drop(columns="l0_mm")
         frame.to_csv(folder / "angles.csv", index=False)
-        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        assert (
+            main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")])
+            == 0
+        )
         folders.append(folder)
     (folders[0] / "truth.csv").write_text("image,psi_deg\n")  # 'short' was rendered by synth
     rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
-    assert main(["compare", *(str(f / "hysteresis.csv") for f in folders),
-                 "--angles", *(str(f / "angles.csv") for f in folders),
-                 "--photosets", *(str(f) for f in folders), "--bootstrap", "0",
-                 "--out", str(rms), "--curves", str(curves)]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                *(str(f / "hysteresis.csv") for f in folders),
+                "--angles",
+                *(str(f / "angles.csv") for f in folders),
+                "--photosets",
+                *(str(f) for f in folders),
+                "--bootstrap",
+                "0",
+                "--out",
+                str(rms),
+                "--curves",
+                str(curves),
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
-    assert ("compare: SS50, l0 220 mm [short; l0 from photo set; materials packaged (pipeline/model/materials.yaml); "
-            "self-check]") in text
+    assert (
+        "compare: SS50, l0 220 mm [short; l0 from photo set; materials packaged "
+        "(pipeline/model/materials.yaml); self-check]"
+    ) in text
     out = pd.read_csv(rms).set_index("datasets")
     default = model.load_materials()["SS50"].l0_mm
     assert out.loc["short", "l0_mm"] == 220.0 and out.loc["long", "l0_mm"] == default
-    assert out.loc["long", "l0_source"] == "materials file" and out.loc["long", "rms_kind"] == "prediction"
+    assert (
+        out.loc["long", "l0_source"] == "materials file"
+        and out.loc["long", "rms_kind"] == "prediction"
+    )
     assert (out["rms_deg"] < 1e-3).all()  # each set was drawn from the model at its own l0
     c = pd.read_csv(curves)
     assert set(c["curve"]) == set(out["curve"])
     short = c[c["curve"] == "SS50, l0 220 mm"]
     assert (short["l0_mm"] == 220.0).all() and len(short) == 400
     expected = model.model_curve("SS50", l0_mm=220.0)
-    np.testing.assert_allclose(short["pressure_kpa"], expected["pressure_kpa"], rtol=1e-5, atol=1e-9)
-    assert not np.allclose(expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3)
-    assert main(["compare", str(folders[0] / "hysteresis.csv"), "--photosets", "a", "b",
-                 "--out", str(rms)]) == 2
+    np.testing.assert_allclose(
+        short["pressure_kpa"], expected["pressure_kpa"], rtol=1e-5, atol=1e-9
+    )
+    assert not np.allclose(
+        expected["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-3
+    )
+    assert (
+        main(
+            [
+                "compare",
+                str(folders[0] / "hysteresis.csv"),
+                "--photosets",
+                "a",
+                "b",
+                "--out",
+                str(rms),
+            ]
+        )
+        == 2
+    )
 
 
 def test_a_dataset_with_its_own_materials_file_is_compared_against_that_files_model():
-    """Own file: its callables, psi0 and l0; pooled only with datasets of the same file; named in each row."""
+    """Own file: its callables, psi0 and l0; pooled only with datasets of the same file; named in
+    each row."""
     from pipeline.compare import DatasetModel
 
-    angles = pd.concat([_angles("std", "SS50", np.nan), _angles("soft", "SS50", np.nan, psi_offset=7.0),
-                        _angles("soft2", "SS50", np.nan, psi_offset=7.0), _angles("short", "SS50", 220.0, psi_offset=7.0)],
-                       ignore_index=True)
+    angles = pd.concat(
+        [
+            _angles("std", "SS50", np.nan),
+            _angles("soft", "SS50", np.nan, psi_offset=7.0),
+            _angles("soft2", "SS50", np.nan, psi_offset=7.0),
+            _angles("short", "SS50", 220.0, psi_offset=7.0),
+        ],
+        ignore_index=True,
+    )
     calls = []
 
     def own_model(material, p, l0_mm):
@@ -314,31 +473,53 @@ def test_a_dataset_with_its_own_materials_file_is_compared_against_that_files_mo
         return linear_model(material, p)
 
     soft = DatasetModel("lab/soft.yaml", own_model, ls_fit, {"SS50": 180.0}, {"SS50": 240.0})
-    out = compare(_hyst_of(angles), angles, model_psi=run_model, fit_k_p=None, psi0_deg={"SS50": 210.0},
-                  default_l0_mm={"SS50": 255.0}, materials_file="packaged",
-                  dataset_models={"soft": soft, "soft2": soft, "short": soft})
+    out = compare(
+        _hyst_of(angles),
+        angles,
+        model_psi=run_model,
+        fit_k_p=None,
+        psi0_deg={"SS50": 210.0},
+        default_l0_mm={"SS50": 255.0},
+        materials_file="packaged",
+        dataset_models={"soft": soft, "soft2": soft, "short": soft},
+    )
     rows = out.set_index("curve")
-    assert list(out["curve"]) == ["SS50, l0 255 mm", "SS50, l0 240 mm, materials lab/soft.yaml",
-                                  "SS50, l0 220 mm, materials lab/soft.yaml"]
+    assert list(out["curve"]) == [
+        "SS50, l0 255 mm",
+        "SS50, l0 240 mm, materials lab/soft.yaml",
+        "SS50, l0 220 mm, materials lab/soft.yaml",
+    ]
     assert rows["datasets"].tolist() == ["std", "soft + soft2", "short"]
     assert rows["materials_file"].tolist() == ["packaged", "lab/soft.yaml", "lab/soft.yaml"]
     assert rows["l0_source"].tolist() == ["materials file", "dataset's materials file", "photo set"]
     assert rows["psi0_deg"].tolist() == [210.0, 180.0, 180.0]  # the file's geometry
-    # each row met its own model exactly: std the run's, soft (+7 deg) its file's, at the file's or photo set's l0
+    # each row met its own model exactly: std the run's, soft (+7 deg) its file's, at the file's or
+    # photo set's l0
     np.testing.assert_allclose(out["rms_deg"], 0.0, atol=1e-12)
     assert sorted(set(calls)) == [("own", 220.0), ("own", 240.0), ("run", 255.0)]
     # without its own file the same data are 7 deg off the run's model
     just_soft = angles[angles["dataset"] == "soft"]
-    plain = compare(_hyst_of(just_soft), just_soft, model_psi=run_model, fit_k_p=None, default_l0_mm={"SS50": 255.0})
-    assert plain["rms_deg"].tolist() == [pytest.approx(7.0)] and plain["curve"].tolist() == ["SS50, l0 255 mm"]
+    plain = compare(
+        _hyst_of(just_soft),
+        just_soft,
+        model_psi=run_model,
+        fit_k_p=None,
+        default_l0_mm={"SS50": 255.0},
+    )
+    assert plain["rms_deg"].tolist() == [pytest.approx(7.0)] and plain["curve"].tolist() == [
+        "SS50, l0 255 mm"
+    ]
 
 
-SOFT_SS50 = ("geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
-             "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n")
+SOFT_SS50 = (
+    "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
+    "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n"
+)
 
 
 def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys):
-    """compare --dataset-materials: the real model of the dataset's file (half SS50's modulus, l0 240 mm)."""
+    """compare --dataset-materials: the real model of the dataset's file (half SS50's modulus, l0
+    240 mm)."""
     from pipeline import model
     from pipeline.cli import main
 
@@ -349,17 +530,45 @@ def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys)
     for name in ("std", "soft"):
         p = np.arange(0.0, 241.0, 40.0)
         psi = model.psi_deg("SS50", p)  # both drawn from the packaged SS50 at its l0
-        rows = [{"image": f"{d}_{pk:g}.jpg", "psi_deg": s, "status": "ok", "reason": "", "pressure_kpa": pk,
-                 "direction": d, "material": "SS50", "actuator": "A1", "trial": 1}
-                for d in ("up", "down") for pk, s in zip(p, psi, strict=True)]
+        rows = [
+            {
+                "image": f"{d}_{pk:g}.jpg",
+                "psi_deg": s,
+                "status": "ok",
+                "reason": "",
+                "pressure_kpa": pk,
+                "direction": d,
+                "material": "SS50",
+                "actuator": "A1",
+                "trial": 1,
+            }
+            for d in ("up", "down")
+            for pk, s in zip(p, psi, strict=True)
+        ]
         folder = tmp_path / name
         folder.mkdir()
         pd.DataFrame(rows).to_csv(folder / "angles.csv", index=False)
-        assert main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")]) == 0
+        assert (
+            main(["aggregate", str(folder / "angles.csv"), "--out", str(folder / "hysteresis.csv")])
+            == 0
+        )
         folders.append(folder)
     rms, curves = tmp_path / "rms.csv", tmp_path / "curves.csv"
-    args = ["compare", *(str(f / "hysteresis.csv") for f in folders), "--angles", *(str(f / "angles.csv") for f in folders),
-            "--datasets", "std", "soft", "--bootstrap", "0", "--out", str(rms), "--curves", str(curves)]
+    args = [
+        "compare",
+        *(str(f / "hysteresis.csv") for f in folders),
+        "--angles",
+        *(str(f / "angles.csv") for f in folders),
+        "--datasets",
+        "std",
+        "soft",
+        "--bootstrap",
+        "0",
+        "--out",
+        str(rms),
+        "--curves",
+        str(curves),
+    ]
     assert main([*args, "--dataset-materials", "-", str(own)]) == 0
     assert f"materials {own}; " in capsys.readouterr().out
     out = pd.read_csv(rms).set_index("datasets")
@@ -374,8 +583,12 @@ def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys)
     c = pd.read_csv(curves)
     own_curve = c[c["curve"] == out.loc["soft", "curve"]]
     assert len(own_curve) == 400 and (own_curve["materials_file"] == str(own)).all()
-    np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft, l0_mm=240.0)["pressure_kpa"],
-                               rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(
+        own_curve["pressure_kpa"],
+        model.model_curve(soft, l0_mm=240.0)["pressure_kpa"],
+        rtol=1e-5,
+        atol=1e-9,
+    )
     std_curve = c[c["curve"] == out.loc["std", "curve"]]
     assert not np.allclose(std_curve["pressure_kpa"], own_curve["pressure_kpa"], equal_nan=True)
     assert main([*args, "--dataset-materials", str(own)]) == 2  # one file per dataset, or '-'
@@ -398,14 +611,51 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     from pipeline.cli import main
 
     short = tmp_path / "short"  # a folder photo set of a shorter actuator (rendered by synth)
-    assert main(["synth", str(short), "--material", "SS50", "--actuators", "1", "--trials", "1",
-                 "--step-kpa", "80", "--max-kpa", "240", "--scene", "clean", "--set", "width=400",
-                 "--set", "height=300", "--l0-mm", "220", "--seed", "3"]) == 0
-    (tmp_path / "soft.yaml").write_text(SOFT_SS50)  # SS50 at mu 0.34 MPa; l0 240 mm, but the photos say 220
+    assert (
+        main(
+            [
+                "synth",
+                str(short),
+                "--material",
+                "SS50",
+                "--actuators",
+                "1",
+                "--trials",
+                "1",
+                "--step-kpa",
+                "80",
+                "--max-kpa",
+                "240",
+                "--scene",
+                "clean",
+                "--set",
+                "width=400",
+                "--set",
+                "height=300",
+                "--l0-mm",
+                "220",
+                "--seed",
+                "3",
+            ]
+        )
+        == 0
+    )
+    (tmp_path / "soft.yaml").write_text(
+        SOFT_SS50
+    )  # SS50 at mu 0.34 MPa; l0 240 mm, but the photos say 220
     config = {
         "datasets": [
-            {"name": "std", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
-             "step_kpa": 80, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 400, "height": 300}},
+            {
+                "name": "std",
+                "source": "synthetic",
+                "material": "SS50",
+                "actuators": 1,
+                "trials": 1,
+                "step_kpa": 80,
+                "max_kpa": 240,
+                "scene": "clean",
+                "scene_set": {"width": 400, "height": 300},
+            },
             {"name": "short", "source": "folder", "path": str(short)},
             {"name": "soft", "source": "folder", "path": str(short), "materials_file": "soft.yaml"},
         ],
@@ -413,8 +663,22 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
         "bench": {"in_report": False},
     }
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
-    run = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
-                          str(tmp_path), "--cores", "2"], capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(repo / "Snakefile"),
+            "--directory",
+            str(tmp_path),
+            "--cores",
+            "2",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-5000:]
     res = tmp_path / "results"
     angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
@@ -426,29 +690,52 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     assert rms.loc["short", "l0_source"] == "photo set"
     assert rms.loc["std", "l0_mm"] == default == 255.0
     assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
-    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at their 220 mm
+    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at
+    # their 220 mm
     soft = model.load_materials(tmp_path / "soft.yaml")["SS50"]
     assert soft.mu_mpa == (0.34,) and model.load_materials()["SS50"].mu_mpa == (0.68,)
-    assert rms.loc["soft", "curve"] == "SS50, l0 220 mm, materials soft.yaml" != rms.loc["short", "curve"]
-    assert rms.loc["soft", "materials_file"] == "soft.yaml" and rms.loc["soft", "l0_source"] == "photo set"
+    assert (
+        rms.loc["soft", "curve"]
+        == "SS50, l0 220 mm, materials soft.yaml"
+        != rms.loc["short", "curve"]
+    )
+    assert (
+        rms.loc["soft", "materials_file"] == "soft.yaml"
+        and rms.loc["soft", "l0_source"] == "photo set"
+    )
     assert rms.loc["soft", "l0_mm"] == 220.0  # the photo set's l0 wins over the file's 240 mm
-    assert (rms.loc[["std", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)").all()
+    assert (
+        rms.loc[["std", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)"
+    ).all()
     h_short = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
     h_soft = pd.read_csv(res / "datasets" / "soft" / "hysteresis.csv")
-    pd.testing.assert_frame_equal(h_short, h_soft)  # same photos: any difference below is the model's
+    pd.testing.assert_frame_equal(
+        h_short, h_soft
+    )  # same photos: any difference below is the model's
     p_s, psi_s = h_soft["pressure_kpa"].to_numpy(float), h_soft["psi_mean_deg"].to_numpy(float)
     at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s, l0_mm=220.0))[0]
     assert rms.loc["soft", "rms_deg"] == pytest.approx(at_soft, rel=1e-4)
-    assert rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0  # drawn from the paper's SS50, not the soft one
+    assert (
+        rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0
+    )  # drawn from the paper's SS50, not the soft one
     # two datasets naming SS50 with different materials files: two model curves, neither overwritten
     own_curve = pd.read_csv(res / "datasets" / "soft" / "model" / "SS50.csv")
     run_curve = pd.read_csv(res / "model" / "SS50.csv")
-    np.testing.assert_allclose(own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9)
-    np.testing.assert_allclose(run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9)
+    np.testing.assert_allclose(
+        own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9
+    )
     assert not np.allclose(own_curve["pressure_kpa"], run_curve["pressure_kpa"], equal_nan=True)
-    soft_compared = pd.read_csv(res / "compare_curves.csv").query("curve == 'SS50, l0 220 mm, materials soft.yaml'")
-    np.testing.assert_allclose(soft_compared["pressure_kpa"], model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
-                               rtol=1e-5)
+    soft_compared = pd.read_csv(res / "compare_curves.csv").query(
+        "curve == 'SS50, l0 220 mm, materials soft.yaml'"
+    )
+    np.testing.assert_allclose(
+        soft_compared["pressure_kpa"],
+        model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
+        rtol=1e-5,
+    )
     # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
     hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
     p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
@@ -459,31 +746,64 @@ def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
     curves = pd.read_csv(res / "compare_curves.csv")
     c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
     assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
-    np.testing.assert_allclose(c220["pressure_kpa"], model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
-                               rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(
+        c220["pressure_kpa"],
+        model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
+        rtol=1e-5,
+        atol=1e-9,
+    )
     doc = pdfium.PdfDocument(str(res / "report.pdf"))
     pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
     doc.close()
     comparison = next(t for t in pages if "Model versus measurements, beside" in t)
-    assert "photos rendered from this package's model, so the RMS is a self-check, not a validation" in comparison
-    assert "Materials file of the model curves: packaged (pipeline/model/materials.yaml) (std, short); soft.yaml (soft)" \
+    assert (
+        "photos rendered from this package's model, so the RMS is a self-check, not a validation"
         in comparison
+    )
+    assert (
+        "Materials file of the model curves: packaged (pipeline/model/materials.yaml) "
+        "(std, short); soft.yaml (soft)" in comparison
+    )
     provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
     assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
     assert "220 (photo set) soft.yaml" in provenance
     import hashlib
 
     inputs = next(t for t in pages if "Input files" in t)
-    assert hashlib.sha256((tmp_path / "soft.yaml").read_bytes()).hexdigest() in inputs.replace(" ", "")
-    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report), nothing else
+    assert hashlib.sha256((tmp_path / "soft.yaml").read_bytes()).hexdigest() in inputs.replace(
+        " ", ""
+    )
+    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report),
+    # nothing else
     with (tmp_path / "soft.yaml").open("a") as fh:
         fh.write("# k_P re-measured\n")
-    dry = subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory",
-                          str(tmp_path), "--cores", "2", "-n"], capture_output=True, text=True)
+    dry = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(repo / "Snakefile"),
+            "--directory",
+            str(tmp_path),
+            "--cores",
+            "2",
+            "-n",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert dry.returncode == 0, dry.stderr[-3000:]
     table = dry.stdout.split("Job stats:")[-1]
-    jobs = {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
-    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[-2000:]
+    jobs = {
+        m[1]: int(m[2])
+        for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE)
+        if m[1] != "total"
+    }
+    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[
+        -2000:
+    ]
     assert f"SS50, l0 {default:g} mm" in provenance
     material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
     assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material

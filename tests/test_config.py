@@ -8,14 +8,14 @@ import subprocess
 import sys
 
 import pytest
-import yaml
 
 from pipeline.config import config_digest, load_schema, validate_config
 from pipeline.errors import UserInputError
 
 
 def _walk(schema, path="config", required=frozenset()):
-    """Every (path, sub-schema, required-here) of the schema; conditional (if/then) requirements count."""
+    """Every (path, sub-schema, required-here) of the schema; conditional (if/then) requirements
+    count."""
     yield path, schema, path.rsplit(".", 1)[-1] in required
     needed = set(schema.get("required", []))
     for block in schema.get("allOf", []):
@@ -44,15 +44,19 @@ def test_the_schema_ships_in_the_package_and_repeats_no_model_choice(repo):
 
     raw = _yaml.safe_load((repo / "pipeline" / "config.schema.yaml").read_text())
     readings = raw["properties"]["model"]["properties"]["readings"]["properties"]
-    assert not [key for key, sub in readings.items() if "enum" in sub]  # only pipeline.model's CHOICES
+    # only pipeline.model's CHOICES
+    assert not [key for key, sub in readings.items() if "enum" in sub]
     assert not (repo / "rules" / "config.schema.yaml").exists()  # one schema, not two
 
 
 def test_schema_defaults_alone_make_a_valid_config(repo):
     cfg = validate_config({}, workdir=repo)
-    assert [(d["name"], d["source"], d["path"]) for d in cfg["datasets"]] == [("sample", "folder", "sample_images")]
+    assert [(d["name"], d["source"], d["path"]) for d in cfg["datasets"]] == [
+        ("sample", "folder", "sample_images")
+    ]
     assert cfg["measure"] == {"method": "default", "jobs": 2, "overlays": True}
-    assert cfg["model"] == {"materials_file": None, "readings": {}}  # readings stay what the user gave
+    # readings stay what the user gave
+    assert cfg["model"] == {"materials_file": None, "readings": {}}
     assert cfg["force"] == {"datasets": [], "grasp_log": None} and cfg["results_dir"] == "results"
 
 
@@ -60,22 +64,39 @@ def test_scene_presets_in_the_schema_are_the_renderers():
     from pipeline.synth import SCENE_PRESETS
 
     schema = load_schema()["properties"]
-    scenes = [schema["datasets"]["items"]["properties"]["scene"],
-              schema["force"]["properties"]["datasets"]["items"]["properties"]["scene"]]
+    scenes = [
+        schema["datasets"]["items"]["properties"]["scene"],
+        schema["force"]["properties"]["datasets"]["items"]["properties"]["scene"],
+    ]
     assert all(sorted(s["enum"]) == sorted(SCENE_PRESETS) for s in scenes)
 
 
 @pytest.mark.parametrize(
     "datasets, message",
     [
-        ([{"name": "a", "source": "synthetic", "material": "DS25"}], "datasets[0].material: unknown material 'DS25'"),
-        ([{"name": "a", "source": "folder", "path": "no/such/folder"}], "datasets[0].path: photo-set folder 'no/such/folder' does not exist"),
-        ([{"name": "a", "source": "synthetic", "material": "DS20", "trials": "six"}], "datasets[0].trials: 'six' is not of type 'integer'"),
+        (
+            [{"name": "a", "source": "synthetic", "material": "DS25"}],
+            "datasets[0].material: unknown material 'DS25'",
+        ),
+        (
+            [{"name": "a", "source": "folder", "path": "no/such/folder"}],
+            "datasets[0].path: photo-set folder 'no/such/folder' does not exist",
+        ),
+        (
+            [{"name": "a", "source": "synthetic", "material": "DS20", "trials": "six"}],
+            "datasets[0].trials: 'six' is not of type 'integer'",
+        ),
         ([{"name": "a", "source": "camera"}], "datasets[0].source: 'camera' is not one of"),
         ([{"name": "a", "source": "synthetic", "material": "DS20"}] * 2, "'a' is used twice"),
-        ([{"name": "a", "source": "rig", "path": "x", "material": "DS20"}], "datasets[0].port: required for source 'rig'"),
+        (
+            [{"name": "a", "source": "rig", "path": "x", "material": "DS20"}],
+            "datasets[0].port: required for source 'rig'",
+        ),
         ([{"name": "a", "source": "folder"}], "datasets[0].path: required for source 'folder'"),
-        ([{"name": "a", "source": "synthetic"}], "datasets[0].material: required for source 'synthetic'"),
+        (
+            [{"name": "a", "source": "synthetic"}],
+            "datasets[0].material: required for source 'synthetic'",
+        ),
         ([{"source": "synthetic", "material": "DS20"}], "datasets[0].name: required"),
     ],
 )
@@ -112,25 +133,54 @@ def test_a_bad_model_reading_is_refused(tmp_path):
         validate_config({"model": {"readings": {"l0_factor": "inches"}}}, workdir=tmp_path)
     assert "model.readings.l0_factor: 'inches' is not one of" in str(exc.value)
     synthetic = [{"name": "a", "source": "synthetic", "material": "SS50"}]
-    cfg = validate_config({"datasets": synthetic, "model": {"readings": {"l0_factor": "metres"}}}, workdir=tmp_path)
+    cfg = validate_config(
+        {"datasets": synthetic, "model": {"readings": {"l0_factor": "metres"}}}, workdir=tmp_path
+    )
     assert cfg["model"] == {"materials_file": None, "readings": {"l0_factor": "metres"}}
 
 
 def test_the_built_package_ships_the_schema_and_validates_without_the_workflow(repo, tmp_path):
-    """setuptools' build_py (what a wheel holds) from a copy of the sources; validate with that alone."""
+    """setuptools' build_py (what a wheel holds) from a copy of the sources; validate with that
+    alone."""
     src = tmp_path / "src"
-    shutil.copytree(repo / "pipeline", src / "pipeline", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(
+        repo / "pipeline", src / "pipeline", ignore=shutil.ignore_patterns("__pycache__")
+    )
     for name in ("pyproject.toml", "README.md"):
         shutil.copy(repo / name, src / name)
     lib = tmp_path / "lib"
-    build = subprocess.run([sys.executable, "-c", "import setuptools; setuptools.setup()", "-q", "build_py", "-d", str(lib)],
-                           cwd=src, capture_output=True, text=True)
+    build = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import setuptools; setuptools.setup()",
+            "-q",
+            "build_py",
+            "-d",
+            str(lib),
+        ],
+        cwd=src,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert build.returncode == 0, build.stderr[-2000:]
     assert (lib / "pipeline" / "config.schema.yaml").is_file()
     check = subprocess.run(
-        [sys.executable, "-c", "from pipeline.config import validate_config; "
-         "print(validate_config({'datasets': [{'name': 'a', 'source': 'synthetic', 'material': 'DS20'}]})['datasets'][0]['scene'])"],
-        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(lib)}, capture_output=True, text=True,
+        [
+            sys.executable,
+            "-c",
+            (
+                "from pipeline.config import validate_config; "
+                "print(validate_config({'datasets': [{'name': 'a', 'source': 'synthetic', "
+                "'material': 'DS20'}]})['datasets'][0]['scene'])"
+            ),
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(lib)},
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert check.returncode == 0 and check.stdout.strip() == "lab", check.stderr[-2000:]
 
@@ -144,7 +194,10 @@ def test_scene_enums_are_the_synth_presets():
     assert dataset["scene"]["enum"] == list(SCENE_PRESETS)
 
 
-SOFT_SS50 = "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2}\ngeometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 240}\n"
+SOFT_SS50 = (
+    "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2}\n"
+    "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 240}\n"
+)
 
 
 def _refused(config, workdir):
@@ -156,25 +209,73 @@ def _refused(config, workdir):
 
 def test_a_dataset_names_its_own_materials_file(tmp_path):
     (tmp_path / "soft.yaml").write_text(SOFT_SS50)
-    cfg = validate_config({"datasets": [{"name": "soft", "source": "synthetic", "material": "SS50", "materials_file": "soft.yaml"},
-                                        {"name": "std", "source": "synthetic", "material": "SS50"}]}, workdir=tmp_path)
+    cfg = validate_config(
+        {
+            "datasets": [
+                {
+                    "name": "soft",
+                    "source": "synthetic",
+                    "material": "SS50",
+                    "materials_file": "soft.yaml",
+                },
+                {"name": "std", "source": "synthetic", "material": "SS50"},
+            ]
+        },
+        workdir=tmp_path,
+    )
     assert [d["materials_file"] for d in cfg["datasets"]] == ["soft.yaml", None]
     assert cfg["model"]["materials_file"] is None  # the global file is untouched
 
 
-@pytest.mark.parametrize("text, message", [
-    (None, "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' does not exist (relative to"),
-    ("materials: [unclosed\n", "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' cannot be used: "),
-    ("materials:\n  SS50: {mu_mpa: [0.3], alpha: [2.0]}\n", "missing key 'k_p'"),
-    ("materials:\n  EF30: {mu_mpa: [0.05], alpha: [2.0], k_p: 2.0}\ngeometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 220}\n",
-     "datasets[1].materials_file (dataset 'soft'): material 'SS50' (named by the dataset) is not in 'soft.yaml', which holds ['EF30']; add 'SS50' to that file"),
-])
-def test_a_bad_dataset_materials_file_is_refused_naming_key_dataset_and_fix(tmp_path, text, message):
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            None,
+            (
+                "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' does not "
+                "exist (relative to"
+            ),
+        ),
+        (
+            "materials: [unclosed\n",
+            (
+                "datasets[1].materials_file (dataset 'soft'): materials file 'soft.yaml' cannot be "
+                "used: "
+            ),
+        ),
+        ("materials:\n  SS50: {mu_mpa: [0.3], alpha: [2.0]}\n", "missing key 'k_p'"),
+        (
+            (
+                "materials:\n  EF30: {mu_mpa: [0.05], alpha: [2.0], k_p: 2.0}\n"
+                "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210, l0_mm: 220}\n"
+            ),
+            (
+                "datasets[1].materials_file (dataset 'soft'): material 'SS50' (named by the "
+                "dataset) is not in 'soft.yaml', which holds ['EF30']; add 'SS50' to that file"
+            ),
+        ),
+    ],
+)
+def test_a_bad_dataset_materials_file_is_refused_naming_key_dataset_and_fix(
+    tmp_path, text, message
+):
     if text is not None:
         (tmp_path / "soft.yaml").write_text(text)
-    out = _refused({"datasets": [{"name": "std", "source": "synthetic", "material": "SS50"},
-                                 {"name": "soft", "source": "synthetic", "material": "SS50", "materials_file": "soft.yaml"}]},
-                   tmp_path)
+    out = _refused(
+        {
+            "datasets": [
+                {"name": "std", "source": "synthetic", "material": "SS50"},
+                {
+                    "name": "soft",
+                    "source": "synthetic",
+                    "material": "SS50",
+                    "materials_file": "soft.yaml",
+                },
+            ]
+        },
+        tmp_path,
+    )
     assert message in out
     assert "datasets[0]" not in out  # the other dataset is fine
     if text is None:
@@ -185,19 +286,54 @@ def test_a_bad_dataset_materials_file_is_refused_naming_key_dataset_and_fix(tmp_
 
 def test_a_folder_dataset_materials_file_must_hold_the_manifests_materials(tmp_path, repo):
     (tmp_path / "soft.yaml").write_text(SOFT_SS50)
-    folder = {"name": "sample", "source": "folder", "path": str(repo / "sample_images"), "materials_file": "soft.yaml"}
+    folder = {
+        "name": "sample",
+        "source": "folder",
+        "path": str(repo / "sample_images"),
+        "materials_file": "soft.yaml",
+    }
     out = _refused({"datasets": [folder]}, tmp_path)
-    assert "datasets[0].materials_file (dataset 'sample'): material 'DS20' (named by the dataset) is not in 'soft.yaml'" in out
+    assert (
+        "datasets[0].materials_file (dataset 'sample'): material 'DS20' (named by the dataset) "
+        "is not in 'soft.yaml'" in out
+    )
     (tmp_path / "soft.yaml").write_text(SOFT_SS50.replace("SS50", "DS20"))
-    assert validate_config({"datasets": [folder]}, workdir=tmp_path)["datasets"][0]["materials_file"] == "soft.yaml"
+    assert (
+        validate_config({"datasets": [folder]}, workdir=tmp_path)["datasets"][0]["materials_file"]
+        == "soft.yaml"
+    )
 
 
-def test_a_bad_global_materials_file_is_refused_and_synthetic_sets_need_a_packaged_material(tmp_path):
+def test_a_bad_global_materials_file_is_refused_and_synthetic_sets_need_a_packaged_material(
+    tmp_path,
+):
     (tmp_path / "bad.yaml").write_text("materials: [unclosed\n")
-    out = _refused({"datasets": [{"name": "a", "source": "synthetic", "material": "SS50"}],
-                    "model": {"materials_file": "bad.yaml"}}, tmp_path)
-    assert "model.materials_file: materials file 'bad.yaml' cannot be used" in out and "not valid YAML" in out
+    out = _refused(
+        {
+            "datasets": [{"name": "a", "source": "synthetic", "material": "SS50"}],
+            "model": {"materials_file": "bad.yaml"},
+        },
+        tmp_path,
+    )
+    assert (
+        "model.materials_file: materials file 'bad.yaml' cannot be used" in out
+        and "not valid YAML" in out
+    )
     (tmp_path / "own.yaml").write_text(SOFT_SS50.replace("SS50", "EF30"))
-    out = _refused({"datasets": [{"name": "a", "source": "synthetic", "material": "EF30", "materials_file": "own.yaml"}]},
-                   tmp_path)
-    assert "datasets[0].material: synthetic photos are rendered from the packaged model, which has no material 'EF30'" in out
+    out = _refused(
+        {
+            "datasets": [
+                {
+                    "name": "a",
+                    "source": "synthetic",
+                    "material": "EF30",
+                    "materials_file": "own.yaml",
+                }
+            ]
+        },
+        tmp_path,
+    )
+    assert (
+        "datasets[0].material: synthetic photos are rendered from the packaged model, which has "
+        "no material 'EF30'" in out
+    )

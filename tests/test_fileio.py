@@ -16,7 +16,11 @@ def test_reads_a_good_table(tmp_path):
 
 @pytest.mark.parametrize(
     "content, message",
-    [(None, "file not found; pass an angles.csv"), ("", "not a readable CSV"), ("a,b\n1,2\n", "missing column(s) ['material']")],
+    [
+        (None, "file not found; pass an angles.csv"),
+        ("", "not a readable CSV"),
+        ("a,b\n1,2\n", "missing column(s) ['material']"),
+    ],
 )
 def test_bad_tables_name_the_file_and_the_fix(tmp_path, content, message):
     p = tmp_path / "angles.csv"

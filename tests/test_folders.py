@@ -17,10 +17,9 @@ def test_staged_folder_replaces_a_previous_output_only_when_complete(tmp_path):
         (tmp / "truth.csv").write_text("v1")
         assert not final.exists() and tmp.name == ".set.partial"
     assert (final / "truth.csv").read_text() == "v1"
-    with pytest.raises(KeyboardInterrupt):
-        with staged_folder(final, marker="truth.csv") as tmp:
-            (tmp / "truth.csv").write_text("v2")
-            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt), staged_folder(final, marker="truth.csv") as tmp:
+        (tmp / "truth.csv").write_text("v2")
+        raise KeyboardInterrupt
     assert (final / "truth.csv").read_text() == "v1"  # the interrupted write left the old set alone
     assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]  # and no partial folder
     with staged_folder(final, marker="truth.csv") as tmp:
@@ -39,9 +38,11 @@ def test_staged_folder_clears_what_a_killed_run_left_and_never_replaces_a_users_
     photos = tmp_path / "photos"
     photos.mkdir()
     (photos / "IMG_0001.jpg").write_bytes(b"raw data")
-    with pytest.raises(UserInputError, match="not an output of this command"):
-        with staged_folder(photos, marker="truth.csv"):
-            pass
+    with (
+        pytest.raises(UserInputError, match="not an output of this command"),
+        staged_folder(photos, marker="truth.csv"),
+    ):
+        pass
     assert (photos / "IMG_0001.jpg").read_bytes() == b"raw data"
     assert not (tmp_path / ".photos.partial").exists()
 

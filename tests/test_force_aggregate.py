@@ -33,13 +33,29 @@ def crafted() -> pd.DataFrame:
         ("SS40", 200.0, "B1", "1", 5.0, 0.05, 0.55, "ok"),
     ]
     df = pd.DataFrame(
-        rows, columns=["material", "pressure_kpa", "actuator", "trial", "force_n", "force_sd_n", "eccentricity", "status"]
+        rows,
+        columns=[
+            "material",
+            "pressure_kpa",
+            "actuator",
+            "trial",
+            "force_n",
+            "force_sd_n",
+            "eccentricity",
+            "status",
+        ],
     )
     df["direction"] = "up"
     df["measured_pressure_kpa"] = df["pressure_kpa"] + 0.5
     df["image"] = [f"img{i}.jpg" for i in range(len(df))]
     df["image_path"] = "/x/" + df["image"]
-    for k, v in {"centre_x_px": 10.0, "centre_y_px": 20.0, "semi_major_px": 30.0, "semi_minor_px": 25.0, "angle_deg": 5.0}.items():
+    for k, v in {
+        "centre_x_px": 10.0,
+        "centre_y_px": 20.0,
+        "semi_major_px": 30.0,
+        "semi_minor_px": 25.0,
+        "angle_deg": 5.0,
+    }.items():
         df[k] = v
     return df
 
@@ -167,5 +183,7 @@ def test_manifest_without_eccentricity_gives_force_only(tmp_path: Path) -> None:
     table = read_tables([path])
     force = force_vs_pressure(table)
     assert force["n_eccentricity"].eq(0).all() and force["eccentricity_mean"].isna().all()
-    assert force.set_index(["material", "pressure_kpa"]).loc[("DS20", 100.0), "force_mean_n"] == pytest.approx(2.75)
+    assert force.set_index(["material", "pressure_kpa"]).loc[
+        ("DS20", 100.0), "force_mean_n"
+    ] == pytest.approx(2.75)
     assert eccentricity_at_max_pressure(table).empty

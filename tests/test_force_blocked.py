@@ -11,7 +11,6 @@ import pandas as pd
 import pytest
 
 from pipeline.cli import main
-from pipeline.measure.settings import resolve_settings
 from pipeline.force.blocked import RESULT_COLUMNS, measure_blocked_image, measure_blocked_photoset
 from pipeline.force.ellipse import fit_ellipse
 from pipeline.force.pages import figures
@@ -22,16 +21,25 @@ from pipeline.force.synth_blocked import (
     blocked_ramp_table,
     render_blocked_photoset,
 )
+from pipeline.measure.settings import resolve_settings
 
 
-def drawn_arc_image(e: float, *, gap_deg: float = 0.0, mm_per_px: float = 0.3, offset_px=(0, 0), seed: int = 0) -> np.ndarray:
+def drawn_arc_image(
+    e: float, *, gap_deg: float = 0.0, mm_per_px: float = 0.3, offset_px=(0, 0), seed: int = 0
+) -> np.ndarray:
     """A plain photo of a blocked line drawn with OpenCV (independent of pipeline.synth)."""
     shape = blocked_arc_mm(e, 270.0, arc_fraction=0.58, gap_deg=gap_deg)
     p = shape.points_mm / mm_per_px
     p[:, 1] *= -1
-    p += np.array([640.0, 480.0]) - (p.min(axis=0) + p.max(axis=0)) / 2 + np.asarray(offset_px, float)
+    p += (
+        np.array([640.0, 480.0])
+        - (p.min(axis=0) + p.max(axis=0)) / 2
+        + np.asarray(offset_px, float)
+    )
     img = np.full((960, 1280, 3), 205, np.uint8)
-    cv2.polylines(img, [np.round(p * 16).astype(np.int32)], False, (25, 25, 25), 6, cv2.LINE_AA, shift=4)
+    cv2.polylines(
+        img, [np.round(p * 16).astype(np.int32)], False, (25, 25, 25), 6, cv2.LINE_AA, shift=4
+    )
     img = cv2.GaussianBlur(img, (0, 0), 0.8)
     noise = np.random.default_rng(seed).normal(0.0, 3.0, img.shape)
     return np.clip(img + noise, 0, 255).astype(np.uint8)
@@ -178,11 +186,15 @@ def test_missing_image_is_one_failed_row(blocked_set: Path, tmp_path: Path) -> N
     assert (table["status"] != "failed").sum() == len(table) - 1
 
 
-def test_cli_end_to_end_and_pages(blocked_set: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_end_to_end_and_pages(
+    blocked_set: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     force_dir = tmp_path / "force"
     ecc = tmp_path / "eccentricity.csv"
     assert main(["force", "measure", str(blocked_set), "--out", str(ecc), "--jobs", "2"]) == 0
-    assert main(["force", "aggregate", str(ecc), "--out", str(force_dir / "force_summary.csv")]) == 0
+    assert (
+        main(["force", "aggregate", str(ecc), "--out", str(force_dir / "force_summary.csv")]) == 0
+    )
     assert main(["force", "grasp", "--example", "--out", str(force_dir / "grasp_summary.csv")]) == 0
     out = capsys.readouterr().out
     assert "force measure:" in out and "force aggregate:" in out and "force grasp:" in out
@@ -208,6 +220,9 @@ def test_cli_bad_input_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str
     bad.write_text("material,object,side,diameter_mm,mass_g,pressure_kpa,held\nDS20,x,inside,90,700,20,perhaps\n")
     assert main(["force", "grasp", str(bad), "--out", str(tmp_path / "g.csv")]) == 2
     assert "line 2, column held" in capsys.readouterr().err
-    assert main(["force", "aggregate", str(tmp_path / "none.csv"), "--out", str(tmp_path / "f.csv")]) == 2
+    assert (
+        main(["force", "aggregate", str(tmp_path / "none.csv"), "--out", str(tmp_path / "f.csv")])
+        == 2
+    )
     assert main(["force", "synth", str(tmp_path / "s"), "--material", "XX99"]) == 2
     assert figures(tmp_path / "empty") == []

@@ -26,7 +26,9 @@ def arc_points(
     speed = np.hypot(a * np.sin(tt), b * np.cos(tt))
     s = np.r_[0.0, np.cumsum((speed[1:] + speed[:-1]) / 2.0 * np.diff(tt))]
     mid = np.interp(np.mod(np.deg2rad(gap_deg) + np.pi, 2 * np.pi), tt, s)
-    ss = np.mod(np.linspace(mid - arc_fraction * s[-1] / 2, mid + arc_fraction * s[-1] / 2, n), s[-1])
+    ss = np.mod(
+        np.linspace(mid - arc_fraction * s[-1] / 2, mid + arc_fraction * s[-1] / 2, n), s[-1]
+    )
     t = np.interp(ss, s, tt)
     pts = ellipse_points((320.0, 240.0, a, b, np.deg2rad(theta_deg)), t)
     return pts + np.random.default_rng(seed).normal(0.0, noise_px, pts.shape)
@@ -64,7 +66,9 @@ def test_exact_points_recover_the_ellipse(e: float, refine: str) -> None:
 @pytest.mark.parametrize("gap_deg", [0.0, 90.0, 140.0])
 def test_partial_noisy_arcs_within_target(e: float, fraction: float, gap_deg: float) -> None:
     """Issue target: |e - truth| <= 0.02 for e in 0.3..0.8, also on partial arcs."""
-    pts = arc_points(e, fraction, gap_deg=gap_deg, noise_px=0.7, seed=int(100 * e + 10 * fraction + gap_deg))
+    pts = arc_points(
+        e, fraction, gap_deg=gap_deg, noise_px=0.7, seed=int(100 * e + 10 * fraction + gap_deg)
+    )
     fit = fit_ellipse(pts)
     assert fit.status == "ok", fit.reason
     assert abs(fit.eccentricity - e) <= 0.02

@@ -1,4 +1,4 @@
-"""Tests of the speed / accuracy comparison in :mod:`pipeline.measure.bench` (issue 6's target).
+"""Tests of the speed / accuracy comparison in :mod:`pipeline.bench.measure` (issue 6's target).
 
 The comparison runs for real on a few small synthetic photos (scikit-image provides the
 skeletonize baseline); the verdict rule is checked as a pure function on made-up tables.
@@ -11,18 +11,30 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.measure import bench
+from pipeline.bench import measure as bench
 
 SPEED_COLUMNS = ["n", "imread_ms", "ours_ms", "ours/imread", "skeleton_ms", "skeleton/ours",
                  "decode_floor_ms", "bare_ms", "max_speedup"]
-PAIRED_COLUMNS = ["size", "tilt_deg", "n", "ours_med_err", "ours_|psi|_med_err", "skel_|psi|_med_err",
-                  "med_diff", "ci_lo", "ci_hi", "ours_as_good"]
+PAIRED_COLUMNS = [
+    "size",
+    "tilt_deg",
+    "n",
+    "ours_med_err",
+    "ours_|psi|_med_err",
+    "skel_|psi|_med_err",
+    "med_diff",
+    "ci_lo",
+    "ci_hi",
+    "ours_as_good",
+]
 
 
 @pytest.fixture(scope="module")
 def small_run(tmp_path_factory: pytest.TempPathFactory) -> pd.DataFrame:
     pytest.importorskip("skimage")
-    return bench.speed(2, seed=3, workdir=tmp_path_factory.mktemp("speed"), sizes=((640, 480),), repeats=1)
+    return bench.speed(
+        2, seed=3, workdir=tmp_path_factory.mktemp("speed"), sizes=((640, 480),), repeats=1
+    )
 
 
 def test_speed_renders_each_image_at_tilt_0_and_lab_tilt(small_run: pd.DataFrame) -> None:
@@ -33,7 +45,8 @@ def test_speed_renders_each_image_at_tilt_0_and_lab_tilt(small_run: pd.DataFrame
     assert (per_image["psi_true"].nunique() == 1).all()
     assert (per_image["ours_s"].nunique() == 1).all()
     assert small_run["psi_true"].nunique() == 2
-    # the baseline gives |psi| only; both methods measure something near the truth on clean lab photos
+    # the baseline gives |psi| only; both methods measure something near the truth on clean lab
+    # photos
     assert (small_run["skeleton_psi"] >= 0).all()
     assert (small_run["ours_status"] == "ok").all()
     assert (small_run["ours_abs_err"] < 2.0).all()
@@ -61,10 +74,14 @@ def test_paired_accuracy_columns_and_ci(small_run: pd.DataFrame) -> None:
     for _, row in paired.iterrows():
         assert row["ci_lo"] <= row["med_diff"] <= row["ci_hi"]
         assert 0.0 <= row["ours_as_good"] <= 1.0
-        assert np.isfinite(row[["ours_|psi|_med_err", "skel_|psi|_med_err", "med_diff"]].to_numpy(float)).all()
+        assert np.isfinite(
+            row[["ours_|psi|_med_err", "skel_|psi|_med_err", "med_diff"]].to_numpy(float)
+        ).all()
 
 
-def test_print_speed_prints_tables_and_verdicts(small_run: pd.DataFrame, capsys: pytest.CaptureFixture[str]) -> None:
+def test_print_speed_prints_tables_and_verdicts(
+    small_run: pd.DataFrame, capsys: pytest.CaptureFixture[str]
+) -> None:
     bench.print_speed(small_run, seed=0)
     out = capsys.readouterr().out
     assert "decode_floor_ms" in out and "ci_hi" in out
@@ -72,22 +89,40 @@ def test_print_speed_prints_tables_and_verdicts(small_run: pd.DataFrame, capsys:
     assert "CI upper bound" in out
 
 
-def _made_up_sp(ours_s: float, skel_s: float, ours_err: np.ndarray, skel_err: np.ndarray) -> pd.DataFrame:
+def _made_up_sp(
+    ours_s: float, skel_s: float, ours_err: np.ndarray, skel_err: np.ndarray
+) -> pd.DataFrame:
     """A :func:`bench.speed`-like frame: 12 images x 2 tilts at one size."""
     n = ours_err.size
     rows = []
     for tilt in (0.0, 1.0):
         for i in range(n):
-            rows.append({"size": "100x100", "image": i, "tilt_deg": tilt, "psi_true": 50.0,
-                         "ours_psi": 50.0 + ours_err[i], "ours_status": "ok", "skeleton_psi": 50.0 + skel_err[i],
-                         "ours_abs_err": abs(ours_err[i]), "ours_absmag_err": abs(ours_err[i]),
-                         "skeleton_absmag_err": abs(skel_err[i]), "imread_s": 0.001, "ours_s": ours_s,
-                         "skeleton_s": skel_s, "decode_floor_s": 0.0005, "bare_s": 0.0006})
+            rows.append(
+                {
+                    "size": "100x100",
+                    "image": i,
+                    "tilt_deg": tilt,
+                    "psi_true": 50.0,
+                    "ours_psi": 50.0 + ours_err[i],
+                    "ours_status": "ok",
+                    "skeleton_psi": 50.0 + skel_err[i],
+                    "ours_abs_err": abs(ours_err[i]),
+                    "ours_absmag_err": abs(ours_err[i]),
+                    "skeleton_absmag_err": abs(skel_err[i]),
+                    "imread_s": 0.001,
+                    "ours_s": ours_s,
+                    "skeleton_s": skel_s,
+                    "decode_floor_s": 0.0005,
+                    "bare_s": 0.0006,
+                }
+            )
     return pd.DataFrame(rows)
 
 
 def _verdict(sp: pd.DataFrame) -> str:
-    return bench.verdicts(bench.speed_table(sp), bench.paired_accuracy(sp, seed=0, resamples=500)).loc["100x100"]
+    return bench.verdicts(
+        bench.speed_table(sp), bench.paired_accuracy(sp, seed=0, resamples=500)
+    ).loc["100x100"]
 
 
 @pytest.mark.parametrize(
@@ -99,7 +134,9 @@ def _verdict(sp: pd.DataFrame) -> str:
     ],
     ids=["20x-and-more-accurate", "slower", "fast-but-less-accurate"],
 )
-def test_verdict(ours_s: float, skel_s: float, ours_sd: float, skel_sd: float, expected: str) -> None:
+def test_verdict(
+    ours_s: float, skel_s: float, ours_sd: float, skel_sd: float, expected: str
+) -> None:
     rng = np.random.default_rng(0)
     sp = _made_up_sp(ours_s, skel_s, rng.normal(0, ours_sd, 12), rng.normal(0, skel_sd, 12))
     assert _verdict(sp) == expected

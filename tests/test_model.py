@@ -265,7 +265,8 @@ def test_l0_shorter_than_the_wall_is_refused_with_the_fix(tmp_path) -> None:
 
 
 def test_physical_limits_and_bad_input() -> None:
-    """Below absolute vacuum is NaN with that reason; NaN psi says so; text and bad options refused."""
+    """Below absolute vacuum is NaN with that reason; NaN psi says so; text and bad options
+    refused."""
     curve = model_curve("SS50", [360.0, np.nan, np.inf, 210.0, 0.0])
     assert curve.pressure_kpa.iloc[:3].isna().all()
     assert list(curve.reason.iloc[:3]) == [
@@ -294,7 +295,9 @@ def test_physical_limits_and_bad_input() -> None:
     for bad in (-400.0, 360.0, math.nan):
         with pytest.raises(UserInputError, match="psi_min_deg"):
             psi_deg("SS50", 10.0, psi_min_deg=bad)
-    with pytest.raises(UserInputError, match=r"psi_min_deg = 250 deg must lie in \[-360, psi0 = 210\)"):
+    with pytest.raises(
+        UserInputError, match=r"psi_min_deg = 250 deg must lie in \[-360, psi0 = 210\)"
+    ):
         psi_deg("SS50", 10.0, psi_min_deg=250.0)
 
 
@@ -522,14 +525,20 @@ def test_cli_pressure_psi_curve_calibrate(tmp_path, capsys) -> None:
     assert "both within +-5 %: yes (SS50 -2.6 %, SS40 +2.7 %)" in in_sample
     assert "DS20 reaches psi = 0" not in in_sample
     assert "DS20 reaches psi = 0" in out_of_sample and "-16.7 %" in out_of_sample
-    assert "RMS: psi = 0 pressures 12.0 %; angles 42.9 deg; ranges of motion 11.3 %" in out_of_sample
+    assert (
+        "RMS: psi = 0 pressures 12.0 %; angles 42.9 deg; ranges of motion 11.3 %" in out_of_sample
+    )
     assert "NOT area-consistent" in out_of_sample
     assert cli_main(["model", "calibrate", "--l0-factor", "fitted_scale", "--l0-mm", "200",
                      "--eq12-scale", "0.25"]) == 0
     text = capsys.readouterr().out
     assert "NOT a derivation of the printed text" in text
     assert "eq12_scale = 0.2500 (given)" in text
-    assert f"fitted to the two model results with these readings and l0: {fit_eq12_scale(l0_mm=200.0):.4f}" in text
+    assert (
+        "fitted to the two model results with these readings and l0: "
+        f"{fit_eq12_scale(l0_mm=200.0):.4f}"
+        in text
+    )
     assert cli_main(["model", "pressure", "--material", "NOPE", "--psi-deg", "0"]) == 2
 
 

@@ -12,9 +12,9 @@ import pytest
 
 from pipeline import photoset as ps
 from pipeline import photoset_init
+from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.colors import ColorError, parse_color
-from pipeline.errors import UserInputError
 
 PATTERN = "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg"
 
@@ -64,7 +64,11 @@ def test_check_names_every_bad_row_and_its_fix(photo_folder):
     assert "line 7: image" in text and "cannot be decoded" in text
     assert all(p.fix for p in problems)
     # the command line prints the same and exits 1
-    out = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(photo_folder)], capture_output=True, text=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "pipeline", "photoset", "check", str(photo_folder)],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert out.returncode == 1 and "direction 'sideways'" in out.stderr
 
 
@@ -78,25 +82,34 @@ def test_missing_l0_is_reported_unless_every_row_has_it(photo_folder):
 
 
 def test_row_overrides_win_over_folder_settings(photo_folder):
-    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": "black", "fixed_end": [5, 6]})
+    photoset_init.init_photoset(
+        photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": "black", "fixed_end": [5, 6]}
+    )
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["l0_mm"] = [np.nan] * (len(m) - 1) + [150.0]
     m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
     m.to_csv(photo_folder / "manifest.csv", index=False)
     rows = ps.load_photoset(photo_folder).rows
     assert rows[-1].l0_mm == 150.0 and all(r.l0_mm == 210.0 for r in rows[:-1])
-    assert rows[0].color == parse_color("blue") and all(r.color == parse_color("black") for r in rows[1:])
+    assert rows[0].color == parse_color("blue") and all(
+        r.color == parse_color("black") for r in rows[1:]
+    )
     assert all(r.fixed_end_px == (5.0, 6.0) for r in rows)
 
 
 def test_bad_settings_values_are_named(photo_folder):
     photoset_init.init_photoset(photo_folder, PATTERN)
-    (photo_folder / "photoset.yaml").write_text("l0_mm: -3\npositive_turn: left\nline_color: chartreuse\n")
+    (photo_folder / "photoset.yaml").write_text(
+        "l0_mm: -3\npositive_turn: left\nline_color: chartreuse\n"
+    )
     text = "\n".join(map(str, ps.validate_photoset(photo_folder)))
     assert "l0_mm = -3" in text and "positive_turn = 'left'" in text and "chartreuse" in text
 
 
-@pytest.mark.parametrize("value, expected", [("red", 2), ("0,0,0-179,255,60", 1), ({"lower": [1, 2, 3], "upper": [4, 5, 6]}, 1)])
+@pytest.mark.parametrize(
+    "value, expected",
+    [("red", 2), ("0,0,0-179,255,60", 1), ({"lower": [1, 2, 3], "upper": [4, 5, 6]}, 1)],
+)
 def test_line_color_ranges(value, expected):
     assert len(parse_color(value).ranges) == expected
 
@@ -107,7 +120,15 @@ def test_line_color_rejects_bad_range():
 
 
 def test_append_rows_is_idempotent(tmp_path):
-    row = {"image": "a.jpg", "pressure_kpa": 10, "direction": "up", "material": "DS20", "actuator": "A1", "trial": 1, "step": 0}
+    row = {
+        "image": "a.jpg",
+        "pressure_kpa": 10,
+        "direction": "up",
+        "material": "DS20",
+        "actuator": "A1",
+        "trial": 1,
+        "step": 0,
+    }
     ps.append_manifest_rows(tmp_path, [row])
     ps.append_manifest_rows(tmp_path, [row, {**row, "image": "b.jpg", "step": 1}])
     df = pd.read_csv(tmp_path / "manifest.csv")
@@ -125,10 +146,16 @@ def test_atomic_write_gives_normal_permissions(tmp_path):
 
 
 def test_folder_hsv_range_fills_rows_without_their_own_colour(photo_folder):
-    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0, "line_color": {"lower": [0, 0, 0], "upper": [179, 255, 60]}})
+    photoset_init.init_photoset(
+        photo_folder,
+        PATTERN,
+        settings={"l0_mm": 210.0, "line_color": {"lower": [0, 0, 0], "upper": [179, 255, 60]}},
+    )
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["line_color"] = ["blue"] + [np.nan] * (len(m) - 1)
     m.to_csv(photo_folder / "manifest.csv", index=False)
     rows = ps.load_photoset(photo_folder).rows
     assert rows[0].color == parse_color("blue")
-    assert all(r.color.ranges == (((0, 0, 0), (179, 255, 60)),) and not r.color.dark_line for r in rows[1:])
+    assert all(
+        r.color.ranges == (((0, 0, 0), (179, 255, 60)),) and not r.color.dark_line for r in rows[1:]
+    )

@@ -1,4 +1,5 @@
-"""The ramp check: a photo off its ramp's trend is flagged; a cosmetically flagged one on it is trusted."""
+"""The ramp check: a photo off its ramp's trend is flagged; a cosmetically flagged one on it is
+trusted."""
 
 from __future__ import annotations
 
@@ -20,9 +21,21 @@ def _ramp(psi_up, psi_down=None, **columns) -> pd.DataFrame:
         psi += list(psi_down)
         direction += ["down"] * len(psi_down)
     n = len(psi)
-    df = pd.DataFrame({"image": [f"i{k}.jpg" for k in range(n)], "psi_deg": psi, "status": "ok", "reason": "",
-                       "pressure_kpa": p, "direction": direction, "material": "DS20", "actuator": "A1", "trial": "1",
-                       "step": range(n), "length_px": 900.0})
+    df = pd.DataFrame(
+        {
+            "image": [f"i{k}.jpg" for k in range(n)],
+            "psi_deg": psi,
+            "status": "ok",
+            "reason": "",
+            "pressure_kpa": p,
+            "direction": direction,
+            "material": "DS20",
+            "actuator": "A1",
+            "trial": "1",
+            "step": range(n),
+            "length_px": 900.0,
+        }
+    )
     for key, value in columns.items():
         df[key] = value
     return df
@@ -38,13 +51,22 @@ def test_a_smooth_fast_ramp_is_left_alone():
     assert (out["status"] == "ok").all(), out[["psi_deg", "reason"]]
 
 
-@pytest.mark.parametrize("k, wrong", [(3, lambda v: -v), (6, lambda v: v + 360.0), (9, lambda v: v + 80.0), (0, lambda v: v - 200.0)])
+@pytest.mark.parametrize(
+    "k, wrong",
+    [
+        (3, lambda v: -v),
+        (6, lambda v: v + 360.0),
+        (9, lambda v: v + 80.0),
+        (0, lambda v: v - 200.0),
+    ],
+)
 def test_a_photo_off_its_ramp_is_flagged(k, wrong):
     psi = _ds20_like()
     psi[k] = wrong(psi[k])
     out = check_ramps(_ramp(psi))
     assert out.loc[k, "status"] == "flagged" and out.loc[k, "reason"].startswith("breaks its ramp")
-    assert (out.drop(index=k)["status"] == "ok").all()  # the outlier does not drag its neighbours down
+    # the outlier does not drag its neighbours down
+    assert (out.drop(index=k)["status"] == "ok").all()
 
 
 def test_a_partial_line_is_flagged_by_its_length():
@@ -67,7 +89,11 @@ def test_a_cosmetic_flag_on_a_photo_that_follows_its_ramp_is_lifted():
 def test_a_cosmetic_flag_off_the_trend_stays_and_failed_rows_are_skipped():
     psi = _ds20_like()
     df = _ramp(psi)
-    df.loc[1, ["psi_deg", "status", "reason"]] = [psi[1] + 30.0, "flagged", "line partly hidden: 80% of l0 visible"]
+    df.loc[1, ["psi_deg", "status", "reason"]] = [
+        psi[1] + 30.0,
+        "flagged",
+        "line partly hidden: 80% of l0 visible",
+    ]
     df.loc[3, ["psi_deg", "status", "reason"]] = [np.nan, "failed", "unreadable image"]
     out = check_ramps(df)
     assert out.loc[1, "status"] == "flagged" and out.loc[3, "status"] == "failed"

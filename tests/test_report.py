@@ -24,37 +24,55 @@ import pypdfium2 as pdfium
 import pytest
 from PIL import Image
 
-from pipeline.bench import analysis
 from pipeline.cli import main
 from pipeline.errors import UserInputError
 from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure
 from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
+from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
+from pipeline.layout.typeset import NA, fmt
 from pipeline.report.build import build_report, report_figures
 from pipeline.report.data import Dataset, ReportInputs, dataset_dates, load_report_data
 from pipeline.report.reasons import top_reasons, words
-from pipeline.report.style import FOOTER_PT, MIN_FONT_PT, report_style
 from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
-from pipeline.report.typeset import NA, fmt
+from pipeline.study import analysis
 
 #: rough p(psi=0) per material, only to make curves of the right shape
 P_ZERO = {"DS20": 65.0, "DS30": 105.0, "SS40": 215.0, "SS50": 600.0}
 P_MAX = {"DS20": 110.0, "DS30": 170.0, "SS40": 250.0, "SS50": 250.0}
 A4_PT = (595.28, 841.89)
 #: a failure reason as the measure stage writes it (quotes an HSV range, then the fix after ';')
-NO_LINE = "no line found: no long thin component of line_color=(((0, 0, 0), (180, 255, 80)),); check line_color"
+NO_LINE = (
+    "no line found: no long thin component of line_color=(((0, 0, 0), (180, 255, 80)),); "
+    "check line_color"
+)
 
 
 def fake_psi(material: str, p: np.ndarray, direction: str) -> np.ndarray:
-    """A Fig. 6-like curve: 210 deg at rest, falling through 0 near P_ZERO; decreasing branch lower."""
+    """A Fig. 6-like curve: 210 deg at rest, falling through 0 near P_ZERO; decreasing branch
+    lower."""
     shift = 0.85 if direction == "down" else 1.0
     x = np.asarray(p, float) / (P_ZERO[material] * shift)
     return 210.0 - 210.0 * x**2.2
 
 
-def make_dataset(root: Path, material: str, *, name: str | None = None, actuators=3, trials=2, step=10.0,
-                 directions=("up", "down"), photos=True, overlays=True, seed=0, synthetic=False,
-                 timestamps: str | None = None, l0_mm: float | None = None) -> Dataset:
-    """Write angles.csv (+ a small photo set and overlays) shaped like the measure stage's outputs."""
+def make_dataset(
+    root: Path,
+    material: str,
+    *,
+    name: str | None = None,
+    actuators=3,
+    trials=2,
+    step=10.0,
+    directions=("up", "down"),
+    photos=True,
+    overlays=True,
+    seed=0,
+    synthetic=False,
+    timestamps: str | None = None,
+    l0_mm: float | None = None,
+) -> Dataset:
+    """Write angles.csv (+ a small photo set and overlays) shaped like the measure stage's
+    outputs."""
     rng = np.random.default_rng(seed)
     folder = root / (name or material)
     photo_dir, overlay_dir = folder / "photos", folder / "overlays"
@@ -73,26 +91,56 @@ def make_dataset(root: Path, material: str, *, name: str | None = None, actuator
                     if rng.random() < 0.05:
                         status, reason, psi = "failed", NO_LINE, float("nan")
                     elif rng.random() < 0.05:
-                        status, reason = "flagged", "line touches the image border; low contrast (31)"
-                    rows.append({"image": image, "psi_deg": psi, "kappa_per_mm": np.radians(psi) / 195.0,
-                                 "length_mm": 195.0, "method": "paper", "residual_px": 0.4, "status": status,
-                                 "reason": reason, "seconds": 0.02, "pressure_kpa": p, "direction": direction,
-                                 "material": material, "actuator": f"A{a}", "trial": t, "step": k})
+                        status, reason = (
+                            "flagged",
+                            "line touches the image border; low contrast (31)",
+                        )
+                    rows.append(
+                        {
+                            "image": image,
+                            "psi_deg": psi,
+                            "kappa_per_mm": np.radians(psi) / 195.0,
+                            "length_mm": 195.0,
+                            "method": "paper",
+                            "residual_px": 0.4,
+                            "status": status,
+                            "reason": reason,
+                            "seconds": 0.02,
+                            "pressure_kpa": p,
+                            "direction": direction,
+                            "material": material,
+                            "actuator": f"A{a}",
+                            "trial": t,
+                            "step": k,
+                        }
+                    )
                     if a == 1 and t == 1 and (photos or overlays):
                         img = np.full((120, 160, 3), 235, np.uint8)
                         ang = 0.0 if not np.isfinite(psi) else psi
-                        cv2.ellipse(img, (80, 60), (40, 40), 0, 0, max(abs(ang), 5.0), (20, 20, 20), 3)
+                        cv2.ellipse(
+                            img, (80, 60), (40, 40), 0, 0, max(abs(ang), 5.0), (20, 20, 20), 3
+                        )
                         if photos:
                             cv2.imwrite(str(photo_dir / image), img)
                         if overlays and k % 2 == 0:  # some overlays missing: falls back to raw
                             img[:24] = (img[:24] * 0.35).astype(np.uint8)  # the overlay's text band
-                            cv2.putText(img, f"{ang:.0f}", (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 255), 1)
+                            cv2.putText(
+                                img,
+                                f"{ang:.0f}",
+                                (5, 18),
+                                cv2.FONT_HERSHEY_SIMPLEX,
+                                0.5,
+                                (0, 0, 255),
+                                1,
+                            )
                             cv2.imwrite(str(overlay_dir / (Path(image).stem + ".jpg")), img)
     table = pd.DataFrame(rows)
     if l0_mm is not None:
         table["l0_mm"] = l0_mm
     if timestamps:
-        table["timestamp"] = pd.date_range(timestamps, periods=len(table), freq="37min").strftime("%Y-%m-%dT%H:%M:%S")
+        table["timestamp"] = pd.date_range(timestamps, periods=len(table), freq="37min").strftime(
+            "%Y-%m-%dT%H:%M:%S"
+        )
     table.to_csv(folder / "angles.csv", index=False)
     (photo_dir / "manifest.csv").write_text("image\n")
     if synthetic:
@@ -103,15 +151,26 @@ def make_dataset(root: Path, material: str, *, name: str | None = None, actuator
 
 def model_curves(path: Path, materials) -> Path:
     psi = np.linspace(210.0, -220.0, 80)
-    frames = [pd.DataFrame({"material": m, "psi_deg": psi,
-                            "pressure_kpa": 1.1 * P_ZERO[m] * np.clip((210.0 - psi) / 210.0, 0, None) ** (1 / 2.2),
-                            "reason": ""}) for m in materials]
+    frames = [
+        pd.DataFrame(
+            {
+                "material": m,
+                "psi_deg": psi,
+                "pressure_kpa": 1.1
+                * P_ZERO[m]
+                * np.clip((210.0 - psi) / 210.0, 0, None) ** (1 / 2.2),
+                "reason": "",
+            }
+        )
+        for m in materials
+    ]
     pd.concat(frames).to_csv(path, index=False)
     return path
 
 
 def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
-    """Run the real aggregate and compare stages (compare with an injected model) on the datasets."""
+    """Run the real aggregate and compare stages (compare with an injected model) on the
+    datasets."""
     from pipeline.aggregate import read_angles
     from pipeline.compare import compare
 
@@ -120,7 +179,9 @@ def pipeline_tables(tmp: Path, datasets) -> tuple[list[Path], Path]:
         out = d.angles_csv.parent / "hysteresis.csv"
         assert main(["aggregate", str(d.angles_csv), "--out", str(out)]) == 0
         hyst.append(out)
-    h = pd.concat([pd.read_csv(p).assign(dataset=d.name) for p, d in zip(hyst, datasets, strict=True)])
+    h = pd.concat(
+        [pd.read_csv(p).assign(dataset=d.name) for p, d in zip(hyst, datasets, strict=True)]
+    )
     angles = pd.concat([read_angles([d.angles_csv]).assign(dataset=d.name) for d in datasets])
     sources = {d.name: "synthetic" if (d.photoset_dir and (d.photoset_dir / "truth.csv").is_file())
                else "measured" for d in datasets}
@@ -158,20 +219,48 @@ def bench_results() -> pd.DataFrame:
                     elif cond == "psi" and v == -360.0:
                         err = 9.0
                     failed = m == "turning" and cond == "psi" and v == 360.0
-                    rows.append({"case_id": f"{cond}-{v}-{seed}", "kind": "sweep", "condition": cond, "value": v,
-                                 "nominal": nominal, "psi_true_deg": v if cond == "psi" else 60.0,
-                                 "bulge": v if cond == "bulge" else 0.0, "seed": seed, "method": m,
-                                 "psi_deg": np.nan if failed else 60.0 + err, "abs_error_deg": np.nan if failed else err,
-                                 "status": "failed" if failed else "ok",
-                                 "degree": (2 if cond == "bulge" and v > 0 else 1) if m in ("turning", "auto") else np.nan,
-                                 "seconds": speed[m] / 1e3, "decode_seconds": 0.004})
+                    rows.append(
+                        {
+                            "case_id": f"{cond}-{v}-{seed}",
+                            "kind": "sweep",
+                            "condition": cond,
+                            "value": v,
+                            "nominal": nominal,
+                            "psi_true_deg": v if cond == "psi" else 60.0,
+                            "bulge": v if cond == "bulge" else 0.0,
+                            "seed": seed,
+                            "method": m,
+                            "psi_deg": np.nan if failed else 60.0 + err,
+                            "abs_error_deg": np.nan if failed else err,
+                            "status": "failed" if failed else "ok",
+                            "degree": (2 if cond == "bulge" and v > 0 else 1)
+                            if m in ("turning", "auto")
+                            else np.nan,
+                            "seconds": speed[m] / 1e3,
+                            "decode_seconds": 0.004,
+                        }
+                    )
     for seed in range(4):
         for m in METHODS:
-            rows.append({"case_id": f"rep-{seed}", "kind": "repeat", "condition": "repeat", "value": 120.0,
-                         "nominal": 120.0, "psi_true_deg": 120.0, "bulge": 0.0, "seed": seed, "method": m,
-                         "psi_deg": 120.0 + 0.01 * seed, "abs_error_deg": 0.01 * seed, "status": "ok",
-                         "degree": 1.0 if m in ("turning", "auto") else np.nan, "seconds": speed[m] / 1e3,
-                         "decode_seconds": 0.004})
+            rows.append(
+                {
+                    "case_id": f"rep-{seed}",
+                    "kind": "repeat",
+                    "condition": "repeat",
+                    "value": 120.0,
+                    "nominal": 120.0,
+                    "psi_true_deg": 120.0,
+                    "bulge": 0.0,
+                    "seed": seed,
+                    "method": m,
+                    "psi_deg": 120.0 + 0.01 * seed,
+                    "abs_error_deg": 0.01 * seed,
+                    "status": "ok",
+                    "degree": 1.0 if m in ("turning", "auto") else np.nan,
+                    "seconds": speed[m] / 1e3,
+                    "decode_seconds": 0.004,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -180,18 +269,28 @@ def write_bench(folder: Path) -> Path:
     folder.mkdir()
     res = bench_results()
     stab = analysis.stability(res)
-    tables = {"speed_accuracy.csv": analysis.speed_accuracy(res), "stability.csv": stab,
-              "breakdown.csv": analysis.breakdown(stab), "repeatability.csv": analysis.repeatability(res),
-              "model_choice.csv": analysis.model_choice(res),
-              "model_cost.csv": pd.DataFrame({"grid_n": [2, 4, 8], "seconds": [0.02, 0.027, 0.04],
-                                              "max_rel_error": [4.8e-4, 3.6e-8, 2.0e-13]})}
+    tables = {
+        "speed_accuracy.csv": analysis.speed_accuracy(res),
+        "stability.csv": stab,
+        "breakdown.csv": analysis.breakdown(stab),
+        "repeatability.csv": analysis.repeatability(res),
+        "model_choice.csv": analysis.model_choice(res),
+        "model_cost.csv": pd.DataFrame(
+            {
+                "grid_n": [2, 4, 8],
+                "seconds": [0.02, 0.027, 0.04],
+                "max_rel_error": [4.8e-4, 3.6e-8, 2.0e-13],
+            }
+        ),
+    }
     for name, t in tables.items():
         t.to_csv(folder / name, index=False)
     return folder
 
 
 def write_force(folder: Path) -> Path:
-    """Force tables from the real aggregation of a per-photo table, a photo and the example grasp log."""
+    """Force tables from the real aggregation of a per-photo table, a photo and the example grasp
+    log."""
     folder.mkdir()
     img = np.full((300, 400, 3), 180, np.uint8)
     cv2.ellipse(img, (200, 150), (120, 90), 0, 0, 360, (40, 40, 40), 4)
@@ -200,10 +299,25 @@ def write_force(folder: Path) -> Path:
     for j, m in enumerate(("DS20", "DS30", "SS40", "SS50")):
         for trial in ("1", "2"):
             for p in (0.0, 30.0, 60.0, 90.0):
-                rows.append({"material": m, "direction": "up", "pressure_kpa": p, "actuator": "A1", "trial": trial,
-                             "force_n": 0.02 * p / (1 + j) + 0.01 * int(trial), "eccentricity": 0.004 * p / (1 + j),
-                             "status": "ok", "image": "photo.jpg", "image_path": "photo.jpg", "centre_x_px": 200.0,
-                             "centre_y_px": 150.0, "semi_major_px": 120.0, "semi_minor_px": 90.0, "angle_deg": 0.0})
+                rows.append(
+                    {
+                        "material": m,
+                        "direction": "up",
+                        "pressure_kpa": p,
+                        "actuator": "A1",
+                        "trial": trial,
+                        "force_n": 0.02 * p / (1 + j) + 0.01 * int(trial),
+                        "eccentricity": 0.004 * p / (1 + j),
+                        "status": "ok",
+                        "image": "photo.jpg",
+                        "image_path": "photo.jpg",
+                        "centre_x_px": 200.0,
+                        "centre_y_px": 150.0,
+                        "semi_major_px": 120.0,
+                        "semi_minor_px": 90.0,
+                        "angle_deg": 0.0,
+                    }
+                )
     per_photo = pd.DataFrame(rows)
     force_vs_pressure(per_photo).to_csv(folder / "force_summary.csv", index=False)
     eccentricity_at_max_pressure(per_photo).to_csv(folder / "eccentricity_summary.csv", index=False)
@@ -212,7 +326,8 @@ def write_force(folder: Path) -> Path:
 
 
 def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: ignore[no-untyped-def]
-    """``make(folder)`` computed once per test run, however many xdist workers ask (lock, then pickle)."""
+    """``make(folder)`` computed once per test run, however many xdist workers ask (lock, then
+    pickle)."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         return make(tmp_path_factory.mktemp(name))
     root = tmp_path_factory.getbasetemp().parent  # one folder per run, shared by its workers
@@ -226,17 +341,35 @@ def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: 
 
 
 def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
-    """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders) and
-    the report built from them."""
-    datasets = [make_dataset(tmp, "DS20", name="sample", actuators=1, seed=9, timestamps="2026-03-02 09:00",
-                             l0_mm=270.0)]  # its own actuator length: its own model curve
-    datasets += [make_dataset(tmp, m, seed=i, synthetic=True) for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))]
+    """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders)
+    and the report built from them."""
+    datasets = [
+        make_dataset(
+            tmp,
+            "DS20",
+            name="sample",
+            actuators=1,
+            seed=9,
+            timestamps="2026-03-02 09:00",
+            l0_mm=270.0,
+        )
+    ]  # its own actuator length: its own model curve
+    datasets += [
+        make_dataset(tmp, m, seed=i, synthetic=True)
+        for i, m in enumerate(("DS20", "DS30", "SS40", "SS50"))
+    ]
     hyst, rms = pipeline_tables(tmp, datasets)
     config = tmp / "config.yaml"
     config.write_text("datasets: []\n")
-    inputs = ReportInputs(datasets=tuple(datasets), hysteresis=tuple(hyst), rms=(rms,),
-                          model_curves=(model_curves(tmp / "curves.csv", P_ZERO),), bench_dir=write_bench(tmp / "bench"),
-                          force_dir=write_force(tmp / "force"), config=config)
+    inputs = ReportInputs(
+        datasets=tuple(datasets),
+        hysteresis=tuple(hyst),
+        rms=(rms,),
+        model_curves=(model_curves(tmp / "curves.csv", P_ZERO),),
+        bench_dir=write_bench(tmp / "bench"),
+        force_dir=write_force(tmp / "force"),
+        config=config,
+    )
     pdf = tmp / "report.pdf"
     build_report(inputs, pdf)
     return inputs, pdf, rms
@@ -250,7 +383,9 @@ def default(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def pages(default, tmp_path_factory):
-    """(label, texts drawn) of every page of the default report, each page drawn once (not saved)."""
+    """(label, texts drawn) of every page of the default report, each page drawn once (not
+    saved)."""
+
     def make(_folder: Path) -> list:
         with report_style():
             made, _ = report_figures(load_report_data(default[0]))
@@ -276,25 +411,44 @@ def test_every_page_is_a4(default):
         doc.close()
     assert len(sizes) >= 16
     for i, (w, h) in enumerate(sizes, start=1):
-        assert w == pytest.approx(A4_PT[0], abs=0.5) and h == pytest.approx(A4_PT[1], abs=0.5), f"page {i}: {w} x {h}"
+        assert w == pytest.approx(A4_PT[0], abs=0.5) and h == pytest.approx(A4_PT[1], abs=0.5), (
+            f"page {i}: {w} x {h}"
+        )
     assert "Provenance" in pdf_text(pdf, 15)
 
 
 def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
     labels = [label for label, _ in pages]
-    assert labels[:15] == ["summary", "overview", "material DS20", "material DS30", "material SS40", "material SS50",
-                           "comparison", "model-curves", "speed-accuracy", "stability", "bench-tables", "model-cost",
-                           "force", "eccentricity", "grasp"]
-    assert labels[15] == "provenance" and all(x == "provenance (continued)" for x in labels[16:])  # long tmp paths
+    assert labels[:15] == [
+        "summary",
+        "overview",
+        "material DS20",
+        "material DS30",
+        "material SS40",
+        "material SS50",
+        "comparison",
+        "model-curves",
+        "speed-accuracy",
+        "stability",
+        "bench-tables",
+        "model-cost",
+        "force",
+        "eccentricity",
+        "grasp",
+    ]
+    # long tmp paths
+    assert labels[15] == "provenance" and all(x == "provenance (continued)" for x in labels[16:])
     for label, texts in pages:
         assert len(texts) > 10, label
         assert overlapping_texts(texts) == [], label
         assert [(t.text, t.size_pt) for t in texts if t.size_pt < MIN_FONT_PT] == [], label
-        assert [t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5] == [], label
+        assert [
+            t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5
+        ] == [], label
 
 
 def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
-    from pipeline.report.style import page
+    from pipeline.layout.style import page
 
     with report_style():
         fig = page()
@@ -315,35 +469,57 @@ def test_page_one_figures_read_back_match_rms_csv(default):
     text = pdf_text(pdf, 0)
     all_lines = text.split("\r\n")
     table = pd.read_csv(rms)
-    assert len(table) == 5  # DS20 twice: the sample set has its own l0 (270 mm), the others the default
-    first = next(i for i, line in enumerate(all_lines) if line.startswith("Material Data run paper"))
+    # DS20 twice: the sample set has its own l0 (270 mm), the others the default
+    assert len(table) == 5
+    first = next(
+        i for i, line in enumerate(all_lines) if line.startswith("Material Data run paper")
+    )
     lines = all_lines[first + 1:first + 1 + len(table)]
     for line, r in zip(lines, table.to_dict("records"), strict=True):
         several = (table["material"] == r["material"]).sum() > 1
         label = f"{r['curve']} ({r['datasets']})" if several else r["material"]
         source = r["data_source"].replace("measured", "real") if several else "synthetic"
         ci = f"{fmt(r['k_p_fit'], 2)} [{fmt(r['k_p_ci_low'], 2)}, {fmt(r['k_p_ci_high'], 2)}]"
-        expected = [fmt(r["range_deg"]), fmt(r["paper_range_deg"]), fmt(r["p_zero_up_kpa"]), fmt(r["p_zero_down_kpa"]),
-                    fmt(r["paper_p_zero_kpa"]), fmt(r["rms_deg"], 1), fmt(r["paper_rms_deg"], 1), ci,
-                    fmt(r["k_p_paper"], 1)]
+        expected = [
+            fmt(r["range_deg"]),
+            fmt(r["paper_range_deg"]),
+            fmt(r["p_zero_up_kpa"]),
+            fmt(r["p_zero_down_kpa"]),
+            fmt(r["paper_p_zero_kpa"]),
+            fmt(r["rms_deg"], 1),
+            fmt(r["paper_rms_deg"], 1),
+            ci,
+            fmt(r["k_p_paper"], 1),
+        ]
         assert line == " ".join([label, source] + expected), line
-    assert lines[0].startswith("DS20, l0 255 mm (DS20) synthetic") and lines[1].startswith("DS20, l0 270 mm (sample) real")
+    assert lines[0].startswith("DS20, l0 255 mm (DS20) synthetic") and lines[1].startswith(
+        "DS20, l0 270 mm (sample) real"
+    )
     ss50 = lines[-1].split(" ")
-    assert ss50[4:7] == [NA, NA, NA]  # never straightens below 250 kPa, and the paper gives no value
+    # never straightens below 250 kPa, and the paper gives no value
+    assert ss50[4:7] == [NA, NA, NA]
     assert "SS50: the mean curve never reaches ψ = 0 up to 250 kPa" in " ".join(text.split())
 
 
 def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     inputs, pdf, _rms = default
     text = " ".join(pdf_text(pdf, 0).split())
-    assert "Photos taken: 2026-03-02 to 2026-03-03 (from the timestamps; no date for DS20, DS30, SS40, SS50)" in text
+    assert (
+        "Photos taken: 2026-03-02 to 2026-03-03 (from the timestamps; no date for DS20, DS30, "
+        "SS40, SS50)"
+        in text
+    )
     assert "no marker line found" in text and "line touches the image border" in text
     assert "(((" not in text and "#" not in text
     angles = pd.concat([pd.read_csv(d.angles_csv).assign(dataset=d.name) for d in inputs.datasets])
     for d in inputs.datasets:
         a = angles[angles["dataset"] == d.name]
-        counts = [str(len(a)), str((a["status"] == "ok").sum()), str((a["status"] == "flagged").sum()),
-                  str((a["status"] == "failed").sum())]
+        counts = [
+            str(len(a)),
+            str((a["status"] == "ok").sum()),
+            str((a["status"] == "flagged").sum()),
+            str((a["status"] == "failed").sum()),
+        ]
         kind = "real" if d.name == "sample" else "synthetic"
         assert f"{d.name} {kind} DS20 " in text or f"{d.name} {kind} {d.name} " in text
         assert " ".join(counts) in text, d.name
@@ -364,13 +540,19 @@ def test_reasons_are_counted_once_per_photo_in_words():
 
 
 def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
-    rows = pd.DataFrame({"image": ["a.jpg", "b.jpg"], "timestamp": ["2025-11-30T23:59:00+00:00", "nonsense"]})
+    rows = pd.DataFrame(
+        {"image": ["a.jpg", "b.jpg"], "timestamp": ["2025-11-30T23:59:00+00:00", "nonsense"]}
+    )
     assert dataset_dates(rows, None) == ("2025-11-30", "2025-11-30", "timestamps")
     exif = Image.Exif()
     exif[306] = "2024:05:06 10:11:12"
     for name in ("a.jpg", "b.jpg"):
         Image.new("RGB", (8, 8)).save(tmp_path / name, exif=exif.tobytes())
-    assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == ("2024-05-06", "2024-05-06", "EXIF")
+    assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == (
+        "2024-05-06",
+        "2024-05-06",
+        "EXIF",
+    )
     Image.new("RGB", (8, 8)).save(tmp_path / "a.jpg")
     Image.new("RGB", (8, 8)).save(tmp_path / "b.jpg")
     assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == (None, None, "")
@@ -378,7 +560,8 @@ def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
 
 def test_missing_values_read_na_on_the_comparison_page(pages):
     comparison = dict(pages)["comparison"]
-    assert sum(t.text == NA for t in comparison) >= 2 + 2  # SS50: table cells and the two bars of P at psi = 0
+    # SS50: table cells and the two bars of P at psi = 0
+    assert sum(t.text == NA for t in comparison) >= 2 + 2
 
 
 def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default):
@@ -388,7 +571,9 @@ def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default
     strip = build_strip(data, "DS20")
     assert strip.actuator_label == "DS20/A1" and strip.dataset == "DS20"
     assert {p.source for p in strip.photos} == {"overlay", "raw"}
-    overlay = cv2.imread(str(default[0].datasets[1].overlays_dir / (Path(strip.images[0]).stem + ".jpg")))
+    overlay = cv2.imread(
+        str(default[0].datasets[1].overlays_dir / (Path(strip.images[0]).stem + ".jpg"))
+    )
     assert crop_banner(overlay).shape[0] == overlay.shape[0] - 24
     text = " ".join(pdf_text(default[1], 2).split())
     assert "actuator DS20/A1, trial 1" in text
@@ -396,9 +581,15 @@ def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default
 
 def test_bench_pages_say_where_each_method_breaks(pages):
     stability = " ".join(t.text for t in dict(pages)["stability"])
-    assert ("paper_corrected, pratt, taubin, hyper: break at true bending angle psi -360 deg (fine at -30), "
-            "camera tilt 12 deg (fine at 5), non-constant curvature 0.2 (fine at 0)") in stability
-    assert "turning: breaks at true bending angle psi -360 deg (fine at -30), true bending angle" not in stability
+    assert (
+        "paper_corrected, pratt, taubin, hyper: break at true bending angle psi -360 deg (fine at "
+        "-30), "
+        "camera tilt 12 deg (fine at 5), non-constant curvature 0.2 (fine at 0)"
+    ) in stability
+    assert (
+        "turning: breaks at true bending angle psi -360 deg (fine at -30), true bending angle"
+        not in stability
+    )
     assert "an image failed" in stability and "(none in this run)" not in stability
     assert "paper: already beyond 2° at the nominal value of psi, noise, tilt, bulge." in stability
     speed = " ".join(t.text for t in dict(pages)["speed-accuracy"])
@@ -414,25 +605,56 @@ def test_bench_pages_say_where_each_method_breaks(pages):
 def test_identical_inputs_identical_bytes_across_processes(default, tmp_path):
     inputs, pdf, rms = default
     d = inputs.datasets
-    args = ["report", "--datasets", *[x.name for x in d], "--angles", *[str(x.angles_csv) for x in d],
-            "--photosets", *[str(x.photoset_dir) for x in d], "--overlays", *[str(x.overlays_dir) for x in d],
-            "--hysteresis", *map(str, inputs.hysteresis), "--rms", str(rms),
-            "--model-curves", *map(str, inputs.model_curves), "--bench-dir", str(inputs.bench_dir),
-            "--force-dir", str(inputs.force_dir), "--config", str(inputs.config)]
+    args = [
+        "report",
+        "--datasets",
+        *[x.name for x in d],
+        "--angles",
+        *[str(x.angles_csv) for x in d],
+        "--photosets",
+        *[str(x.photoset_dir) for x in d],
+        "--overlays",
+        *[str(x.overlays_dir) for x in d],
+        "--hysteresis",
+        *map(str, inputs.hysteresis),
+        "--rms",
+        str(rms),
+        "--model-curves",
+        *map(str, inputs.model_curves),
+        "--bench-dir",
+        str(inputs.bench_dir),
+        "--force-dir",
+        str(inputs.force_dir),
+        "--config",
+        str(inputs.config),
+    ]
     out = tmp_path / "cli.pdf"
-    proc = subprocess.run([sys.executable, "-m", "pipeline", *args, "--out", str(out)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "pipeline", *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert proc.returncode == 0, proc.stderr
     assert out.read_bytes() == pdf.read_bytes()  # a fresh process (as Snakemake runs it) = this one
     assert b"CreationDate" not in out.read_bytes()
-    small = dataclasses.replace(inputs, datasets=inputs.datasets[:1], hysteresis=(), rms=(), model_curves=(),
-                                bench_dir=None, force_dir=None)
+    small = dataclasses.replace(
+        inputs,
+        datasets=inputs.datasets[:1],
+        hysteresis=(),
+        rms=(),
+        model_curves=(),
+        bench_dir=None,
+        force_dir=None,
+    )
     build_report(small, tmp_path / "a.pdf")
     inputs.config.write_text("datasets: [changed]\n")
     try:
         build_report(small, tmp_path / "b.pdf")
     finally:
         inputs.config.write_text("datasets: []\n")
-    assert (tmp_path / "a.pdf").read_bytes() != (tmp_path / "b.pdf").read_bytes()  # its digest is printed
+    # its digest is printed
+    assert (tmp_path / "a.pdf").read_bytes() != (tmp_path / "b.pdf").read_bytes()
 
 
 def test_the_summary_says_which_model_readings_were_used(tmp_path):
@@ -454,7 +676,8 @@ def test_one_material_without_optional_tables(tmp_path):
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert res.materials == ("SS40",)
-    assert res.pages == 5  # summary, overview, SS40, comparison, provenance (no rms.csv: no model-curve page)
+    # summary, overview, SS40, comparison, provenance (no rms.csv: no model-curve page)
+    assert res.pages == 5
     text = " ".join(pdf_text(out, 0).split())
     assert "SS40 unknown" in text  # no photo-set folder: neither real nor synthetic can be told
     assert "SS40: no row in --rms" in text
@@ -486,19 +709,28 @@ def test_bench_and_force_folders_missing_or_broken(tmp_path):
 
 
 def test_bad_inputs_exit_2(tmp_path):
-    angles = str(make_dataset(tmp_path, "DS30", actuators=1, trials=1, photos=False, overlays=False).angles_csv)
+    angles = str(
+        make_dataset(
+            tmp_path, "DS30", actuators=1, trials=1, photos=False, overlays=False
+        ).angles_csv
+    )
     out = str(tmp_path / "r.pdf")
     assert main(["report", "--angles", angles, "--photosets", "a", "b", "--out", out]) == 2
     assert main(["report", "--angles", str(tmp_path / "missing.csv"), "--out", out]) == 2
-    assert main(["report", "--angles", angles, "--rms", angles, "--model-curves", angles, "--out", out]) == 2
+    assert (
+        main(
+            ["report", "--angles", angles, "--rms", angles, "--model-curves", angles, "--out", out]
+        )
+        == 2
+    )
 
 
 def test_each_material_has_one_colour_on_every_page(default):
     from matplotlib.colors import to_rgb
 
     from pipeline.force import pages as force_pages
+    from pipeline.layout.style import material_colors
     from pipeline.report.pages import overview_page
-    from pipeline.report.style import material_colors
     from pipeline.report.summary import summary_page
 
     data = load_report_data(default[0])
@@ -506,18 +738,23 @@ def test_each_material_has_one_colour_on_every_page(default):
     with report_style():
         figures = [summary_page(data, "0", [], []), overview_page(data)]
         figures += force_pages.figures(data.inputs.force_dir, colors=colors)
-        figures += force_pages.figures(data.inputs.force_dir)  # the force CLI's pages, without the report
+        # the force CLI's pages, without the report
+        figures += force_pages.figures(data.inputs.force_dir)
     seen = 0
     for fig in figures:
         for ax in fig.axes:
             for line in ax.get_lines():
                 if line.get_label() in colors:
-                    assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), fig.get_label()
+                    assert to_rgb(line.get_color()) == pytest.approx(colors[line.get_label()]), (
+                        fig.get_label()
+                    )
                     seen += 1
             if ax.get_title() in colors:
-                assert to_rgb(ax.title.get_color()) == pytest.approx(colors[ax.get_title()])  # overview panels
+                # overview panels
+                assert to_rgb(ax.title.get_color()) == pytest.approx(colors[ax.get_title()])
                 seen += 1
-    assert seen >= 4 + 4 + 2 * (4 + 7)  # summary plot, overview titles; force and grasp lines (report and CLI)
+    # summary plot, overview titles; force and grasp lines (report and CLI)
+    assert seen >= 4 + 4 + 2 * (4 + 7)
 
 
 def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_path):

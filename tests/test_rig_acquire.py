@@ -25,8 +25,17 @@ from pipeline.rig.acquire import EXIT_CODES
 from pipeline.rig.emulator import Emulator, Faults, PlantParams
 
 REPO = Path(__file__).resolve().parents[1]
-COLUMNS = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step", "timestamp",
-           "measured_pressure_kpa"]
+COLUMNS = [
+    "image",
+    "pressure_kpa",
+    "direction",
+    "material",
+    "actuator",
+    "trial",
+    "step",
+    "timestamp",
+    "measured_pressure_kpa",
+]
 FULL_RAMP = [0, 50, 100, 120, 100, 50, 0]  # --step-kpa 50 --max-kpa 120
 
 
@@ -41,13 +50,40 @@ def photo(tmp_path_factory) -> Path:
 
 
 def acquire_cmd(port: str, out: Path, photo: Path, *extra: str, trials: int = 2) -> list[str]:
-    return [sys.executable, "-m", "pipeline", "acquire", "--port", port, "--camera", f"cmd:cp {photo} {{path}}",
-            "--material", "DS20", "--actuator", "A1", "--trials", str(trials), "--step-kpa", "50",
-            "--max-kpa", "120", "--settle-s", "0", "--l0-mm", "200", "--out", str(out), "--no-progress", *extra]
+    return [
+        sys.executable,
+        "-m",
+        "pipeline",
+        "acquire",
+        "--port",
+        port,
+        "--camera",
+        f"cmd:cp {photo} {{path}}",
+        "--material",
+        "DS20",
+        "--actuator",
+        "A1",
+        "--trials",
+        str(trials),
+        "--step-kpa",
+        "50",
+        "--max-kpa",
+        "120",
+        "--settle-s",
+        "0",
+        "--l0-mm",
+        "200",
+        "--out",
+        str(out),
+        "--no-progress",
+        *extra,
+    ]
 
 
 def run(cmd: list[str], timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=timeout, check=False)
+    return subprocess.run(
+        cmd, cwd=REPO, capture_output=True, text=True, timeout=timeout, check=False
+    )
 
 
 def main_inprocess(cmd: list[str], capsys) -> tuple[int, str, str]:
@@ -64,7 +100,8 @@ def manifest(out: Path) -> pd.DataFrame:
 
 
 def assert_consistent(out: Path) -> pd.DataFrame:
-    """The folder is a valid photo set: every row's image exists, no duplicates, steps in ramp order."""
+    """The folder is a valid photo set: every row's image exists, no duplicates, steps in ramp
+    order."""
     assert validate_photoset(out, decode_images=True) == []
     df = manifest(out)
     assert list(df.columns[: len(COLUMNS)]) == COLUMNS
@@ -154,7 +191,9 @@ def test_sigint_vents_and_keeps_manifest_intact(tmp_path, photo):
     with Emulator() as emu:
         cmd = acquire_cmd(emu.port, out, photo, trials=6)
         cmd[cmd.index("--settle-s") + 1] = "0.15"
-        proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        proc = subprocess.Popen(
+            cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
         deadline = time.monotonic() + 30
         while time.monotonic() < deadline:
             if (out / "manifest.csv").is_file() and len(manifest(out)) >= 3:
@@ -172,19 +211,27 @@ def test_sigint_vents_and_keeps_manifest_intact(tmp_path, photo):
 def test_limit_refused_before_anything_is_sent(tmp_path, photo, capsys):
     out = tmp_path / "set"
     cal = tmp_path / "cal.yaml"
-    cal.write_text("method: linear\npoints:\n- {dac_code: 0, pressure_kpa: 0}\n- {dac_code: 4095, pressure_kpa: 500}\nmax_kpa: 100\n")
+    cal.write_text(
+        "method: linear\npoints:\n- {dac_code: 0, pressure_kpa: 0}\n- {dac_code: 4095, "
+        "pressure_kpa: 500}\nmax_kpa: 100\n"
+    )
     with Emulator() as emu:
-        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--calibration", str(cal)), capsys)
+        code, _, err = main_inprocess(
+            acquire_cmd(emu.port, out, photo, "--calibration", str(cal)), capsys
+        )
         assert not [c for c in emu.stats.received if c.startswith("SET")]
     assert code == 6
     assert "above the driver limit 100 kPa" in err
 
 
 def test_base_protocol_firmware_ramp_completes_and_vents(tmp_path, photo, capsys):
-    """Firmware with only ID/SET/GET/VENT/EVT ESTOP: the ramp runs to --max-kpa, vents, and says what it lacked."""
+    """Firmware with only ID/SET/GET/VENT/EVT ESTOP: the ramp runs to --max-kpa, vents, and says
+    what it lacked."""
     out = tmp_path / "set"
     with Emulator(protocol="base", seed=2) as emu:
-        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--watchdog-s", "5", trials=1), capsys)
+        code, _, err = main_inprocess(
+            acquire_cmd(emu.port, out, photo, "--watchdog-s", "5", trials=1), capsys
+        )
         assert code == 0, err
         assert emu.setpoint_kpa == 0.0 and emu.pressure_kpa == 0.0
         received = list(emu.stats.received)
@@ -194,12 +241,15 @@ def test_base_protocol_firmware_ramp_completes_and_vents(tmp_path, photo, capsys
     sets = [float(c.split()[1]) for c in received if c.startswith("SET")]
     assert max(sets) == 120.0  # the limit came from the command line
     extension_commands = [c for c in received if c.split()[0] not in ("ID", "SET", "GET", "VENT")]
-    assert extension_commands == ["CFG", "WDOG 0.0000", "SCALE"]  # probed once at connect, never used
+    # probed once at connect, never used
+    assert extension_commands == ["CFG", "WDOG 0.0000", "SCALE"]
     assert "not used: firmware circact-pico 1.1 has no CFG" in err and "--max-kpa 120 kPa" in err
     assert "has no WDOG" in err and "acquire: done" in err
     out_blocked = tmp_path / "blocked"
     with Emulator(protocol="base") as emu:
-        code, _, err = main_inprocess(acquire_cmd(emu.port, out_blocked, photo, "--mode", "blocked", trials=1), capsys)
+        code, _, err = main_inprocess(
+            acquire_cmd(emu.port, out_blocked, photo, "--mode", "blocked", trials=1), capsys
+        )
         assert not [c for c in emu.stats.received if c.startswith("SET")]  # nothing pressurised
     assert code == EXIT_CODES["error"] and "blocked mode needs the load cell" in err
     assert not (out_blocked / "manifest.csv").exists()
@@ -219,13 +269,20 @@ def test_blocked_mode_records_force_statistics(tmp_path, photo, capsys):
     out = tmp_path / "set"
     plant = PlantParams(monitor_noise_kpa=0.0, force_noise_n=0.02)
     with Emulator(plant=plant, seed=7) as emu:
-        code, _, err = main_inprocess(acquire_cmd(emu.port, out, photo, "--mode", "blocked", "--force-samples", "8", trials=1), capsys)
+        code, _, err = main_inprocess(
+            acquire_cmd(
+                emu.port, out, photo, "--mode", "blocked", "--force-samples", "8", trials=1
+            ),
+            capsys,
+        )
         assert code == 0, err
         assert [c for c in emu.stats.received if c.startswith("TARE")]
     df = assert_consistent(out)
     assert {"force_n", "force_sd_n", "force_samples"} <= set(df.columns)
     assert (df["force_samples"] == 8).all()
-    expected = [plant.force_n(p) - plant.force_n(0.0) for p in df["measured_pressure_kpa"].clip(lower=0)]
+    expected = [
+        plant.force_n(p) - plant.force_n(0.0) for p in df["measured_pressure_kpa"].clip(lower=0)
+    ]
     assert np.allclose(df["force_n"], expected, atol=0.04)  # 4 sd of the mean of 8 readings
     assert ((df["force_sd_n"] > 0.005) & (df["force_sd_n"] < 0.05)).all()
     up = df[df["direction"] == "up"]["force_n"].to_numpy()
@@ -253,14 +310,17 @@ def test_dry_run_prints_plan_and_resume_point(tmp_path, photo, capsys):
 
 
 def test_bad_options_exit_2(tmp_path, photo, capsys):
-    code, _, err = main_inprocess(acquire_cmd("/dev/null", tmp_path / "x", photo, "--trials", "0"), capsys)
+    code, _, err = main_inprocess(
+        acquire_cmd("/dev/null", tmp_path / "x", photo, "--trials", "0"), capsys
+    )
     assert code == 2 and "--trials" in err
     code, _, err = main_inprocess(acquire_cmd("/nonexistent/tty", tmp_path / "x", photo), capsys)
     assert code == 4 and "cannot open serial port" in err
 
 
 def test_watched_folder_camera(tmp_path, photo, capsys):
-    """``dir:`` takes the first image that arrives after each request (a feeder writes one every 30 ms)."""
+    """``dir:`` takes the first image that arrives after each request (a feeder writes one every 30
+    ms)."""
     watch = tmp_path / "watch"
     watch.mkdir()
     (watch / "old.png").write_bytes(photo.read_bytes())  # present before: never used
@@ -296,9 +356,32 @@ def test_watched_folder_camera(tmp_path, photo, capsys):
 
 
 def synthetic_cmd(port: str, out: Path, *extra: str, step: int = 40, top: int = 120) -> list[str]:
-    return [sys.executable, "-m", "pipeline", "acquire", "--port", port, "--camera", "synthetic:clean",
-            "--material", "DS20", "--actuator", "A1", "--trials", "1", "--step-kpa", str(step), "--max-kpa", str(top),
-            "--settle-s", "0", "--out", str(out), "--no-progress", *extra]
+    return [
+        sys.executable,
+        "-m",
+        "pipeline",
+        "acquire",
+        "--port",
+        port,
+        "--camera",
+        "synthetic:clean",
+        "--material",
+        "DS20",
+        "--actuator",
+        "A1",
+        "--trials",
+        "1",
+        "--step-kpa",
+        str(step),
+        "--max-kpa",
+        str(top),
+        "--settle-s",
+        "0",
+        "--out",
+        str(out),
+        "--no-progress",
+        *extra,
+    ]
 
 
 def test_synthetic_camera_virtual_rig(tmp_path):
@@ -321,14 +404,17 @@ def test_synthetic_camera_virtual_rig(tmp_path):
 
 
 def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
-    """Live measurement ends the up leg once psi <= -psi0; the down leg mirrors it; resume keeps it."""
+    """Live measurement ends the up leg once psi <= -psi0; the down leg mirrors it; resume keeps
+    it."""
     from pipeline.measure import measure_image
     from pipeline.model import load_materials, psi_deg
 
     psi0 = load_materials()["DS20"].psi0_deg
     out = tmp_path / "set"
-    # ID, CFG, WDOG 0, SCALE, VENT, WDOG, VENT, then SET+GET per step: the port drops right after the
-    # 6th photo (100 kPa), the one that reaches -psi0, before any down step: the re-run must find the peak
+    # ID, CFG, WDOG 0, SCALE, VENT, WDOG, VENT, then SET+GET per step: the port drops right after
+    # the
+    # 6th photo (100 kPa), the one that reaches -psi0, before any down step: the re-run must find
+    # the peak
     with Emulator(seed=2, faults=Faults(drop_after=19)) as emu:
         first = run(synthetic_cmd(emu.port, out, "--stop-at-psi0", step=20, top=260), timeout=120)
     assert first.returncode == 4
@@ -346,8 +432,11 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     assert list(down["pressure_kpa"]) == sorted(up["pressure_kpa"][:-1], reverse=True)
     assert df["step"].tolist() == list(range(len(df)))
     # the stop is where the measured psi first reaches -psi0 (and not before)
-    psis = [measure_image(cv2.imread(str(out / name)), settings).psi_deg for name, settings in zip(df["image"], ps.rows)
-            if name in set(up["image"])]
+    psis = [
+        measure_image(cv2.imread(str(out / name)), settings).psi_deg
+        for name, settings in zip(df["image"], ps.rows)
+        if name in set(up["image"])
+    ]
     assert psis[-1] <= -psi0 and all(p > -psi0 for p in psis[:-1])
     assert float(psi_deg("DS20", np.array([peak]))[0]) < -psi0 + 30
 
@@ -355,7 +444,22 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
 def test_synthetic_blocked_rig(tmp_path, capsys):
     out = tmp_path / "set"
     with Emulator(seed=3) as emu:
-        code, _, err = main_inprocess(synthetic_cmd(emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100), capsys)
+        code, _, err = main_inprocess(
+            synthetic_cmd(
+                emu.port, out, "--mode", "blocked", "--force-samples", "3", step=50, top=100
+            ),
+            capsys,
+        )
     assert code == 0, err
     df = load_photoset(out).manifest
     assert len(df) == 5 and df["force_n"].notna().all() and (df["force_samples"] == 3).all()
+
+
+def test_rig_benchmark_times_a_real_live_measurement():
+    """The live-psi figure of ``bench rig`` is the cost of measuring, not of a failed
+    measurement."""
+    from pipeline.bench.rig import synthetic_costs
+
+    costs = synthetic_costs(2)
+    assert costs["live_psi_measured"] == 2
+    assert costs["live_psi_measure_median_ms"] > 0

@@ -1,4 +1,5 @@
-"""Camera backends on real inputs (a video file, shell commands, a folder) and camera failure handling."""
+"""Camera backends on real inputs (a video file, shell commands, a folder) and camera failure
+handling."""
 
 from __future__ import annotations
 
@@ -81,12 +82,38 @@ def test_camera_failure_mid_ramp_vents_and_keeps_rows(tmp_path, capsys):
     src = tmp_path / "a.png"
     cv2.imwrite(str(src), np.zeros((8, 8, 3), np.uint8))
     counter = tmp_path / "n"
-    command = f"n=$(cat {counter} 2>/dev/null || echo 0); echo $((n+1)) > {counter}; [ $n -lt 2 ] && cp {src} {{path}}"
+    command = (
+        f"n=$(cat {counter} 2>/dev/null || echo 0); echo $((n+1)) > {counter}; "
+        f"[ $n -lt 2 ] && cp {src} {{path}}"
+    )
     out = tmp_path / "set"
     with Emulator() as emu:
-        code = main(["acquire", "--port", emu.port, "--camera", f"cmd:{command}", "--material", "DS20", "--actuator",
-                     "A1", "--trials", "1", "--step-kpa", "50", "--max-kpa", "100", "--settle-s", "0", "--l0-mm", "200",
-                     "--out", str(out), "--no-progress"])
+        code = main(
+            [
+                "acquire",
+                "--port",
+                emu.port,
+                "--camera",
+                f"cmd:{command}",
+                "--material",
+                "DS20",
+                "--actuator",
+                "A1",
+                "--trials",
+                "1",
+                "--step-kpa",
+                "50",
+                "--max-kpa",
+                "100",
+                "--settle-s",
+                "0",
+                "--l0-mm",
+                "200",
+                "--out",
+                str(out),
+                "--no-progress",
+            ]
+        )
         assert emu.setpoint_kpa == 0.0
     err = capsys.readouterr().err
     assert code == 5 and "camera failed" in err and "vented to 0 kPa" in err

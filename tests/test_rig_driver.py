@@ -36,19 +36,25 @@ def test_set_get_through_pty_follows_the_plant():
             assert result.dac_code == rigcore.kpa_to_code(p, rigcore.Config())
             reading = rig.get()
             assert reading.setpoint_kpa == pytest.approx(p)
-            expected = 0.0 if p == 0 else 0.95 * rigcore.code_to_kpa(result.dac_code, rigcore.Config()) - 2.0
+            expected = (
+                0.0
+                if p == 0
+                else 0.95 * rigcore.code_to_kpa(result.dac_code, rigcore.Config()) - 2.0
+            )
             assert reading.measured_kpa == pytest.approx(expected, abs=0.2)  # one ADC step
             assert not reading.estop
     assert emu.setpoint_kpa == 0.0  # leaving the context vents
 
 
 def test_base_protocol_firmware_connects_and_extensions_are_optional(tmp_path):
-    """Firmware that speaks only ID, SET, GET, VENT: set/get/vent work, extensions raise without being sent."""
+    """Firmware that speaks only ID, SET, GET, VENT: set/get/vent work, extensions raise without
+    being sent."""
     with Emulator(protocol="base", seed=1) as emu, PicoDriver.open(emu.port, max_kpa=150) as rig:
         assert rig.info is not None and rig.info.extensions == frozenset()
         assert rig.info.missing == ("CFG", "WDOG", "LOAD") and rig.info.max_kpa is None
         probes = list(emu.stats.received)
-        assert probes == ["ID", "CFG", "WDOG 0.0000", "SCALE"]  # each probed once, no retry on ERR PARSE
+        # each probed once, no retry on ERR PARSE
+        assert probes == ["ID", "CFG", "WDOG 0.0000", "SCALE"]
         assert rig.set_kpa(100).pressure_kpa == 100
         assert rig.get().setpoint_kpa == 100
         with pytest.raises(LimitError) as info:  # the host limit from the caller still applies
@@ -64,7 +70,8 @@ def test_base_protocol_firmware_connects_and_extensions_are_optional(tmp_path):
         with pytest.raises(UnsupportedError, match="no CFG"):
             PicoDriver.open(emu.port, max_kpa=150, calibration=cal)
         assert not [c for c in emu.stats.received if c.startswith("SET")]
-    with Emulator() as emu, PicoDriver.open(emu.port, max_kpa=150) as rig:  # our firmware: everything found
+    # our firmware: everything found
+    with Emulator() as emu, PicoDriver.open(emu.port, max_kpa=150) as rig:
         assert rig.info is not None and rig.info.missing == () and rig.info.max_kpa == 300.0
 
 
@@ -82,7 +89,10 @@ def test_host_limit_refuses_before_sending():
 
 
 def test_device_limit_is_reported():
-    with Emulator(cfg=rigcore.Config(max_kpa=150)) as emu, PicoDriver.open(emu.port, max_kpa=400) as rig:
+    with (
+        Emulator(cfg=rigcore.Config(max_kpa=150)) as emu,
+        PicoDriver.open(emu.port, max_kpa=400) as rig,
+    ):
         with pytest.raises(LimitError) as info:
             rig.set_kpa(200)
         assert info.value.sent is True and "150" in str(info.value)
@@ -91,7 +101,10 @@ def test_device_limit_is_reported():
 
 
 def test_garbage_lines_are_skipped():
-    with Emulator(faults=Faults(garbage_every=1), seed=4) as emu, PicoDriver.open(emu.port, max_kpa=260) as rig:
+    with (
+        Emulator(faults=Faults(garbage_every=1), seed=4) as emu,
+        PicoDriver.open(emu.port, max_kpa=260) as rig,
+    ):
         for p in range(0, 101, 10):
             assert rig.set_kpa(p).pressure_kpa == p
             assert rig.get().setpoint_kpa == p
@@ -99,12 +112,17 @@ def test_garbage_lines_are_skipped():
 
 
 def test_slow_replies_ok_within_timeout_and_lost_beyond():
-    with Emulator(faults=Faults(slow_s=0.05)) as emu, PicoDriver.open(emu.port, max_kpa=260, timeout_s=1.0) as rig:
+    with (
+        Emulator(faults=Faults(slow_s=0.05)) as emu,
+        PicoDriver.open(emu.port, max_kpa=260, timeout_s=1.0) as rig,
+    ):
         rig.set_kpa(30)
         assert rig.get().setpoint_kpa == 30
-    with Emulator(faults=Faults(slow_s=0.6)) as emu:
-        with pytest.raises(PortLostError, match="no reply"):
-            PicoDriver.open(emu.port, max_kpa=260, timeout_s=0.3)
+    with (
+        Emulator(faults=Faults(slow_s=0.6)) as emu,
+        pytest.raises(PortLostError, match="no reply"),
+    ):
+        PicoDriver.open(emu.port, max_kpa=260, timeout_s=0.3)
 
 
 def test_dropped_connection_raises_port_lost():
@@ -127,7 +145,8 @@ def test_dropped_connection_with_link_reconnects(tmp_path):
         with pytest.raises(PortLostError):
             rig.get()
         rig.close()
-        with PicoDriver.open(str(link), max_kpa=260) as rig2:  # same name, new pty, same device state
+        # same name, new pty, same device state
+        with PicoDriver.open(str(link), max_kpa=260) as rig2:
             assert rig2.get().setpoint_kpa == 50.0
 
 
@@ -162,7 +181,10 @@ def test_device_watchdog_vents_a_silent_host():
 
 
 def test_estop_fault_at_kth_set():
-    with Emulator(faults=Faults(estop_at_set=2)) as emu, PicoDriver.open(emu.port, max_kpa=260) as rig:
+    with (
+        Emulator(faults=Faults(estop_at_set=2)) as emu,
+        PicoDriver.open(emu.port, max_kpa=260) as rig,
+    ):
         rig.set_kpa(10)
         rig.sleep(0.05)
         rig.set_kpa(20)
@@ -176,13 +198,17 @@ def test_calibration_routine_corrects_the_regulator(points, tmp_path):
     plant = PlantParams(gain=0.93, offset_kpa=-3.0, monitor_noise_kpa=0.1)
     with Emulator(plant=plant, seed=2) as emu:
         with PicoDriver.open(emu.port, max_kpa=260) as rig:
-            cal = run_calibration(rig, [float(p) for p in points], settle_s=0.0, samples=4, max_kpa=255)
+            cal = run_calibration(
+                rig, [float(p) for p in points], settle_s=0.0, samples=4, max_kpa=255
+            )
             rig.set_kpa(200)
             uncalibrated = rig.get().measured_kpa
         path = tmp_path / "cal.yaml"
         write_calibration(path, cal)
         cal2 = read_calibration(path)
-        assert cal2.method == ("linear" if len(points) == 2 else "piecewise") and cal2.max_kpa == 255
+        assert (
+            cal2.method == ("linear" if len(points) == 2 else "piecewise") and cal2.max_kpa == 255
+        )
         with PicoDriver.open(emu.port, max_kpa=260, calibration=cal2) as rig:
             assert rig.max_kpa == 255
             errors = []
@@ -229,15 +255,22 @@ def test_load_cell_tare_readings_and_scale():
 
 
 def test_parse_faults():
-    assert parse_faults(["drop-after=5", "slow=0.1", "garbage-every=3", "estop-at-set=2"]) == Faults(5, 2, 0.1, 3)
+    assert parse_faults(
+        ["drop-after=5", "slow=0.1", "garbage-every=3", "estop-at-set=2"]
+    ) == Faults(5, 2, 0.1, 3)
     for bad in (["boom=1"], ["slow=x"], ["garbage-every=0"]):
         with pytest.raises(UserInputError):
             parse_faults(bad)
 
 
 def test_emulate_cli_prints_port_and_serves_until_killed():
-    proc = subprocess.Popen([sys.executable, "-m", "pipeline", "rig", "emulate", "--seed", "1"], cwd=REPO,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pipeline", "rig", "emulate", "--seed", "1"],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         line = proc.stdout.readline()
         assert line.startswith("PORT /dev/")
@@ -255,12 +288,30 @@ def test_calibrate_cli_from_monitor_and_from_readings(tmp_path, capsys):
 
     with Emulator(plant=PlantParams(gain=0.9, offset_kpa=-2.0)) as emu:
         path = tmp_path / "cal.yaml"
-        code = main(["rig", "calibrate", "--port", emu.port, "--out", str(path), "--points-kpa", "0,100,200",
-                     "--settle-s", "0", "--samples", "3", "--max-kpa", "250"])
+        code = main(
+            [
+                "rig",
+                "calibrate",
+                "--port",
+                emu.port,
+                "--out",
+                str(path),
+                "--points-kpa",
+                "0,100,200",
+                "--settle-s",
+                "0",
+                "--samples",
+                "3",
+                "--max-kpa",
+                "250",
+            ]
+        )
         assert code == 0 and "3 points" in capsys.readouterr().out
         cal = read_calibration(path)
         assert cal.method == "piecewise" and cal.max_kpa == 250
-        assert cal.code_to_kpa(cal.dac_code[-1]) == pytest.approx(0.9 * rigcore.code_to_kpa(cal.dac_code[-1], rigcore.Config()) - 2, abs=0.5)
+        assert cal.code_to_kpa(cal.dac_code[-1]) == pytest.approx(
+            0.9 * rigcore.code_to_kpa(cal.dac_code[-1], rigcore.Config()) - 2, abs=0.5
+        )
         assert emu.setpoint_kpa == 0.0
     readings = tmp_path / "gauge.csv"
     readings.write_text("dac_code,pressure_kpa\n400,47.5\n2000,242.0\n")
@@ -281,7 +332,12 @@ def test_load_cli_sets_scale_from_a_known_force(tmp_path, capsys):
         rig.set_kpa(120)
         known = plant.force_n(emu.pressure_kpa)  # the "weight" hanging on the cell
         rig.close()  # no vent: keep the force on
-        assert main(["rig", "load", "--port", emu.port, "--known-n", f"{known:.5f}", "--samples", "20"]) == 0
+        assert (
+            main(
+                ["rig", "load", "--port", emu.port, "--known-n", f"{known:.5f}", "--samples", "20"]
+            )
+            == 0
+        )
         out = capsys.readouterr().out
         new_scale = float(out.split("scale ")[1].split()[0])
         assert new_scale == pytest.approx(plant.load_counts_per_newton, rel=0.01)

@@ -1,4 +1,5 @@
-"""Firmware logic on the host: parsing, DAC/ADC arithmetic, limits, e-stop, load cell (no serial port)."""
+"""Firmware logic on the host: parsing, DAC/ADC arithmetic, limits, e-stop, load cell (no serial
+port)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ def test_dac_code_round_trip_every_code():
 
 
 def test_dac_scaling_and_clipping():
-    # 12-bit MCP4921 behind a 5/3.3 amplifier into a 0-5 V, 0-500 kPa regulator: 4096 codes = 500 kPa
+    # 12-bit MCP4921 behind a 5/3.3 amplifier into a 0-5 V, 0-500 kPa regulator: 4096 codes = 500
+    # kPa
     assert rigcore.kpa_to_code(250.0, CFG) == 2048
     assert rigcore.kpa_to_code(0.0, CFG) == 0
     assert rigcore.kpa_to_code(-5.0, CFG) == 0
@@ -53,7 +55,8 @@ def test_monitor_adc_round_trip_within_one_lsb():
         u16 = rigcore.kpa_to_monitor_u16(p, CFG)
         assert 0 <= u16 <= 65535
         assert abs(rigcore.monitor_kpa(u16, CFG) - p) <= lsb_kpa
-    assert rigcore.kpa_to_monitor_u16(0.0, CFG) & 0xF == rigcore.kpa_to_monitor_u16(0.0, CFG) >> 12  # MicroPython 12->16 bit scaling
+    # MicroPython 12->16 bit scaling
+    assert rigcore.kpa_to_monitor_u16(0.0, CFG) & 0xF == rigcore.kpa_to_monitor_u16(0.0, CFG) >> 12
 
 
 def test_hx711_sign_extension():
@@ -65,9 +68,29 @@ def test_hx711_sign_extension():
 
 @pytest.mark.parametrize(
     "line",
-    ["", "   ", "SET", "SET 1 2", "SET abc", "SET 12abc", "SET nan", "SET inf", "SET 1e999", "SET 0x10",
-     "FOO", "GET 1", "VENT now", "ID x", "SET " + "1" * 70, "SET\t5", b"\xff\xfeSET 5", "SCALE 0", "TARE 0", "TARE 2.5",
-     "LOAD 3"],
+    [
+        "",
+        "   ",
+        "SET",
+        "SET 1 2",
+        "SET abc",
+        "SET 12abc",
+        "SET nan",
+        "SET inf",
+        "SET 1e999",
+        "SET 0x10",
+        "FOO",
+        "GET 1",
+        "VENT now",
+        "ID x",
+        "SET " + "1" * 70,
+        "SET\t5",
+        b"\xff\xfeSET 5",
+        "SCALE 0",
+        "TARE 0",
+        "TARE 2.5",
+        "LOAD 3",
+    ],
 )
 def test_malformed_lines_get_err_parse(line):
     c = rigcore.Controller(rigcore.SimpleHardware())
@@ -108,7 +131,8 @@ def test_estop_vents_reports_once_and_blocks_set():
     hw.estop = False
     assert c.handle("SET 50") == ["OK SET 50.000 410"]
     hw.estop = True
-    assert c.handle("GET")[0] == "EVT ESTOP"  # a press between commands is reported before the reply
+    # a press between commands is reported before the reply
+    assert c.handle("GET")[0] == "EVT ESTOP"
 
 
 def test_watchdog_vents_when_the_host_goes_silent():
@@ -146,12 +170,21 @@ def test_host_protocol_encode_parse():
     assert encode("TARE", 3) == b"TARE 3\n"
     assert parse_reply("OK SET 12.500 102").fields == ("12.500", "102")
     assert parse_reply("EVT ESTOP").kind == "EVT"
-    for junk in ["OK GET 1 2", "OK GET 12.0 x7 ??", "ERR WHAT", b"\xff\xfe", "OK", "hello world", "EVT FIRE"]:
+    for junk in [
+        "OK GET 1 2",
+        "OK GET 12.0 x7 ??",
+        "ERR WHAT",
+        b"\xff\xfe",
+        "OK",
+        "hello world",
+        "EVT FIRE",
+    ]:
         assert parse_reply(junk) is None
 
 
 def test_firmware_files_are_micropython_portable():
-    """rigcore imports nothing; main.py imports only MicroPython modules and rigcore; both compile."""
+    """rigcore imports nothing; main.py imports only MicroPython modules and rigcore; both
+    compile."""
     core = ast.parse((FIRMWARE_DIR / "rigcore.py").read_text())
     assert not [n for n in ast.walk(core) if isinstance(n, (ast.Import, ast.ImportFrom))]
     assert not [n for n in ast.walk(core) if isinstance(n, ast.JoinedStr)]  # no f-strings

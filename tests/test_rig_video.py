@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.photoset import validate_photoset
+from pipeline.photoset_check import check_photoset
 from pipeline.photoset_measure import measure_photoset
 from pipeline.rig.emulator import Emulator, Faults, PlantParams
 
@@ -17,10 +17,40 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def video_cmd(port: str, out: Path, *extra: str, trials: int = 1) -> list[str]:
-    return [sys.executable, "-m", "pipeline", "acquire", "--record", "video", "--port", port, "--camera", "synthetic",
-            "--material", "SS40", "--actuator", "A1", "--trials", str(trials), "--max-kpa", "40", "--rate-kpa-s", "80",
-            "--rest-s", "0.2", "--fps", "10", "--log-hz", "20", "--video-size", "160x120", "--out", str(out),
-            "--no-progress", *extra]
+    return [
+        sys.executable,
+        "-m",
+        "pipeline",
+        "acquire",
+        "--record",
+        "video",
+        "--port",
+        port,
+        "--camera",
+        "synthetic",
+        "--material",
+        "SS40",
+        "--actuator",
+        "A1",
+        "--trials",
+        str(trials),
+        "--max-kpa",
+        "40",
+        "--rate-kpa-s",
+        "80",
+        "--rest-s",
+        "0.2",
+        "--fps",
+        "10",
+        "--log-hz",
+        "20",
+        "--video-size",
+        "160x120",
+        "--out",
+        str(out),
+        "--no-progress",
+        *extra,
+    ]
 
 
 def run(cmd: list[str]) -> subprocess.CompletedProcess[str]:
@@ -40,20 +70,28 @@ def test_a_continuous_ramp_is_recorded_as_a_video_photo_set_and_resumed(tmp_path
         again = run(video_cmd(emu.port, out, trials=2))  # trial 1 is kept, trial 2 recorded
         assert again.returncode == 0, again.stderr
     assert "1 trial(s) already recorded" in again.stdout
-    assert validate_photoset(out) == []
+    assert check_photoset(out) == []
     m = pd.read_csv(out / "manifest.csv")
     assert list(m["trial"]) == [1, 2] and (m["clock_offset_s"] == 0).all()
     log = pd.read_csv(out / m["pressure_log"].iloc[0])
     frames = pd.read_csv(out / m["frame_times"].iloc[0])
-    assert log["time_s"].iloc[0] < frames["time_s"].iloc[0] and frames["time_s"].iloc[-1] < log["time_s"].iloc[-1]
+    assert (
+        log["time_s"].iloc[0] < frames["time_s"].iloc[0]
+        and frames["time_s"].iloc[-1] < log["time_s"].iloc[-1]
+    )
     assert np.allclose(np.diff(frames["time_s"]).mean(), 0.1, atol=0.03)
     angles = measure_photoset(out)
     first = angles[angles["trial"].astype(str) == "1"]
     assert (first["status"] == "ok").mean() > 0.9
-    assert np.allclose(first["time_s"], frames["time_s"])  # the recorder's stamps, on the log's clock
+    # the recorder's stamps, on the log's clock
+    assert np.allclose(first["time_s"], frames["time_s"])
     peak = int(first["measured_pressure_kpa"].idxmax())
-    assert first.loc[:peak, "direction"].iloc[:-2].eq("up").all() and first.loc[peak + 3:, "direction"].eq("down").all()
-    assert first["psi_deg"].iloc[0] > first["psi_deg"].min() + 10  # bent by the pressure, back at rest later
+    assert (
+        first.loc[:peak, "direction"].iloc[:-2].eq("up").all()
+        and first.loc[peak + 3 :, "direction"].eq("down").all()
+    )
+    # bent by the pressure, back at rest later
+    assert first["psi_deg"].iloc[0] > first["psi_deg"].min() + 10
     assert 30 < first["measured_pressure_kpa"].max() < 41
 
 
@@ -68,18 +106,36 @@ def test_an_estop_vents_keeps_the_interrupted_recording_and_a_rerun_records_the_
         assert "re-run the same command to record trial 1 again" in stopped.stderr
         assert not (out / "manifest.csv").exists()
         kept = sorted(p.name for p in out.glob("*.interrupted.*"))
-        assert kept == ["SS40_A1_t1_ramp.avi.interrupted.avi", "SS40_A1_t1_ramp_frames.csv.interrupted.csv",
-                        "SS40_A1_t1_ramp_pressure.csv.interrupted.csv"]
+        assert kept == [
+            "SS40_A1_t1_ramp.avi.interrupted.avi",
+            "SS40_A1_t1_ramp_frames.csv.interrupted.csv",
+            "SS40_A1_t1_ramp_pressure.csv.interrupted.csv",
+        ]
         emu.release_estop()
         resumed = run(video_cmd(str(link), out))
         assert resumed.returncode == 0, resumed.stderr
-    assert len(pd.read_csv(out / "manifest.csv")) == 1 and validate_photoset(out) == []
+    assert len(pd.read_csv(out / "manifest.csv")) == 1 and check_photoset(out) == []
 
 
 def test_dry_run_and_cameras_that_cannot_record_video(tmp_path):
-    plan = run(video_cmd("-", tmp_path / "rec", "--dry-run", "--profile", "steps", "--step-kpa", "20", "--hold-s", "2"))
+    plan = run(
+        video_cmd(
+            "-",
+            tmp_path / "rec",
+            "--dry-run",
+            "--profile",
+            "steps",
+            "--step-kpa",
+            "20",
+            "--hold-s",
+            "2",
+        )
+    )
     assert plan.returncode == 0, plan.stderr
-    assert "steps of 20 kPa to 40 kPa and back, 2 s each" in plan.stdout and "to do: trials [1]" in plan.stdout
+    assert (
+        "steps of 20 kPa to 40 kPa and back, 2 s each" in plan.stdout
+        and "to do: trials [1]" in plan.stdout
+    )
     with Emulator() as emu:
         cmd = video_cmd(emu.port, tmp_path / "rec")
         cmd[cmd.index("synthetic")] = "dir:/tmp"

@@ -1,11 +1,11 @@
-"""Settings are parsed once into MeasureSettings; colours; a bad row is a failed row, not a refused set."""
+"""Settings are parsed once into MeasureSettings; colours; a bad row is a failed row, not a refused
+set."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 
-import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -23,8 +23,25 @@ L0_MM = 180.0
 # colours
 
 
-@pytest.mark.parametrize("name", ["black", "white", "grey", "gray", "red", "orange", "yellow", "green", "cyan", "blue",
-                                  "purple", "magenta", "pink", "violet"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "black",
+        "white",
+        "grey",
+        "gray",
+        "red",
+        "orange",
+        "yellow",
+        "green",
+        "cyan",
+        "blue",
+        "purple",
+        "magenta",
+        "pink",
+        "violet",
+    ],
+)
 def test_every_colour_name_parses(name):
     spec = parse_color(name)
     assert spec.ranges and spec.describe().startswith(spec.text)
@@ -35,7 +52,8 @@ def test_only_the_name_black_is_the_dark_line_filter():
     # an explicit range that bounds only the value means exactly that range
     spec = parse_color("0,0,0-179,255,60")
     assert not spec.dark_line
-    img = np.full((10, 10, 3), 70, np.uint8)  # V = 70: inside 'black' (V <= 80) but not inside V <= 60
+    # V = 70: inside 'black' (V <= 80) but not inside V <= 60
+    img = np.full((10, 10, 3), 70, np.uint8)
     assert color_mask(img, spec).sum() == 0
 
 
@@ -52,7 +70,9 @@ def test_colours_are_described_in_words():
     assert "H 0-10 or 170-179" in parse_color("red").describe()
 
 
-@pytest.mark.parametrize("bgr, wraps", [((40, 40, 200), True), ((200, 120, 40), False), ((128, 128, 128), False)])
+@pytest.mark.parametrize(
+    "bgr, wraps", [((40, 40, 200), True), ((200, 120, 40), False), ((128, 128, 128), False)]
+)
 def test_pick_color_selects_what_was_picked(bgr, wraps):
     img = np.zeros((60, 60, 3), np.uint8)
     img[20:40, 20:40] = bgr
@@ -72,20 +92,36 @@ def test_pick_color_outside_the_image_is_refused():
 
 
 def test_resolved_settings_are_typed():
-    s = resolve_settings(l0_mm="210", mm_per_px=0.2, fixed_end=[np.int64(3), 4.5], roi=[0, 0, 100, 50],
-                         exclude=[[[0, 0], [10, 0], [10, 10]]], fixed_direction_deg="90", target="body", line_color="white")
+    s = resolve_settings(
+        l0_mm="210",
+        mm_per_px=0.2,
+        fixed_end=[np.int64(3), 4.5],
+        roi=[0, 0, 100, 50],
+        exclude=[[[0, 0], [10, 0], [10, 10]]],
+        fixed_direction_deg="90",
+        target="body",
+        line_color="white",
+    )
     assert s.l0_mm == 210.0 and s.fixed_end_px == (3.0, 4.5) and s.fixed_direction_deg == 90.0
     assert len(s.roi) == 4 and len(s.exclude) == 1 and s.color == parse_color("white")
     assert resolve_settings(l0_mm=1, target="body").color is None  # a body needs no colour
     assert resolve_settings(l0_mm=1).color == parse_color("black")  # a line is black by default
 
 
-@pytest.mark.parametrize("raw, key", [
-    ({"l0_mm": 0}, "l0_mm"), ({}, "l0_mm"), ({"l0_mm": 1, "target": "tip"}, "target"),
-    ({"l0_mm": 1, "roi": [5, 5, 1, 1]}, "roi"), ({"l0_mm": 1, "exclude": [[[0, 0], [1, 1]]]}, "exclude"),
-    ({"l0_mm": 1, "fixed_direction_deg": "left"}, "fixed_direction_deg"), ({"l0_mm": 1, "fixed_end": "near"}, "fixed_end"),
-    ({"l0_mm": 1, "positive_turn": "left"}, "positive_turn"), ({"l0_mm": 1, "background": "nope.jpg"}, "background"),
-])
+@pytest.mark.parametrize(
+    "raw, key",
+    [
+        ({"l0_mm": 0}, "l0_mm"),
+        ({}, "l0_mm"),
+        ({"l0_mm": 1, "target": "tip"}, "target"),
+        ({"l0_mm": 1, "roi": [5, 5, 1, 1]}, "roi"),
+        ({"l0_mm": 1, "exclude": [[[0, 0], [1, 1]]]}, "exclude"),
+        ({"l0_mm": 1, "fixed_direction_deg": "left"}, "fixed_direction_deg"),
+        ({"l0_mm": 1, "fixed_end": "near"}, "fixed_end"),
+        ({"l0_mm": 1, "positive_turn": "left"}, "positive_turn"),
+        ({"l0_mm": 1, "background": "nope.jpg"}, "background"),
+    ],
+)
 def test_bad_settings_name_the_key_and_the_fix(raw, key, tmp_path):
     settings, problems = settings_problems(raw, folder=tmp_path)
     assert settings is None and [p.key for p in problems] == [key] and problems[0].fix
@@ -96,7 +132,11 @@ def test_bad_settings_name_the_key_and_the_fix(raw, key, tmp_path):
 def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
     from pipeline import photoset_init
 
-    photoset_init.init_photoset(photo_folder, "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", settings={"l0_mm": 210.0})
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0},
+    )
     calls = {"yaml": 0, "csv": 0}
     real_yaml, real_csv = ps.yaml.safe_load, ps.pd.read_csv
 
@@ -117,7 +157,11 @@ def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
 def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folder):
     from pipeline import photoset_init
 
-    photoset_init.init_photoset(photo_folder, "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", settings={"l0_mm": 210.0})
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0},
+    )
     m = pd.read_csv(photo_folder / "manifest.csv")
     m["roi"] = ["[5000, 5000, 6000, 6000]"] + [""] * (len(m) - 1)
     m["exclude"] = [""] * (len(m) - 1) + ["[[[0, 0], [5, 5]]]"]
@@ -140,8 +184,19 @@ def small_set(tmp_path_factory):
         r = render_actuator(float(psi), L0_MM, scene, seed=i)
         name = f"p{i}.jpg"
         (folder / name).write_bytes(r.jpeg_bytes)
-        rows.append({"image": name, "pressure_kpa": 10.0 * i, "direction": "up", "material": "DS20", "actuator": "A1",
-                     "trial": "1", "step": i, "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+        rows.append(
+            {
+                "image": name,
+                "pressure_kpa": 10.0 * i,
+                "direction": "up",
+                "material": "DS20",
+                "actuator": "A1",
+                "trial": "1",
+                "step": i,
+                "fixed_end_x": r.fixed_end_px[0],
+                "fixed_end_y": r.fixed_end_px[1],
+            }
+        )
     ps.write_manifest(folder, pd.DataFrame(rows))
     ps.write_settings(folder, {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px, "line_color": "black"})
     return folder
@@ -169,7 +224,11 @@ def test_each_kind_of_bad_row_fails_alone_and_the_rest_is_measured(small_set, tm
     m = pd.concat([m, m.iloc[[0]]], ignore_index=True)  # a duplicated row
     m.to_csv(folder / "manifest.csv", index=False)
     # photoset check stays strict and names every row
-    check = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(folder)], capture_output=True, text=True)
+    check = subprocess.run(
+        [sys.executable, "-m", "pipeline", "photoset", "check", str(folder)],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert check.returncode == 1
     for _, message in BAD_ROWS.values():
         assert message in check.stderr
@@ -178,7 +237,10 @@ def test_each_kind_of_bad_row_fails_alone_and_the_rest_is_measured(small_set, tm
     failed = set(angles.index[angles["status"] == "failed"])
     assert failed == {1, 2, 3, 4, 6, 9}, angles[["image", "status", "reason"]]
     for i, (_, message) in enumerate(BAD_ROWS.values(), start=1):
-        assert message in angles.loc[i, "reason"] and f"manifest line {i + 2}" in angles.loc[i, "reason"]
+        assert (
+            message in angles.loc[i, "reason"]
+            and f"manifest line {i + 2}" in angles.loc[i, "reason"]
+        )
     assert "vacuum" in angles.loc[6, "reason"] and "twice" in angles.loc[9, "reason"]
     assert (angles.loc[[0, 5, 7, 8], "status"] == "ok").all()
     assert angles.loc[7, "pressure_kpa"] == -40.0

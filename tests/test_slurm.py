@@ -22,7 +22,9 @@ from pipeline.cluster import SLURM_SETTINGS, slurm_problems
 
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 PROFILE = "rules/profiles/slurm"
-NO_SBATCH_ENV = {k: v for k, v in os.environ.items() if k not in ("SBATCH_ACCOUNT", "SBATCH_PARTITION")}
+NO_SBATCH_ENV = {
+    k: v for k, v in os.environ.items() if k not in ("SBATCH_ACCOUNT", "SBATCH_PARTITION")
+}
 
 
 def _tiny_config(repo: Path) -> dict:
@@ -33,14 +35,31 @@ def _tiny_config(repo: Path) -> dict:
     """
     return {
         "datasets": [
-            {"name": "tiny", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1,
-             "step_kpa": 60, "max_kpa": 240, "scene": "clean", "scene_set": {"width": 480, "height": 360}},
+            {
+                "name": "tiny",
+                "source": "synthetic",
+                "material": "SS50",
+                "actuators": 1,
+                "trials": 1,
+                "step_kpa": 60,
+                "max_kpa": 240,
+                "scene": "clean",
+                "scene_set": {"width": 480, "height": 360},
+            },
         ],
         "compare": {"bootstrap": 20},
         "bench": {"in_report": False},
         "force": {
-            "datasets": [{"name": "force_SS50", "source": "synthetic", "material": "SS50", "trials": 1,
-                          "step_kpa": 60, "seed": 50}],
+            "datasets": [
+                {
+                    "name": "force_SS50",
+                    "source": "synthetic",
+                    "material": "SS50",
+                    "trials": 1,
+                    "step_kpa": 60,
+                    "seed": 50,
+                }
+            ],
             "grasp_log": str(repo / "pipeline" / "force" / "data" / "grasp_example.csv"),
         },
     }
@@ -49,7 +68,7 @@ def _tiny_config(repo: Path) -> dict:
 def _snakemake(workdir: Path, repo: Path, *args: str, env=None, **kw):
     return subprocess.run(
         [*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(workdir), *args],
-        capture_output=True, text=True, env=env, **kw,
+        capture_output=True, text=True, env=env, **kw, check=False,
     )
 
 
@@ -99,7 +118,9 @@ def test_profile_polls_soon_keeps_logs_and_shows_failures(repo):
 
 def test_slurm_extra_installs_the_plugin_and_the_readme_uses_it(repo):
     tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
-    extras = tomllib.loads((repo / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    extras = tomllib.loads((repo / "pyproject.toml").read_text())["project"][
+        "optional-dependencies"
+    ]
     assert any(req.startswith("snakemake-executor-plugin-slurm") for req in extras["slurm"])
     assert any(req.endswith("[slurm]") for req in extras["test"])
     readme = (repo / "README.md").read_text()
@@ -116,18 +137,25 @@ def _cluster_problem() -> str | None:
     if shutil.which("sinfo") is None:
         return "no SLURM client (sinfo) on PATH"
     try:
-        out = subprocess.run(["sinfo", "-h", "-o", "%T"], capture_output=True, text=True, timeout=30)
+        out = subprocess.run(
+            ["sinfo", "-h", "-o", "%T"], capture_output=True, text=True, timeout=30, check=False
+        )
     except subprocess.TimeoutExpired:
         return "sinfo did not answer within 30 s"
     states = out.stdout.split()
-    if out.returncode != 0 or not any(s.rstrip("*~#") in ("idle", "mixed", "allocated", "completing") for s in states):
-        return f"no SLURM node is up (sinfo: {(out.stdout + out.stderr).strip()[:300] or 'no nodes'})"
+    if out.returncode != 0 or not any(
+        s.rstrip("*~#") in ("idle", "mixed", "allocated", "completing") for s in states
+    ):
+        return (
+            f"no SLURM node is up (sinfo: {(out.stdout + out.stderr).strip()[:300] or 'no nodes'})"
+        )
     return None
 
 
 @pytest.fixture(scope="module")
 def slurm_env() -> dict[str, str]:
-    """Environment for a run on the cluster; skips (fails under PIPELINE_REQUIRE_SLURM=1) without one."""
+    """Environment for a run on the cluster; skips (fails under PIPELINE_REQUIRE_SLURM=1) without
+    one."""
     problem = _cluster_problem()
     if problem:
         message = f"{problem}; start a single-node cluster with .ci/slurm-up"
@@ -169,8 +197,19 @@ def test_workflow_on_slurm_gives_the_same_report_as_the_local_run(repo, tmp_path
         (d / "config.yaml").write_text(cfg)
     log = (cluster / "snakemake.out").open("w+")
     slurm_run = subprocess.Popen(
-        [*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(cluster), "--profile", str(repo / PROFILE)],
-        stdout=log, stderr=subprocess.STDOUT, text=True, env=slurm_env,
+        [
+            *SNAKEMAKE,
+            "-s",
+            str(repo / "Snakefile"),
+            "--directory",
+            str(cluster),
+            "--profile",
+            str(repo / PROFILE),
+        ],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env=slurm_env,
     )
     try:
         local_run = _snakemake(local, repo, "--cores", "2")
@@ -185,15 +224,28 @@ def test_workflow_on_slurm_gives_the_same_report_as_the_local_run(repo, tmp_path
     assert slurm_run.returncode == 0, output[-5000:]
 
     # the same bytes where the inputs are the same
-    assert (cluster / "results/report.pdf").read_bytes() == (local / "results/report.pdf").read_bytes()
+    assert (cluster / "results/report.pdf").read_bytes() == (
+        local / "results/report.pdf"
+    ).read_bytes()
     for table in ("rms.csv", "force/force_summary.csv", "datasets/tiny/hysteresis.csv"):
-        assert (cluster / "results" / table).read_bytes() == (local / "results" / table).read_bytes(), table
+        assert (cluster / "results" / table).read_bytes() == (
+            local / "results" / table
+        ).read_bytes(), table
 
     # every rule ran as a SLURM job of the profile's account and partition, threads -> CPUs
     jobs = _slurm_jobs(output)
     assert {_rule(j) for j in jobs} == {
-        "synth_photoset", "measure", "aggregate", "model_curve", "compare", "resolved_config", "report",
-        "force_synth_photoset", "force_measure", "force_aggregate", "force_grasp",
+        "synth_photoset",
+        "measure",
+        "aggregate",
+        "model_curve",
+        "compare",
+        "resolved_config",
+        "report",
+        "force_synth_photoset",
+        "force_measure",
+        "force_aggregate",
+        "force_grasp",
     }
     assert all(j["state"] == "COMPLETED" for j in jobs), jobs
     assert {(j["account"], j["partition"]) for j in jobs} == {

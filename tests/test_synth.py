@@ -1,4 +1,5 @@
-"""Tests of the synthetic renderer (pipeline.synth): exact truth, protocol, hysteresis, determinism."""
+"""Tests of the synthetic renderer (pipeline.synth): exact truth, protocol, hysteresis,
+determinism."""
 
 from __future__ import annotations
 
@@ -93,7 +94,9 @@ def test_centreline_rejects_bad_input(kwargs):
 
 @pytest.mark.parametrize("psi", [-360.0, -210.0, -45.0, 0.0, 30.0, 210.0, 360.0])
 def test_rendered_centreline_matches_truth(psi):
-    r = render_actuator(psi, 195.0, scene_from("clean", **SMALL), seed=1, bulge=0.2 if psi < 0 else 0.0)
+    r = render_actuator(
+        psi, 195.0, scene_from("clean", **SMALL), seed=1, bulge=0.2 if psi < 0 else 0.0
+    )
     assert psi_from_points(r.centreline_px, y_down=True) == pytest.approx(psi, abs=0.05)
     assert r.psi_image_deg == pytest.approx(psi, abs=0.05)
     assert r.line_in_frame
@@ -114,8 +117,15 @@ def test_positive_psi_turns_counter_clockwise_on_screen():
 
 
 def test_drawn_line_is_centred_on_the_truth():
-    scene = scene_from("clean", width=640, height=480, body_translucency=1.0, clamp=False, tube=False,
-                       line_width_px=5.0)
+    scene = scene_from(
+        "clean",
+        width=640,
+        height=480,
+        body_translucency=1.0,
+        clamp=False,
+        tube=False,
+        line_width_px=5.0,
+    )
     for psi in (-250.0, 75.0):
         r = render_actuator(psi, 195.0, scene, seed=3)
         grey = r.image[..., 1].astype(float)
@@ -138,7 +148,9 @@ def test_drawn_line_is_centred_on_the_truth():
 @pytest.mark.parametrize("colour", ["black", "blue", "red", "green"])
 @pytest.mark.parametrize("preset", ["clean", "lab"])
 def test_line_colour_is_inside_the_photoset_hsv_range(colour, preset):
-    r = render_actuator(120.0, 195.0, scene_from(preset, line_color=colour, line_width_px=5.0, **SMALL), seed=4)
+    r = render_actuator(
+        120.0, 195.0, scene_from(preset, line_color=colour, line_width_px=5.0, **SMALL), seed=4
+    )
     hsv = cv2.cvtColor(r.image, cv2.COLOR_BGR2HSV)
     mask = np.zeros(hsv.shape[:2], np.uint8)
     for lo, hi in parse_color(colour).ranges:
@@ -158,14 +170,23 @@ def test_render_curve_accepts_any_curve_and_is_deterministic():
     c = render_curve(ellipse, scene, seed=8, fixed_end_px=(200.0, 300.0), rotation_deg=90.0)
     assert a.fixed_end_px == pytest.approx((200.0, 300.0), abs=1e-6)
     assert a.jpeg_bytes == b.jpeg_bytes and a.jpeg_bytes != c.jpeg_bytes
-    assert cv2.imdecode(np.frombuffer(a.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR).shape == (360, 480, 3)
+    assert cv2.imdecode(np.frombuffer(a.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR).shape == (
+        360,
+        480,
+        3,
+    )
 
 
 def test_scene_from_overrides_and_errors():
     s = scene_from("lab", width="640", height=480, noise_sigma="4", clamp="false")
     assert (s.width, s.noise_sigma, s.clamp) == (640, 4.0, False)
     assert s.mm_per_px == pytest.approx(SCENE_PRESETS["lab"].mm_per_px * 2)
-    for bad in ({"nope": 1}, {"noise_sigma": "x"}, {"line_contrast": 2.0}, {"line_color": "purple"}):
+    for bad in (
+        {"nope": 1},
+        {"noise_sigma": "x"},
+        {"line_contrast": 2.0},
+        {"line_color": "purple"},
+    ):
         with pytest.raises(UserInputError):
             scene_from("lab", **bad)
     with pytest.raises(UserInputError):
@@ -177,8 +198,13 @@ def test_scene_from_overrides_and_errors():
 
 def trial_of(material="DS20", psi_fn=toy_psi, **kw) -> TrialActuator:
     curve = loading_curve(material, max_kpa=500, psi_fn=psi_fn)
-    return TrialActuator(material, curve, psi0_deg=kw.get("psi0", 210.0), stiffness=kw.get("k", 1.0),
-                         behaviour=behaviour_for(material))
+    return TrialActuator(
+        material,
+        curve,
+        psi0_deg=kw.get("psi0", 210.0),
+        stiffness=kw.get("k", 1.0),
+        behaviour=behaviour_for(material),
+    )
 
 
 def test_ramp_stops_at_minus_psi0_then_returns():
@@ -194,13 +220,17 @@ def test_ramp_stops_at_minus_psi0_then_returns():
 
 
 def test_ramp_stops_at_max_pressure_including_a_partial_last_step():
-    trial = trial_of("SS50", psi_fn=lambda m, p, branch="loading": 210.0 - 0.2 * np.asarray(p, float))
+    trial = trial_of(
+        "SS50", psi_fn=lambda m, p, branch="loading": 210.0 - 0.2 * np.asarray(p, float)
+    )
     up, reason = ramp_pressures(trial, step_kpa=30, max_kpa=100)
     assert reason == "max_pressure" and up.tolist() == [0, 30, 60, 90, 100]
 
 
 def test_ramp_stops_where_the_model_ends():
-    nan_tail = lambda m, p, branch="loading": np.where(np.asarray(p) > 45, np.nan, 210.0 - np.asarray(p, float))
+    nan_tail = lambda m, p, branch="loading": np.where(
+        np.asarray(p) > 45, np.nan, 210.0 - np.asarray(p, float)
+    )
     up, reason = ramp_pressures(trial_of(psi_fn=nan_tail), step_kpa=10, max_kpa=260)
     assert reason == "model_limit" and up.tolist() == [0, 10, 20, 30, 40]
 
@@ -208,18 +238,27 @@ def test_ramp_stops_where_the_model_ends():
 @pytest.mark.parametrize("material", sorted(BEHAVIOURS))
 def test_unloading_needs_less_pressure_for_the_same_angle(material):
     trial = trial_of(material)
-    ramp = plan_ramp(trial, step_kpa=10, max_kpa=260, rng=np.random.default_rng(0), photo_noise=False)
+    ramp = plan_ramp(
+        trial, step_kpa=10, max_kpa=260, rng=np.random.default_rng(0), photo_noise=False
+    )
     up = ramp[ramp.direction == "up"].set_index("pressure_kpa")["psi_deg"]
     down = ramp[ramp.direction == "down"].set_index("pressure_kpa")["psi_deg"]
     inner = down.index[(down.index > 0)]
-    assert (down[inner] < up[inner]).all()  # smaller angle at the same pressure = less pressure for the angle
+    # smaller angle at the same pressure = less pressure for the angle
+    assert (down[inner] < up[inner]).all()
     assert down[0.0] == pytest.approx(up[0.0])
 
 
 def test_softer_silicones_show_more_hysteresis():
     widths = {}
     for material in ("DS20", "SS50"):
-        ramp = plan_ramp(trial_of(material), step_kpa=10, max_kpa=260, rng=np.random.default_rng(0), photo_noise=False)
+        ramp = plan_ramp(
+            trial_of(material),
+            step_kpa=10,
+            max_kpa=260,
+            rng=np.random.default_rng(0),
+            photo_noise=False,
+        )
         up = ramp[ramp.direction == "up"].set_index("pressure_kpa")["psi_deg"]
         down = ramp[ramp.direction == "down"].set_index("pressure_kpa")["psi_deg"]
         widths[material] = float((up[down.index] - down).abs().mean())
@@ -227,7 +266,9 @@ def test_softer_silicones_show_more_hysteresis():
 
 
 def test_bulge_only_past_zero_and_only_for_soft_silicones():
-    assert trial_of("DS20").bulge([100.0, 0.0, -105.0, -210.0]).tolist() == pytest.approx([0, 0, 0.175, 0.35])
+    assert trial_of("DS20").bulge([100.0, 0.0, -105.0, -210.0]).tolist() == pytest.approx(
+        [0, 0, 0.175, 0.35]
+    )
     assert trial_of("SS50").bulge([-210.0]).tolist() == [0.0]
 
 
@@ -235,7 +276,15 @@ def test_bulge_only_past_zero_and_only_for_soft_silicones():
 
 
 def small_set(tmp_path: Path, name: str, **kw) -> tuple[Path, pd.DataFrame]:
-    args = {"actuators": 2, "trials": 2, "seed": 5, "scene": "lab", "step_kpa": 40, "scene_overrides": SMALL, "psi_fn": toy_psi}
+    args = {
+        "actuators": 2,
+        "trials": 2,
+        "seed": 5,
+        "scene": "lab",
+        "step_kpa": 40,
+        "scene_overrides": SMALL,
+        "psi_fn": toy_psi,
+    }
     args.update(kw)
     out = tmp_path / name
     return out, render_photoset(out, "DS20", **args)
@@ -249,10 +298,21 @@ def test_photoset_is_valid_and_consistent_with_truth(tmp_path):
     assert list(ps.manifest["image"]) == list(truth["image"])
     assert truth["line_in_frame"].all()
     assert (truth["psi_deg"] - truth["psi_image_deg"]).abs().max() < 0.6  # 1 deg camera tilt
-    assert {"material", "actuator", "trial", "pressure_kpa", "direction", "bulge", "scene", "noise_sigma"} <= set(truth)
+    assert {
+        "material",
+        "actuator",
+        "trial",
+        "pressure_kpa",
+        "direction",
+        "bulge",
+        "scene",
+        "noise_sigma",
+    } <= set(truth)
     saved = pd.read_csv(out / "truth.csv")
     assert np.allclose(saved["psi_deg"], truth["psi_deg"], rtol=1e-5)
-    assert ps.settings["fixed_end"] == pytest.approx([truth["fixed_end_x"][0], truth["fixed_end_y"][0]], abs=0.01)
+    assert ps.settings["fixed_end"] == pytest.approx(
+        [truth["fixed_end_x"][0], truth["fixed_end_y"][0]], abs=0.01
+    )
     img = cv2.imread(str(out / truth["image"][0]))
     assert img.shape == (360, 480, 3)
 
@@ -279,8 +339,26 @@ def test_cli_writes_a_photoset_and_rejects_bad_keys(tmp_path, capsys):
     from pipeline.cli import main
 
     out = tmp_path / "cli"
-    rc = main(["synth", str(out), "--material", "SS50", "--actuators", "1", "--trials", "1", "--step-kpa", "130",
-               "--set", "width=320", "--set", "height=240", "--scene", "clean"])
+    rc = main(
+        [
+            "synth",
+            str(out),
+            "--material",
+            "SS50",
+            "--actuators",
+            "1",
+            "--trials",
+            "1",
+            "--step-kpa",
+            "130",
+            "--set",
+            "width=320",
+            "--set",
+            "height=240",
+            "--scene",
+            "clean",
+        ]
+    )
     assert rc == 0 and "images of SS50" in capsys.readouterr().out
     assert validate_photoset(out) == []
     assert main(["synth", str(out), "--material", "SS50", "--set", "colour=red"]) == 2
@@ -290,14 +368,48 @@ def test_cli_writes_a_photoset_and_rejects_bad_keys(tmp_path, capsys):
 def test_ctrl_c_mid_synth_leaves_no_partial_set_and_keeps_the_previous_one(tmp_path):
     """SIGINT to the process group (Ctrl-C in a terminal) while `synth` renders with two workers."""
     out = tmp_path / "set"
-    cmd = [sys.executable, "-m", "pipeline", "synth", str(out), "--material", "SS50", "--actuators", "2",
-           "--trials", "1", "--step-kpa", "20", "--scene", "clean", "--set", "width=320", "--set", "height=240",
-           "--jobs", "2"]
-    render_photoset(out, "SS50", actuators=1, trials=1, step_kpa=130, scene="clean", scene_overrides=SMALL,
-                    psi_fn=toy_psi)  # a previous set in the same place
+    cmd = [
+        sys.executable,
+        "-m",
+        "pipeline",
+        "synth",
+        str(out),
+        "--material",
+        "SS50",
+        "--actuators",
+        "2",
+        "--trials",
+        "1",
+        "--step-kpa",
+        "20",
+        "--scene",
+        "clean",
+        "--set",
+        "width=320",
+        "--set",
+        "height=240",
+        "--jobs",
+        "2",
+    ]
+    render_photoset(
+        out,
+        "SS50",
+        actuators=1,
+        trials=1,
+        step_kpa=130,
+        scene="clean",
+        scene_overrides=SMALL,
+        psi_fn=toy_psi,
+    )  # a previous set in the same place
     previous = sha(out)
-    proc = subprocess.Popen(cmd, cwd=REPO, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+    proc = subprocess.Popen(
+        cmd,
+        cwd=REPO,
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     partial = tmp_path / ".set.partial"
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not (partial.is_dir() and any(partial.glob("*.jpg"))):
@@ -316,5 +428,8 @@ def test_committed_sample_images():
     truth = pd.read_csv(folder / "truth.csv", dtype={"trial": str})
     manifest = load_photoset(folder).manifest
     assert list(truth["image"]) == list(manifest["image"])
-    assert truth["scene"].eq("lab").all() and truth["psi_deg"].min() < -150 < 150 < truth["psi_deg"].max()
+    assert (
+        truth["scene"].eq("lab").all()
+        and truth["psi_deg"].min() < -150 < 150 < truth["psi_deg"].max()
+    )
     assert sum(p.stat().st_size for p in folder.iterdir()) < 5 * 2**20

@@ -17,7 +17,11 @@ from pipeline.errors import UserInputError
 from pipeline.measure.colors import parse_color
 from pipeline.photoset import load_photoset, validate_photoset
 from pipeline.synth import make_backdrop, make_camera, render_actuator, render_curve, scene_from
-from pipeline.synth.centreline import actuator_centreline_mm, curvature_weights, peak_curvature_per_mm
+from pipeline.synth.centreline import (
+    actuator_centreline_mm,
+    curvature_weights,
+    peak_curvature_per_mm,
+)
 from pipeline.synth.photoset_writer import BACKGROUND_IMAGE, render_photoset
 from pipeline.synth.scene import render_background, world_extent_mm
 
@@ -41,11 +45,17 @@ def psi_from_points(points: np.ndarray, y_down: bool) -> float:
     return -turn if y_down else turn
 
 
-def render_with_empty(preset: str, psi: float, *, rotation: float = 25.0, seed: int = 3, **overrides):
+def render_with_empty(
+    preset: str, psi: float, *, rotation: float = 25.0, seed: int = 3, **overrides
+):
     """A photo and the same scene without the actuator (one backdrop, no noise)."""
     scene = scene_from(preset, **{**VIEW, "noise_sigma": 0.0, **overrides})
     pts = actuator_centreline_mm(psi, L0, scene)
-    camera = make_camera(scene, rotation_deg=rotation, extent_mm=world_extent_mm(pts, scene.body_width_mm, scene.tip_cap_mm))
+    camera = make_camera(
+        scene,
+        rotation_deg=rotation,
+        extent_mm=world_extent_mm(pts, scene.body_width_mm, scene.tip_cap_mm),
+    )
     backdrop = make_backdrop(scene, camera, seed=seed, keepout_mm=[pts])
     r = render_curve(pts, scene, seed=seed + 1, backdrop=backdrop)
     return scene, r, render_background(backdrop, scene, seed=0)
@@ -57,8 +67,11 @@ def normals_px(curve: np.ndarray) -> np.ndarray:
     return np.column_stack([-t[:, 1], t[:, 0]])
 
 
-def edges_across(mask: np.ndarray, curve: np.ndarray, half_px: float, fractions: np.ndarray) -> np.ndarray:
-    """For points of ``curve`` at ``fractions`` of its samples: the two edges of ``mask`` along the normal.
+def edges_across(
+    mask: np.ndarray, curve: np.ndarray, half_px: float, fractions: np.ndarray
+) -> np.ndarray:
+    """For points of ``curve`` at ``fractions`` of its samples: the two edges of ``mask`` along the
+    normal.
 
     Returns (k, 2) offsets (px, along the normal) of the last masked sample on each side of the
     curve, walking out from it (bilinear mask >= 0.5).
@@ -68,7 +81,10 @@ def edges_across(mask: np.ndarray, curve: np.ndarray, half_px: float, fractions:
     offs = np.arange(-1.6 * half_px, 1.6 * half_px + 1e-9, 0.05)
     xs = c[:, None, 0] + offs[None, :] * n[:, None, 0]
     ys = c[:, None, 1] + offs[None, :] * n[:, None, 1]
-    inside = map_coordinates(mask.astype(float), [ys.ravel(), xs.ravel()], order=1).reshape(xs.shape) >= 0.5
+    inside = (
+        map_coordinates(mask.astype(float), [ys.ravel(), xs.ravel()], order=1).reshape(xs.shape)
+        >= 0.5
+    )
     zero = np.argmin(np.abs(offs))
     out = []
     for row in inside:
@@ -89,7 +105,8 @@ def edges_across(mask: np.ndarray, curve: np.ndarray, half_px: float, fractions:
 @pytest.mark.parametrize("psi", [-200.0, -60.0, 0.0, 90.0, 180.0])
 @pytest.mark.parametrize("preset", BODY_PRESETS)
 def test_truth_is_the_centre_line_of_the_drawn_body_and_turns_through_psi(preset, psi):
-    # a black table so that every part of the body differs from the empty scene (a translucent body's
+    # a black table so that every part of the body differs from the empty scene (a translucent
+    # body's
     # shaded edge can match a grey backdrop: realistic, but this test is about geometry)
     scene, r, empty = render_with_empty(preset, psi, tilt_deg=0.0, shadow=0.0, table_bgr="black")
     assert r.target == "body"
@@ -99,10 +116,12 @@ def test_truth_is_the_centre_line_of_the_drawn_body_and_turns_through_psi(preset
     # ... and it runs midway between the two long edges of what was drawn (the outline mask)
     mask = np.abs(r.image.astype(np.int16) - empty.astype(np.int16)).max(axis=2) > 6
     half = scene.body_width_mm / 2 / scene.mm_per_px
-    e = edges_across(mask, r.centreline_px, half, np.linspace(0.01, 0.99, 50))  # clamp face to free end
+    # clamp face to free end
+    e = edges_across(mask, r.centreline_px, half, np.linspace(0.01, 0.99, 50))
     mid, width = e.mean(axis=1), e[:, 1] - e[:, 0]
     assert np.abs(mid).mean() < 0.3 and np.abs(mid).max() < 1.0
-    # the width drawn: the body's, ribs bulging up to 5 % a side, the mask's threshold catching the blur
+    # the width drawn: the body's, ribs bulging up to 5 % a side, the mask's threshold catching the
+    # blur
     assert 2 * half - 2 < np.median(width) < 2 * half * 1.1 + 4
     # the body leaves the clamp at the fixed end in the direction stated
     assert r.fixed_end_px == pytest.approx(tuple(r.centreline_px[0]))
@@ -110,7 +129,7 @@ def test_truth_is_the_centre_line_of_the_drawn_body_and_turns_through_psi(preset
 
 
 def test_tilted_camera_truth_is_the_projected_body_centre_line():
-    scene, r, _ = render_with_empty("grey_dots", 120.0, tilt_deg=3.0)
+    _scene, r, _ = render_with_empty("grey_dots", 120.0, tilt_deg=3.0)
     assert psi_from_points(r.centreline_px, y_down=True) == pytest.approx(r.psi_image_deg, abs=0.05)
     assert 0 < abs(r.psi_image_deg - 120.0) < 1.5
 
@@ -138,7 +157,9 @@ def test_shapes_turn_through_psi_over_l0(shape, extra, psi):
     scene = scene_from("clean", shape=shape, **extra)
     pts = actuator_centreline_mm(psi, 195.0, scene)
     first_chord = np.arctan2(*(pts[1] - pts[0])[::-1])  # half a chord's turn off the tangent (+x)
-    assert np.allclose(pts[0], 0) and abs(first_chord) <= np.radians(abs(psi)) / (len(pts) - 1) + 1e-12
+    assert (
+        np.allclose(pts[0], 0) and abs(first_chord) <= np.radians(abs(psi)) / (len(pts) - 1) + 1e-12
+    )
     assert psi_from_points(pts, y_down=False) == pytest.approx(psi, abs=0.05)
     assert np.hypot(*np.diff(pts, axis=0).T).sum() == pytest.approx(195.0, rel=1e-6)
 
@@ -165,7 +186,8 @@ def test_chambers_bend_only_where_weighted():
     u = np.linspace(0, 1, 3001)[1:-1]
     middle = (u > 1 / 3 + 0.03) & (u < 2 / 3 - 0.03)
     assert np.abs(k[middle]).max() < 1e-6
-    assert k[u < 0.3].mean() == pytest.approx(np.radians(-120.0) / 120.0, rel=0.02)  # 2/3 of l0 bends
+    # 2/3 of l0 bends
+    assert k[u < 0.3].mean() == pytest.approx(np.radians(-120.0) / 120.0, rel=0.02)
     w = curvature_weights(np.array([0.1, 0.5, 0.9]), "chambers", chamber_bend=(1.0, 0.0, 1.0))
     assert w.tolist() == [1.0, 0.0, 1.0]
 
@@ -176,9 +198,17 @@ def test_folding_body_is_refused_before_anything_is_written(tmp_path):
         render_actuator(330.0, 100.0, scene, seed=1)
     out = tmp_path / "folded"
     with pytest.raises(UserInputError, match="fold"):
-        render_photoset(out, "DS20", actuators=1, trials=1, step_kpa=200, scene="grey_dots", l0_mm=100.0,
-                        scene_overrides={"body_width_mm": 25.0, "width": 320, "height": 240},
-                        psi_fn=lambda m, p, branch="loading": 330.0 - np.asarray(p, float))
+        render_photoset(
+            out,
+            "DS20",
+            actuators=1,
+            trials=1,
+            step_kpa=200,
+            scene="grey_dots",
+            l0_mm=100.0,
+            scene_overrides={"body_width_mm": 25.0, "width": 320, "height": 240},
+            psi_fn=lambda m, p, branch="loading": 330.0 - np.asarray(p, float),
+        )
     assert not out.exists() or not list(out.glob("*.jpg"))
 
 
@@ -207,23 +237,39 @@ def test_dots_are_drawn_where_the_truth_puts_them():
     _, with_dots, _ = render_with_empty("grey_dots", 140.0, **kw)
     _, without, _ = render_with_empty("grey_dots", 140.0, dots=0, **kw)
     assert len(with_dots.dots_px) == 8 and len(without.dots_px) == 0
-    diff = np.abs(with_dots.image.astype(np.int16) - without.image.astype(np.int16)).max(axis=2) > 25
+    diff = (
+        np.abs(with_dots.image.astype(np.int16) - without.image.astype(np.int16)).max(axis=2) > 25
+    )
     n, _, _, centroids = cv2.connectedComponentsWithStats(diff.astype(np.uint8))
     assert n - 1 == 8
-    near = np.hypot(*(centroids[1:, None, :] - with_dots.dots_px[None, :, :]).transpose(2, 0, 1)).min(axis=1)
+    near = np.hypot(
+        *(centroids[1:, None, :] - with_dots.dots_px[None, :, :]).transpose(2, 0, 1)
+    ).min(axis=1)
     assert near.max() < 1.0
     # white markers are bright; on the centre line (layout 'centre') they lie within 1 mm of it
     px = np.round(with_dots.dots_px).astype(int)
     assert with_dots.image[px[:, 1], px[:, 0]].min() > 180
-    to_line = np.hypot(*(with_dots.dots_px[:, None, :] - with_dots.centreline_px[None, ::20, :]).transpose(2, 0, 1)).min(axis=1)
+    to_line = np.hypot(
+        *(with_dots.dots_px[:, None, :] - with_dots.centreline_px[None, ::20, :]).transpose(2, 0, 1)
+    ).min(axis=1)
     assert to_line.max() * 0.45 < 1.0
 
 
 @pytest.mark.parametrize("preset,texture", [("green_fibre", "fibre"), ("dark_translucent", "ribs")])
 def test_texture_repeats_along_the_body_at_its_pitch(preset, texture):
     def spectrum(**kw):
-        scene = scene_from(preset, width=800, height=600, mm_per_px=0.25, noise_sigma=0.0, specular=0.0,
-                           chamber_bend=(1.0,), texture_pitch_mm=3.0, tilt_deg=0.0, **kw)
+        scene = scene_from(
+            preset,
+            width=800,
+            height=600,
+            mm_per_px=0.25,
+            noise_sigma=0.0,
+            specular=0.0,
+            chamber_bend=(1.0,),
+            texture_pitch_mm=3.0,
+            tilt_deg=0.0,
+            **kw,
+        )
         r = render_actuator(60.0, 120.0, scene, seed=5)
         grey = cv2.cvtColor(r.image, cv2.COLOR_BGR2GRAY).astype(float)
         c = r.centreline_px
@@ -279,9 +325,20 @@ def test_new_scene_knobs_are_validated_and_parsed():
     assert s.table_bgr == (58, 160, 40) and s.chamber_bend == (0.0, 1.0, 1.0) and s.dots == 6
     assert not s.marker_line and not s.plain_body
     assert scene_from("lab").plain_body
-    for bad in ({"texture": "knit"}, {"clamp_style": "vice"}, {"marker_line": False}, {"chamber_bend": "-1,1"},
-                {"chamber_bend": "0,0"}, {"dot_color": "red"}, {"body_width_mm": 80}, {"table_bgr": "mauve"},
-                {"specular": 1.5}, {"straight_base_fraction": 0.95}, {"shape": "spiral"}, {"dots": -1}):
+    for bad in (
+        {"texture": "knit"},
+        {"clamp_style": "vice"},
+        {"marker_line": False},
+        {"chamber_bend": "-1,1"},
+        {"chamber_bend": "0,0"},
+        {"dot_color": "red"},
+        {"body_width_mm": 80},
+        {"table_bgr": "mauve"},
+        {"specular": 1.5},
+        {"straight_base_fraction": 0.95},
+        {"shape": "spiral"},
+        {"dots": -1},
+    ):
         with pytest.raises(UserInputError):
             scene_from("lab", **bad)
 
@@ -290,8 +347,16 @@ def test_new_scene_knobs_are_validated_and_parsed():
 
 
 def body_set(tmp_path: Path, preset: str, name: str = "set", **kw) -> tuple[Path, pd.DataFrame]:
-    args = {"actuators": 1, "trials": 2, "seed": 4, "scene": preset, "step_kpa": 110, "psi_fn": toy_psi,
-            "scene_overrides": {"width": 480, "height": 360}, "l0_mm": 195.0}
+    args = {
+        "actuators": 1,
+        "trials": 2,
+        "seed": 4,
+        "scene": preset,
+        "step_kpa": 110,
+        "psi_fn": toy_psi,
+        "scene_overrides": {"width": 480, "height": 360},
+        "l0_mm": 195.0,
+    }
     args.update(kw)
     out = tmp_path / name
     return out, render_photoset(out, "DS20", **args)
@@ -309,12 +374,20 @@ def test_body_photoset_is_a_valid_body_photoset(tmp_path, preset):
     assert truth["target"].eq("body").all() and truth["line_in_frame"].all()
     assert (truth["psi_deg"] - truth["psi_image_deg"]).abs().max() < 0.6  # 1 deg camera tilt
     # the fixed end: the body's centre line at the clamp face (ramps differ by the mounting jitter)
-    assert np.hypot(truth["fixed_end_x"] - raw["fixed_end"][0], truth["fixed_end_y"] - raw["fixed_end"][1]).max() < 1.0
+    assert (
+        np.hypot(
+            truth["fixed_end_x"] - raw["fixed_end"][0], truth["fixed_end_y"] - raw["fixed_end"][1]
+        ).max()
+        < 1.0
+    )
     manifest = pd.read_csv(out / "manifest.csv")
     if scene.known_fixed_direction:
         assert np.allclose(manifest["fixed_direction_deg"], truth["fixed_direction_deg"], atol=1e-3)
-        assert [row.fixed_direction_deg for row in ps.rows] == pytest.approx(list(truth["fixed_direction_deg"]), abs=1e-3)
-        assert truth.groupby("trial")["fixed_direction_deg"].first().diff().abs().max() > 0.01  # per ramp
+        assert [row.fixed_direction_deg for row in ps.rows] == pytest.approx(
+            list(truth["fixed_direction_deg"]), abs=1e-3
+        )
+        # per ramp
+        assert truth.groupby("trial")["fixed_direction_deg"].first().diff().abs().max() > 0.01
     else:
         assert "fixed_direction_deg" not in manifest
     if scene.background_photo:
@@ -332,25 +405,54 @@ def test_body_photoset_is_a_valid_body_photoset(tmp_path, preset):
 
 def test_body_photosets_same_seed_same_bytes_whatever_the_jobs(tmp_path):
     def sha(folder: Path) -> dict[str, str]:
-        return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+        return {
+            p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())
+        }
 
     a, _ = body_set(tmp_path, "green_fibre", "a", jobs=1)
     b, _ = body_set(tmp_path, "green_fibre", "b", jobs=2)
     c, _ = body_set(tmp_path, "green_fibre", "c", seed=5)
     ha, hb, hc = sha(a), sha(b), sha(c)
     assert BACKGROUND_IMAGE in ha and ha == hb
-    assert sum(ha[k] != hc.get(k) for k in ha if k.endswith(".jpg")) >= len([k for k in ha if k.endswith(".jpg")]) - 1
+    assert (
+        sum(ha[k] != hc.get(k) for k in ha if k.endswith(".jpg"))
+        >= len([k for k in ha if k.endswith(".jpg")]) - 1
+    )
 
 
 def test_cli_renders_a_body_preset_with_shape_knobs(tmp_path, capsys):
     from pipeline.cli import main
 
     out = tmp_path / "cli"
-    rc = main(["synth", str(out), "--material", "SS50", "--actuators", "1", "--trials", "1", "--step-kpa", "150",
-               "--max-kpa", "150",
-               "--scene", "green_fibre", "--set", "width=320", "--set", "height=240", "--set", "chamber_bend=0,0,1",
-               "--set", "known_fixed_direction=true"])
+    rc = main(
+        [
+            "synth",
+            str(out),
+            "--material",
+            "SS50",
+            "--actuators",
+            "1",
+            "--trials",
+            "1",
+            "--step-kpa",
+            "150",
+            "--max-kpa",
+            "150",
+            "--scene",
+            "green_fibre",
+            "--set",
+            "width=320",
+            "--set",
+            "height=240",
+            "--set",
+            "chamber_bend=0,0,1",
+            "--set",
+            "known_fixed_direction=true",
+        ]
+    )
     assert rc == 0 and "scene green_fibre" in capsys.readouterr().out
     assert validate_photoset(out) == []
     truth = pd.read_csv(out / "truth.csv")
-    assert truth["shape"].eq("chambers").all() and "fixed_direction_deg" in pd.read_csv(out / "manifest.csv")
+    assert truth["shape"].eq("chambers").all() and "fixed_direction_deg" in pd.read_csv(
+        out / "manifest.csv"
+    )

@@ -14,13 +14,20 @@ import pytest
 
 from pipeline import photoset
 from pipeline.errors import UserInputError
+from pipeline.photoset_check import check_photoset
 from pipeline.photoset_measure import measure_photoset
 from pipeline.synth.video import Dynamics, render_video, simulate, toy_actuator
 from pipeline.video import measure as video_measure
 from pipeline.video.clips import resolve_clips
 from pipeline.video.profile import PressureProfile
 from pipeline.video.reader import probe_video, read_frames
-from pipeline.video.timeline import PressureLog, frame_conditions, read_pressure_log, step_times, turning_points
+from pipeline.video.timeline import (
+    PressureLog,
+    frame_conditions,
+    read_pressure_log,
+    step_times,
+    turning_points,
+)
 
 SCENE = {"width": 320, "height": 240, "tilt_deg": 0.0}
 MEASURED = ["psi_deg", "status", "reason", "frame", "time_s", "pressure_kpa", "direction", "step"]
@@ -39,9 +46,18 @@ def _video(folder: Path) -> Path:
 def test_every_frame_is_a_row_with_its_time_pressure_and_direction(video_set, measured):
     truth = pd.read_csv(video_set / "truth.csv")
     assert len(measured) == len(truth) == 135
-    assert {"frame", "time_s", "pressure_kpa", "measured_pressure_kpa", "direction", "step", "since_step_s"} <= set(measured.columns)
+    assert {
+        "frame",
+        "time_s",
+        "pressure_kpa",
+        "measured_pressure_kpa",
+        "direction",
+        "step",
+        "since_step_s",
+    } <= set(measured.columns)
     m = measured.merge(truth, on=["image", "frame"], suffixes=("", "_true"), validate="one_to_one")
-    assert np.allclose(m["time_s"], m["time_s_true"], atol=1e-6)  # frame k at 0.7 + k / 10 s on the log clock
+    # frame k at 0.7 + k / 10 s on the log clock
+    assert np.allclose(m["time_s"], m["time_s_true"], atol=1e-6)
     ok = m[m["status"] == "ok"]
     assert len(ok) >= 130
     err = (ok["psi_deg"] - ok["psi_image_deg"]).abs()
@@ -59,7 +75,11 @@ def test_every_frame_is_a_row_with_its_time_pressure_and_direction(video_set, me
 
 
 def test_chunks_in_workers_give_the_same_rows_as_one_pass(video_set, measured, monkeypatch):
-    monkeypatch.setattr(video_measure, "chunk_ranges", lambda n, seekable, jobs: [(a, min(16, n - a)) for a in range(0, n, 16)])
+    monkeypatch.setattr(
+        video_measure,
+        "chunk_ranges",
+        lambda n, seekable, jobs: [(a, min(16, n - a)) for a in range(0, n, 16)],
+    )
     serial = measure_photoset(video_set, jobs=1)
     pd.testing.assert_frame_equal(serial[MEASURED], measured[MEASURED])
 
@@ -79,7 +99,7 @@ def test_truncated_video_keeps_the_frames_it_could_read_and_fails_the_rest(video
     # frames read after the unusable index (packets skipped from the start) are the same frames
     intact = measure_photoset(video_set, jobs=1).set_index("frame")
     assert np.allclose(read.set_index("frame")["psi_deg"], intact.loc[read["frame"], "psi_deg"])
-    text = "\n".join(map(str, photoset.validate_photoset(folder)))
+    text = "\n".join(map(str, check_photoset(folder)))
     assert f"only frames 0-{len(read) - 1} of the 135 of video {path.name} can be read" in text
 
 
@@ -89,7 +109,9 @@ def test_unreadable_video_is_one_failed_row_or_one_per_listed_frame(video_set, t
     out = measure_photoset(folder)
     assert len(out) == 1 and out["status"].iloc[0] == "failed" and pd.isna(out["frame"].iloc[0])
     assert "cannot be opened" in out["reason"].iloc[0]
-    pd.DataFrame({"frame": range(12), "time_s": np.arange(12) / 10}).to_csv(folder / "frames.csv", index=False)
+    pd.DataFrame({"frame": range(12), "time_s": np.arange(12) / 10}).to_csv(
+        folder / "frames.csv", index=False
+    )
     m = pd.read_csv(folder / "manifest.csv")
     m["frame_times"] = "frames.csv"
     m.to_csv(folder / "manifest.csv", index=False)
@@ -103,15 +125,21 @@ def test_a_log_not_covering_the_video_is_refused_naming_both_spans(video_set, tm
     log_path = folder / pd.read_csv(folder / "manifest.csv")["pressure_log"].iloc[0]
     log = pd.read_csv(log_path)
     log[log["time_s"] <= 5.0].to_csv(log_path, index=False)
-    problems = [p for p in photoset.validate_photoset(folder) if not p.warning]
+    problems = [p for p in check_photoset(folder) if not p.warning]
     assert len(problems) == 1 and problems[0].line == 2
     assert "spans 0.70-14.10 s on the log clock" in problems[0].message
     assert "covers 0.00-5.00 s" in problems[0].message
-    cli = subprocess.run([sys.executable, "-m", "pipeline", "photoset", "check", str(folder)], capture_output=True, text=True)
+    cli = subprocess.run(
+        [sys.executable, "-m", "pipeline", "photoset", "check", str(folder)],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert cli.returncode == 1 and "covers 0.00-5.00 s" in cli.stderr
     out = measure_photoset(folder)
     outside = out["time_s"] > 5.0
-    assert (out.loc[outside, "status"] == "failed").all() and out.loc[outside, "psi_deg"].isna().all()
+    assert (out.loc[outside, "status"] == "failed").all() and out.loc[
+        outside, "psi_deg"
+    ].isna().all()
     assert out.loc[outside, "reason"].str.contains("outside the pressure log").all()
     assert (out.loc[~outside, "status"] != "failed").all()
 
@@ -131,7 +159,10 @@ def test_frame_times_file_replaces_the_container_times(video_set, tmp_path):
 def test_manifest_rows_of_videos_name_their_problems(video_set, tmp_path):
     folder = _copy(video_set, tmp_path)
     m = pd.read_csv(folder / "manifest.csv", dtype=str)
-    bad = pd.concat([m, m.assign(clock_offset_s="soon", pressure_log=""), m.assign(video="", trial="2")], ignore_index=True)
+    bad = pd.concat(
+        [m, m.assign(clock_offset_s="soon", pressure_log=""), m.assign(video="", trial="2")],
+        ignore_index=True,
+    )
     bad.to_csv(folder / "manifest.csv", index=False)
     text = "\n".join(str(p) for p in photoset.load_photoset(folder).problems)
     assert "line 3: video 'SS40_A1_t1_steps.avi' is listed twice (also line 2)" in text
@@ -141,17 +172,32 @@ def test_manifest_rows_of_videos_name_their_problems(video_set, tmp_path):
     assert "line 4: video name is empty" in text
     out = measure_photoset(folder)
     assert len(out) == 135 + 135 + 1  # line 4 names no video: one row says why
-    assert (out.iloc[:135]["status"] != "failed").all() and (out.iloc[135:]["status"] == "failed").all()
-    assert out.iloc[140]["reason"].startswith("manifest line 3: video 'SS40_A1_t1_steps.avi' is listed twice")
+    assert (out.iloc[:135]["status"] != "failed").all() and (
+        out.iloc[135:]["status"] == "failed"
+    ).all()
+    assert out.iloc[140]["reason"].startswith(
+        "manifest line 3: video 'SS40_A1_t1_steps.avi' is listed twice"
+    )
     with pytest.raises(UserInputError, match="missing column"):
-        pd.DataFrame({"video": ["a.avi"], "material": ["SS40"]}).to_csv(folder / "manifest.csv", index=False)
+        pd.DataFrame({"video": ["a.avi"], "material": ["SS40"]}).to_csv(
+            folder / "manifest.csv", index=False
+        )
         photoset.read_manifest(folder)
 
 
 def test_mpeg4_frames_are_read_decoded_and_measured_the_same_way(tmp_path):
     folder = tmp_path / "mp4v"
-    truth = render_video(folder, "SS40", profile=PressureProfile("ramp", max_kpa=60, rate_kpa_s=60), fps=10, rest_s=0.2,
-                         scene="lab", scene_overrides=SCENE, seed=4, codec="mp4v")
+    truth = render_video(
+        folder,
+        "SS40",
+        profile=PressureProfile("ramp", max_kpa=60, rate_kpa_s=60),
+        fps=10,
+        rest_s=0.2,
+        scene="lab",
+        scene_overrides=SCENE,
+        seed=4,
+        codec="mp4v",
+    )
     info = probe_video(_video(folder))
     assert info.fourcc in ("FMP4", "mp4v") and not info.packets and info.seekable
     out = measure_photoset(folder, jobs=2)
@@ -173,11 +219,22 @@ def test_h264_is_written_when_the_build_can_and_refused_by_name_when_not(tmp_pat
 
 
 def test_rendering_is_deterministic(tmp_path):
-    kw = dict(profile=PressureProfile("ramp", max_kpa=30, rate_kpa_s=60), fps=5, rest_s=0.2, scene="lab",
-              scene_overrides=SCENE, seed=9)
+    kw = {
+        "profile": PressureProfile("ramp", max_kpa=30, rate_kpa_s=60),
+        "fps": 5,
+        "rest_s": 0.2,
+        "scene": "lab",
+        "scene_overrides": SCENE,
+        "seed": 9,
+    }
     render_video(tmp_path / "a", "SS40", **kw)
     render_video(tmp_path / "b", "SS40", **kw)
-    for name in ("manifest.csv", "truth.csv", "SS40_A1_t1_ramp.avi", "SS40_A1_t1_ramp_pressure.csv"):
+    for name in (
+        "manifest.csv",
+        "truth.csv",
+        "SS40_A1_t1_ramp.avi",
+        "SS40_A1_t1_ramp_pressure.csv",
+    ):
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
 
 
@@ -186,7 +243,9 @@ def test_rendering_is_deterministic(tmp_path):
 
 def test_direction_turns_at_confirmed_extremes_only():
     rng = np.random.default_rng(1)
-    p = np.concatenate([np.linspace(0, 100, 101), np.full(20, 100.0), np.linspace(100, 0, 101)]) + rng.normal(0, 0.2, 222)
+    p = np.concatenate(
+        [np.linspace(0, 100, 101), np.full(20, 100.0), np.linspace(100, 0, 101)]
+    ) + rng.normal(0, 0.2, 222)
     tp = turning_points(p)
     assert len(tp) == 1 and 100 <= tp[0] <= 121  # at the top hold, not at a noise wiggle
     log = PressureLog("log.csv", np.arange(222) * 0.1, p)
@@ -199,7 +258,8 @@ def test_steps_are_jumps_followed_by_a_hold_not_a_fast_ramp():
     steps = PressureProfile("steps", max_kpa=40, step_kpa=20, hold_s=4)
     log = PressureLog("s.csv", t, steps.setpoint_kpa(t))
     assert np.allclose(step_times(log), steps.step_times_s(), atol=0.051)
-    ramp = PressureProfile("ramp", max_kpa=200, rate_kpa_s=60)  # 3 kPa per log row: fast, but no hold
+    # 3 kPa per log row: fast, but no hold
+    ramp = PressureProfile("ramp", max_kpa=200, rate_kpa_s=60)
     assert step_times(PressureLog("r.csv", t, ramp.setpoint_kpa(t))).size == 0
 
 
@@ -215,9 +275,18 @@ def test_pressure_log_problems_name_the_line(tmp_path):
 
 def test_first_order_lags_reach_63_percent_after_tau():
     dyn = Dynamics(tau_pressure_s=0.0, tau_psi_s=0.5)
-    sim = simulate(PressureProfile("steps", max_kpa=50, step_kpa=50, hold_s=5), toy_actuator(), dyn, start_s=0.0, end_s=10.0)
-    psi = np.interp([5.0, 5.5, 9.9], sim["time_s"], sim["psi_deg"])  # the step to 50 kPa at 5 s: 210 -> 110 deg
-    assert np.isclose(psi[0], 210, atol=0.2) and np.isclose(psi[1], 210 - 100 * (1 - np.exp(-1)), atol=0.3)
+    sim = simulate(
+        PressureProfile("steps", max_kpa=50, step_kpa=50, hold_s=5),
+        toy_actuator(),
+        dyn,
+        start_s=0.0,
+        end_s=10.0,
+    )
+    # the step to 50 kPa at 5 s: 210 -> 110 deg
+    psi = np.interp([5.0, 5.5, 9.9], sim["time_s"], sim["psi_deg"])
+    assert np.isclose(psi[0], 210, atol=0.2) and np.isclose(
+        psi[1], 210 - 100 * (1 - np.exp(-1)), atol=0.3
+    )
     assert np.isclose(psi[2], 110, atol=0.1)
 
 
@@ -238,7 +307,11 @@ def test_truncated_avi_cannot_seek_and_is_read_by_skipping(video_set, tmp_path):
 def test_clips_know_their_span_and_the_log(video_set):
     clip = resolve_clips(photoset.load_photoset(video_set))[0]
     assert clip.n_frames == 135 and clip.clock_offset_s == 0.7 and clip.problems == ()
-    assert np.allclose(clip.span_s(), (0.7, 14.1)) and clip.log is not None and clip.log.span_s[0] == 0.0
+    assert (
+        np.allclose(clip.span_s(), (0.7, 14.1))
+        and clip.log is not None
+        and clip.log.span_s[0] == 0.0
+    )
 
 
 def test_the_ramp_check_runs_over_time(measured):
@@ -246,7 +319,10 @@ def test_the_ramp_check_runs_over_time(measured):
 
     bad = measured.copy()
     bad.loc[60, "psi_deg"] += 40.0  # one frame read wrongly
-    shuffled = bad.sample(frac=1.0, random_state=1)  # row order must not matter: frames are ordered by time
+    # row order must not matter: frames are ordered by time
+    shuffled = bad.sample(frac=1.0, random_state=1)
     out = check_ramps(shuffled).loc[bad.index]
-    assert out.loc[60, "status"] == "flagged" and out.loc[60, "reason"].startswith("breaks its ramp")
+    assert out.loc[60, "status"] == "flagged" and out.loc[60, "reason"].startswith(
+        "breaks its ramp"
+    )
     assert (out.drop(index=60)["status"] == measured.drop(index=60)["status"]).all()

@@ -1,4 +1,5 @@
-"""Continuous aggregation: step-response figures against closed forms and the video's truth, loops."""
+"""Continuous aggregation: step-response figures against closed forms and the video's truth,
+loops."""
 
 from __future__ import annotations
 
@@ -12,9 +13,9 @@ import pytest
 from pipeline.aggregate import aggregate_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.synth.video import Dynamics, simulate, toy_actuator
-from pipeline.video.profile import PressureProfile
 from pipeline.video import continuous
 from pipeline.video.continuous import loops, step_response, steps, write_continuous
+from pipeline.video.profile import PressureProfile
 
 T = np.arange(0.0, 6.0, 0.01)
 
@@ -27,50 +28,79 @@ def test_first_order_step_gives_its_closed_form_times():
     r = step_response(T, _first_order(0.3), step_time_s=1.0, before_deg=50.0)
     assert r["rise_time_s"] == pytest.approx(0.3 * np.log(9), abs=0.01)
     assert r["settling_time_s"] == pytest.approx(0.3 * np.log(50), abs=0.02)
-    assert r["overshoot_pct"] == 0.0 and r["note"] == "" and r["change"] == pytest.approx(30.0, abs=0.01)
+    assert (
+        r["overshoot_pct"] == 0.0
+        and r["note"] == ""
+        and r["change"] == pytest.approx(30.0, abs=0.01)
+    )
 
 
 def test_underdamped_step_gives_its_overshoot_and_settling():
     zeta, wn = 0.3, 8.0
     wd = wn * np.sqrt(1 - zeta**2)
     u = np.clip(T - 1.0, 0, None)
-    y = 10.0 - 20.0 * (1 - np.exp(-zeta * wn * u) * (np.cos(wd * u) + zeta / np.sqrt(1 - zeta**2) * np.sin(wd * u)))
+    y = 10.0 - 20.0 * (
+        1 - np.exp(-zeta * wn * u) * (np.cos(wd * u) + zeta / np.sqrt(1 - zeta**2) * np.sin(wd * u))
+    )
     r = step_response(T, y, step_time_s=1.0, before_deg=10.0)
-    assert r["overshoot_pct"] == pytest.approx(100 * np.exp(-zeta * np.pi / np.sqrt(1 - zeta**2)), abs=0.5)
+    assert r["overshoot_pct"] == pytest.approx(
+        100 * np.exp(-zeta * np.pi / np.sqrt(1 - zeta**2)), abs=0.5
+    )
     outside = np.flatnonzero(np.abs(y - (-10.0)) > 0.02 * 20.0)
     assert r["settling_time_s"] == pytest.approx(T[outside[-1] + 1] - 1.0, abs=0.02)
 
 
 def test_a_hold_too_short_or_a_change_too_small_has_no_figures():
-    short = step_response(T[T < 2.2], _first_order(0.5)[T < 2.2], step_time_s=1.0, before_deg=50.0)  # 2.4 tau
+    # 2.4 tau
+    short = step_response(T[T < 2.2], _first_order(0.5)[T < 2.2], step_time_s=1.0, before_deg=50.0)
     assert short["note"] == "did not settle within the hold"
-    assert np.isnan(short["settling_time_s"]) and np.isnan(short["rise_time_s"]) and np.isnan(short["overshoot_pct"])
+    assert (
+        np.isnan(short["settling_time_s"])
+        and np.isnan(short["rise_time_s"])
+        and np.isnan(short["overshoot_pct"])
+    )
     flat = step_response(T, np.full_like(T, 50.0) + 0.3 * (T > 1), step_time_s=1.0, before_deg=50.0)
     assert "too small" in flat["note"] and np.isnan(flat["rise_time_s"])
 
 
 def test_steps_measured_on_the_video_match_the_steps_of_its_truth(video_set, measured):
     truth = pd.read_csv(video_set / "truth.csv")
-    ideal = measured.drop(columns="psi_deg").merge(truth[["image", "frame", "psi_image_deg"]], on=["image", "frame"])
+    ideal = measured.drop(columns="psi_deg").merge(
+        truth[["image", "frame", "psi_image_deg"]], on=["image", "frame"]
+    )
     ideal = ideal.rename(columns={"psi_image_deg": "psi_deg"}).assign(status="ok")
     got, curves = steps(measured)
     want, _ = steps(ideal)
-    assert list(got["step"]) == [1, 2, 3, 4] and list(got["direction"]) == ["up", "up", "down", "down"]
+    assert list(got["step"]) == [1, 2, 3, 4] and list(got["direction"]) == [
+        "up",
+        "up",
+        "down",
+        "down",
+    ]
     assert np.allclose(got["time_s"], [1.2 + 2.5 * k for k in range(1, 5)], atol=1e-6)
     assert list(got["to_kpa"]) == [40, 80, 40, 0] and list(got["from_kpa"]) == [0, 40, 80, 40]
     assert np.allclose(got["psi_final_deg"], want["psi_final_deg"], atol=0.2)
     assert np.allclose(got["rise_time_s"], want["rise_time_s"], atol=0.1)  # one frame period
     # the closed form: the actuator's 0.4 s lag behind the regulator's 0.15 s lag (simulated finely)
-    sim = simulate(PressureProfile("steps", max_kpa=40, step_kpa=40, hold_s=2.5), toy_actuator(), Dynamics(), start_s=0.0,
-                   end_s=5.0)
+    sim = simulate(
+        PressureProfile("steps", max_kpa=40, step_kpa=40, hold_s=2.5),
+        toy_actuator(),
+        Dynamics(),
+        start_s=0.0,
+        end_s=5.0,
+    )
     hold = sim[sim["time_s"] >= 2.5]
-    exact = step_response(hold["time_s"].to_numpy(), hold["psi_deg"].to_numpy(), step_time_s=2.5, before_deg=210.0)
+    exact = step_response(
+        hold["time_s"].to_numpy(), hold["psi_deg"].to_numpy(), step_time_s=2.5, before_deg=210.0
+    )
     assert np.allclose(got["rise_time_s"], exact["rise_time_s"], atol=0.1)
     assert np.allclose(got["pressure_rise_time_s"], 0.15 * np.log(9), atol=0.1)
     assert (got["change_deg"].iloc[:2] < -10).all() and (got["change_deg"].iloc[2:] > 10).all()
     assert set(curves["step"]) == {1, 2, 3, 4}
     start = curves.sort_values("since_step_s").groupby("step").first()
-    assert (start["response"].abs() < 0.1).all() and (curves.groupby("step")["response"].max() > 0.9).all()
+    assert (start["response"].abs() < 0.1).all() and (
+        curves.groupby("step")["response"].max() > 0.9
+    ).all()
 
 
 def test_loops_and_cycles_of_the_video(measured):
@@ -78,7 +108,8 @@ def test_loops_and_cycles_of_the_video(measured):
     assert set(binned["direction"]) == {"up", "down"} and (binned["cycle"] == 1).all()
     assert binned.groupby("direction")["n"].sum().sum() == (measured["status"] == "ok").sum()
     assert len(cycles) == 1 and cycles["bins_compared"].iloc[0] >= 3
-    # mean setpoint rate over each leg: 80 kPa from the first frame (0.7 s) to the end of the top hold (8.7 s)
+    # mean setpoint rate over each leg: 80 kPa from the first frame (0.7 s) to the end of the top
+    # hold (8.7 s)
     assert cycles["rate_up_kpa_s"].iloc[0] == pytest.approx(80 / (8.6 - 0.7), rel=0.02)
     with pytest.raises(UserInputError, match="positive"):
         loops(measured, bin_kpa=0)
@@ -87,28 +118,57 @@ def test_loops_and_cycles_of_the_video(measured):
 def test_hysteresis_of_frames_is_binned_and_a_video_trial_counts_once_per_level(measured):
     h = aggregate_hysteresis(measured)
     assert len(h) < 40 and np.allclose(h["pressure_kpa"] % continuous.BIN_KPA, 0)
-    assert (h["n"] == 1).all() and (h["n_trials"] == 1).all()  # one trial: one value per bin, sd undefined
-    two = pd.concat([measured, measured.assign(trial="2", psi_deg=measured["psi_deg"] + 1.0)], ignore_index=True)
+    # one trial: one value per bin, sd undefined
+    assert (h["n"] == 1).all() and (h["n_trials"] == 1).all()
+    two = pd.concat(
+        [measured, measured.assign(trial="2", psi_deg=measured["psi_deg"] + 1.0)], ignore_index=True
+    )
     h2 = aggregate_hysteresis(two)
-    assert (h2["n"] == 2).all() and np.allclose(h2["psi_sd_deg"], np.sqrt(0.5))  # values x and x + 1
+    # values x and x + 1
+    assert (h2["n"] == 2).all() and np.allclose(h2["psi_sd_deg"], np.sqrt(0.5))
     level = h[(h["direction"] == "up") & (h["pressure_kpa"] == 40)]
-    frames = measured[(measured["direction"] == "up") & ((measured["measured_pressure_kpa"] / 5).round() == 8)
-                      & (measured["status"] == "ok")]
+    frames = measured[
+        (measured["direction"] == "up")
+        & ((measured["measured_pressure_kpa"] / 5).round() == 8)
+        & (measured["status"] == "ok")
+    ]
     assert np.isclose(level["psi_mean_deg"].iloc[0], frames["psi_deg"].mean())
 
 
 def test_cli_writes_every_table_and_refuses_photos(measured, tmp_path):
     path = tmp_path / "angles.csv"
     measured.to_csv(path, index=False)
-    out = subprocess.run([sys.executable, "-m", "pipeline", "continuous", str(path), "--out-dir", str(tmp_path / "c")],
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pipeline",
+            "continuous",
+            str(path),
+            "--out-dir",
+            str(tmp_path / "c"),
+        ],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert out.returncode == 0, out.stderr
     assert "1 cycle(s), 4 step(s)" in out.stdout
     for name in continuous.FILES:
         assert (tmp_path / "c" / name).is_file()
     measured.drop(columns=["frame"]).to_csv(path, index=False)
-    out = subprocess.run([sys.executable, "-m", "pipeline", "continuous", str(path), "--out-dir", str(tmp_path / "d")],
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pipeline",
+            "continuous",
+            str(path),
+            "--out-dir",
+            str(tmp_path / "d"),
+        ],
+        capture_output=True,
+        text=True, check=False,
+    )
     assert out.returncode == 2 and "needs the frames of a video" in out.stderr
 
 

@@ -24,9 +24,13 @@ def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
     base = ReportInputs(datasets=(Dataset("steps", angles),), title="t")
     plain = build_report(base, tmp_path / "plain.pdf")
     with_video = build_report(
-        ReportInputs(datasets=base.datasets, title="t",
-                     video_dirs=(tmp_path / "continuous" / "steps_a", tmp_path / "continuous" / "steps_b")),
-        tmp_path / "video.pdf")
+        ReportInputs(
+            datasets=base.datasets,
+            title="t",
+            video_dirs=(tmp_path / "continuous" / "steps_a", tmp_path / "continuous" / "steps_b"),
+        ),
+        tmp_path / "video.pdf",
+    )
     assert with_video.pages == plain.pages + 2
     pages = _text(tmp_path / "video.pdf")
     video_pages = [p for p in pages if "Video dataset" in p]

@@ -16,9 +16,21 @@ from pipeline.bench.campaign import run_accuracy
 pytestmark = pytest.mark.slow
 
 CONFIG = {
-    "datasets": [{"name": "vid", "source": "synthetic_video", "material": "SS40", "profile": "steps", "max_kpa": 80,
-                  "step_kpa": 40, "hold_s": 2.5, "fps": 10, "rest_s": 0.5, "scene": "lab",
-                  "scene_set": {"width": 320, "height": 240, "tilt_deg": 0}}],
+    "datasets": [
+        {
+            "name": "vid",
+            "source": "synthetic_video",
+            "material": "SS40",
+            "profile": "steps",
+            "max_kpa": 80,
+            "step_kpa": 40,
+            "hold_s": 2.5,
+            "fps": 10,
+            "rest_s": 0.5,
+            "scene": "lab",
+            "scene_set": {"width": 320, "height": 240, "tilt_deg": 0},
+        }
+    ],
     "compare": {"bootstrap": 20},
     "bench": {"in_report": False},
     "force": {"grasp_log": None},
@@ -26,8 +38,20 @@ CONFIG = {
 
 
 def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "snakemake", "-s", str(repo / "Snakefile"), "--directory", str(workdir),
-                           *args], capture_output=True, text=True)
+    return subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(repo / "Snakefile"),
+            "--directory",
+            str(workdir),
+            *args,
+        ],
+        capture_output=True,
+        text=True, check=False,
+    )
 
 
 def test_a_video_dataset_runs_from_render_to_its_report_page(tmp_path, repo):

@@ -53,7 +53,7 @@ def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedPro
     return subprocess.run(
         [*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(workdir), *args],
         capture_output=True,
-        text=True,
+        text=True, check=False,
     )
 
 
@@ -74,10 +74,15 @@ def _workdir(path: Path, repo: Path, config: dict) -> Path:
 
 def _planned_jobs(stdout: str) -> dict[str, int]:
     table = stdout.split("Job stats:")[-1]
-    return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE) if m[1] != "total"}
+    return {
+        m[1]: int(m[2])
+        for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE)
+        if m[1] != "total"
+    }
 
 
-#: tests using the finished run go to one xdist worker (pyproject: --dist loadgroup), which builds it once
+#: tests using the finished run go to one xdist worker (pyproject: --dist loadgroup), which builds
+#: it once
 ON_THE_FINISHED_RUN = pytest.mark.xdist_group("finished_run")
 
 
@@ -92,14 +97,16 @@ def finished_run(tmp_path_factory, request):
 
 @ON_THE_FINISHED_RUN
 def test_outputs_exist_and_hold_real_numbers(finished_run):
-    repo, workdir = finished_run
+    _repo, workdir = finished_run
     res = workdir / "results"
     for name in ("sample", "tiny"):
         angles = pd.read_csv(res / "datasets" / name / "angles.csv")
         assert {"image", "psi_deg", "status", "pressure_kpa", "direction"} <= set(angles.columns)
         assert (angles["status"] != "failed").mean() > 0.9
         hyst = pd.read_csv(res / "datasets" / name / "hysteresis.csv")
-        assert {"material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n"} <= set(hyst.columns)
+        assert {"material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n"} <= set(
+            hyst.columns
+        )
     # both sets carry ground truth: the run is measured against it
     accuracy = run_accuracy(res).set_index("dataset")
     assert set(accuracy.index) == {"sample", "tiny"}
@@ -125,12 +132,26 @@ def test_rerun_does_nothing(finished_run):
 def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     repo, workdir = finished_run
     cfg = _tiny_config()
-    cfg["datasets"].append({"name": "new", "source": "synthetic", "material": "SS50", "actuators": 1, "trials": 1, "step_kpa": 120, "max_kpa": 240})
+    cfg["datasets"].append(
+        {
+            "name": "new",
+            "source": "synthetic",
+            "material": "SS50",
+            "actuators": 1,
+            "trials": 1,
+            "step_kpa": 120,
+            "max_kpa": 240,
+        }
+    )
     (workdir / "config2.yaml").write_text(yaml.safe_dump(cfg))
-    out = _snakemake(workdir, repo, "-n", "--cores", "2", "--configfile", str(workdir / "config2.yaml"))
+    out = _snakemake(
+        workdir, repo, "-n", "--cores", "2", "--configfile", str(workdir / "config2.yaml")
+    )
     assert out.returncode == 0, out.stderr[-3000:]
     jobs = _planned_jobs(out.stdout)
-    assert jobs.get("synth_photoset") == 1 and jobs.get("measure") == 1 and jobs.get("aggregate") == 1
+    assert (
+        jobs.get("synth_photoset") == 1 and jobs.get("measure") == 1 and jobs.get("aggregate") == 1
+    )
     assert jobs.get("compare") == 1 and jobs.get("report") == 1
     assert "model_curve" not in jobs  # SS50's curve is already there
     assert "results/datasets/new/angles.csv" in out.stdout
@@ -143,7 +164,9 @@ def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     cfg = _tiny_config()
     cfg["model"] = {"readings": {"l0_factor": "metres", "jacobian": "deformed"}}
     (workdir / "config3.yaml").write_text(yaml.safe_dump(cfg))
-    out = _snakemake(workdir, repo, "-n", "-p", "--cores", "2", "--configfile", str(workdir / "config3.yaml"))
+    out = _snakemake(
+        workdir, repo, "-n", "-p", "--cores", "2", "--configfile", str(workdir / "config3.yaml")
+    )
     assert out.returncode == 0, out.stderr[-3000:]
     jobs = _planned_jobs(out.stdout)
     assert jobs.get("model_curve") == 2 and jobs.get("compare") == 1  # DS20 (sample) and SS50
@@ -182,20 +205,29 @@ def _users_checkout(repo: Path, path: Path) -> Path:
 
 
 def _every_stage_config(checkout: Path) -> dict:
-    """One of each input: a folder set, synthetic sets, folder and synthetic force sets, a grasp log, the bench.
+    """One of each input: a folder set, synthetic sets, folder and synthetic force sets, a grasp
+    log, the bench.
 
-    The folder's name has a space and a scene override shell syntax: both must reach the commands intact.
+    The folder's name has a space and a scene override shell syntax: both must reach the commands
+    intact.
     """
     photos = "lab photos"  # copied into the work folder
     return {
         "datasets": [
             {"name": "lab", "source": "folder", "path": photos},
-            {"name": "DS20", "source": "synthetic", "material": "DS20", "scene_set": {"noise_sigma": "1 $(touch x)"}},
+            {
+                "name": "DS20",
+                "source": "synthetic",
+                "material": "DS20",
+                "scene_set": {"noise_sigma": "1 $(touch x)"},
+            },
             {"name": "SS50", "source": "synthetic", "material": "SS50"},
         ],
         "force": {
-            "datasets": [{"name": "force_lab", "source": "folder", "path": photos},
-                         {"name": "force_SS40", "source": "synthetic", "material": "SS40"}],
+            "datasets": [
+                {"name": "force_lab", "source": "folder", "path": photos},
+                {"name": "force_SS40", "source": "synthetic", "material": "SS40"},
+            ],
             "grasp_log": str(checkout / "pipeline" / "force" / "data" / "grasp_example.csv"),
         },
     }
@@ -211,40 +243,64 @@ def test_lint_and_dry_run_plan_every_stage(checkout, repo, tmp_path):
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     out = _snakemake(work, src, "-n", "-p", "--cores", "2")
     assert out.returncode == 0, out.stderr[-3000:]
-    commands = [shlex.split(line) for line in re.findall(r"^Shell command: (.*)$", out.stdout, re.MULTILINE)]
-    measure = next(c for c in commands if "measure" in c and "lab photos" in c)  # one argument, not two
+    commands = [
+        shlex.split(line) for line in re.findall(r"^Shell command: (.*)$", out.stdout, re.MULTILINE)
+    ]
+    # one argument, not two
+    measure = next(c for c in commands if "measure" in c and "lab photos" in c)
     assert measure[measure.index("measure") + 1] == "lab photos"
     synth = next(c for c in commands if "synth" in c and "results/photosets/DS20" in c)
-    assert synth[synth.index("--set") + 1] == "noise_sigma=1 $(touch x)"  # quoted: never run by the shell
+    # quoted: never run by the shell
+    assert synth[synth.index("--set") + 1] == "noise_sigma=1 $(touch x)"
     assert _planned_jobs(out.stdout) == {
-        "all": 1, "synth_photoset": 2, "measure": 3, "aggregate": 3, "model_curve": 2, "compare": 1,
-        "force_synth_photoset": 1, "force_measure": 2, "force_aggregate": 1, "force_grasp": 1, "bench_default": 1,
-        "resolved_config": 1, "report": 1,
+        "all": 1,
+        "synth_photoset": 2,
+        "measure": 3,
+        "aggregate": 3,
+        "model_curve": 2,
+        "compare": 1,
+        "force_synth_photoset": 1,
+        "force_measure": 2,
+        "force_aggregate": 1,
+        "force_grasp": 1,
+        "bench_default": 1,
+        "resolved_config": 1,
+        "report": 1,
     }
-    # a folder's measure job waits for the digest of the folder's bytes (kept under results/digests/)
-    for line in ("input: results/digests/datasets/lab.sha256", "input: results/digests/force/force_lab.sha256"):
+    # a folder's measure job waits for the digest of the folder's bytes (kept under
+    # results/digests/)
+    for line in (
+        "input: results/digests/datasets/lab.sha256",
+        "input: results/digests/force/force_lab.sha256",
+    ):
         assert line in out.stdout
     assert (work / "results" / "digests" / "force" / "force_lab.sha256").is_file()
 
 
 def test_slurm_profile_plans_the_workflow(repo, tmp_path):
     work = tmp_path / "clone"
-    shutil.copytree(repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__"))
+    shutil.copytree(
+        repo, work, ignore=shutil.ignore_patterns("results", ".snakemake", ".git", "__pycache__")
+    )
     cfg = _tiny_config()
     cfg["datasets"][0]["path"] = "sample_images"
-    (work / "config.yaml").write_text(yaml.safe_dump(cfg))  # the test's own config, never the user's
+    # the test's own config, never the user's
+    (work / "config.yaml").write_text(yaml.safe_dump(cfg))
     out = subprocess.run(
         [*SNAKEMAKE, "--executor", "slurm", "--profile", "rules/profiles/slurm", "-n"],
         cwd=work, capture_output=True, text=True,
-        env={**os.environ, "SBATCH_ACCOUNT": "lab", "SBATCH_PARTITION": "debug"},
+        env={**os.environ, "SBATCH_ACCOUNT": "lab", "SBATCH_PARTITION": "debug"}, check=False,
     )
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     assert _planned_jobs(out.stdout)["measure"] == len(cfg["datasets"])
 
 
 @ON_THE_FINISHED_RUN
-def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_finishes(finished_run, tmp_path):
-    """A re-taken photo re-runs its set's jobs only; Ctrl-C mid-measure; a plain re-run completes."""
+def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_finishes(
+    finished_run, tmp_path
+):
+    """A re-taken photo re-runs its set's jobs only; Ctrl-C mid-measure; a plain re-run
+    completes."""
     repo, done = finished_run
     work = tmp_path / "wf"
     shutil.copytree(done, work)  # photos, results and Snakemake's records, modification times kept
@@ -253,20 +309,32 @@ def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_fin
     fixed, donor = "DS20_A1_t1_s003_up_30kPa.jpg", "DS20_A1_t1_s008_up_80kPa.jpg"
     shutil.copyfile(work / PHOTOS / donor, work / PHOTOS / fixed)  # the lab re-took one photo
     # run, and Ctrl-C it (SIGINT to the process group, as a terminal sends it) while measure runs
-    run = subprocess.Popen([*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(work), "--cores", "2"],
-                           start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    run = subprocess.Popen(
+        [*SNAKEMAKE, "-s", str(repo / "Snakefile"), "--directory", str(work), "--cores", "2"],
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     partial = angles.parent / ".overlays.partial"
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and run.poll() is None and not (partial.is_dir() and any(partial.iterdir())):
+    while (
+        time.monotonic() < deadline
+        and run.poll() is None
+        and not (partial.is_dir() and any(partial.iterdir()))
+    ):
         time.sleep(0.01)
     assert run.poll() is None, "the run ended before it could be interrupted"
     os.killpg(run.pid, signal.SIGINT)
     interrupted, _ = run.communicate(timeout=120)
     assert run.returncode != 0
     only_this_set = {"measure": 1, "aggregate": 1, "compare": 1, "report": 1, "all": 1}
-    assert _planned_jobs(interrupted.split("Terminating")[0]) == only_this_set  # what the photo set off
+    # what the photo set off
+    assert _planned_jobs(interrupted.split("Terminating")[0]) == only_this_set
     outputs = re.findall(r"output: (\S+)", interrupted)
-    assert "results/datasets/sample/angles.csv," in outputs and not [o for o in outputs if "/tiny/" in o]
+    assert "results/datasets/sample/angles.csv," in outputs and not [
+        o for o in outputs if "/tiny/" in o
+    ]
     assert any((work / ".snakemake" / "incomplete").iterdir())  # a job was cut short ...
     assert not partial.exists()  # ... and its half-written overlays are gone
     out = _snakemake(work, repo, "--cores", "2")  # ... and a plain re-run finishes it
@@ -287,21 +355,35 @@ def test_a_failed_job_shows_the_end_of_its_log_on_the_console(tmp_path, repo):
     (tmp_path / "grasp.csv").write_text("material,mass_g\nDS20,10\n")  # columns missing
     out = _snakemake(tmp_path, repo, "--cores", "1", "results/force/grasp_summary.csv")
     assert out.returncode != 0
-    message = (tmp_path / "results" / "logs" / "force_grasp.log").read_text().strip().splitlines()[-1]
+    message = (
+        (tmp_path / "results" / "logs" / "force_grasp.log").read_text().strip().splitlines()[-1]
+    )
     assert "grasp.csv: missing column(s)" in message  # the log names the file and the fix ...
     assert message in out.stderr  # ... and the console shows it, not only an exit status
 
 
 def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, repo):
-    """A `rig` dataset: Snakemake runs `acquire` against the pty emulator, photos land outside results/."""
+    """A `rig` dataset: Snakemake runs `acquire` against the pty emulator, photos land outside
+    results/."""
     from pipeline.rig.emulator import Emulator
 
     with Emulator(seed=4) as emu:
         cfg = {
             "datasets": [
-                {"name": "rigA1", "source": "rig", "path": "data/rigA1", "port": emu.port, "camera": "synthetic",
-                 "material": "SS50", "actuator": "A1", "trials": 1, "step_kpa": 100, "max_kpa": 200,
-                 "settle_s": 0, "l0_mm": 270},
+                {
+                    "name": "rigA1",
+                    "source": "rig",
+                    "path": "data/rigA1",
+                    "port": emu.port,
+                    "camera": "synthetic",
+                    "material": "SS50",
+                    "actuator": "A1",
+                    "trials": 1,
+                    "step_kpa": 100,
+                    "max_kpa": 200,
+                    "settle_s": 0,
+                    "l0_mm": 270,
+                },
             ],
             "bench": {"in_report": False},
         }

@@ -1,8 +1,7 @@
-"""Speed/accuracy and stability study of the angle methods and the model (issue "bench").
+"""Every benchmark, in one home with one entry point: ``python -m pipeline bench WHAT [options]``.
 
-Modules: :mod:`grids` (the scenes: one condition swept at a time), :mod:`run` (render and
-measure with every method side by side), :mod:`analysis` (tables: speed/accuracy with the
-Pareto front, stability, breakdown points, repeatability, adaptive model choice, model cost),
-:mod:`charts` (figures), :mod:`pages` (``figures(bench_dir)`` for the report) and :mod:`cli`
-(``python -m pipeline bench``).  Findings: ``docs/bench.md``.
+Benchmarks print figures (ratios side by side in one run); they are not timed tests.  Each
+module is one benchmark with a ``main(argv)`` (also runnable as ``python -m pipeline.bench.WHAT``);
+:mod:`pipeline.bench.cli` lists them.  This package sits above everything it measures and
+nothing of the pipeline imports it.
 """

@@ -1,6 +1,6 @@
 """Accuracy of a finished run on its synthetic photo sets: angles.csv against truth.csv.
 
-``python -m pipeline.bench.campaign [RESULTS_DIR]`` prints, per dataset whose photo set has a
+``python -m pipeline bench campaign [RESULTS_DIR]`` prints, per dataset whose photo set has a
 ``truth.csv`` (synthetic sets under ``RESULTS_DIR/photosets/`` and committed sets such as
 ``sample_images/``), the status counts and the median / 95th-percentile / largest absolute error
 of the ``ok`` rows, against the angle seen in the image (``psi_image_deg``, which includes the
@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 import yaml
+
+from pipeline.errors import UserInputError
 
 
 def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
@@ -30,8 +33,8 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
     Returns
     -------
     dict
-        n, n_ok, n_flagged, n_failed, median/p95/max absolute error vs the image angle and median/p95
-        vs the physical angle (deg), and n_ok_over_5deg.
+        n, n_ok, n_flagged, n_failed, median/p95/max absolute error vs the image angle and
+        median/p95 vs the physical angle (deg), and n_ok_over_5deg.
 
     Examples
     --------
@@ -41,8 +44,15 @@ def campaign_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> dict[str, floa
     0.5
     """
     seen = "psi_image_deg" if "psi_image_deg" in truth.columns else "psi_deg"
-    keys = ["image", "frame"] if "frame" in truth.columns and "frame" in angles.columns else ["image"]  # a video: per frame
-    m = angles.merge(truth[keys + ["psi_deg"] + ([seen] if seen != "psi_deg" else [])], on=keys, suffixes=("", "_true"))
+    # a video: per frame
+    keys = (
+        ["image", "frame"] if "frame" in truth.columns and "frame" in angles.columns else ["image"]
+    )
+    m = angles.merge(
+        truth[keys + ["psi_deg"] + ([seen] if seen != "psi_deg" else [])],
+        on=keys,
+        suffixes=("", "_true"),
+    )
     ok = m[m["status"] == "ok"]
     err = (ok["psi_deg"] - ok[seen if seen != "psi_deg" else "psi_deg_true"]).abs()
     err_phys = (ok["psi_deg"] - ok["psi_deg_true"]).abs()
@@ -67,7 +77,13 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     A relative photo-set path in the config is relative to the run's working folder (the one
     holding ``results_dir``), wherever this is called from.
     """
-    config = yaml.safe_load((config_path or results_dir / "config.resolved.yaml").read_text())
+    path = config_path or Path(results_dir) / "config.resolved.yaml"
+    if not path.is_file():
+        raise UserInputError(
+            f"{path}: not found; pass the results folder of a finished run (snakemake writes it "
+            "there)"
+        )
+    config = yaml.safe_load(path.read_text())
     results_dir = Path(results_dir)
     configured = Path(config.get("results_dir", "results"))
     depth = len(configured.parts)
@@ -76,7 +92,9 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     rows = []
     for ds in config["datasets"]:
         synthetic = ds["source"] in ("synthetic", "synthetic_video")
-        folder = results_dir / "photosets" / ds["name"] if synthetic else workdir / ds.get("path", "")
+        folder = (
+            results_dir / "photosets" / ds["name"] if synthetic else workdir / ds.get("path", "")
+        )
         angles = results_dir / "datasets" / ds["name"] / "angles.csv"
         if (folder / "truth.csv").is_file() and angles.is_file():
             stats = campaign_errors(pd.read_csv(angles), pd.read_csv(folder / "truth.csv"))
@@ -84,10 +102,18 @@ def run_accuracy(results_dir: Path, config_path: Path | None = None) -> pd.DataF
     return pd.DataFrame(rows)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Print the accuracy table of a finished run."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.bench.campaign", description=__doc__.splitlines()[0])
-    parser.add_argument("results_dir", nargs="?", default="results", type=Path, help="results folder of a finished run")
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench campaign", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "results_dir",
+        nargs="?",
+        default="results",
+        type=Path,
+        help="results folder of a finished run",
+    )
     args = parser.parse_args(argv)
     table = run_accuracy(args.results_dir)
     if table.empty:

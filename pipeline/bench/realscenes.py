@@ -1,4 +1,4 @@
-"""``python -m pipeline.bench.realscenes``: the angle measurement on real-photo scenes.
+"""``python -m pipeline bench realscenes``: the angle measurement on real-photo scenes.
 
 Two parts, printed as tables:
 
@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
@@ -39,8 +40,15 @@ BODY_SCENES: dict[str, dict[str, object]] = {
 _PRESET = {"lab_body": "lab"}
 
 
-def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 960,
-               fixed_direction: bool = False, scenes: tuple[str, ...] | None = None) -> pd.DataFrame:
+def body_cases(
+    n: int = 12,
+    *,
+    seed: int = 30,
+    width: int = 1280,
+    height: int = 960,
+    fixed_direction: bool = False,
+    scenes: tuple[str, ...] | None = None,
+) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
     Parameters
@@ -70,30 +78,50 @@ def body_cases(n: int = 12, *, seed: int = 30, width: int = 1280, height: int = 
             continue
         scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)  # type: ignore[arg-type]
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
-            r = render_actuator(float(psi), 270.0, scene, seed=seed + i, bulge=0.4 if i % 2 else 0.0)
+            r = render_actuator(
+                float(psi), 270.0, scene, seed=seed + i, bulge=0.4 if i % 2 else 0.0
+            )
             img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
             extra = {}
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
-            settings = resolve_settings(l0_mm=270.0, target="body", fixed_end=[float(v) for v in r.fixed_end_px], **extra)
+            settings = resolve_settings(
+                l0_mm=270.0, target="body", fixed_end=[float(v) for v in r.fixed_end_px], **extra
+            )
             t0 = time.perf_counter()
             res = measure_image(img, settings)
-            rows.append({"scene": name, "psi_true_deg": r.psi_image_deg, "psi_deg": res.psi_deg,
-                         "error_deg": res.psi_deg - r.psi_image_deg, "status": res.status, "reason": res.reason,
-                         "ms": 1000 * (time.perf_counter() - t0)})
+            rows.append(
+                {
+                    "scene": name,
+                    "psi_true_deg": r.psi_image_deg,
+                    "psi_deg": res.psi_deg,
+                    "error_deg": res.psi_deg - r.psi_image_deg,
+                    "status": res.status,
+                    "reason": res.reason,
+                    "ms": 1000 * (time.perf_counter() - t0),
+                }
+            )
     return pd.DataFrame(rows)
 
 
 def score(df: pd.DataFrame, tolerance: float | pd.Series, by: str = "scene") -> pd.DataFrame:
-    """Per group: photos, median / p95 |error|, ok, ok and right, ok and wrong (the count that must be 0)."""
+    """Per group: photos, median / p95 |error|, ok, ok and right, ok and wrong (must be 0)."""
     d = df.assign(abs_err=df["error_deg"].abs(), tol=tolerance)
     d["right"] = d["abs_err"] <= d["tol"]
-    out = d.groupby(by, sort=False).apply(lambda g: pd.Series({
-        "n": len(g), "median_abs_deg": g["abs_err"].median(), "p95_abs_deg": g["abs_err"].quantile(0.95),
-        "right": int(g["right"].sum()), "ok": int((g["status"] == "ok").sum()),
-        "ok_right": int(((g["status"] == "ok") & g["right"]).sum()),
-        "ok_wrong": int(((g["status"] == "ok") & ~g["right"]).sum()),
-    }), include_groups=False)
+    out = d.groupby(by, sort=False).apply(
+        lambda g: pd.Series(
+            {
+                "n": len(g),
+                "median_abs_deg": g["abs_err"].median(),
+                "p95_abs_deg": g["abs_err"].quantile(0.95),
+                "right": int(g["right"].sum()),
+                "ok": int((g["status"] == "ok").sum()),
+                "ok_right": int(((g["status"] == "ok") & g["right"]).sum()),
+                "ok_wrong": int(((g["status"] == "ok") & ~g["right"]).sum()),
+            }
+        ),
+        include_groups=False,
+    )
     return out
 
 
@@ -109,36 +137,68 @@ def dev_set(folder: Path, jobs: int = 1) -> pd.DataFrame:
     return m
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Print the real-photo and the synthetic-analogue tables."""
     here = Path(__file__).resolve().parents[2]
-    parser = argparse.ArgumentParser(prog="python -m pipeline.bench.realscenes", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--dev-set", type=Path, default=here / "tests" / "data" / "xia2023_strips",
-                        help="a photo set with labels.csv (default: the committed real strips, tests/data/xia2023_strips)")
-    parser.add_argument("--n", type=int, default=12, help="rendered photos per synthetic scene (default 12)")
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench realscenes", description=__doc__.split("\n\n")[0]
+    )
+    parser.add_argument(
+        "--dev-set",
+        type=Path,
+        default=here / "tests" / "data" / "xia2023_strips",
+        help="a photo set with labels.csv (default: the committed real strips, "
+             "tests/data/xia2023_strips)",
+    )
+    parser.add_argument(
+        "--n", type=int, default=12, help="rendered photos per synthetic scene (default 12)"
+    )
     parser.add_argument("--seed", type=int, default=30)
     args = parser.parse_args(argv)
     pd.set_option("display.width", 200)
     pd.set_option("display.max_colwidth", 90)
     if (args.dev_set / "labels.csv").is_file():
         m = dev_set(args.dev_set)
-        print(f"== real photos: {args.dev_set.name} (labels: psi_signed_net_deg, tolerance_deg per photo)")
-        print(m[["image", "psi_deg", "psi_signed_net_deg", "tolerance_deg", "error_deg", "status", "reason"]]
-              .round(1).to_string(index=False))
+        print(
+            f"== real photos: {args.dev_set.name} (labels: psi_signed_net_deg, tolerance_deg per "
+            "photo)"
+        )
+        print(
+            m[
+                [
+                    "image",
+                    "psi_deg",
+                    "psi_signed_net_deg",
+                    "tolerance_deg",
+                    "error_deg",
+                    "status",
+                    "reason",
+                ]
+            ]
+            .round(1)
+            .to_string(index=False)
+        )
         s = score(m.assign(set=args.dev_set.name), m["tolerance_deg"], by="set")
         print(s.to_string())
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
     for fixed in (False, True):
         df = body_cases(args.n, seed=args.seed, fixed_direction=fixed)
-        print(f"\n== synthetic analogues, body mode, fixed end given{', fixed_direction_deg given' if fixed else ''} "
-              f"(right: |error| <= {TOLERANCE_DEG:g} deg)")
+        print(
+            "\n== synthetic analogues, body mode, fixed end "
+            f"given{', fixed_direction_deg given' if fixed else ''} "
+            f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
+        )
         print(score(df, TOLERANCE_DEG).round(2).to_string())
         print(f"   median time per 1280x960 photo: {df['ms'].median():.0f} ms")
         wrong = df[(df["status"] == "ok") & (df["error_deg"].abs() > TOLERANCE_DEG)]
         if len(wrong):
             print("   ok but wrong:")
-            print(wrong[["scene", "psi_true_deg", "psi_deg", "error_deg"]].round(1).to_string(index=False))
+            print(
+                wrong[["scene", "psi_true_deg", "psi_deg", "error_deg"]]
+                .round(1)
+                .to_string(index=False)
+            )
     return 0
 
 

@@ -10,7 +10,6 @@ aggregate_force  ``force_vs_pressure``, ``eccentricity_at_max_pressure`` (mean +
 grasp            ``read_grasp_log``, ``heaviest_held`` (Fig. 8B data)
 pages            ``figures(force_dir) -> list[Figure]`` for the PDF report (and ``grasp_figure``)
 cli              ``python -m pipeline force synth|measure|aggregate|grasp|pages``
-bench            ``python -m pipeline.force.bench``: eccentricity accuracy on points and photos
 
 Modules are imported on demand (``from pipeline.force.ellipse import fit_ellipse``), so this
 package import stays light.

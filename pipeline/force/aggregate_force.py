@@ -36,15 +36,45 @@ import pandas as pd
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 
-REQUIRED: tuple[str, ...] = ("material", "direction", "pressure_kpa", "actuator", "trial", "force_n")
+REQUIRED: tuple[str, ...] = (
+    "material",
+    "direction",
+    "pressure_kpa",
+    "actuator",
+    "trial",
+    "force_n",
+)
 
 FORCE_SUMMARY_COLUMNS: tuple[str, ...] = (
-    "material", "direction", "pressure_kpa", "force_mean_n", "force_sd_n", "n", "n_actuators", "n_trials",
-    "sample_sd_n", "measured_pressure_mean_kpa", "eccentricity_mean", "eccentricity_sd", "n_eccentricity",
+    "material",
+    "direction",
+    "pressure_kpa",
+    "force_mean_n",
+    "force_sd_n",
+    "n",
+    "n_actuators",
+    "n_trials",
+    "sample_sd_n",
+    "measured_pressure_mean_kpa",
+    "eccentricity_mean",
+    "eccentricity_sd",
+    "n_eccentricity",
 )
 ECCENTRICITY_SUMMARY_COLUMNS: tuple[str, ...] = (
-    "material", "pressure_kpa", "eccentricity_mean", "eccentricity_sd", "n", "n_excluded", "force_mean_n",
-    "image", "image_path", "image_eccentricity", "centre_x_px", "centre_y_px", "semi_major_px", "semi_minor_px",
+    "material",
+    "pressure_kpa",
+    "eccentricity_mean",
+    "eccentricity_sd",
+    "n",
+    "n_excluded",
+    "force_mean_n",
+    "image",
+    "image_path",
+    "image_eccentricity",
+    "centre_x_px",
+    "centre_y_px",
+    "semi_major_px",
+    "semi_minor_px",
     "angle_deg",
 )
 
@@ -58,13 +88,19 @@ def read_tables(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
         When a file is missing, unreadable or lacks a needed column.
     """
     if not paths:
-        raise UserInputError("no input table given; pass one or more eccentricity.csv (or blocked manifest.csv) files")
+        raise UserInputError(
+            "no input table given; pass one or more eccentricity.csv (or blocked manifest.csv) "
+            "files"
+        )
     frames = []
     for p in map(Path, paths):
         df = read_table(
-            p, "an eccentricity.csv from 'python -m pipeline force measure' (or a blocked manifest.csv)",
+            p,
+            "an eccentricity.csv from 'python -m pipeline force measure' (or a blocked "
+            "manifest.csv)",
             required=REQUIRED,
-            hint="a blocked-force table needs force_n (newtons) per row: record with 'acquire --mode blocked' or 'force synth'",
+            hint="a blocked-force table needs force_n (newtons) per row: record with 'acquire "
+                 "--mode blocked' or 'force synth'",
             dtype={"actuator": str, "trial": str, "material": str, "direction": str},
         )
         df["source"] = str(p)
@@ -91,7 +127,9 @@ def force_vs_pressure(table: pd.DataFrame) -> pd.DataFrame:
     df = df[np.isfinite(df["force_n"]) & np.isfinite(df["pressure_kpa"])]
     has_e = "eccentricity" in df.columns
     rows = []
-    for (material, direction, pressure), g in df.groupby(["material", "direction", "pressure_kpa"], sort=True):
+    for (material, direction, pressure), g in df.groupby(
+        ["material", "direction", "pressure_kpa"], sort=True
+    ):
         force = g["force_n"].to_numpy(float)
         row: dict[str, object] = {
             "material": material,
@@ -148,14 +186,22 @@ def eccentricity_at_max_pressure(table: pd.DataFrame) -> pd.DataFrame:
             "eccentricity_sd": float(np.std(e, ddof=1)) if len(e) > 1 else float("nan"),
             "n": len(e),
             "n_excluded": int(len(g) - len(e)),
-            "force_mean_n": float(pd.to_numeric(g["force_n"], errors="coerce").mean()) if "force_n" in g else float("nan"),
+            "force_mean_n": float(pd.to_numeric(g["force_n"], errors="coerce").mean())
+            if "force_n" in g
+            else float("nan"),
         }
         if len(e):
             rep = ok.iloc[int(np.argmin(np.abs(e - np.mean(e))))]
             row["image"] = rep.get("image")
             row["image_path"] = rep.get("image_path")
             row["image_eccentricity"] = float(rep["eccentricity"])
-            for key in ("centre_x_px", "centre_y_px", "semi_major_px", "semi_minor_px", "angle_deg"):
+            for key in (
+                "centre_x_px",
+                "centre_y_px",
+                "semi_major_px",
+                "semi_minor_px",
+                "angle_deg",
+            ):
                 row[key] = float(rep[key]) if key in rep.index else float("nan")
         rows.append(row)
     return pd.DataFrame(rows, columns=list(ECCENTRICITY_SUMMARY_COLUMNS))

@@ -17,8 +17,8 @@ and ``e = sqrt(1 - b**2/a**2)`` is reported with the same status semantics as th
 
 One bad photo never stops the set.  The output table (``eccentricity.csv``) has one row per
 manifest row, same order: :data:`RESULT_COLUMNS`, then the manifest's pressure/force columns
-carried over, then ``image_path`` (the photo's path as the photo set folder was given, for report overlays;
-not resolved, so that the table does not depend on where the working directory lies).
+carried over, then ``image_path`` (the photo's path as the photo set folder was given, for report
+overlays; not resolved, so that the table does not depend on where the working directory lies).
 """
 
 from __future__ import annotations
@@ -37,13 +37,36 @@ from pipeline.measure.colors import BLACK, ColorSpec
 from pipeline.measure.settings import MeasureSettings
 
 RESULT_COLUMNS: tuple[str, ...] = (
-    "image", "eccentricity", "eccentricity_sd", "semi_major_px", "semi_minor_px", "semi_major_mm", "semi_minor_mm",
-    "centre_x_px", "centre_y_px", "angle_deg", "arc_fraction", "residual_px", "length_px", "method", "status",
-    "reason", "seconds",
+    "image",
+    "eccentricity",
+    "eccentricity_sd",
+    "semi_major_px",
+    "semi_minor_px",
+    "semi_major_mm",
+    "semi_minor_mm",
+    "centre_x_px",
+    "centre_y_px",
+    "angle_deg",
+    "arc_fraction",
+    "residual_px",
+    "length_px",
+    "method",
+    "status",
+    "reason",
+    "seconds",
 )
 CARRIED_COLUMNS: tuple[str, ...] = (
-    "pressure_kpa", "direction", "material", "actuator", "trial", "step", "measured_pressure_kpa", "force_n",
-    "force_sd_n", "force_samples", "timestamp",
+    "pressure_kpa",
+    "direction",
+    "material",
+    "actuator",
+    "trial",
+    "step",
+    "measured_pressure_kpa",
+    "force_n",
+    "force_sd_n",
+    "force_samples",
+    "timestamp",
 )
 
 
@@ -104,7 +127,9 @@ class EccentricityResult:
 def _failed(reason: str) -> EccentricityResult:
     from pipeline.force.ellipse import failed_fit
 
-    return EccentricityResult(failed_fit(reason), float("nan"), float("nan"), "failed", reason, np.empty((0, 2)))
+    return EccentricityResult(
+        failed_fit(reason), float("nan"), float("nan"), "failed", reason, np.empty((0, 2))
+    )
 
 
 def line_flags(line: Any, length_px: float, expected_length_px: float | None) -> list[str]:
@@ -166,7 +191,9 @@ def blank_thick_blobs(image_bgr: np.ndarray, color: ColorSpec = BLACK) -> tuple[
     radius = clamp_radius_px(half_width)
     # close the blob's lighter details (frame, screw heads) so it reads as one solid thick blob
     k = 2 * int(np.ceil(2.0 * radius)) + 1
-    solid = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    solid = cv2.morphologyEx(
+        mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    )
     dt = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
     n, labels = cv2.connectedComponents((dt > radius).astype(np.uint8), connectivity=8)
     if n <= 1:
@@ -232,7 +259,9 @@ def measure_blocked_image(
     expected = settings.l0_mm / mm_per_px if mm_per_px else None
     fit = fit_ellipse(pts, refine=refine, **fit_options)
     if not fit:
-        return EccentricityResult(fit, length, float(mm_per_px) if scale_ok else float("nan"), "failed", fit.reason, pts)
+        return EccentricityResult(
+            fit, length, float(mm_per_px) if scale_ok else float("nan"), "failed", fit.reason, pts
+        )
     reasons = line_flags(line, length, expected) + ([fit.reason] if fit.reason else [])
     return EccentricityResult(
         fit=fit,
@@ -273,7 +302,9 @@ def _measure_row(task: _Task) -> dict[str, Any]:
     elif not p.is_file():
         result = _failed(f"image file {p.name} not found")
     else:
-        result = measure_blocked_image(_read_image(p), task.settings, refine=task.refine, **task.fit_options)  # type: ignore[arg-type]
+        result = measure_blocked_image(
+            _read_image(p), task.settings, refine=task.refine, **task.fit_options
+        )  # type: ignore[arg-type]
     row = result.row()
     row["seconds"] = round(time.perf_counter() - t0, 4)
     return row
@@ -315,7 +346,9 @@ def measure_blocked_photoset(
     ps = load_photoset(folder)
     m = ps.manifest
     tasks = [
-        _Task(str(ps.image_path(str(image))), ps.rows[i], ps.row_reason(i), refine, dict(fit_options))
+        _Task(
+            str(ps.image_path(str(image))), ps.rows[i], ps.row_reason(i), refine, dict(fit_options)
+        )
         for i, image in enumerate(m["image"])
     ]
     rows = map_photos(_measure_row, tasks, jobs=jobs, preload=["pipeline.force.blocked"])

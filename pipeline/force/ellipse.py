@@ -121,7 +121,13 @@ class EllipseFit:
     def points(self, n: int = 200) -> NDArray[np.float64]:
         """``n`` points on the fitted ellipse (px), for drawing overlays."""
         return ellipse_points(
-            (self.centre_x_px, self.centre_y_px, self.semi_major_px, self.semi_minor_px, np.deg2rad(self.angle_deg)),
+            (
+                self.centre_x_px,
+                self.centre_y_px,
+                self.semi_major_px,
+                self.semi_minor_px,
+                np.deg2rad(self.angle_deg),
+            ),
             np.linspace(0.0, 2.0 * np.pi, n),
         )
 
@@ -129,7 +135,9 @@ class EllipseFit:
 def failed_fit(reason: str, n_points: int = 0, method: str = "direct") -> EllipseFit:
     """A falsy :class:`EllipseFit` with NaN numbers and the given reason."""
     nan = float("nan")
-    return EllipseFit(nan, nan, nan, nan, nan, nan, nan, nan, nan, n_points, 0, method, "failed", reason)
+    return EllipseFit(
+        nan, nan, nan, nan, nan, nan, nan, nan, nan, n_points, 0, method, "failed", reason
+    )
 
 
 def eccentricity(semi_major: float, semi_minor: float) -> float:
@@ -161,7 +169,9 @@ def ellipse_points(params: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
     xc, yc, a, b, th = (float(v) for v in np.asarray(params, dtype=float))
     t = np.asarray(t, dtype=float)
     c, s = np.cos(th), np.sin(th)
-    return np.c_[xc + a * np.cos(t) * c - b * np.sin(t) * s, yc + a * np.cos(t) * s + b * np.sin(t) * c]
+    return np.c_[
+        xc + a * np.cos(t) * c - b * np.sin(t) * s, yc + a * np.cos(t) * s + b * np.sin(t) * c
+    ]
 
 
 def fit_ellipse(
@@ -262,13 +272,20 @@ def fit_ellipse(
     e = eccentricity(a, b)
     reasons = []
     if fraction < min_arc_fraction:
-        reasons.append(f"arc covers {fraction:.0%} of the ellipse (< {min_arc_fraction:.0%}): e not trustworthy")
+        reasons.append(
+            f"arc covers {fraction:.0%} of the ellipse (< {min_arc_fraction:.0%}): e not "
+            "trustworthy"
+        )
     if not np.isfinite(e_sd) or e_sd > max_eccentricity_sd:
         reasons.append(f"eccentricity uncertain (sd {e_sd:.3f} > {max_eccentricity_sd})")
     if residual > max_residual_px:
-        reasons.append(f"line is not an ellipse (RMS residual {residual:.1f} px > {max_residual_px})")
+        reasons.append(
+            f"line is not an ellipse (RMS residual {residual:.1f} px > {max_residual_px})"
+        )
     if n_outliers > max_outlier_fraction * n:
-        reasons.append(f"{n_outliers / n:.0%} of the line points are off the ellipse (ignored in the fit)")
+        reasons.append(
+            f"{n_outliers / n:.0%} of the line points are off the ellipse (ignored in the fit)"
+        )
     return EllipseFit(
         centre_x_px=float(xc),
         centre_y_px=float(yc),
@@ -304,7 +321,9 @@ def _direct_fit(pts: NDArray[np.float64]) -> NDArray[np.float64] | None:
 
     shift = pts.mean(axis=0)  # fit in centred coordinates: better conditioned in float32
     (cx, cy), (w, h), ang = cv2.fitEllipseDirect((pts - shift).astype(np.float32))
-    params = np.array([cx + shift[0], cy + shift[1], w / 2.0, h / 2.0, np.deg2rad(ang)], dtype=float)
+    params = np.array(
+        [cx + shift[0], cy + shift[1], w / 2.0, h / 2.0, np.deg2rad(ang)], dtype=float
+    )
     if not np.all(np.isfinite(params)) or params[2] <= 0 or params[3] <= 0:
         return None
     return _canonical(params)
@@ -319,7 +338,9 @@ def _canonical(params: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.array([xc, yc, a, b, np.mod(th, np.pi)])
 
 
-def _foot_angles(pts: NDArray[np.float64], params: NDArray[np.float64], iterations: int = 12) -> NDArray[np.float64]:
+def _foot_angles(
+    pts: NDArray[np.float64], params: NDArray[np.float64], iterations: int = 12
+) -> NDArray[np.float64]:
     """Parametric angle of each point's orthogonal foot on the ellipse (Newton on t)."""
     xc, yc, a, b, th = params
     c, s = np.cos(th), np.sin(th)
@@ -330,7 +351,12 @@ def _foot_angles(pts: NDArray[np.float64], params: NDArray[np.float64], iteratio
         ct, st = np.cos(t), np.sin(t)
         # f(t) = (p - X(t)) . X'(t) in the ellipse frame
         f = (u - a * ct) * (-a * st) + (v - b * st) * (b * ct)
-        df = (a * st) * (-a * st) + (u - a * ct) * (-a * ct) + (-b * ct) * (b * ct) + (v - b * st) * (-b * st)
+        df = (
+            (a * st) * (-a * st)
+            + (u - a * ct) * (-a * ct)
+            + (-b * ct) * (b * ct)
+            + (v - b * st) * (-b * st)
+        )
         step = np.where(np.abs(df) > 1e-12, f / df, 0.0)
         t = t - np.clip(step, -0.5, 0.5)
     return t
@@ -366,7 +392,9 @@ def _signed_distances(
     return d, jac
 
 
-def _geometric_fit(pts: NDArray[np.float64], start: NDArray[np.float64]) -> NDArray[np.float64] | None:
+def _geometric_fit(
+    pts: NDArray[np.float64], start: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
     """Orthogonal-distance least squares from ``start``; None when it does not converge sanely."""
     scale = float(max(start[2], 1.0))
     x0 = start.copy()
@@ -402,7 +430,9 @@ def _arc_fraction(pts: NDArray[np.float64], params: NDArray[np.float64]) -> floa
     return float(np.clip(covered / perimeter(a, b), 0.0, 1.0))
 
 
-def _eccentricity_sd(pts: NDArray[np.float64], params: NDArray[np.float64], dist: NDArray[np.float64]) -> float:
+def _eccentricity_sd(
+    pts: NDArray[np.float64], params: NDArray[np.float64], dist: NDArray[np.float64]
+) -> float:
     """Standard error of e: residual variance x (J^T J)^-1 propagated through e(a, b)."""
     n = len(pts)
     if n <= 5:

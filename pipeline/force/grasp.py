@@ -37,7 +37,15 @@ from pipeline.fileio import read_table
 #: the example log shipped with the package (values transcribed from the paper's text, Fig. 8B/8C)
 EXAMPLE_LOG = Path(__file__).with_name("data") / "grasp_example.csv"
 
-GRASP_COLUMNS: tuple[str, ...] = ("material", "object", "side", "diameter_mm", "mass_g", "pressure_kpa", "held")
+GRASP_COLUMNS: tuple[str, ...] = (
+    "material",
+    "object",
+    "side",
+    "diameter_mm",
+    "mass_g",
+    "pressure_kpa",
+    "held",
+)
 SIDES: tuple[str, ...] = ("inside", "outside")
 _HELD_WORDS: dict[str, bool] = {
     "yes": True, "y": True, "true": True, "1": True, "1.0": True,
@@ -76,7 +84,8 @@ def read_grasp_log(path: str | os.PathLike[str]) -> pd.DataFrame:
     missing = [c for c in GRASP_COLUMNS if c not in raw.columns]
     if missing:
         raise UserInputError(
-            f"{path}: missing column(s) {missing}; the header must contain {', '.join(GRASP_COLUMNS)}"
+            f"{path}: missing column(s) {missing}; the header must contain "
+            f"{', '.join(GRASP_COLUMNS)}"
         )
     if raw.empty:
         raise UserInputError(f"{path}: no rows; add one row per grasp attempt")
@@ -120,7 +129,9 @@ def validate_grasp_log(raw: pd.DataFrame, *, source: str = "grasp log") -> pd.Da
                 problems.append(f"{where}, column {key}: empty (fix: fill in the {key})")
         side = str(row["side"]).strip().lower()
         if side not in SIDES:
-            problems.append(f"{where}, column side: {row['side']!r} (fix: write 'inside' or 'outside')")
+            problems.append(
+                f"{where}, column side: {row['side']!r} (fix: write 'inside' or 'outside')"
+            )
         out.at[i, "side"] = side
         for key, values in numbers.items():
             text = str(row[key]).strip()
@@ -129,9 +140,14 @@ def validate_grasp_log(raw: pd.DataFrame, *, source: str = "grasp log") -> pd.Da
             except ValueError:
                 value = float("nan")
             if not np.isfinite(value):
-                problems.append(f"{where}, column {key}: {text!r} is not a number (fix: {fixes[key]})")
+                problems.append(
+                    f"{where}, column {key}: {text!r} is not a number (fix: {fixes[key]})"
+                )
             elif value < 0 or (value == 0 and key != "pressure_kpa"):
-                problems.append(f"{where}, column {key}: {value:g} must be {'>= 0' if key == 'pressure_kpa' else '> 0'} (fix: {fixes[key]})")
+                problems.append(
+                    f"{where}, column {key}: {value:g} must be "
+                    f"{'>= 0' if key == 'pressure_kpa' else '> 0'} (fix: {fixes[key]})"
+                )
             values.append(value)
         word = str(row["held"]).strip().lower()
         if word not in _HELD_WORDS:

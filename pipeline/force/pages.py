@@ -14,7 +14,7 @@ grasp_summary.csv          ``force grasp``: Fig. 8B heaviest mass held (g) again
 =========================  =====================================================================
 
 Every page is A4 in the report's style; each material has the same colour as on the report's
-own pages (:func:`pipeline.report.style.material_colors`).
+own pages (:func:`pipeline.layout.style.material_colors`).
 """
 
 from __future__ import annotations
@@ -30,8 +30,8 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import offset_copy
 
 from pipeline.fileio import read_table
-from pipeline.report.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
-from pipeline.report.typeset import Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.style import FOOTER_PT, MARGIN_PT, Color, material_colors, page, report_style
+from pipeline.layout.typeset import Column, Flow, Table, fmt, table_height_pt
 
 FORCE_SUMMARY = "force_summary.csv"
 ECCENTRICITY_SUMMARY = "eccentricity_summary.csv"
@@ -46,7 +46,11 @@ PAGE_W_PT = 595.0
 
 def _read(force_dir: Path, name: str) -> pd.DataFrame | None:
     path = force_dir / name
-    return read_table(path, f"the {name} written by 'python -m pipeline force'") if path.is_file() else None
+    return (
+        read_table(path, f"the {name} written by 'python -m pipeline force'")
+        if path.is_file()
+        else None
+    )
 
 
 def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[Figure]:
@@ -58,7 +62,7 @@ def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[
         Folder written by ``python -m pipeline force aggregate/grasp``.
     colors : mapping, optional
         Colour of each material (the report passes its own); others get
-        :func:`~pipeline.report.style.material_colors`.
+        :func:`~pipeline.layout.style.material_colors`.
 
     Returns
     -------
@@ -67,7 +71,14 @@ def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[
     """
     force_dir = Path(force_dir)
     tables = {name: _read(force_dir, name) for name in FILES}
-    found = sorted({str(m) for t in tables.values() if t is not None and "material" in t for m in t["material"]})
+    found = sorted(
+        {
+            str(m)
+            for t in tables.values()
+            if t is not None and "material" in t
+            for m in t["material"]
+        }
+    )
     palette = {**material_colors(sorted(set(found) | set(colors or {}))), **dict(colors or {})}
     out: list[Figure] = []
     if tables[FORCE_SUMMARY] is not None:
@@ -96,16 +107,26 @@ def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color]) -> Figure:
             f = d["force_mean_n"].to_numpy(float)
             sd = np.nan_to_num(d["force_sd_n"].to_numpy(float))
             label = str(material) if direction == "up" else f"{material} (decreasing P)"
-            ax.plot(p, f, "-" if direction == "up" else "--", marker="o", ms=3, color=c, label=label)
-            ax.fill_between(p, f - sd, f + sd, color=c, alpha=0.25 if direction == "up" else 0.12, lw=0)
-    sd_max = float(np.nanmax(summary["force_sd_n"].to_numpy(float))) if len(summary) else float("nan")
+            ax.plot(
+                p, f, "-" if direction == "up" else "--", marker="o", ms=3, color=c, label=label
+            )
+            ax.fill_between(
+                p, f - sd, f + sd, color=c, alpha=0.25 if direction == "up" else 0.12, lw=0
+            )
+    sd_max = (
+        float(np.nanmax(summary["force_sd_n"].to_numpy(float))) if len(summary) else float("nan")
+    )
     n = int(summary["n"].max()) if "n" in summary and len(summary) else 0
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel("blocked force F (N)")
     span = float(np.nanmax(summary["force_mean_n"].to_numpy(float))) if len(summary) else 0.0
     hidden = span > 0 and 2 * sd_max < 0.02 * span
-    ax.set_title(f"Blocked force against pressure (cf. Fig. 7A)\nmean of {n} ramp(s) per level, ± 1 sd shaded; "
-                 f"largest sd {fmt(sd_max, 3)} N" + (", so the shading hides behind the lines" if hidden else ""))
+    ax.set_title(
+        f"Blocked force against pressure (cf. Fig. 7A)\nmean of {n} ramp(s) per level, ± 1 sd "
+        "shaded; "
+        f"largest sd {fmt(sd_max, 3)} N"
+        + (", so the shading hides behind the lines" if hidden else "")
+    )
     ax.legend(loc="upper left", frameon=False)
     if has_e:
         ax2 = axes[1]
@@ -114,24 +135,54 @@ def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color]) -> Figure:
             d = d[d["direction"] == "up"] if (d["direction"] == "up").any() else d
             e = d["eccentricity_mean"].to_numpy(float)
             sd = np.nan_to_num(d["eccentricity_sd"].to_numpy(float))
-            ax2.errorbar(d["pressure_kpa"], e, yerr=sd, fmt="o-", ms=3, capsize=2, color=colors[str(material)],
-                         label=str(material))
+            ax2.errorbar(
+                d["pressure_kpa"],
+                e,
+                yerr=sd,
+                fmt="o-",
+                ms=3,
+                capsize=2,
+                color=colors[str(material)],
+                label=str(material),
+            )
         ax2.set_xlabel(P_LABEL)
         ax2.set_ylabel("eccentricity e (-)")
         ax2.set_ylim(0, 1)
-        ax2.set_title("Eccentricity of the blocked inextensible layer, increasing P (ok photos; bars: ± 1 sd)")
+        ax2.set_title(
+            "Eccentricity of the blocked inextensible layer, increasing P (ok photos; bars: ± 1 sd)"
+        )
         ax2.legend(loc="upper left", frameon=False)
     return fig
 
 
 def eccentricity_table(summary: pd.DataFrame) -> Table:
     """e at the maximum pressure per material, typeset."""
-    rows = tuple((str(r["material"]), fmt(r["pressure_kpa"], 0), fmt(r["eccentricity_mean"], 3),
-                  fmt(r["eccentricity_sd"], 3), fmt(r["n"], 0), fmt(r["n_excluded"], 0), fmt(r["force_mean_n"], 2))
-                 for _, r in summary.iterrows())
-    return Table(columns=(Column("material", "left"), Column("max pressure (kPa)"), Column("e mean (-)"),
-                          Column("e sd (-)"), Column("photos ok"), Column("excluded"), Column("force (N)")),
-                 rows=rows, title="Eccentricity at the maximum pressure (cf. Fig. 7B)", size=8.0)
+    rows = tuple(
+        (
+            str(r["material"]),
+            fmt(r["pressure_kpa"], 0),
+            fmt(r["eccentricity_mean"], 3),
+            fmt(r["eccentricity_sd"], 3),
+            fmt(r["n"], 0),
+            fmt(r["n_excluded"], 0),
+            fmt(r["force_mean_n"], 2),
+        )
+        for _, r in summary.iterrows()
+    )
+    return Table(
+        columns=(
+            Column("material", "left"),
+            Column("max pressure (kPa)"),
+            Column("e mean (-)"),
+            Column("e sd (-)"),
+            Column("photos ok"),
+            Column("excluded"),
+            Column("force (N)"),
+        ),
+        rows=rows,
+        title="Eccentricity at the maximum pressure (cf. Fig. 7B)",
+        size=8.0,
+    )
 
 
 @report_style()
@@ -167,12 +218,22 @@ def _draw_photo(ax: Axes, r: pd.Series, base: Path | None, color: Color) -> None
             image = cv2.imread(str(p), cv2.IMREAD_COLOR)
     ax.set_axis_off()
     if image is None:
-        ax.text(0.5, 0.5, f"{title}\n(photo not available)", ha="center", va="center", transform=ax.transAxes)
+        ax.text(
+            0.5,
+            0.5,
+            f"{title}\n(photo not available)",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+        )
         return
     f = min(1.0, PHOTO_MAX_WIDTH_PX / image.shape[1])
     small = cv2.resize(image, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else image
-    ax.imshow(cv2.cvtColor(small, cv2.COLOR_BGR2RGB), extent=(-0.5, image.shape[1] - 0.5, image.shape[0] - 0.5, -0.5),
-              interpolation="none")
+    ax.imshow(
+        cv2.cvtColor(small, cv2.COLOR_BGR2RGB),
+        extent=(-0.5, image.shape[1] - 0.5, image.shape[0] - 0.5, -0.5),
+        interpolation="none",
+    )
     keys = ("centre_x_px", "centre_y_px", "semi_major_px", "semi_minor_px", "angle_deg")
     if all(k in r.index and np.isfinite(r[k]) for k in keys):
         t = np.linspace(0.0, 2.0 * np.pi, 300)
@@ -188,17 +249,32 @@ def _draw_photo(ax: Axes, r: pd.Series, base: Path | None, color: Color) -> None
 def grasp_table(summary: pd.DataFrame) -> Table:
     """The grasp-log summary, one row per material, side and object: mass held at each pressure."""
     rows = []
-    for (material, side, diameter), g in summary.groupby(["material", "side", "diameter_mm"], sort=True):
+    for (material, side, diameter), g in summary.groupby(
+        ["material", "side", "diameter_mm"], sort=True
+    ):
         cells = [f"{fmt(r.pressure_kpa, 0)}: " + ("not held" if not np.isfinite(r.max_mass_held_g)
                                                   else fmt(r.max_mass_held_g, 0))
                  for r in g.sort_values("pressure_kpa").itertuples()]
         rows.append((str(material), str(side), fmt(diameter, 0), ", ".join(cells),
                      f"{int(g['n_held'].sum())} of {int(g['n_attempts'].sum())}"))
-    return Table(columns=(Column("material", "left"), Column("side", "left"), Column("object diameter (mm)"),
-                          Column("pressure (kPa): heaviest mass held (g)", "left", wrap_pt=260.0),
-                          Column("attempts held")),
-                 rows=tuple(rows), title="Grasp log summary", size=7.5,
-                 notes=("not held: no attempt at that pressure held the object (a red x on the zero line above).",))
+    return Table(
+        columns=(
+            Column("material", "left"),
+            Column("side", "left"),
+            Column("object diameter (mm)"),
+            Column("pressure (kPa): heaviest mass held (g)", "left", wrap_pt=260.0),
+            Column("attempts held"),
+        ),
+        rows=tuple(rows),
+        title="Grasp log summary",
+        size=7.5,
+        notes=(
+            (
+                "not held: no attempt at that pressure held the object (a red x on the zero line "
+                "above)."
+            ),
+        ),
+    )
 
 
 @report_style()
@@ -220,7 +296,10 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
     -------
     matplotlib.figure.Figure
     """
-    palette = {**material_colors(sorted(summary["material"].astype(str).unique())), **dict(colors or {})}
+    palette = {
+        **material_colors(sorted(summary["material"].astype(str).unique())),
+        **dict(colors or {}),
+    }
     groups = list(summary.groupby(["side", "diameter_mm"], sort=True))
     table = grasp_table(summary)
     width = PAGE_W_PT - 2 * MARGIN_PT
@@ -233,22 +312,50 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
         ax.set_axis_off()
         return fig
     cols = 2 if len(groups) > 1 else 1
-    axes = fig.subplots(int(np.ceil(len(groups) / cols)), cols, squeeze=False, sharex=True, sharey=True)
+    axes = fig.subplots(
+        int(np.ceil(len(groups) / cols)), cols, squeeze=False, sharex=True, sharey=True
+    )
     p_max = float(summary["pressure_kpa"].max())
     m_max = float(np.nanmax(np.append(summary["max_mass_held_g"].to_numpy(float), 1.0)))
     for ax, ((side, diameter), g) in zip(axes.flat, groups, strict=False):
         for j, (material, m) in enumerate(g.groupby("material", sort=True)):
             m = m.sort_values("pressure_kpa")
             ok = m["max_mass_held_g"].notna()
-            # shrinking markers drawn on top of each other: materials with equal values stay visible as rings
-            ax.plot(m.loc[ok, "pressure_kpa"], m.loc[ok, "max_mass_held_g"], "o-", color=palette[str(material)],
-                    label=str(material), ms=max(10.0 - 1.7 * j, 5.0), mec="white", mew=0.6, lw=1.2, zorder=2 + j)
+            # shrinking markers drawn on top of each other: materials with equal values stay visible
+            # as rings
+            ax.plot(
+                m.loc[ok, "pressure_kpa"],
+                m.loc[ok, "max_mass_held_g"],
+                "o-",
+                color=palette[str(material)],
+                label=str(material),
+                ms=max(10.0 - 1.7 * j, 5.0),
+                mec="white",
+                mew=0.6,
+                lw=1.2,
+                zorder=2 + j,
+            )
             if (~ok).any():
-                ax.plot(m.loc[~ok, "pressure_kpa"], np.zeros(int((~ok).sum())), "x", color="#b00000", ms=8, mew=2,
-                        clip_on=False, zorder=5)
+                ax.plot(
+                    m.loc[~ok, "pressure_kpa"],
+                    np.zeros(int((~ok).sum())),
+                    "x",
+                    color="#b00000",
+                    ms=8,
+                    mew=2,
+                    clip_on=False,
+                    zorder=5,
+                )
                 for p in m.loc[~ok, "pressure_kpa"]:
-                    ax.text(p, 0.0, f"{material} not held", ha="center", fontsize=7.0, color="#b00000",
-                            transform=offset_copy(ax.transData, fig=fig, y=8.0, units="points"))
+                    ax.text(
+                        p,
+                        0.0,
+                        f"{material} not held",
+                        ha="center",
+                        fontsize=7.0,
+                        color="#b00000",
+                        transform=offset_copy(ax.transData, fig=fig, y=8.0, units="points"),
+                    )
         ax.set_title(f"{side} an object of {diameter:g} mm diameter")
         ax.set_xlim(-0.04 * p_max - 1.0, 1.08 * p_max + 1.0)
         ax.set_ylim(0.0, 1.15 * m_max)

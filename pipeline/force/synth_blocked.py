@@ -34,7 +34,6 @@ import os
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -83,7 +82,10 @@ BLOCKED_MATERIALS: dict[str, BlockedMaterial] = {
 def blocked_material(material: str) -> BlockedMaterial:
     """The :class:`BlockedMaterial` of a name; UserInputError naming the known ones."""
     if material not in BLOCKED_MATERIALS:
-        raise UserInputError(f"material {material!r} has no blocked-force curve; use one of {sorted(BLOCKED_MATERIALS)}")
+        raise UserInputError(
+            f"material {material!r} has no blocked-force curve; use one of "
+            f"{sorted(BLOCKED_MATERIALS)}"
+        )
     return BLOCKED_MATERIALS[material]
 
 
@@ -196,7 +198,9 @@ def blocked_arc_mm(
     )
 
 
-def _t_of_s(ss: NDArray[np.float64], tt: NDArray[np.float64], s: NDArray[np.float64], total: float) -> NDArray[np.float64]:
+def _t_of_s(
+    ss: NDArray[np.float64], tt: NDArray[np.float64], s: NDArray[np.float64], total: float
+) -> NDArray[np.float64]:
     """Parametric angle at arc lengths ``ss`` (may run past the 0/2pi seam), unwrapped."""
     laps = np.floor(ss / total)
     return np.interp(ss - laps * total, s, tt) + 2.0 * np.pi * laps
@@ -229,7 +233,9 @@ def blocked_ramp_table(
     """
     m = blocked_material(material)
     if actuators < 1 or trials < 1 or force_samples < 2 or not step_kpa > 0:
-        raise UserInputError("need actuators >= 1, trials >= 1, force_samples >= 2 and step_kpa > 0")
+        raise UserInputError(
+            "need actuators >= 1, trials >= 1, force_samples >= 2 and step_kpa > 0"
+        )
     top = m.max_kpa if max_kpa is None else float(max_kpa)
     pressures = np.arange(0.0, top + 1e-9, step_kpa)
     if pressures[-1] < top - 1e-9:
@@ -259,7 +265,9 @@ def blocked_ramp_table(
                         "actuator": actuator,
                         "trial": str(trial),
                         "step": step,
-                        "measured_pressure_kpa": round(float(p + rng.normal(0.0, 0.4)), 2) if p > 0 else 0.0,
+                        "measured_pressure_kpa": round(float(p + rng.normal(0.0, 0.4)), 2)
+                        if p > 0
+                        else 0.0,
                         "force_n": round(float(np.mean(samples)), 4),
                         "force_sd_n": round(float(np.std(samples, ddof=1)), 4),
                         "force_samples": int(force_samples),
@@ -278,8 +286,18 @@ MANIFEST_COLUMNS: tuple[str, ...] = (
     "measured_pressure_kpa", "force_n", "force_sd_n", "force_samples",
 )
 TRUTH_COLUMNS: tuple[str, ...] = (
-    "image", "eccentricity", "force_true_n", "semi_major_mm", "semi_minor_mm", "arc_fraction", "gap_deg",
-    "rotation_deg", "pressure_kpa", "material", "actuator", "trial",
+    "image",
+    "eccentricity",
+    "force_true_n",
+    "semi_major_mm",
+    "semi_minor_mm",
+    "arc_fraction",
+    "gap_deg",
+    "rotation_deg",
+    "pressure_kpa",
+    "material",
+    "actuator",
+    "trial",
 )
 
 
@@ -330,7 +348,7 @@ def render_blocked_photoset(
     pandas.DataFrame
         The manifest written.
     """
-    from pipeline.fileio import atomic_write_bytes
+    from pipeline.fileio import atomic_write_bytes, write_table
     from pipeline.folders import staged_folder
     from pipeline.photoset import TRUTH, write_manifest, write_settings
     from pipeline.synth import child_seed, render_curve, scene_from
@@ -338,15 +356,26 @@ def render_blocked_photoset(
     with staged_folder(out_dir, marker=TRUTH) as tmp:  # the set appears complete or not at all
         sc = scene_from(scene, **dict(scene_overrides or {}))
         table = blocked_ramp_table(
-            material, actuators=actuators, trials=trials, seed=seed, step_kpa=step_kpa, max_kpa=max_kpa,
-            force_samples=force_samples, arc_fraction=arc_fraction, gap_deg=gap_deg,
+            material,
+            actuators=actuators,
+            trials=trials,
+            seed=seed,
+            step_kpa=step_kpa,
+            max_kpa=max_kpa,
+            force_samples=force_samples,
+            arc_fraction=arc_fraction,
+            gap_deg=gap_deg,
         )
         truth_rows = []
         fixed_ends = []
         for k, row in table.iterrows():
-            shape = blocked_arc_mm(row["eccentricity"], l0_mm, arc_fraction=row["arc_fraction"], gap_deg=row["gap_deg"])
+            shape = blocked_arc_mm(
+                row["eccentricity"], l0_mm, arc_fraction=row["arc_fraction"], gap_deg=row["gap_deg"]
+            )
             image = render_curve(
-                shape.points_mm, sc, seed=child_seed(int(seed), zlib.crc32(material.encode()), int(k)),
+                shape.points_mm,
+                sc,
+                seed=child_seed(int(seed), zlib.crc32(material.encode()), int(k)),
                 rotation_deg=row["rotation_deg"],
             )
             atomic_write_bytes(tmp / row["image"], image.jpeg_bytes)
@@ -382,6 +411,6 @@ def render_blocked_photoset(
             },
         )
         truth = pd.DataFrame(truth_rows, columns=list(TRUTH_COLUMNS))
-        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n").encode())
+        write_table(truth, tmp / TRUTH, float_format=None)
     return manifest
 

@@ -20,24 +20,25 @@ a background photo or a colour, its centre line between the two long edges) ->
 ``failed`` with reasons) -> :mod:`~pipeline.measure.overlay`.  After a whole set,
 :mod:`pipeline.ramp_check` compares each photo with its ramp.
 
-Body mode (``target: body``) reads psi as the tip angle (:func:`~pipeline.measure.estimators.tangents`):
-on synthetic analogues of real scenes (``python -m pipeline.bench.realscenes``) the median error is
-1.3-1.8 deg and p95 3-6 deg; on the committed real strips 5 of 10 photos are within their label's
-tolerance and none is ``ok`` outside it.
+Body mode (``target: body``) reads psi as the tip angle
+(:func:`~pipeline.measure.estimators.tangents`): on synthetic analogues of real scenes (``python -m
+pipeline bench realscenes``) the median error is 1.3-1.8 deg and p95 3-6 deg; on the committed real
+strips 5 of 10 photos are within their label's tolerance and none is ``ok`` outside it.
 ``AngleResult.degree`` (angles.csv column ``degree``, after ``seconds``) is the complexity of the
 curve model used: 1 = circular arc, more = the turning-angle series ``turning`` / ``auto`` chose.
 
-Files (``measure_file``, :func:`pipeline.photoset_measure.measure_photoset`) with a black line are decoded in grey at reduced
-size; the extraction runs on a further halved copy and the centre line is refined on the decoded
-image (:mod:`~pipeline.measure.refine`: darkness-profile centroids across the line), which
-costs a third of the work and is as precise; a result that is not ``ok`` there is measured again
-at the decoded size.  ``measure_image`` on a colour array uses the decoded-size path only.
+Files (``measure_file``, :func:`pipeline.photoset_measure.measure_photoset`) with a black line are
+decoded in grey at reduced size; the extraction runs on a further halved copy and the centre line is
+refined on the decoded image (:mod:`~pipeline.measure.refine`: darkness-profile centroids across the
+line), which costs a third of the work and is as precise; a result that is not ``ok`` there is
+measured again at the decoded size.  ``measure_image`` on a colour array uses the decoded-size path
+only.
 
 Default method: ``auto``
 ------------------------
 ``auto`` is the Hyper circle fit, switching to ``turning`` only when a BIC-chosen tangent-angle
 fit says the curvature is not constant and the two disagree by more than 1.5 deg.  Measured
-with ``python -m pipeline.measure.bench`` (lab scenes: noise, blur, JPEG 90, textured table,
+with ``python -m pipeline bench measure`` (lab scenes: noise, blur, JPEG 90, textured table,
 uneven light, distractor marks, clamp, tube, tilt 0-3 deg; |error| in deg):
 
 ==================  ===========================  ===========================

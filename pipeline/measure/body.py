@@ -139,7 +139,9 @@ def kmeans3(points: np.ndarray, iterations: int = 12) -> tuple[np.ndarray, np.nd
 def _ring(allowed: np.ndarray) -> np.ndarray:
     h, w = allowed.shape
     k = max(3, int(0.04 * max(h, w)))
-    inner = cv2.erode(allowed, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    inner = cv2.erode(
+        allowed, np.ones((k, k), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0
+    )
     return cv2.subtract(allowed, inner) > 0
 
 
@@ -200,10 +202,17 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
         med = float(np.median(on_ring))
         spread = max(1.4826 * float(np.median(np.abs(on_ring - med))), 0.5)
         like = np.sqrt(((lab_grid - a_grid @ coef) ** 2).sum(axis=1)) < med + 3.0 * spread + 2.0
-        fit_a, fit_v = a_grid[like], lab_grid[like]  # every allowed pixel that looks like it (uneven light)
+        # every allowed pixel that looks like it (uneven light)
+        fit_a, fit_v = a_grid[like], lab_grid[like]
     cy, cx = np.mgrid[0 : h + 7 : 8, 0 : w + 7 : 8].astype(np.float32)
-    coarse = (_design(cx.ravel(), cy.ravel(), w, h) @ coef).reshape(cy.shape[0], cy.shape[1], 3).astype(np.float32)
-    model = cv2.resize(coarse, (cx.shape[1] * 8, cy.shape[0] * 8), interpolation=cv2.INTER_LINEAR)[:h, :w]
+    coarse = (
+        (_design(cx.ravel(), cy.ravel(), w, h) @ coef)
+        .reshape(cy.shape[0], cy.shape[1], 3)
+        .astype(np.float32)
+    )
+    model = cv2.resize(coarse, (cx.shape[1] * 8, cy.shape[0] * 8), interpolation=cv2.INTER_LINEAR)[
+        :h, :w
+    ]
     diff = np.sqrt(((lab - model) ** 2).sum(axis=2)).astype(np.float32)
     others = [centres[c] for c in order[1:]]
     region_px = lab_grid[:: max(1, len(lab_grid) // KMEANS_PIXELS)]
@@ -219,7 +228,9 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     return diff, sigma
 
 
-def background_difference(image_bgr: np.ndarray, background_bgr: np.ndarray) -> tuple[np.ndarray, float]:
+def background_difference(
+    image_bgr: np.ndarray, background_bgr: np.ndarray
+) -> tuple[np.ndarray, float]:
     """Colour distance of each pixel from the same pixel of the empty-scene photo, and its noise."""
     lab, ref = _lab(image_bgr), _lab(background_bgr)
     diff = np.sqrt(((lab - ref) ** 2).sum(axis=2)).astype(np.float32)
@@ -240,7 +251,8 @@ def _hysteresis(diff: np.ndarray, high: float, low: float) -> np.ndarray:
     Faint pixels count only within a few pixels of a clear one (:data:`GROW_FRACTION`).
     """
     strong = (diff > high).astype(np.uint8)
-    reach = max(3, int(round(GROW_FRACTION * max(diff.shape))))  # faint pixels next to clear ones only
+    # faint pixels next to clear ones only
+    reach = max(3, round(GROW_FRACTION * max(diff.shape)))
     near = cv2.dilate(strong, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2))
     weak = ((diff > low) & (near > 0)).astype(np.uint8)
     n, labels = cv2.connectedComponents(weak, connectivity=8)
@@ -251,7 +263,11 @@ def _hysteresis(diff: np.ndarray, high: float, low: float) -> np.ndarray:
 
 
 def body_mask(
-    image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float = 1.0, background_bgr: np.ndarray | None = None
+    image_bgr: np.ndarray,
+    settings: MeasureSettings,
+    *,
+    scale: float = 1.0,
+    background_bgr: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The pixels of the actuator body (before choosing one component).
 
@@ -287,8 +303,8 @@ def body_mask(
             diff, sigma = background_difference(image_bgr, background_bgr)
         else:
             diff, sigma = backdrop_difference(image_bgr, allowed)
-        inside = diff[allowed > 0]
-        # any clear difference is body: a translucent body differs faintly (splitting the differences
+        # any clear difference is body: a translucent body differs faintly (splitting the
+        # differences
         # in two, faint vs strong, cut translucent bodies down to their highlights)
         thr = max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
         mask &= _hysteresis(diff, thr, max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE))
@@ -301,19 +317,27 @@ def body_mask(
 def _clean(mask: np.ndarray) -> np.ndarray:
     """Close texture gaps, fill small holes, open away specks."""
     h, w = mask.shape
-    k = max(3, int(round(0.006 * max(h, w))) | 1)
-    m = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    k = max(3, round(0.006 * max(h, w)) | 1)
+    m = cv2.morphologyEx(
+        mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    )
     m = cv2.morphologyEx(m, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
     contours, hier = cv2.findContours(m, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
     if hier is not None:
         area = float(m.sum())
-        holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1 and cv2.contourArea(c) < MAX_HOLE_FRACTION * area]
+        holes = [
+            c
+            for c, hh in zip(contours, hier[0])
+            if hh[3] != -1 and cv2.contourArea(c) < MAX_HOLE_FRACTION * area
+        ]
         if holes:
             cv2.drawContours(m, holes, -1, 1, cv2.FILLED)
     return m
 
 
-def _component(mask: np.ndarray, fixed_xy: tuple[float, float] | None) -> tuple[np.ndarray, int, bool]:
+def _component(
+    mask: np.ndarray, fixed_xy: tuple[float, float] | None
+) -> tuple[np.ndarray, int, bool]:
     """The body component: nearest the fixed end (among large ones), else the largest.
 
     Returns (component mask, number of rival components of comparable size, fixed end reached).
@@ -327,7 +351,10 @@ def _component(mask: np.ndarray, fixed_xy: tuple[float, float] | None) -> tuple[
     pick, reached = big[0], fixed_xy is None
     if fixed_xy is not None:
         h, w = mask.shape
-        fx, fy = int(np.clip(round(fixed_xy[0]), 0, w - 1)), int(np.clip(round(fixed_xy[1]), 0, h - 1))
+        fx, fy = (
+            int(np.clip(round(fixed_xy[0]), 0, w - 1)),
+            int(np.clip(round(fixed_xy[1]), 0, h - 1)),
+        )
         best = None
         for lab in big + [int(i) + 1 for i in order if int(i) + 1 not in big][:5]:
             comp = (labels == lab).astype(np.uint8)
@@ -342,7 +369,9 @@ def _component(mask: np.ndarray, fixed_xy: tuple[float, float] | None) -> tuple[
     return (labels == pick).astype(np.uint8), rivals, reached
 
 
-def _ridge_path(comp: np.ndarray, dt: np.ndarray, start_xy: tuple[float, float] | None) -> tuple[np.ndarray, bool]:
+def _ridge_path(
+    comp: np.ndarray, dt: np.ndarray, start_xy: tuple[float, float] | None
+) -> tuple[np.ndarray, bool]:
     """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end."""
     ys, xs = np.nonzero(comp)
     graph = _pixel_graph(ys, xs, comp.shape)
@@ -390,7 +419,10 @@ def _smooth(points: np.ndarray, sigma: float) -> np.ndarray:
     win = int(2 * round(1.5 * sigma) + 1)
     if sigma <= 0 or len(points) < max(win, 5):
         return points
-    return np.c_[savgol_filter(points[:, 0], win, 2, mode="interp"), savgol_filter(points[:, 1], win, 2, mode="interp")]
+    return np.c_[
+        savgol_filter(points[:, 0], win, 2, mode="interp"),
+        savgol_filter(points[:, 1], win, 2, mode="interp"),
+    ]
 
 
 def _normals(points: np.ndarray) -> np.ndarray:
@@ -414,7 +446,9 @@ LOCAL_THICKNESS_FLOOR = 0.7
 LOCAL_WIDTH_HALF_WIDTHS = 12.0
 
 
-def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[np.ndarray, tuple[float, float]]:
+def _trim_by_thickness(
+    path: np.ndarray, dt: np.ndarray, half: float
+) -> tuple[np.ndarray, tuple[float, float]]:
     """Drop the path's ends where the body tapers (tips, corners) or thickens (clamp, blobs).
 
     A taper is judged against the body's own thickness just inside that end (a body that is
@@ -429,9 +463,16 @@ def _trim_by_thickness(path: np.ndarray, dt: np.ndarray, half: float) -> tuple[n
     not_blob = thick <= BLOB_THICKNESS * half
     ends = []
     for from_end in (s, s[-1] - s):
-        near = (from_end >= LOCAL_FROM_END_HALF_WIDTHS[0] * half) & (from_end <= LOCAL_FROM_END_HALF_WIDTHS[1] * half) & not_blob
+        near = (
+            (from_end >= LOCAL_FROM_END_HALF_WIDTHS[0] * half)
+            & (from_end <= LOCAL_FROM_END_HALF_WIDTHS[1] * half)
+            & not_blob
+        )
         ref = float(np.median(thick[near])) if near.sum() >= 3 else half
-        ends.append((thick >= TIP_THICKNESS * float(np.clip(ref, LOCAL_THICKNESS_FLOOR * half, half))) & not_blob)
+        ends.append(
+            (thick >= TIP_THICKNESS * float(np.clip(ref, LOCAL_THICKNESS_FLOOR * half, half)))
+            & not_blob
+        )
     good_start, good_end = ends
     if good_start.sum() < 8 or good_end.sum() < 8:
         return path, (0.0, 0.0)
@@ -456,7 +497,9 @@ def local_widths(widths: np.ndarray, window: int) -> np.ndarray:
     """
     w = pd.Series(widths, dtype=float)
     ref = w.rolling(max(1, window), center=True, min_periods=1).median()
-    return ref.fillna(float(np.nanmedian(widths)) if np.isfinite(widths).any() else np.nan).to_numpy()
+    return ref.fillna(
+        float(np.nanmedian(widths)) if np.isfinite(widths).any() else np.nan
+    ).to_numpy()
 
 
 def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
@@ -554,7 +597,9 @@ def _march(
                 break
             step = mid[1]
             d = step - prev  # the course over the last few points, not one step's jitter
-            if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or float(d @ t) < np.cos(np.deg2rad(25.0)) * np.hypot(*d):
+            if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or float(d @ t) < np.cos(
+                np.deg2rad(25.0)
+            ) * np.hypot(*d):
                 break  # not moving on, or turning off the line's course (a corner, a cap)
             new.append(step)
             new_w.append(float(wid[1]))
@@ -578,12 +623,18 @@ def _follow_ridge(ridge: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray
     rest = (seg > seg[i] + MARCH_STEP_PX) & (seg <= seg[-1] - RIDGE_TIP_HALF_WIDTHS * half)
     if rest.sum() < half:
         return pts
-    tail = _smooth(_resample(np.vstack([pts[-1:], ridge[rest]]), 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))[1:]
+    tail = _smooth(
+        _resample(np.vstack([pts[-1:], ridge[rest]]), 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half)
+    )[1:]
     return np.vstack([pts, tail])
 
 
 def _extensions(
-    comp: np.ndarray, pts: np.ndarray, half: float, fixed_xy: tuple[float, float] | None, capped: bool
+    comp: np.ndarray,
+    pts: np.ndarray,
+    half: float,
+    fixed_xy: tuple[float, float] | None,
+    capped: bool,
 ) -> tuple[float, float]:
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
@@ -609,11 +660,16 @@ def _extensions(
             continue
         d = q - p
         along, across = d @ t, np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
-        sel = (across <= half) & (along > 0) & (along <= 2.5 * half + 2.0)  # this end's tip, not what lies beyond a gap
+        # this end's tip, not what lies beyond a gap
+        sel = (across <= half) & (along > 0) & (along <= 2.5 * half + 2.0)
         if sel.any():  # the tip's pixels run on from the end without a gap
             a = np.sort(along[sel])
             gap = np.nonzero(np.diff(np.r_[0.0, a]) > 2.0)[0]
-            out.append(float(a[gap[0] - 1]) if gap.size and gap[0] > 0 else (0.0 if gap.size else float(a[-1])))
+            out.append(
+                float(a[gap[0] - 1])
+                if gap.size and gap[0] > 0
+                else (0.0 if gap.size else float(a[-1]))
+            )
         else:
             out.append(0.0)
     return out[0], out[1]
@@ -626,7 +682,9 @@ def _midpoints(soft: np.ndarray, points: np.ndarray, reach: float) -> tuple[np.n
     off = np.arange(-k, k + 1, dtype=np.float32) / 2.0
     mx = (points[:, 0:1] + n[:, 0:1] * off).astype(np.float32)
     my = (points[:, 1:2] + n[:, 1:2] * off).astype(np.float32)
-    prof = cv2.remap(soft, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0.0)
+    prof = cv2.remap(
+        soft, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0.0
+    )
     c = k  # the centre sample
     inside = prof >= 0.5
     # the run of inside samples around the centre
@@ -681,23 +739,37 @@ def extract_body(
     if image_bgr is None or image_bgr.ndim != 3:
         raise NoLineFound("unreadable image (not a colour image)")
     h, w = image_bgr.shape[:2]
-    raw, strength, contrast = body_mask(image_bgr, settings, scale=scale, background_bgr=background_bgr)
+    raw, strength, contrast = body_mask(
+        image_bgr, settings, scale=scale, background_bgr=background_bgr
+    )
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     allowed_px = float(h * w if region is None else region.sum())
     selected = float(raw.sum()) / max(allowed_px, 1.0)
     what = settings.describe_color()
     if raw.sum() < 20:
-        raise NoLineFound(f"no body found: nothing {what}; check line_color / background / roi (python -m pipeline photoset preview shows what they select)")
+        raise NoLineFound(
+            f"no body found: nothing {what}; check line_color / background / roi (python -m "
+            "pipeline photoset preview shows what they select)"
+        )
     if selected > 0.6:
-        raise NoLineFound(f"no body found: {100 * selected:.0f}% of the photo is selected ({what}); narrow line_color or roi (python -m pipeline photoset preview)")
+        raise NoLineFound(
+            f"no body found: {100 * selected:.0f}% of the photo is selected ({what}); narrow "
+            "line_color or roi (python -m pipeline photoset preview)"
+        )
     mask = _clean(raw)
     fe = None
     if settings.fixed_end_px is not None:
-        fe = ((settings.fixed_end_px[0] - (scale - 1) / 2) / scale, (settings.fixed_end_px[1] - (scale - 1) / 2) / scale)
+        fe = (
+            (settings.fixed_end_px[0] - (scale - 1) / 2) / scale,
+            (settings.fixed_end_px[1] - (scale - 1) / 2) / scale,
+        )
     try:
         comp, rivals, reached = _component(mask, fe)
     except NoLineFound:
-        raise NoLineFound(f"no body found: nothing {what} survives the clean-up; check line_color / background / roi (python -m pipeline photoset preview)") from None
+        raise NoLineFound(
+            f"no body found: nothing {what} survives the clean-up; check line_color / background / "
+            "roi (python -m pipeline photoset preview)"
+        ) from None
     dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
     path, guessed = _ridge_path(comp, dt, fe if reached else None)
     # the body's half-width along its own ridge (not over the whole component: a tube or a clamp
@@ -706,7 +778,10 @@ def extract_body(
     half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
-        raise NoLineFound(f"no body found: the selection ({what}) is a blob, not an elongated actuator ({length:.0f} px long, {2 * half:.0f} px wide)")
+        raise NoLineFound(
+            f"no body found: the selection ({what}) is a blob, not an elongated actuator "
+            f"({length:.0f} px long, {2 * half:.0f} px wide)"
+        )
     ridge = path  # the whole ridge, end to end: what the centre line should cover
     path, _ = _trim_by_thickness(path, dt, half)
     soft = _soft_body(comp, strength)
@@ -716,18 +791,23 @@ def extract_body(
     for _ in range(2):
         moved, wid = _midpoints(soft, pts, reach=3.0 * half + 4.0)
         med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
-        ref = local_widths(wid, int(round(LOCAL_WIDTH_HALF_WIDTHS * half)))
+        ref = local_widths(wid, int(round(LOCAL_WIDTH_HALF_WIDTHS * half)))  # noqa: RUF046 (numpy scalar)
         bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * ref) | (wid < END_WIDTH_LOW * ref)
         moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
-        span = _good_span(~bad, max(3, int(round(half))))
-        if span is not None:  # the ends where the profile runs into the clamp or round the tip: dropped
+        span = _good_span(~bad, max(3, int(round(half))))  # noqa: RUF046 (numpy scalar)
+        # the ends where the profile runs into the clamp or round the tip: dropped
+        if span is not None:
             i0, i1 = span
             moved, wid = moved[i0 : i1 + 1], wid[i0 : i1 + 1]
         pts = _smooth(_resample(moved, 1.0), max(1.0, SMOOTH_HALF_WIDTHS * half))
         fill = np.nan_to_num(wid, nan=med)
         widths = np.interp(np.linspace(0, 1, len(pts)), np.linspace(0, 1, len(fill)), fill)
-    reach = max(3, int(round(LOCAL_WIDTH_HALF_WIDTHS * half / 2)))
-    end_med = (float(np.median(widths[:reach])), float(np.median(widths[-reach:]))) if len(widths) else (2.0 * half,) * 2
+    reach = max(3, int(round(LOCAL_WIDTH_HALF_WIDTHS * half / 2)))  # noqa: RUF046 (numpy scalar)
+    end_med = (
+        (float(np.median(widths[:reach])), float(np.median(widths[-reach:])))
+        if len(widths)
+        else (2.0 * half,) * 2
+    )
     body_width = float(np.nanmedian(widths)) if np.isfinite(widths).any() else 2.0 * half
     pts, widths = _march(soft, pts, widths, half, end_med)
     along_ridge = _follow_ridge(ridge, pts, half)
@@ -737,9 +817,19 @@ def extract_body(
     trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
     # the body proper (not the tube or a plate joined to it at the clamp) may not reach the border
     near = np.zeros_like(comp)
-    cv2.polylines(near, [np.round(pts * 16).astype(np.int32)], False, 1, max(3, int(2 * half)) * 2 + 1, cv2.LINE_8, 4)
+    cv2.polylines(
+        near,
+        [np.round(pts * 16).astype(np.int32)],
+        False,
+        1,
+        max(3, int(2 * half)) * 2 + 1,
+        cv2.LINE_8,
+        4,
+    )
     ys, xs = np.nonzero(near & comp)
-    touches = bool(len(xs)) and bool(xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1)
+    touches = bool(len(xs)) and bool(
+        xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1
+    )
     contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
     holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1] if hier is not None else []
     loop = bool(holes) and max(cv2.contourArea(c) for c in holes) > 4.0 * half * half

@@ -8,14 +8,14 @@ radial distortion k1 about the image centre from one photo; k2 as well from thre
 the homography from the undistorted image to the board's plane (``findHomography``).  The
 result, a :class:`PlaneCalibration`, maps image points to the plane.
 
-Only the extracted centre line is mapped (:func:`plane_centreline`, called by
-:mod:`pipeline.measure.core` once the line is ready), never the image: a few hundred points cost
+Only the extracted centre line is mapped (:func:`pipeline.measure.core.plane_centreline`, once
+the line is ready), never the image: a few hundred points cost
 microseconds.  The plane frame is scaled to *plane pixels* of :attr:`PlaneCalibration.mm_per_px`
 mm and turned to match the photo at the board's centre, so every downstream number (lengths,
 residuals, the ramp check) keeps its pixel meaning while psi, the curvature and ``length_mm``
 are those of the physical plane (psi = mean curvature in 1/mm times ``l0_mm``).
 
-Measured (``python -m pipeline.measure.calibration_bench``, 8 rendered poses with the camera
+Measured (``python -m pipeline bench calibration``, 8 rendered poses with the camera
 3-8 deg off nadir and |k1| <= 0.1, 106 lab photos at 1280x960, one board photo each): |psi
 error| against the physical angle, ok rows, median 0.042 deg and p95 0.18 deg calibrated,
 against 2.0 deg and 10.4 deg for the same photos measured in the image with ``mm_per_px``; the
@@ -29,7 +29,8 @@ Examples
 >>> for j in range(7):
 ...     for i in range(10):
 ...         if (i + j) % 2 == 0:
-...             _ = cv2.rectangle(img, (120 + 40 * i, 100 + 40 * j), (159 + 40 * i, 139 + 40 * j), 20, -1)
+...             x, y = 120 + 40 * i, 100 + 40 * j
+...             _ = cv2.rectangle(img, (x, y), (x + 39, y + 39), 20, -1)
 >>> corners = find_board(img, (9, 6))
 >>> corners.shape
 (54, 2)
@@ -46,20 +47,17 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-if TYPE_CHECKING:  # pragma: no cover - types only (settings imports this module)
-    from pipeline.measure.extract import LineExtraction
-    from pipeline.measure.settings import MeasureSettings
-
-#: a calibration whose reprojection error is above this (px) is doubtful: every row using it is flagged
+#: a calibration whose reprojection error is above this (px) is doubtful: every row using it is
+#: flagged
 MAX_RMS_PX = 1.0
 #: board photos needed before k2 is estimated as well as k1
 VIEWS_FOR_K2 = 3
@@ -143,9 +141,12 @@ class PlaneCalibration:
                 f"{self.mm_per_px:.4f} mm/px, k1 {self.k1:+.3f}, {self.views} board photo(s)")
 
     def to_plane(self, points_px: ArrayLike) -> NDArray[np.float64]:
-        """Image px (x right, y down) -> plane px (undistorted, rectified; ``mm_per_px`` mm each)."""
+        """Image px (x right, y down) -> plane px (undistorted, rectified; ``mm_per_px`` mm
+        each)."""
         p = np.asarray(points_px, np.float64).reshape(-1, 1, 2)
-        und = cv2.undistortPoints(p, self.k, np.asarray(self.dist_coeffs), P=self.k, criteria=_UNDISTORT_CRITERIA)
+        und = cv2.undistortPoints(
+            p, self.k, np.asarray(self.dist_coeffs), P=self.k, criteria=_UNDISTORT_CRITERIA
+        )
         return cv2.perspectiveTransform(und, self.h).reshape(-1, 2)
 
     def to_image(self, points_plane: ArrayLike) -> NDArray[np.float64]:
@@ -216,7 +217,9 @@ def board_points_mm(inner_corners: tuple[int, int], square_mm: float) -> NDArray
     return np.column_stack([i.ravel(), j.ravel()]).astype(float) * float(square_mm)
 
 
-def find_board(grey: NDArray[np.uint8], inner_corners: tuple[int, int]) -> NDArray[np.float64] | None:
+def find_board(
+    grey: NDArray[np.uint8], inner_corners: tuple[int, int]
+) -> NDArray[np.float64] | None:
     """Sub-pixel inner corners of a chessboard in a grey photo, row by row; None when not found.
 
     Tries OpenCV's sector-based detector as it is, then with normalised contrast and an
@@ -236,8 +239,11 @@ def _jacobian(h: NDArray[np.float64], p: NDArray[np.float64]) -> NDArray[np.floa
     return np.column_stack([(q[0] - q[1]) / 2, (q[2] - q[3]) / 2])
 
 
-def _plane_frame(h_mm: NDArray[np.float64], centre_px: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
-    """Homography to plane px: board mm scaled by the centre's scale, turned (and un-mirrored) to the photo."""
+def _plane_frame(
+    h_mm: NDArray[np.float64], centre_px: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], float]:
+    """Homography to plane px: board mm scaled by the centre's scale, turned (and un-mirrored) to
+    the photo."""
     j = _jacobian(h_mm, centre_px)  # mm per undistorted px at the centre
     s = float(np.sqrt(abs(np.linalg.det(j))))
     u, _, vt = np.linalg.svd(np.linalg.inv(j))
@@ -278,14 +284,29 @@ def calibrate_views(
     w, h = int(image_size[0]), int(image_size[1])
     board = board_points_mm(inner_corners, square_mm)
     obj = np.column_stack([board, np.zeros(len(board))]).astype(np.float32)
-    k0 = np.array([[float(max(w, h)), 0.0, (w - 1) / 2], [0.0, float(max(w, h)), (h - 1) / 2], [0.0, 0.0, 1.0]])
-    flags = (cv2.CALIB_USE_INTRINSIC_GUESS | cv2.CALIB_FIX_PRINCIPAL_POINT | cv2.CALIB_FIX_ASPECT_RATIO
-             | cv2.CALIB_ZERO_TANGENT_DIST | cv2.CALIB_FIX_K3)
+    k0 = np.array(
+        [
+            [float(max(w, h)), 0.0, (w - 1) / 2],
+            [0.0, float(max(w, h)), (h - 1) / 2],
+            [0.0, 0.0, 1.0],
+        ]
+    )
+    flags = (
+        cv2.CALIB_USE_INTRINSIC_GUESS
+        | cv2.CALIB_FIX_PRINCIPAL_POINT
+        | cv2.CALIB_FIX_ASPECT_RATIO
+        | cv2.CALIB_ZERO_TANGENT_DIST
+        | cv2.CALIB_FIX_K3
+    )
     if len(corners_px) < VIEWS_FOR_K2:
         flags |= cv2.CALIB_FIX_K2
     rms, k, dist, _, _ = cv2.calibrateCamera(
-        [obj] * len(corners_px), [np.asarray(c, np.float32).reshape(-1, 1, 2) for c in corners_px], (w, h),
-        k0, np.zeros(5), flags=flags,
+        [obj] * len(corners_px),
+        [np.asarray(c, np.float32).reshape(-1, 1, 2) for c in corners_px],
+        (w, h),
+        k0,
+        np.zeros(5),
+        flags=flags,
     )
     dist = np.asarray(dist, float).ravel()[:5]
     plane = np.asarray(corners_px[0], np.float64).reshape(-1, 1, 2)
@@ -296,14 +317,21 @@ def calibrate_views(
     residual = cv2.perspectiveTransform(und.reshape(-1, 1, 2), h_mm).reshape(-1, 2) - board
     h_plane, s = _plane_frame(h_mm, und.mean(axis=0))
     return PlaneCalibration(
-        image_size=(w, h), camera_matrix=tuple(float(v) for v in k.ravel()),
-        dist_coeffs=tuple(float(v) for v in dist), homography=tuple(float(v) for v in (h_plane / h_plane[2, 2]).ravel()),
-        mm_per_px=s, rms_px=float(rms), rms_mm=float(np.sqrt((residual**2).sum(axis=1).mean())),
-        views=len(corners_px), corners=int(sum(len(c) for c in corners_px)),
+        image_size=(w, h),
+        camera_matrix=tuple(float(v) for v in k.ravel()),
+        dist_coeffs=tuple(float(v) for v in dist),
+        homography=tuple(float(v) for v in (h_plane / h_plane[2, 2]).ravel()),
+        mm_per_px=s,
+        rms_px=float(rms),
+        rms_mm=float(np.sqrt((residual**2).sum(axis=1).mean())),
+        views=len(corners_px),
+        corners=int(sum(len(c) for c in corners_px)),
     )
 
 
-def fingerprint(boards: Sequence[str | os.PathLike[str]], square_mm: float, inner_corners: tuple[int, int]) -> str:
+def fingerprint(
+    boards: Sequence[str | os.PathLike[str]], square_mm: float, inner_corners: tuple[int, int]
+) -> str:
     """sha256 of the model version, the board size and every board photo's bytes."""
     digest = hashlib.sha256(f"{MODEL_VERSION}|{float(square_mm)!r}|{tuple(inner_corners)}".encode())
     for path in boards:
@@ -332,14 +360,19 @@ def calibrate_files(
         this = (grey.shape[1], grey.shape[0])
         if size is not None and this != size:
             raise CalibrationError(
-                f"calibration board photo {name!r} is {this[0]}x{this[1]} px but {Path(boards[0]).name!r} is "
-                f"{size[0]}x{size[1]} px: every board photo must come from the camera at the resolution of the photos")
+                f"calibration board photo {name!r} is {this[0]}x{this[1]} px but "
+                f"{Path(boards[0]).name!r} is "
+                f"{size[0]}x{size[1]} px: every board photo must come from the camera at the "
+                "resolution of the photos"
+            )
         size = this
         found = find_board(grey, inner_corners)
         if found is None:
             raise CalibrationError(
-                f"calibration board photo {name!r}: no chessboard with {inner_corners[0]}x{inner_corners[1]} "
-                "inner corners found")
+                f"calibration board photo {name!r}: no chessboard with "
+                f"{inner_corners[0]}x{inner_corners[1]} "
+                "inner corners found"
+            )
         corners.append(found)
     assert size is not None
     cal = calibrate_views(corners, size, inner_corners, square_mm)
@@ -375,7 +408,12 @@ def store_entry(cal: Calibration, folder: str | os.PathLike[str]) -> dict[str, A
             names.append(str(Path(b).relative_to(Path(folder).resolve())))
         except ValueError:
             names.append(str(b))
-    return {"boards": names, "square_mm": cal.square_mm, "inner_corners": list(cal.inner_corners), **asdict(cal.plane)}
+    return {
+        "boards": names,
+        "square_mm": cal.square_mm,
+        "inner_corners": list(cal.inner_corners),
+        **asdict(cal.plane),
+    }
 
 
 def write_store(folder: str | os.PathLike[str], calibrations: Sequence[Calibration]) -> Path:
@@ -383,8 +421,14 @@ def write_store(folder: str | os.PathLike[str], calibrations: Sequence[Calibrati
     from pipeline.fileio import atomic_write_bytes
 
     entries = [store_entry(c, folder) for c in calibrations if c.plane is not None]
-    text = json.dumps({"format": 1, "note": "written by 'python -m pipeline photoset calibrate'; do not edit",
-                       "calibrations": entries}, indent=1)
+    text = json.dumps(
+        {
+            "format": 1,
+            "note": "written by 'python -m pipeline photoset calibrate'; do not edit",
+            "calibrations": entries,
+        },
+        indent=1,
+    )
     path = Path(folder) / STORE
     atomic_write_bytes(path, (text + "\n").encode())
     return path
@@ -402,19 +446,25 @@ class CalibrationCache:
         self._done: dict[tuple[Any, ...], Calibration | CalibrationError] = {}
 
     def resolve(self, spec: Calibration) -> Calibration:
-        """``spec`` with its :class:`PlaneCalibration`; raise :class:`CalibrationError` if impossible."""
+        """``spec`` with its :class:`PlaneCalibration`; raise :class:`CalibrationError` if
+        impossible."""
         if spec.key not in self._done:
             try:
                 fp = fingerprint(spec.boards, spec.square_mm, spec.inner_corners)
                 if fp in self._stored:
                     self._done[spec.key] = replace(spec, plane=self._stored[fp], stored=True)
                 else:
-                    self._done[spec.key] = replace(spec, plane=calibrate_files(spec.boards, spec.square_mm,
-                                                                               spec.inner_corners), stored=False)
+                    self._done[spec.key] = replace(
+                        spec,
+                        plane=calibrate_files(spec.boards, spec.square_mm, spec.inner_corners),
+                        stored=False,
+                    )
             except CalibrationError as exc:
                 self._done[spec.key] = exc
             except OSError as exc:
-                self._done[spec.key] = CalibrationError(f"calibration board photo cannot be read ({exc.strerror or exc})")
+                self._done[spec.key] = CalibrationError(
+                    f"calibration board photo cannot be read ({exc.strerror or exc})"
+                )
         done = self._done[spec.key]
         if isinstance(done, CalibrationError):
             raise done
@@ -422,91 +472,39 @@ class CalibrationCache:
 
 
 # --------------------------------------------------------------------------------------------
-# measuring on the plane (the one hook in pipeline.measure.core)
+# measuring on the plane (pipeline.measure.core.plane_centreline maps the centre line)
 
 
-def check_size(plane: PlaneCalibration, shape: Sequence[int], scale: float, board: str = "the board photo") -> None:
-    """Raise :class:`CalibrationMismatch` unless an image of ``shape`` reduced by ``scale`` fits ``plane``.
+def check_size(
+    plane: PlaneCalibration, shape: Sequence[int], scale: float, board: str = "the board photo"
+) -> None:
+    """Raise :class:`CalibrationMismatch` unless an image of ``shape`` reduced by ``scale`` fits
+    ``plane``.
 
     Examples
     --------
-    >>> cal = PlaneCalibration((1280, 960), (1.0,) * 9, (0.0,) * 5, (1.0,) * 9, 0.3, 0.1, 0.01, 1, 54)
+    >>> cal = PlaneCalibration((1280, 960), (1.0,) * 9, (0.0,) * 5, (1.0,) * 9, 0.3, 0.1, 0.01, 1,
+    ...                        54)
     >>> check_size(cal, (240, 320, 3), 4.0)
-    >>> check_size(cal, (180, 320, 3), 4.0)
+    >>> check_size(cal, (180, 320, 3), 4.0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pipeline.measure.calibration.CalibrationMismatch: the photo is 1280x720 px but the board photo is 1280x960 px: calibrate with a board photo taken by this camera at this resolution
+    pipeline.measure.calibration.CalibrationMismatch: the photo is 1280x720 px but ...
     """
     w, h = plane.image_size
     if abs(shape[1] * scale - w) > scale or abs(shape[0] * scale - h) > scale:
         raise CalibrationMismatch(
-            f"the photo is {round(shape[1] * scale)}x{round(shape[0] * scale)} px but {board} is {w}x{h} px: "
-            "calibrate with a board photo taken by this camera at this resolution")
+            f"the photo is {round(shape[1] * scale)}x{round(shape[0] * scale)} px but {board} is "
+            f"{w}x{h} px: "
+            "calibrate with a board photo taken by this camera at this resolution"
+        )
 
 
-def _extended_ends(points: NDArray[np.float64], trimmed_px: tuple[float, float]) -> NDArray[np.float64]:
-    """The two ends of the measured line: the first/last point carried on by the trimmed lengths."""
-    out = []
-    for end, nxt, trim in ((points[0], points[min(3, len(points) - 1)], trimmed_px[0]),
-                           (points[-1], points[max(len(points) - 4, 0)], trimmed_px[1])):
-        d = end - nxt
-        n = float(np.hypot(*d))
-        out.append(end + (d / n * trim if n > 0 else 0.0))
-    return np.asarray(out)
-
-
-def plane_centreline(
-    line: LineExtraction, settings: MeasureSettings, shape: Sequence[int], scale: float
-) -> tuple[NDArray[np.float64], tuple[float, float], MeasureSettings]:
-    """The centre line as the estimators take it: y up, and on the plane when the photo is calibrated.
-
-    Parameters
-    ----------
-    line : LineExtraction
-        The extracted (and refined) centre line, original image px.
-    settings : MeasureSettings
-        The photo's settings.
-    shape : sequence of int
-        Shape of the work image (rows, columns, ...).
-    scale : float
-        Original px per work px.
-
-    Returns
-    -------
-    points : ndarray (N, 2)
-        Centre line in a y-up frame: image px, or plane px when calibrated.
-    ends_px : (float, float)
-        Length of the line beyond the first and the last point, in the same units.
-    settings : MeasureSettings
-        Unchanged without a calibration; else with ``mm_per_px`` the plane px size and
-        ``fixed_direction_deg`` turned to the plane.
-
-    Raises
-    ------
-    CalibrationMismatch
-        When the photo has another resolution than the board photo.
-    """
-    flip = np.array([1.0, -1.0])
-    cal = settings.calibration
-    if cal is None or cal.plane is None:
-        return line.centreline_px * flip, line.trimmed_px, settings
-    plane = cal.plane
-    check_size(plane, shape, scale, f"the board photo {Path(cal.boards[0]).name}")
-    pts = line.centreline_px
-    q = plane.to_plane(pts)
-    ends_img = _extended_ends(pts, line.trimmed_px)
-    ends_q = plane.to_plane(ends_img)
-    ends = (float(np.hypot(*(ends_q[0] - q[0]))), float(np.hypot(*(ends_q[1] - q[-1]))))
-    direction = settings.fixed_direction_deg
-    if direction is not None:
-        a = np.deg2rad(direction)
-        d = plane.to_plane([pts[0], pts[0] + 10.0 * np.array([np.cos(a), -np.sin(a)])])
-        direction = float(np.rad2deg(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0])))
-    return q * flip, ends, replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction)
-
-
-def rectify(image: NDArray[np.uint8], plane: PlaneCalibration, scale: float = 1.0) -> NDArray[np.uint8]:
-    """The photo (reduced by ``scale``) remapped to the plane: undistorted and seen from straight above.
+def rectify(
+    image: NDArray[np.uint8], plane: PlaneCalibration, scale: float = 1.0
+) -> NDArray[np.uint8]:
+    """The photo (reduced by ``scale``) remapped to the plane: undistorted and seen from straight
+    above.
 
     Output pixel (x, y) shows plane px (x * scale, y * scale), so the result lies over the photo
     at the board's centre.
@@ -523,14 +521,11 @@ def describe_problem(cal: Calibration, exc: Exception) -> tuple[str, str]:
     """(message, fix) of a calibration that cannot be computed."""
     text = str(exc)
     if "no chessboard" in text:
-        return text, ("check inner_corners (count where four squares meet: a board of 10 x 7 squares has 9 x 6) "
-                      "and that the whole board is in the photo, flat, sharp and evenly lit")
+        return text, (
+            "check inner_corners (count where four squares meet: a board of 10 x 7 squares has 9 x "
+            "6) "
+            "and that the whole board is in the photo, flat, sharp and evenly lit"
+        )
     if "px but" in text:
         return text, "take every board photo with the camera and resolution of the actuator photos"
     return text, "re-take or re-export the board photo"
-
-
-def as_mapping(cal: Calibration) -> Mapping[str, Any]:
-    """The spec as a ``calibration:`` value (for messages and the CLI)."""
-    return {"board": [Path(b).name for b in cal.boards], "square_mm": cal.square_mm,
-            "inner_corners": list(cal.inner_corners)}

@@ -4,8 +4,9 @@ A colour is written by the user as a name (``black``, ``white``, ``grey``, ``red
 ``yellow``, ``green``, ``cyan``, ``blue``, ``purple``, ``magenta``), an explicit HSV range
 ``"h,s,v-h,s,v"`` in OpenCV units (H 0-179, S and V 0-255), a mapping
 ``{lower: [h, s, v], upper: [h, s, v]}``, or several of these: a YAML list, or one manifest cell
-with the parts separated by ``;`` (``"red;orange"``, ``"0,90,50-10,255,255;170,90,50-179,255,255"``).
-It is parsed once, by :func:`parse_color`, into a :class:`ColorSpec`.
+with the parts separated by ``;`` (``"red;orange"``,
+``"0,90,50-10,255,255;170,90,50-179,255,255"``). It is parsed once, by :func:`parse_color`, into a
+:class:`ColorSpec`.
 
 Only the *name* ``black`` selects a dark drawn line by its local darkness (a black-hat filter
 that ignores the clamp and shadows, see :func:`pipeline.measure.extract.line_mask`); an explicit
@@ -112,7 +113,11 @@ def _bound(label: str, lo: int, hi: int, top: int) -> str | None:
 
 def _describe_ranges(ranges: Sequence[HsvRange]) -> str:
     # red-like pairs that share S and V bounds read as one hue list
-    if len(ranges) == 2 and ranges[0][0][1:] == ranges[1][0][1:] and ranges[0][1][1:] == ranges[1][1][1:]:
+    if (
+        len(ranges) == 2
+        and ranges[0][0][1:] == ranges[1][0][1:]
+        and ranges[0][1][1:] == ranges[1][1][1:]
+    ):
         (a, b), (c, d) = ranges
         hue = f"H {a[0]}-{b[0]} or {c[0]}-{d[0]}"
         rest = [t for t in (_bound("S", a[1], b[1], 255), _bound("V", a[2], b[2], 255)) if t]
@@ -125,9 +130,14 @@ def _describe_ranges(ranges: Sequence[HsvRange]) -> str:
 
 
 def _check_range(lo: Sequence[int], hi: Sequence[int], text: str) -> HsvRange:
-    if len(lo) != 3 or len(hi) != 3 or any(not 0 <= a <= b <= m for a, b, m in zip(lo, hi, _LIMITS)):
+    if (
+        len(lo) != 3
+        or len(hi) != 3
+        or any(not 0 <= a <= b <= m for a, b, m in zip(lo, hi, _LIMITS))
+    ):
         raise ColorError(
-            f"HSV range {text!r} is invalid: need 0 <= lower <= upper with H <= 179 and S, V <= 255 "
+            f"HSV range {text!r} is invalid: need 0 <= lower <= upper with H <= 179 and S, V <= "
+            "255 "
             "(OpenCV units; a hue that wraps, like red, is two ranges joined by ';')"
         )
     return (int(lo[0]), int(lo[1]), int(lo[2])), (int(hi[0]), int(hi[1]), int(hi[2]))
@@ -138,7 +148,10 @@ def _parse_part(part: Any) -> tuple[str, tuple[HsvRange, ...]]:
         try:
             lo, hi = [int(x) for x in part["lower"]], [int(x) for x in part["upper"]]
         except (KeyError, TypeError, ValueError) as exc:
-            raise ColorError(f"colour range {dict(part)!r} needs 'lower' and 'upper' lists of three integers [h, s, v]") from exc
+            raise ColorError(
+                f"colour range {dict(part)!r} needs 'lower' and 'upper' lists of three integers "
+                "[h, s, v]"
+            ) from exc
         text = f"{lo[0]},{lo[1]},{lo[2]}-{hi[0]},{hi[1]},{hi[2]}"
         return text, (_check_range(lo, hi, text),)
     if not isinstance(part, str):
@@ -191,7 +204,9 @@ def parse_color(value: Any) -> ColorSpec:
     elif isinstance(value, (list, tuple)):
         parts = list(value)
     else:
-        raise ColorError(f"colour {value!r} is not understood; give a name, an HSV range or a list of them")
+        raise ColorError(
+            f"colour {value!r} is not understood; give a name, an HSV range or a list of them"
+        )
     if not parts:
         raise ColorError("colour is empty; give a name such as 'black' or an HSV range")
     texts, ranges = [], []
@@ -253,7 +268,7 @@ def pick_color(image_bgr: np.ndarray, x: float, y: float, radius_px: float = 4.0
     --------
     >>> img = np.zeros((20, 20, 3), np.uint8); img[:] = (40, 40, 200)     # BGR red
     >>> pick_color(img, 10, 10).text
-    '0,100,140-10,255,255;170,100,140-179,255,255'
+    '0,144,130-6,255,255;174,144,130-179,255,255'
     """
     h, w = image_bgr.shape[:2]
     if not (0 <= x < w and 0 <= y < h):
@@ -275,7 +290,11 @@ def pick_color(image_bgr: np.ndarray, x: float, y: float, radius_px: float = 4.0
     h_lo, h_hi = centre - half, centre + half
     s_v = f"{int(s_lo)},{int(v_lo)}", f"{int(s_hi)},{int(v_hi)}"
     if h_lo < 0:
-        return parse_color(f"0,{s_v[0]}-{int(h_hi)},{s_v[1]};{int(180 + h_lo)},{s_v[0]}-179,{s_v[1]}")
+        return parse_color(
+            f"0,{s_v[0]}-{int(h_hi)},{s_v[1]};{int(180 + h_lo)},{s_v[0]}-179,{s_v[1]}"
+        )
     if h_hi > 179:
-        return parse_color(f"0,{s_v[0]}-{int(h_hi - 180)},{s_v[1]};{int(h_lo)},{s_v[0]}-179,{s_v[1]}")
+        return parse_color(
+            f"0,{s_v[0]}-{int(h_hi - 180)},{s_v[1]};{int(h_lo)},{s_v[0]}-179,{s_v[1]}"
+        )
     return parse_color(f"{int(h_lo)},{s_v[0]}-{int(h_hi)},{s_v[1]}")

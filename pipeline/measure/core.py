@@ -13,16 +13,25 @@ from __future__ import annotations
 
 import functools
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
 import numpy as np
+from numpy.typing import NDArray
 
-from pipeline.measure.calibration import CalibrationMismatch, plane_centreline
-from pipeline.measure.estimators import METHODS, CurveEstimate, auto_choice, hyper, tangents, turning_quick
+from pipeline.measure.calibration import CalibrationMismatch, check_size
+from pipeline.measure.estimators import (
+    METHODS,
+    CurveEstimate,
+    auto_choice,
+    hyper,
+    tangents,
+    turning_quick,
+)
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
-from pipeline.measure.quality import assess, assess_body
+from pipeline.measure.quality import Quality, assess, assess_body
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
 
@@ -92,6 +101,35 @@ def failed(method: str, reason: str) -> AngleResult:
     return AngleResult(nan, nan, nan, method, nan, "failed", reason, np.empty((0, 2)))
 
 
+def _measured(
+    psi: float,
+    est: CurveEstimate,
+    line: LineExtraction,
+    quality: Quality,
+    settings: MeasureSettings,
+    method: str,
+) -> AngleResult:
+    """The :class:`AngleResult` of a measured photo: psi, the fit ``est`` of ``line`` and its
+    quality.
+
+    ``settings`` are those the fit used (on a calibrated plane: the plane's ``mm_per_px``).
+    """
+    mm_per_px = settings.mm_per_px
+    return AngleResult(
+        psi_deg=psi,
+        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
+        length_mm=float(est.length_px * mm_per_px) if mm_per_px else float("nan"),
+        method=method,
+        residual_px=est.residual_px,
+        status=quality.status,
+        reason=quality.reason,
+        centreline_px=line.centreline_px,
+        line_width_px=line.width_px,
+        degree=int(est.degree),
+        length_px=float(est.length_px),
+    )
+
+
 def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
     """Largest factor in (1, 2, 4, 8) keeping the work image at least ``work_width_px`` wide.
 
@@ -106,7 +144,9 @@ def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
     return f
 
 
-def _psi_from(est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | None, length_px: float) -> float:
+def _psi_from(
+    est: CurveEstimate, sign: float, l0_mm: float, mm_per_px: float | None, length_px: float
+) -> float:
     if mm_per_px:
         return float(np.rad2deg(sign * est.kappa_per_px / mm_per_px * l0_mm))
     return float(np.rad2deg(sign * est.kappa_per_px * length_px))
@@ -135,15 +175,25 @@ def measure_work_image(
         return measure_body(image_bgr, settings, scale=scale, method=method)
     l0_mm, mm_per_px = settings.l0_mm, settings.mm_per_px
     assert settings.color is not None
-    region = None if image_bgr is None else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    region = (
+        None
+        if image_bgr is None
+        else region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
+    )
     try:
         line: LineExtraction = extract_centreline(
-            image_bgr, color=settings.color, fixed_end_px=settings.fixed_end_px, scale=scale, region=region
+            image_bgr,
+            color=settings.color,
+            fixed_end_px=settings.fixed_end_px,
+            scale=scale,
+            region=region,
         )
     except NoLineFound as exc:
         return failed(method, str(exc))
     if fine is not None:
-        refined = refine_centreline(fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px)
+        refined = refine_centreline(
+            fine, line.centreline_px, scale=fine_scale, half_width_px=0.5 * line.width_px
+        )
         line = replace(line, centreline_px=refined)
     try:  # y-up: on-screen ccw is positive; calibrated: undistorted, on the plane (plane px)
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
@@ -153,7 +203,8 @@ def measure_work_image(
     rng = np.random.default_rng(SEED)
     sign = settings.sign
     try:
-        arc = hyper(pts, rng, ends_px=ends)  # the arc and quick turning fits serve the quality check
+        # the arc and quick turning fits serve the quality check
+        arc = hyper(pts, rng, ends_px=ends)
         trn = turning_quick(pts, rng, ends_px=ends)
         if method == "hyper":
             est = arc
@@ -169,7 +220,11 @@ def measure_work_image(
         # the full turning fit was run: its quick linear proxy is too crude a check (it
         # extrapolates a polynomial to the ends); the fit with one term more or less is the check
         trn = CurveEstimate(
-            est.neighbour_turning_rad / est.length_px, est.neighbour_turning_rad, est.length_px, est.residual_px, est.degree
+            est.neighbour_turning_rad / est.length_px,
+            est.neighbour_turning_rad,
+            est.length_px,
+            est.residual_px,
+            est.degree,
         )
     quality = assess(
         line,
@@ -181,18 +236,74 @@ def measure_work_image(
         psi_arc_deg=_psi_from(arc, sign, l0_mm, mm_per_px, length_px),
         turning_degree=trn.degree,
     )
-    return AngleResult(
-        psi_deg=psi,
-        kappa_per_mm=float(np.deg2rad(psi) / l0_mm),
-        length_mm=float(length_px * mm_per_px) if mm_per_px else float("nan"),
-        method=method,
-        residual_px=est.residual_px,
-        status=quality.status,
-        reason=quality.reason,
-        centreline_px=line.centreline_px,
-        line_width_px=line.width_px,
-        degree=int(est.degree),
-        length_px=float(est.length_px),
+    return _measured(psi, est, line, quality, settings, method)
+
+
+def _extended_ends(
+    points: NDArray[np.float64], trimmed_px: tuple[float, float]
+) -> NDArray[np.float64]:
+    """The two ends of the measured line: the first/last point carried on by the trimmed lengths."""
+    out = []
+    for end, nxt, trim in ((points[0], points[min(3, len(points) - 1)], trimmed_px[0]),
+                           (points[-1], points[max(len(points) - 4, 0)], trimmed_px[1])):
+        d = end - nxt
+        n = float(np.hypot(*d))
+        out.append(end + (d / n * trim if n > 0 else 0.0))
+    return np.asarray(out)
+
+
+def plane_centreline(
+    line: LineExtraction, settings: MeasureSettings, shape: Sequence[int], scale: float
+) -> tuple[NDArray[np.float64], tuple[float, float], MeasureSettings]:
+    """The centre line as the estimators take it: y up, and on the plane when the photo is
+    calibrated.
+
+    Parameters
+    ----------
+    line : LineExtraction
+        The extracted (and refined) centre line, original image px.
+    settings : MeasureSettings
+        The photo's settings.
+    shape : sequence of int
+        Shape of the work image (rows, columns, ...).
+    scale : float
+        Original px per work px.
+
+    Returns
+    -------
+    points : ndarray (N, 2)
+        Centre line in a y-up frame: image px, or plane px when calibrated.
+    ends_px : (float, float)
+        Length of the line beyond the first and the last point, in the same units.
+    settings : MeasureSettings
+        Unchanged without a calibration; else with ``mm_per_px`` the plane px size and
+        ``fixed_direction_deg`` turned to the plane.
+
+    Raises
+    ------
+    CalibrationMismatch
+        When the photo has another resolution than the board photo.
+    """
+    flip = np.array([1.0, -1.0])
+    cal = settings.calibration
+    if cal is None or cal.plane is None:
+        return line.centreline_px * flip, line.trimmed_px, settings
+    plane = cal.plane
+    check_size(plane, shape, scale, f"the board photo {Path(cal.boards[0]).name}")
+    pts = line.centreline_px
+    q = plane.to_plane(pts)
+    ends_img = _extended_ends(pts, line.trimmed_px)
+    ends_q = plane.to_plane(ends_img)
+    ends = (float(np.hypot(*(ends_q[0] - q[0]))), float(np.hypot(*(ends_q[1] - q[-1]))))
+    direction = settings.fixed_direction_deg
+    if direction is not None:
+        a = np.deg2rad(direction)
+        d = plane.to_plane([pts[0], pts[0] + 10.0 * np.array([np.cos(a), -np.sin(a)])])
+        direction = float(np.rad2deg(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0])))
+    return (
+        q * flip,
+        ends,
+        replace(settings, mm_per_px=plane.mm_per_px, fixed_direction_deg=direction),
     )
 
 
@@ -205,7 +316,9 @@ def _background(path: str, shape: tuple[int, int]) -> np.ndarray | None:
     return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
 
 
-def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD) -> AngleResult:
+def measure_body(
+    image_bgr: np.ndarray, settings: MeasureSettings, *, scale: float, method: str = DEFAULT_METHOD
+) -> AngleResult:
     """psi of the actuator's body (``target: body``): its centre line's total turning.
 
     ``auto`` is :func:`~pipeline.measure.estimators.tangents` here (the tip angle: a body is
@@ -218,22 +331,32 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     if settings.background_path is not None and image_bgr is not None:
         background = _background(settings.background_path, image_bgr.shape[:2])
         if background is None:
-            return failed(method, f"background photo {Path(settings.background_path).name} cannot be decoded")
+            return failed(
+                method, f"background photo {Path(settings.background_path).name} cannot be decoded"
+            )
     try:
         body = extract_body(image_bgr, settings, scale=scale, background_bgr=background)
     except NoLineFound as exc:
         return failed(method, str(exc))
     line = body.line
-    try:  # ends: the tangents are carried to the clamp face and to the tip (not over a cap); calibrated: on the plane
+    # ends: the tangents are carried to the clamp face and to the tip (not over a cap); calibrated:
+    # on the plane
+    try:
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
     rng = np.random.default_rng(SEED)
-    base = None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    base = (
+        None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
+    )
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
-        est = tip if method in ("auto", "tangents") or base is not None else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+        est = (
+            tip
+            if method in ("auto", "tangents") or base is not None
+            else METHODS[method](pts, rng, ends_px=line.trimmed_px)
+        )
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
@@ -242,7 +365,9 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
     quality = assess_body(
         line,
         psi_deg=psi,
-        psi_check_deg=float(np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))),
+        psi_check_deg=float(
+            np.rad2deg(sign * (tip.neighbour_turning_rad if est is tip else est.turning_rad))
+        ),
         widths_px=body.widths_px,
         expected_length_px=settings.l0_mm / settings.mm_per_px if settings.mm_per_px else None,
         length_px=est.length_px,
@@ -254,20 +379,8 @@ def measure_body(image_bgr: np.ndarray, settings: MeasureSettings, *, scale: flo
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
     )
-    mm = settings.mm_per_px
-    return AngleResult(
-        psi_deg=psi,
-        kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
-        length_mm=float(est.length_px * mm) if mm else float("nan"),
-        method="tangents" if method == "auto" or base is not None else method,
-        residual_px=est.residual_px,
-        status=quality.status,
-        reason=quality.reason,
-        centreline_px=line.centreline_px,
-        line_width_px=line.width_px,
-        degree=int(est.degree),
-        length_px=float(est.length_px),
-    )
+    used = "tangents" if method == "auto" or base is not None else method
+    return _measured(psi, est, line, quality, settings, used)
 
 
 def measure_image(
@@ -304,7 +417,8 @@ def measure_image(
     >>> img = np.full((480, 640, 3), 200, np.uint8)
     >>> t = np.linspace(0, np.pi, 200)                      # half circle, radius 150 px
     >>> pts = np.c_[320 + 150 * np.cos(t), 300 - 150 * np.sin(t)]
-    >>> _ = cv2.polylines(img, [np.round(pts * 16).astype(np.int32)], False, (20, 20, 20), 5, cv2.LINE_AA, 4)
+    >>> line = [np.round(pts * 16).astype(np.int32)]
+    >>> _ = cv2.polylines(img, line, False, (20, 20, 20), 5, cv2.LINE_AA, 4)
     >>> s = resolve_settings(l0_mm=150 * np.pi, mm_per_px=1.0, fixed_end=[470, 300])
     >>> r = measure_image(img, s)
     >>> print(round(r.psi_deg), r.status)
@@ -313,14 +427,21 @@ def measure_image(
     if image_bgr is None or image_bgr.ndim != 3:
         return measure_work_image(image_bgr, settings, scale=1.0, method=method)
     f = reduction_for(image_bgr.shape[1], work_width_px)
-    res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
+    res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
-        res = measure_work_image(_reduce(image_bgr, f), settings, scale=float(f), method=method)
+        res = measure_work_image(
+            reduce_image(image_bgr, f), settings, scale=float(f), method=method
+        )
     return res
 
 
-_REDUCED = {1: cv2.IMREAD_COLOR, 2: cv2.IMREAD_REDUCED_COLOR_2, 4: cv2.IMREAD_REDUCED_COLOR_4, 8: cv2.IMREAD_REDUCED_COLOR_8}
+_REDUCED = {
+    1: cv2.IMREAD_COLOR,
+    2: cv2.IMREAD_REDUCED_COLOR_2,
+    4: cv2.IMREAD_REDUCED_COLOR_4,
+    8: cv2.IMREAD_REDUCED_COLOR_8,
+}
 _REDUCED_GREY = {
     1: cv2.IMREAD_GRAYSCALE, 2: cv2.IMREAD_REDUCED_GRAYSCALE_2, 4: cv2.IMREAD_REDUCED_GRAYSCALE_4,
     8: cv2.IMREAD_REDUCED_GRAYSCALE_8,
@@ -358,7 +479,10 @@ def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
 
 
 def decode_for_work(
-    data: np.ndarray, work_width_px: int = WORK_WIDTH_PX, factor: int | None = None, grey: bool = False
+    data: np.ndarray,
+    work_width_px: int = WORK_WIDTH_PX,
+    factor: int | None = None,
+    grey: bool = False,
 ) -> tuple[np.ndarray | None, int]:
     """Decode image bytes, directly at reduced size for large JPEGs (DCT scaling: much faster).
 
@@ -388,13 +512,17 @@ def decode_for_work(
     if img is None:
         return None, 1
     f = factor if factor is not None else reduction_for(img.shape[1], work_width_px)
-    return _reduce(img, f), f
+    return reduce_image(img, f), f
 
 
-def _reduce(image: np.ndarray, factor: int) -> np.ndarray:
+def reduce_image(image: np.ndarray, factor: int) -> np.ndarray:
+    """``image`` reduced ``factor`` times in each direction (INTER_AREA); itself for ``factor`` <=
+    1."""
     if factor <= 1:
         return image
-    return cv2.resize(image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA)
+    return cv2.resize(
+        image, (image.shape[1] // factor, image.shape[0] // factor), interpolation=cv2.INTER_AREA
+    )
 
 
 def decodes_grey(settings: MeasureSettings) -> bool:
@@ -422,14 +550,25 @@ def measure_file(
         data = np.fromfile(str(path), dtype=np.uint8)
     except OSError as exc:
         return failed(method, f"unreadable image: {exc.strerror or exc}"), time.perf_counter() - t0
-    img, f = decode_for_work(data, work_width_px, grey=decodes_grey(settings)) if data.size else (None, 1)
+    img, f = (
+        decode_for_work(data, work_width_px, grey=decodes_grey(settings))
+        if data.size
+        else (None, 1)
+    )
     if img is None:
-        return failed(method, f"unreadable image: {Path(path).name} cannot be decoded"), time.perf_counter() - t0
+        return failed(
+            method, f"unreadable image: {Path(path).name} cannot be decoded"
+        ), time.perf_counter() - t0
     return measure_decoded(data, img, f, settings, method=method), time.perf_counter() - t0
 
 
 def measure_decoded(
-    data: np.ndarray | None, img: np.ndarray, factor: int, settings: MeasureSettings, *, method: str = DEFAULT_METHOD,
+    data: np.ndarray | None,
+    img: np.ndarray,
+    factor: int,
+    settings: MeasureSettings,
+    *,
+    method: str = DEFAULT_METHOD,
     full: np.ndarray | None = None,
 ) -> AngleResult:
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
@@ -444,16 +583,20 @@ def measure_decoded(
     decode, the usual photo only one small one.
     """
     if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
-        coarse = _reduce(img, 2)
-        res = measure_work_image(coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor))
+        coarse = reduce_image(img, 2)
+        res = measure_work_image(
+            coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor)
+        )
         # anything doubtful (gaps, rivals, border, ...) is measured again at the decoded size
         if res.status == "ok" and res.line_width_px / (2 * factor) >= MIN_COARSE_LINE_WIDTH_PX:
             return res
     res = measure_work_image(img, settings, scale=float(factor), method=method)
-    while factor > 1 and (res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX):
+    while factor > 1 and (
+        res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX
+    ):
         factor //= 2
         if full is not None:
-            finer = _reduce(full, factor)
+            finer = reduce_image(full, factor)
         else:
             assert data is not None
             finer, factor = decode_for_work(data, factor=factor, grey=img.ndim == 2)

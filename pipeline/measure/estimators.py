@@ -9,10 +9,10 @@ Methods
 -------
 ``paper``
     Faithful to the paper (Section II.C): curvature at 100 random places along the curve,
-    each from three *nearby* centre-line points (2 % of the line apart), unsigned, averaged (the overall sign is
-    taken from the turning direction, otherwise negative angles could not be reported).
-    Pixel noise makes each nearby-triple curvature large and of random sign, so the unsigned
-    average is biased upwards: a straight line never reads 0 deg.  Kept to show the trap.
+    each from three *nearby* centre-line points (2 % of the line apart), unsigned, averaged (the
+    overall sign is taken from the turning direction, otherwise negative angles could not be
+    reported). Pixel noise makes each nearby-triple curvature large and of random sign, so the
+    unsigned average is biased upwards: a straight line never reads 0 deg.  Kept to show the trap.
 ``paper_corrected``
     Same sampling idea, but signed three-point (Menger) curvature over *widely spaced* triples
     (spacing a quarter to a half of the line): unbiased, and exact for any three points of an
@@ -104,7 +104,11 @@ class Estimator(Protocol):
     """
 
     def __call__(
-        self, points: np.ndarray, rng: np.random.Generator, *, ends_px: tuple[float, float] = (0.0, 0.0)
+        self,
+        points: np.ndarray,
+        rng: np.random.Generator,
+        *,
+        ends_px: tuple[float, float] = (0.0, 0.0),
     ) -> CurveEstimate: ...
 
 
@@ -202,7 +206,7 @@ def paper(
     n = len(points)
     if n < 5:
         raise ValueError("need at least 5 centre-line points")
-    m = max(int(round(NEARBY_FRACTION * n)), 1)
+    m = max(round(NEARBY_FRACTION * n), 1)
     i = rng.integers(m, n - m, size=N_SAMPLES)
     k = np.abs(menger_curvature(points[i - m], points[i], points[i + m]))
     return _estimate(_turn_sign(points) * float(k.mean()), points, np.nan, ends_px)
@@ -231,7 +235,8 @@ def paper_corrected(
 def _constraint(kind: str, zbar: float, xbar: float, ybar: float) -> np.ndarray:
     pratt = np.array([[0, 0, 0, -2], [0, 1, 0, 0], [0, 0, 1, 0], [-2, 0, 0, 0]], float)
     taubin = np.array(
-        [[4 * zbar, 2 * xbar, 2 * ybar, 0], [2 * xbar, 1, 0, 0], [2 * ybar, 0, 1, 0], [0, 0, 0, 0]], float
+        [[4 * zbar, 2 * xbar, 2 * ybar, 0], [2 * xbar, 1, 0, 0], [2 * ybar, 0, 1, 0], [0, 0, 0, 0]],
+        float,
     )
     return {"pratt": pratt, "taubin": taubin, "hyper": 2 * taubin - pratt}[kind]
 
@@ -307,7 +312,9 @@ def hyper(
 # turning angle
 
 
-def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.ndarray, np.ndarray, int, float]:
+def turning_fit(
+    points: np.ndarray, max_degree: int = MAX_DEGREE
+) -> tuple[np.ndarray, np.ndarray, int, float]:
     """Fit tangent angle against arc length with a polynomial degree chosen by BIC.
 
     The tangent angle is taken from chords between consecutive points (pass the output of
@@ -349,14 +356,17 @@ def turning_fit(points: np.ndarray, max_degree: int = MAX_DEGREE) -> tuple[np.nd
 
 
 def _cosine_theta(u: np.ndarray, coef: np.ndarray) -> np.ndarray:
-    """theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi): curvature psi + sum b_k cos(k pi u)."""
+    """theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi): curvature psi + sum b_k cos(k pi
+    u)."""
     theta = coef[0] + coef[1] * u
     for k, b in enumerate(coef[2:], start=1):
         theta = theta + b * np.sin(k * np.pi * u) / (k * np.pi)
     return theta
 
 
-def _shape_model(params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]) -> np.ndarray:
+def _shape_model(
+    params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]
+) -> np.ndarray:
     """Chunk means of the curve p(s) = p0 + stretch * int (cos theta, sin theta) ds.
 
     ``u`` runs over the whole line, [0, 1] from the fixed end to the free end; the data (the
@@ -411,12 +421,18 @@ def turning(
     worse = 0
     for k in range(min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
         fit = least_squares(
-            lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(), x0, method="lm", xtol=1e-10, ftol=1e-10
+            lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(),
+            x0,
+            method="lm",
+            xtol=1e-10,
+            ftol=1e-10,
         )
         rss = float(np.sum(fit.fun**2))
         psi_of[k + 1] = float(fit.x[4])
         m = 2 * n
-        bic = m * np.log(max(rss, 1e-300) / m) + (k + 5) * (np.log(m) if CRITERION == "bic" else 2.0)
+        bic = m * np.log(max(rss, 1e-300) / m) + (k + 5) * (
+            np.log(m) if CRITERION == "bic" else 2.0
+        )
         if best is None or bic < best[0]:
             best, worse = (bic, fit.x, k + 1, rss), 0
         else:
@@ -444,7 +460,7 @@ def turning_quick(
     if len(points) < 4:
         raise ValueError("need at least 4 centre-line points")
     means, piece = chunk_means(points)
-    s_mid, coef, deg, rss = turning_fit(means)
+    _s_mid, coef, deg, rss = turning_fit(means)
     span = float(arc_length(means)[-1])
     length = span + piece + ends_px[0] + ends_px[1]
     # u = 2 s / span - 1 runs from the first mean to the last; the line ends lie beyond them
@@ -465,12 +481,14 @@ TANGENT_WINDOW_FRACTION = 0.15
 TANGENT_DEGREE = 1
 
 
-def _end_angle(s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool) -> tuple[float, float]:
+def _end_angle(
+    s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool
+) -> tuple[float, float]:
     """Tangent angle at arc length ``at`` from a fit over the first/last ``window``; and its RMS."""
     sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
     if sel.sum() < 3:
         sel = np.zeros_like(sel)
-        sel[:3] = True if from_start else False
+        sel[:3] = bool(from_start)
         if not from_start:
             sel[-3:] = True
     deg = min(TANGENT_DEGREE, int(sel.sum()) - 2)
@@ -480,7 +498,10 @@ def _end_angle(s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, f
 
 
 def end_tangents(
-    points: np.ndarray, *, ends_px: tuple[float, float] = (0.0, 0.0), window_fraction: float | None = None
+    points: np.ndarray,
+    *,
+    ends_px: tuple[float, float] = (0.0, 0.0),
+    window_fraction: float | None = None,
 ) -> tuple[float, float, float]:
     """Tangent angles (rad, y-up, unwrapped along the line) at both ends of the whole line.
 
@@ -513,7 +534,8 @@ def end_tangents(
     means, piece = chunk_means(points)
     d = np.diff(means, axis=0)
     theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
-    s_mid = (np.arange(1, len(means)) * piece).astype(float)  # chords between means: tangent at the chunk boundary
+    # chords between means: tangent at the chunk boundary
+    s_mid = (np.arange(1, len(means)) * piece).astype(float)
     total = len(means) * piece
     window = max(window_fraction * total, 3.0 * piece)
     a, ra = _end_angle(s_mid, theta, -ends_px[0], window, True)
@@ -537,13 +559,15 @@ def tangents(
     if len(points) < 4:
         raise ValueError("need at least 4 centre-line points")
     a, b, rms = end_tangents(points, ends_px=ends_px)
-    a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)  # the check
+    # the check
+    a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)
     if base_rad is not None:
         base = base_rad + 2 * np.pi * np.round((a - base_rad) / (2 * np.pi))
         a2, a = a2 - a + base, base
     length = smooth_length(points) + ends_px[0] + ends_px[1]
     psi, check = b - a, b2 - a2
-    resid_px = float(rms * length * TANGENT_WINDOW_FRACTION / np.sqrt(12.0))  # angle misfit as a sideways offset
+    # angle misfit as a sideways offset
+    resid_px = float(rms * length * TANGENT_WINDOW_FRACTION / np.sqrt(12.0))
     return CurveEstimate(psi / length, psi, length, resid_px, 1, check)
 
 
@@ -573,7 +597,10 @@ def auto_choice(
     ends_px: tuple[float, float] = (0.0, 0.0),
 ) -> CurveEstimate:
     """The ``auto`` decision given the Hyper and quick turning estimates already computed."""
-    if quick.degree >= 2 and abs(np.rad2deg(quick.kappa_per_px - arc.kappa_per_px) * arc.length_px) > AUTO_SWITCH_DEG:
+    if (
+        quick.degree >= 2
+        and abs(np.rad2deg(quick.kappa_per_px - arc.kappa_per_px) * arc.length_px) > AUTO_SWITCH_DEG
+    ):
         return turning(points, rng, ends_px=ends_px)
     return arc
 

@@ -24,6 +24,7 @@ on a reduced image (``scale`` > 1).
 from __future__ import annotations
 
 from dataclasses import dataclass
+
 import cv2
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -123,9 +124,15 @@ def line_mask(image_bgr: np.ndarray, color: ColorSpec) -> tuple[np.ndarray, np.n
         Line strength (black-hat response, or the mask for colour ranges).
     """
     if color.dark_line:
-        v = image_bgr if image_bgr.ndim == 2 else cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
+        v = (
+            image_bgr
+            if image_bgr.ndim == 2
+            else cv2.max(cv2.max(image_bgr[:, :, 0], image_bgr[:, :, 1]), image_bgr[:, :, 2])
+        )
         k = _kernel_px(image_bgr.shape)
-        bh = cv2.morphologyEx(v, cv2.MORPH_BLACKHAT, cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)))
+        bh = cv2.morphologyEx(
+            v, cv2.MORPH_BLACKHAT, cv2.getStructuringElement(cv2.MORPH_RECT, (k, k))
+        )
         hist = cv2.calcHist([bh], [0], None, [256], [0, 256]).ravel()
         cum = np.cumsum(hist[::-1])  # pixels at or above each level, from 255 down
         peak = 255 - int(np.searchsorted(cum, 0.001 * bh.size))
@@ -136,7 +143,9 @@ def line_mask(image_bgr: np.ndarray, color: ColorSpec) -> tuple[np.ndarray, np.n
     return mask, mask
 
 
-def region_mask(shape: tuple[int, ...], roi: Polygon | None, exclude: tuple[Polygon, ...], scale: float = 1.0) -> np.ndarray | None:
+def region_mask(
+    shape: tuple[int, ...], roi: Polygon | None, exclude: tuple[Polygon, ...], scale: float = 1.0
+) -> np.ndarray | None:
     """0/1 mask of where the actuator may be (inside ``roi``, outside every ``exclude``), or None.
 
     Polygons are in original pixels; ``scale`` is original px per px of ``shape``.
@@ -144,7 +153,7 @@ def region_mask(shape: tuple[int, ...], roi: Polygon | None, exclude: tuple[Poly
     Examples
     --------
     >>> m = region_mask((10, 10), ((0, 0), (5, 0), (5, 10), (0, 10)), ())
-    >>> int(m.sum()) > 0 and m[5, 8] == 0
+    >>> bool(m.sum() > 0 and m[5, 8] == 0)
     True
     """
     if roi is None and not exclude:
@@ -195,7 +204,9 @@ def _ridge_half_width(sub: np.ndarray) -> float:
     return float(np.median(vals)) if vals.size else 0.5
 
 
-def _candidates(mask: np.ndarray, fixed_xy: tuple[float, float] | None, max_candidates: int = 10) -> list[_Candidate]:
+def _candidates(
+    mask: np.ndarray, fixed_xy: tuple[float, float] | None, max_candidates: int = 10
+) -> list[_Candidate]:
     # external contours are ~50x cheaper than connectedComponentsWithStats on a full frame
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
     h, w = mask.shape
@@ -215,7 +226,9 @@ def _candidates(mask: np.ndarray, fixed_xy: tuple[float, float] | None, max_cand
         dist = np.inf
         if fixed_xy is not None:
             pts = c.reshape(-1, 2).astype(float)
-            dist = float(np.sqrt(np.min((pts[:, 0] - fixed_xy[0]) ** 2 + (pts[:, 1] - fixed_xy[1]) ** 2)))
+            dist = float(
+                np.sqrt(np.min((pts[:, 0] - fixed_xy[0]) ** 2 + (pts[:, 1] - fixed_xy[1]) ** 2))
+            )
         out.append(_Candidate(x0, y0, sub, float("nan"), float(length), dist))
     return out
 
@@ -235,6 +248,27 @@ def _choose(cands: list[_Candidate], near_px: float) -> tuple[_Candidate, bool]:
     return max(cands, key=lambda c: c.length), False
 
 
+def line_component(
+    mask: np.ndarray, fixed_end_px: tuple[float, float] | None, near_px: float
+) -> tuple[int, int, np.ndarray]:
+    """The component of a line mask that :func:`extract_centreline` starts from.
+
+    The longest line-like component reaching ``fixed_end_px`` (within ``near_px``), else the
+    longest; as ``(x0, y0, sub)``: its 0/1 mask ``sub`` in its bounding box (1 px margin) at
+    ``(x0, y0)`` of ``mask``.  Pixels of the work image throughout.
+
+    Raises
+    ------
+    NoLineFound
+        When ``mask`` holds nothing line-like.
+    """
+    cands = _candidates(mask, fixed_end_px)
+    if not cands:
+        raise NoLineFound("no line found: nothing long and thin in the mask")
+    best, _ = _choose(cands, near_px)
+    return best.x0, best.y0, best.sub
+
+
 def _fill_small_holes(sub: np.ndarray, max_fraction: float = 0.1) -> np.ndarray:
     """Fill holes smaller than ``max_fraction`` of the box (a clamp's frame becomes a block).
 
@@ -243,7 +277,11 @@ def _fill_small_holes(sub: np.ndarray, max_fraction: float = 0.1) -> np.ndarray:
     contours, hier = cv2.findContours(sub, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
     if hier is None:
         return sub
-    holes = [c for c, h in zip(contours, hier[0]) if h[3] != -1 and cv2.contourArea(c) < max_fraction * sub.size]
+    holes = [
+        c
+        for c, h in zip(contours, hier[0])
+        if h[3] != -1 and cv2.contourArea(c) < max_fraction * sub.size
+    ]
     if not holes:
         return sub
     filled = sub.copy()
@@ -259,7 +297,9 @@ def _cut_thick_parts(sub: np.ndarray, half_width: float) -> tuple[np.ndarray, np
     if dt.max() <= radius:
         return sub, None
     k = 2 * radius + 1
-    thick = cv2.morphologyEx(filled, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    thick = cv2.morphologyEx(
+        filled, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    )
     # everything within a disc radius of the thick part belongs to it (clamp frames, edges)
     thick = cv2.dilate(thick, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 5,) * 2))
     line = sub & (1 - thick)
@@ -280,7 +320,8 @@ _NEIGHBOUR_PX = np.hypot(_NEIGHBOURS[:, 0], _NEIGHBOURS[:, 1])
 
 
 def _pixel_graph(ys: np.ndarray, xs: np.ndarray, shape: tuple[int, int]) -> csr_matrix:
-    """8-neighbour graph of the pixels ``(ys, xs)``, both directions stored, built as CSR directly."""
+    """8-neighbour graph of the pixels ``(ys, xs)``, both directions stored, built as CSR
+    directly."""
     idx = np.full((shape[0] + 2, shape[1] + 2), -1, np.int32)
     idx[ys + 1, xs + 1] = np.arange(len(ys), dtype=np.int32)
     nb = idx[ys[:, None] + 1 + _NEIGHBOURS[:, 0], xs[:, None] + 1 + _NEIGHBOURS[:, 1]]  # (n, 8)
@@ -319,7 +360,9 @@ def order_pixels(
     """
     ys, xs = np.nonzero(sub)
     graph = _pixel_graph(ys, xs, sub.shape)
-    seed = 0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
+    seed = (
+        0 if start_xy is None else int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
+    )
     d0 = dijkstra(graph, directed=True, indices=seed)
     d0[~np.isfinite(d0)] = -1.0
     a = int(np.argmax(d0))  # the far (free) end
@@ -374,7 +417,9 @@ def _value(image: np.ndarray) -> np.ndarray:
     return image if image.ndim == 2 else image.max(axis=2)
 
 
-def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+def _cut_dark_blocks(
+    image: np.ndarray, cand: _Candidate, line: np.ndarray
+) -> tuple[np.ndarray, np.ndarray | None]:
     """Cut the line where it runs into a dark block (a clamp the black-hat mask left out).
 
     Only used with ``fixed_end: auto``, where no given fixed end truncates the line.
@@ -388,7 +433,9 @@ def _cut_dark_blocks(image: np.ndarray, cand: _Candidate, line: np.ndarray) -> t
     dark = (v <= 110).astype(np.uint8)
     radius = int(np.ceil(clamp_radius_px(cand.half_width)))
     k = 2 * radius + 1
-    block = cv2.morphologyEx(dark, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    block = cv2.morphologyEx(
+        dark, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    )
     if not block.any():
         return line, None
     block = cv2.dilate(block, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 5,) * 2))
@@ -438,7 +485,7 @@ def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> 
     """Mean darkness (255 - V) in a square around a line end: high next to a dark clamp."""
     r = int(6 * half_width + 8)
     h, w = image.shape[:2]
-    x, y = int(round(xy[0])), int(round(xy[1]))
+    x, y = int(round(xy[0])), int(round(xy[1]))  # noqa: RUF046 (numpy scalar)
     roi = image[max(y - r, 0) : min(y + r + 1, h), max(x - r, 0) : min(x + r + 1, w)]
     if roi.size == 0:
         return 0.0
@@ -446,7 +493,11 @@ def _surround_darkness(image: np.ndarray, xy: np.ndarray, half_width: float) -> 
 
 
 def _bridge(
-    line: np.ndarray, points: np.ndarray, others: list[_Candidate], best: _Candidate, max_gap_px: float
+    line: np.ndarray,
+    points: np.ndarray,
+    others: list[_Candidate],
+    best: _Candidate,
+    max_gap_px: float,
 ) -> tuple[np.ndarray, int, int, int] | None:
     """Join a fragment continuing the line past a gap (glare, occlusion) with a straight bridge.
 
@@ -478,10 +529,14 @@ def _bridge(
         x1 = max(best.x0 + line.shape[1], c.x0 + c.sub.shape[1])
         y1 = max(best.y0 + line.shape[0], c.y0 + c.sub.shape[0])
         union = np.zeros((y1 - y0, x1 - x0), np.uint8)
-        union[best.y0 - y0 : best.y0 - y0 + line.shape[0], best.x0 - x0 : best.x0 - x0 + line.shape[1]] |= line
-        union[c.y0 - y0 : c.y0 - y0 + c.sub.shape[0], c.x0 - x0 : c.x0 - x0 + c.sub.shape[1]] |= c.sub
-        thick = max(int(round(2 * best.half_width)), 1)
-        p0 = (int(round(end[0] - x0)), int(round(end[1] - y0)))
+        union[
+            best.y0 - y0 : best.y0 - y0 + line.shape[0], best.x0 - x0 : best.x0 - x0 + line.shape[1]
+        ] |= line
+        union[c.y0 - y0 : c.y0 - y0 + c.sub.shape[0], c.x0 - x0 : c.x0 - x0 + c.sub.shape[1]] |= (
+            c.sub
+        )
+        thick = max(int(round(2 * best.half_width)), 1)  # noqa: RUF046 (numpy scalar)
+        p0 = (int(round(end[0] - x0)), int(round(end[1] - y0)))  # noqa: RUF046 (numpy scalar)
         cv2.line(union, p0, (int(gx[i] - x0), int(gy[i] - y0)), 1, thick)
         others.remove(c)
         return union, x0, y0, int(np.count_nonzero(c.sub))
@@ -520,14 +575,21 @@ def extract_centreline(
     NoLineFound
         If no line-like component of the colour exists.
     """
-    if image_bgr is None or not (image_bgr.ndim == 2 or (image_bgr.ndim == 3 and image_bgr.shape[2] == 3)):
+    if image_bgr is None or not (
+        image_bgr.ndim == 2 or (image_bgr.ndim == 3 and image_bgr.shape[2] == 3)
+    ):
         raise NoLineFound("unreadable image (not a colour or grey image)")
     if image_bgr.ndim == 2 and not color.dark_line:
-        raise NoLineFound(f"a grey image cannot show line_color {color.describe()}; decode it in colour")
+        raise NoLineFound(
+            f"a grey image cannot show line_color {color.describe()}; decode it in colour"
+        )
     h, w = image_bgr.shape[:2]
     fe = None
     if fixed_end_px is not None and np.all(np.isfinite(fixed_end_px)):
-        fe = ((fixed_end_px[0] - (scale - 1) / 2) / scale, (fixed_end_px[1] - (scale - 1) / 2) / scale)
+        fe = (
+            (fixed_end_px[0] - (scale - 1) / 2) / scale,
+            (fixed_end_px[1] - (scale - 1) / 2) / scale,
+        )
     mask, weight = line_mask(image_bgr, color)
     if region is not None:
         mask &= region
@@ -543,28 +605,46 @@ def extract_centreline(
     others = [c for c in cands if c is not best]
     best = _with_width(best)
     others = [_with_width(c) if c.length >= RIVAL_FRACTION * best.length else c for c in others]
-    rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
+    rivals = sum(
+        1
+        for c in others
+        if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width
+    )
     line, thick = _cut_thick_parts(best.sub, best.half_width)
     if fe is None and thick is None:
         line, thick = _cut_dark_blocks(image_bgr, best, line)
     band = max(1.0, min(2.0, best.half_width))
     fe_sub = None if fe is None else (fe[0] - best.x0, fe[1] - best.y0)
     x0, y0 = best.x0, best.y0
-    points, branched, ends = order_pixels(line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band)
+    points, branched, ends = order_pixels(
+        line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band
+    )
     bridged = 0
     for _ in range(3):
         if len(points) < 4:
             break
         max_gap = 0.25 * float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
-        joined = _bridge(line, points, others, _Candidate(x0, y0, line, best.half_width, best.length, 0.0), max_gap)
+        joined = _bridge(
+            line,
+            points,
+            others,
+            _Candidate(x0, y0, line, best.half_width, best.length, 0.0),
+            max_gap,
+        )
         if joined is None:
             break
         line, x0, y0, n_px = joined
         bridged += n_px
         fe_sub = None if fe is None else (fe[0] - x0, fe[1] - y0)
-        points, branched, ends = order_pixels(line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band)
+        points, branched, ends = order_pixels(
+            line, weight[y0 : y0 + line.shape[0], x0 : x0 + line.shape[1]], fe_sub, band
+        )
     if bridged:
-        rivals = sum(1 for c in others if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width)
+        rivals = sum(
+            1
+            for c in others
+            if c.length >= RIVAL_FRACTION * best.length and c.half_width < 2.0 * best.half_width
+        )
     if len(points) < 8:
         raise NoLineFound(f"no line found: the longest candidate is only {len(points)} bands long")
     fixed_auto = fe is None
@@ -583,11 +663,14 @@ def extract_centreline(
         if clamp_end is None:
             darkness = [_surround_darkness(image_bgr, e, best.half_width) for e in ends_g]
             clamp_seen = clamp_seen or abs(darkness[0] - darkness[1]) >= 20.0
-            clamp_end = 1 if darkness[1] > darkness[0] else 0  # the clamp (dark block) sits at the fixed end
+            # the clamp (dark block) sits at the fixed end
+            clamp_end = 1 if darkness[1] > darkness[0] else 0
         if clamp_end == 1:
             points, ends = points[::-1], ends[::-1]
     ys, xs = np.nonzero(line)
-    touches = bool(xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1)
+    touches = bool(
+        xs.min() + x0 <= 0 or ys.min() + y0 <= 0 or xs.max() + x0 >= w - 1 or ys.max() + y0 >= h - 1
+    )
     gpts = points + np.array([x0, y0], float)
     # drop about one line width at each end: the band centroids bend towards the corner pixel
     # where the geodesic sweep starts, which would tilt the end tangents

@@ -18,7 +18,9 @@ OVERLAY_WIDTH_PX = 640
 _COLOURS = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
 
 
-def draw_overlay(image_bgr: np.ndarray, result: AngleResult, *, scale: float = 1.0, title: str = "") -> np.ndarray:
+def draw_overlay(
+    image_bgr: np.ndarray, result: AngleResult, *, scale: float = 1.0, title: str = ""
+) -> np.ndarray:
     """The photo with the extracted centre line, the fixed end and psi written on it.
 
     Parameters
@@ -38,24 +40,43 @@ def draw_overlay(image_bgr: np.ndarray, result: AngleResult, *, scale: float = 1
         BGR image at most :data:`OVERLAY_WIDTH_PX` wide.
     """
     f = min(1.0, OVERLAY_WIDTH_PX / image_bgr.shape[1])
-    out = cv2.resize(image_bgr, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else image_bgr.copy()
+    out = (
+        cv2.resize(image_bgr, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+        if f < 1
+        else image_bgr.copy()
+    )
     k = f / scale
     colour = _COLOURS.get(result.status, (255, 255, 255))
     if len(result.centreline_px):
         pts = (result.centreline_px - (scale - 1) / 2) * k
         cv2.polylines(out, [np.round(pts * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
         cv2.circle(out, tuple(int(v) for v in np.round(pts[0])), 6, (255, 80, 0), 2, cv2.LINE_AA)
-    text = f"psi = {result.psi_deg:+.1f} deg ({result.method})" if result.status != "failed" else "failed"
+    text = (
+        f"psi = {result.psi_deg:+.1f} deg ({result.method})"
+        if result.status != "failed"
+        else "failed"
+    )
     lines = [t for t in (title, text, result.reason[:90]) if t]
     if lines:
         box = out[: 10 + 22 * len(lines), :]
         box[:] = (box * 0.35).astype(np.uint8)
     for i, t in enumerate(lines):
-        cv2.putText(out, t, (8, 22 + 22 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.55, colour if i else (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(
+            out,
+            t,
+            (8, 22 + 22 * i),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.55,
+            colour if i else (255, 255, 255),
+            1,
+            cv2.LINE_AA,
+        )
     return out
 
 
-def contact_sheet(paths: Sequence[Path], *, columns: int = 6, tile_width_px: int = 320) -> np.ndarray:
+def contact_sheet(
+    paths: Sequence[Path], *, columns: int = 6, tile_width_px: int = 320
+) -> np.ndarray:
     """Tile overlay images (in the given order) into one sheet; unreadable tiles stay grey."""
     if not paths:
         raise ValueError("no overlays for a contact sheet")
@@ -63,9 +84,15 @@ def contact_sheet(paths: Sequence[Path], *, columns: int = 6, tile_width_px: int
     for p in paths:
         img = cv2.imread(str(p))
         tiles.append(img)
-    h_ref = next((t.shape[0] * tile_width_px // t.shape[1] for t in tiles if t is not None), tile_width_px * 3 // 4)
+    h_ref = next(
+        (t.shape[0] * tile_width_px // t.shape[1] for t in tiles if t is not None),
+        tile_width_px * 3 // 4,
+    )
     grey = np.full((h_ref, tile_width_px, 3), 128, np.uint8)
-    tiles = [grey if t is None else cv2.resize(t, (tile_width_px, h_ref), interpolation=cv2.INTER_AREA) for t in tiles]
+    tiles = [
+        grey if t is None else cv2.resize(t, (tile_width_px, h_ref), interpolation=cv2.INTER_AREA)
+        for t in tiles
+    ]
     rows = int(np.ceil(len(tiles) / columns))
     tiles += [np.zeros_like(grey)] * (rows * columns - len(tiles))
     return np.vstack([np.hstack(tiles[r * columns : (r + 1) * columns]) for r in range(rows)])

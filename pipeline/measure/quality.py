@@ -9,8 +9,8 @@ Never a silent wrong number: whatever the estimator returns, a row is ``flagged`
 - the contrast between line and surroundings is low;
 - the curvature is not constant beyond what the arc model explains (the BIC-chosen tangent-angle
   fit needs degree >= 2 *and* its psi differs from the Hyper circle fit's by more than
-  ``NONCONSTANT_DEG``); the ``turning`` and ``auto`` methods measure such lines correctly, so for it this is
-  only noted in ``reason`` and the row stays ``ok``;
+  ``NONCONSTANT_DEG``); the ``turning`` and ``auto`` methods measure such lines correctly, so for it
+  this is only noted in ``reason`` and the row stays ``ok``;
 - the estimator disagrees with both the arc and the turning fits by more than
   ``DISAGREE_DEG`` (e.g. the faithful ``paper`` average, biased by pixel noise); when the full
   ``turning`` fit gave psi (``turning``, or ``auto`` on non-constant curvature) its "turning
@@ -29,6 +29,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from pipeline.measure.extract import LineExtraction
 
 #: below this colour distance (BGR units) the contrast is low
@@ -41,7 +43,11 @@ DISAGREE_DEG = 3.0
 LENGTH_LOW, LENGTH_HIGH = 0.93, 1.07
 #: flags that doubt only how much of the line was seen, not the angle read from it: a photo
 #: flagged for these alone is trusted again when its psi agrees with its ramp (pipeline.ramp_check)
-COSMETIC_FLAGS: tuple[str, ...] = ("line partly hidden", "line touches the image border", "body partly hidden")
+COSMETIC_FLAGS: tuple[str, ...] = (
+    "line partly hidden",
+    "line touches the image border",
+    "body partly hidden",
+)
 
 
 @dataclass(frozen=True)
@@ -53,7 +59,9 @@ class Quality:
 
 
 
-def line_flags(line: LineExtraction, length_px: float, expected_length_px: float | None) -> list[str]:
+def line_flags(
+    line: LineExtraction, length_px: float, expected_length_px: float | None
+) -> list[str]:
     """Reasons to distrust an extracted line, whatever is computed from it (angle or ellipse).
 
     Parameters
@@ -78,7 +86,9 @@ def line_flags(line: LineExtraction, length_px: float, expected_length_px: float
         if ratio < LENGTH_LOW:
             flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
         elif ratio > LENGTH_HIGH:
-            flags.append(f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line")
+            flags.append(
+                f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line"
+            )
     if line.n_candidates > 1:
         flags.append(f"{line.n_candidates} candidate lines")
     if line.contrast < LOW_CONTRAST:
@@ -161,7 +171,7 @@ def assess_body(
     *,
     psi_deg: float,
     psi_check_deg: float,
-    widths_px: "np.ndarray",
+    widths_px: np.ndarray,
     expected_length_px: float | None,
     length_px: float,
     base_mismatch_deg: float | None,
@@ -197,31 +207,56 @@ def assess_body(
         core = w[int(0.1 * len(w)) : max(int(0.9 * len(w)), int(0.1 * len(w)) + 1)]
         lo, hi = np.percentile(core, [10, 90])
         if lo > 0 and hi / lo > WIDTH_RATIO:
-            flags.append(f"uneven outline (width {lo:.0f}-{hi:.0f} px): check line_color / roi / exclude in photoset preview")
+            flags.append(
+                f"uneven outline (width {lo:.0f}-{hi:.0f} px): check line_color / roi / exclude in "
+                "photoset preview"
+            )
     if abs(psi_check_deg - psi_deg) > TIP_UNSTABLE_DEG:
-        flags.append(f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)")
+        flags.append(
+            f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)"
+        )
     if line.branched_fraction > 0.05:
         flags.append("body closes on itself")
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
     if continues:
-        flags.append("the selection goes on past a gap beyond the free end: part of the body may be missed (photoset preview shows it)")
+        flags.append(
+            "the selection goes on past a gap beyond the free end: part of the body may be missed "
+            "(photoset preview shows it)"
+        )
     if free_end_width_ratio < NARROW_FREE_END:
-        flags.append(f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: one side of it may not be selected "
-                     "(faint), which turns its direction; check with photoset preview")
+        flags.append(
+            f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: one side of "
+            "it may not be selected "
+            "(faint), which turns its direction; check with photoset preview"
+        )
     if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
-        flags.append(f"the free end's direction is uncertain: the centre line stops {end_short_px:.0f} px short of the body's "
-                     f"end, and carried on along the selection there its direction changes by {abs(ridge_tip_deg):.0f} deg (photoset preview shows it)")
+        flags.append(
+            f"the free end's direction is uncertain: the centre line stops {end_short_px:.0f} px "
+            "short of the body's "
+            "end, and carried on along the selection there its direction changes by "
+            f"{abs(ridge_tip_deg):.0f} deg (photoset preview shows it)"
+        )
     elif end_short_px > 1.5 * line.width_px + 4.0:
-        flags.append(f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven outline there): check with photoset preview")
+        flags.append(
+            f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven "
+            "outline there): check with photoset preview"
+        )
     if start_gap_px > 2.0 * line.width_px + 4.0:
-        flags.append(f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or fixed_end is off")
+        flags.append(
+            f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or "
+            "fixed_end is off"
+        )
     if expected_length_px and length_px < 0.8 * expected_length_px:
-        flags.append(f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible")
+        flags.append(
+            f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible"
+        )
     if base_mismatch_deg is not None:
         notes.append("psi from the free end's tangent against fixed_direction_deg")
         if abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
-            flags.append(f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg")
+            flags.append(
+                f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
+            )
     if selected_fraction > 0.35:
         notes.append(f"selection covers {100 * selected_fraction:.0f}% of the photo")
     return Quality("flagged" if flags else "ok", "; ".join(flags + notes))

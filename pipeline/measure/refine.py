@@ -32,13 +32,17 @@ def _normals(points: np.ndarray, window: int = 3) -> np.ndarray:
     return np.c_[-t[:, 1], t[:, 0]]
 
 
-def _profile_shift(fine: np.ndarray, q: np.ndarray, nrm: np.ndarray, half_range: float) -> tuple[np.ndarray, np.ndarray]:
+def _profile_shift(
+    fine: np.ndarray, q: np.ndarray, nrm: np.ndarray, half_range: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Darkness centroid offset (fine px, along ``nrm``) of the profile at each point."""
     k = int(np.ceil(half_range * SAMPLES_PER_PX))
     off = np.arange(-k, k + 1, dtype=np.float32) / SAMPLES_PER_PX
     mapx = (q[:, 0:1] + nrm[:, 0:1] * off).astype(np.float32)
     mapy = (q[:, 1:2] + nrm[:, 1:2] * off).astype(np.float32)
-    prof = cv2.remap(fine, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).astype(np.float32)
+    prof = cv2.remap(fine, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).astype(
+        np.float32
+    )
     dark = prof.max(axis=1, keepdims=True) - prof
     peak = dark.max(axis=1, keepdims=True)
     wt = np.maximum(dark - FLOOR_FRACTION * peak, 0.0)

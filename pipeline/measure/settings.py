@@ -47,10 +47,10 @@ Examples
 >>> s = resolve_settings({"l0_mm": 210, "roi": [0, 0, 100, 50], "target": "body"})
 >>> s.target, s.color, s.roi[2]
 ('body', None, (100.0, 50.0))
->>> resolve_settings({"l0_mm": -1})
+>>> resolve_settings({"l0_mm": -1})  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-pipeline.measure.settings.SettingsError: l0_mm = -1 must be a positive number (fix: set l0_mm to the length of the marked layer in mm)
+pipeline.measure.settings.SettingsError: l0_mm = -1 must be a positive number (fix: set l0_mm ...)
 """
 
 from __future__ import annotations
@@ -61,7 +61,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from pipeline.measure.calibration import Calibration, CalibrationCache, CalibrationError, describe_problem
+from pipeline.measure.calibration import (
+    Calibration,
+    CalibrationCache,
+    CalibrationError,
+    describe_problem,
+)
 from pipeline.measure.colors import BLACK, ColorError, ColorSpec, parse_color
 
 #: a polygon in image pixels: ((x, y), ...)
@@ -76,8 +81,19 @@ KEYS: tuple[str, ...] = (
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
-    "l0_mm", "mm_per_px", "line_color", "fixed_end_x", "fixed_end_y", "positive_turn", "target", "background",
-    "roi", "exclude", "fixed_direction_deg", "method", "calibration",
+    "l0_mm",
+    "mm_per_px",
+    "line_color",
+    "fixed_end_x",
+    "fixed_end_y",
+    "positive_turn",
+    "target",
+    "background",
+    "roi",
+    "exclude",
+    "fixed_direction_deg",
+    "method",
+    "calibration",
 )
 
 
@@ -155,7 +171,9 @@ class MeasureSettings:
     def describe_color(self) -> str:
         """The selection in words, for reasons and previews."""
         if self.color is None:
-            return "differs from the " + ("background photo" if self.background_path else "backdrop")
+            return "differs from the " + (
+                "background photo" if self.background_path else "backdrop"
+            )
         return f"line_color {self.color.describe()}"
 
 
@@ -174,7 +192,9 @@ def is_missing(value: Any) -> bool:
     return isinstance(value, str) and not value.strip()
 
 
-def _number(raw: Mapping[str, Any], key: str, problems: list[SettingProblem], fix: str) -> float | None:
+def _number(
+    raw: Mapping[str, Any], key: str, problems: list[SettingProblem], fix: str
+) -> float | None:
     value = raw.get(key)
     if is_missing(value):
         return None
@@ -198,15 +218,23 @@ def _points(value: Any, key: str) -> Polygon:
         except yaml.YAMLError as exc:
             raise ValueError(f"{key} {value!r} is not a list ({exc})") from None
     if not isinstance(value, (list, tuple)):
-        raise ValueError(f"{key} = {value!r} is not a box [x0, y0, x1, y1] or a polygon [[x, y], ...]")
-    if len(value) == 4 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value):
+        raise ValueError(  # noqa: TRY004 (callers report ValueError as a Problem)
+            f"{key} = {value!r} is not a box [x0, y0, x1, y1] or a polygon [[x, y], ...]"
+        )
+    if len(value) == 4 and all(
+        isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value
+    ):
         x0, y0, x1, y1 = (float(v) for v in value)
         if not (x1 > x0 and y1 > y0):
             raise ValueError(f"{key} box {list(value)} needs x1 > x0 and y1 > y0")
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
     pts = []
     for p in value:
-        if not (isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in p)):
+        if not (
+            isinstance(p, (list, tuple))
+            and len(p) == 2
+            and all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in p)
+        ):
             raise ValueError(f"{key} point {p!r} is not [x, y]")
         pts.append((float(p[0]), float(p[1])))
     if len(pts) < 3:
@@ -214,7 +242,9 @@ def _points(value: Any, key: str) -> Polygon:
     return tuple(pts)
 
 
-def _fixed_end(raw: Mapping[str, Any], problems: list[SettingProblem]) -> tuple[float, float] | None:
+def _fixed_end(
+    raw: Mapping[str, Any], problems: list[SettingProblem]
+) -> tuple[float, float] | None:
     if "fixed_end_x" in raw or "fixed_end_y" in raw:
         x, y = raw.get("fixed_end_x"), raw.get("fixed_end_y")
         if not (is_missing(x) and is_missing(y)):
@@ -224,18 +254,37 @@ def _fixed_end(raw: Mapping[str, Any], problems: list[SettingProblem]) -> tuple[
                     return fx, fy
             except (TypeError, ValueError):
                 pass
-            problems.append(SettingProblem("fixed_end", f"fixed_end_x, fixed_end_y = {x!r}, {y!r}", "give both as pixel numbers, or leave both empty"))
+            problems.append(
+                SettingProblem(
+                    "fixed_end",
+                    f"fixed_end_x, fixed_end_y = {x!r}, {y!r}",
+                    "give both as pixel numbers, or leave both empty",
+                )
+            )
             return None
     fe = raw.get("fixed_end", "auto")
     if is_missing(fe) or fe == "auto":
         return None
-    if isinstance(fe, (list, tuple)) and len(fe) == 2 and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in fe):
+    if (
+        isinstance(fe, (list, tuple))
+        and len(fe) == 2
+        and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in fe)
+    ):
         return float(fe[0]), float(fe[1])
-    problems.append(SettingProblem("fixed_end", f"fixed_end = {fe!r}", "use 'auto' or a pixel position [x, y] near the clamped end"))
+    problems.append(
+        SettingProblem(
+            "fixed_end",
+            f"fixed_end = {fe!r}",
+            "use 'auto' or a pixel position [x, y] near the clamped end",
+        )
+    )
     return None
 
 
-_CALIBRATION_FIX = "write calibration as {board: <board photo>, square_mm: <square side in mm>, inner_corners: [<columns>, <rows>]}"
+_CALIBRATION_FIX = (
+    "write calibration as {board: <board photo>, square_mm: <square side in mm>, "
+    "inner_corners: [<columns>, <rows>]}"
+)
 
 
 def _yaml_value(value: Any) -> Any:
@@ -255,7 +304,8 @@ def merge_calibration(folder_value: Any, row_value: Any) -> Any:
 
     Examples
     --------
-    >>> merge_calibration({"board": "a.jpg", "square_mm": 20, "inner_corners": [9, 6]}, "b.jpg")["board"]
+    >>> given = {"board": "a.jpg", "square_mm": 20, "inner_corners": [9, 6]}
+    >>> merge_calibration(given, "b.jpg")["board"]
     'b.jpg'
     >>> merge_calibration({"board": "a.jpg", "square_mm": 20}, "{square_mm: 25}")
     {'board': 'a.jpg', 'square_mm': 25}
@@ -270,7 +320,10 @@ def merge_calibration(folder_value: Any, row_value: Any) -> Any:
 
 
 def _calibration(
-    raw: Mapping[str, Any], folder: Any, problems: list[SettingProblem], cache: CalibrationCache | None
+    raw: Mapping[str, Any],
+    folder: Any,
+    problems: list[SettingProblem],
+    cache: CalibrationCache | None,
 ) -> Calibration | None:
     """The ``calibration`` setting, computed (or read from the store) -- or its problems."""
     from pathlib import Path
@@ -282,28 +335,64 @@ def _calibration(
     if isinstance(value, (str, list, tuple)):
         value = {"board": value}
     if not isinstance(value, Mapping):
-        problems.append(SettingProblem("calibration", f"calibration = {raw.get('calibration')!r} is not a mapping", _CALIBRATION_FIX))
+        problems.append(
+            SettingProblem(
+                "calibration",
+                f"calibration = {raw.get('calibration')!r} is not a mapping",
+                _CALIBRATION_FIX,
+            )
+        )
         return None
     bad = len(problems)
     unknown = sorted(set(map(str, value)) - {"board", "square_mm", "inner_corners"})
     if unknown:
-        problems.append(SettingProblem("calibration", f"calibration key(s) {unknown} unknown", _CALIBRATION_FIX))
+        problems.append(
+            SettingProblem("calibration", f"calibration key(s) {unknown} unknown", _CALIBRATION_FIX)
+        )
     boards = value.get("board")
     boards = [boards] if isinstance(boards, str) else boards
     paths: list[str] = []
-    if not isinstance(boards, (list, tuple)) or not boards or not all(isinstance(b, str) and b.strip() for b in boards):
-        problems.append(SettingProblem("calibration", f"calibration board = {value.get('board')!r}: name the board photo(s)", _CALIBRATION_FIX))
+    if (
+        not isinstance(boards, (list, tuple))
+        or not boards
+        or not all(isinstance(b, str) and b.strip() for b in boards)
+    ):
+        problems.append(
+            SettingProblem(
+                "calibration",
+                f"calibration board = {value.get('board')!r}: name the board photo(s)",
+                _CALIBRATION_FIX,
+            )
+        )
     else:
         for b in boards:
             path = Path(b.strip())
             if folder is not None and not path.is_absolute():
                 path = Path(folder) / path
             if not path.is_file():
-                problems.append(SettingProblem("calibration", f"calibration board photo {b!r} does not exist", "put the photo of the checkerboard (lying where the actuator lies) in the photo-set folder and name it in calibration: board"))
+                problems.append(
+                    SettingProblem(
+                        "calibration",
+                        f"calibration board photo {b!r} does not exist",
+                        "put the photo of the checkerboard (lying where the actuator lies) in the "
+                        "photo-set folder and name it in calibration: board",
+                    )
+                )
             paths.append(str(path.resolve()))
-    square = _number(value, "square_mm", problems, "set calibration square_mm to the side of one board square in mm (measure the print)")
+    square = _number(
+        value,
+        "square_mm",
+        problems,
+        "set calibration square_mm to the side of one board square in mm (measure the print)",
+    )
     if square is None and not any(p.key == "square_mm" for p in problems[bad:]):
-        problems.append(SettingProblem("calibration", "calibration square_mm is missing", "add square_mm: <side of one board square in mm> to calibration"))
+        problems.append(
+            SettingProblem(
+                "calibration",
+                "calibration square_mm is missing",
+                "add square_mm: <side of one board square in mm> to calibration",
+            )
+        )
     corners = value.get("inner_corners")
     if isinstance(corners, str):  # "9x6" or "9, 6"
         corners = corners.lower().replace("x", ",").split(",")
@@ -314,7 +403,14 @@ def _calibration(
         if not (2 <= cols <= 100 and 2 <= rows <= 100):
             raise ValueError(corners)
     except ValueError:
-        problems.append(SettingProblem("calibration", f"calibration inner_corners = {value.get('inner_corners')!r}", "give [columns, rows] of inner corners (where four squares meet): a board of 10 x 7 squares has [9, 6]"))
+        problems.append(
+            SettingProblem(
+                "calibration",
+                f"calibration inner_corners = {value.get('inner_corners')!r}",
+                "give [columns, rows] of inner corners (where four squares meet): a board of 10 x "
+                "7 squares has [9, 6]",
+            )
+        )
         cols = rows = 0
     if len(problems) > bad or square is None:
         return None
@@ -353,17 +449,41 @@ def settings_problems(
     problems: list[SettingProblem] = []
     l0 = _number(raw, "l0_mm", problems, "set l0_mm to the length of the marked layer in mm")
     if l0 is None and not any(p.key == "l0_mm" for p in problems):
-        problems.append(SettingProblem("l0_mm", "l0_mm is missing", "add 'l0_mm: <length of the marked layer in mm>' to photoset.yaml (or an l0_mm manifest column)"))
-    mpp = _number(raw, "mm_per_px", problems, "set mm_per_px to the image scale in mm per pixel, or leave it out")
+        problems.append(
+            SettingProblem(
+                "l0_mm",
+                "l0_mm is missing",
+                "add 'l0_mm: <length of the marked layer in mm>' to photoset.yaml (or an l0_mm "
+                "manifest column)",
+            )
+        )
+    mpp = _number(
+        raw,
+        "mm_per_px",
+        problems,
+        "set mm_per_px to the image scale in mm per pixel, or leave it out",
+    )
     target = raw.get("target")
     target = "line" if is_missing(target) else str(target).strip().lower()
     if target not in TARGETS:
-        problems.append(SettingProblem("target", f"target = {raw.get('target')!r}", "use 'line' (a drawn line) or 'body' (the actuator's outline)"))
+        problems.append(
+            SettingProblem(
+                "target",
+                f"target = {raw.get('target')!r}",
+                "use 'line' (a drawn line) or 'body' (the actuator's outline)",
+            )
+        )
         target = "line"
     turn = raw.get("positive_turn")
     turn = "ccw" if is_missing(turn) else str(turn).strip().lower()
     if turn not in POSITIVE_TURNS:
-        problems.append(SettingProblem("positive_turn", f"positive_turn = {raw.get('positive_turn')!r}", "use 'ccw' or 'cw'"))
+        problems.append(
+            SettingProblem(
+                "positive_turn",
+                f"positive_turn = {raw.get('positive_turn')!r}",
+                "use 'ccw' or 'cw'",
+            )
+        )
         turn = "ccw"
     color: ColorSpec | None = BLACK if target == "line" else None
     if not is_missing(raw.get("line_color")):
@@ -380,14 +500,27 @@ def settings_problems(
         except (TypeError, ValueError):
             fixed_direction = float("nan")
         if isinstance(direction, bool) or not math.isfinite(fixed_direction):
-            problems.append(SettingProblem("fixed_direction_deg", f"fixed_direction_deg = {direction!r} is not a number", "give the direction in degrees, counter-clockwise from +x on screen (0 = to the right, 90 = up)"))
+            problems.append(
+                SettingProblem(
+                    "fixed_direction_deg",
+                    f"fixed_direction_deg = {direction!r} is not a number",
+                    "give the direction in degrees, counter-clockwise from +x on screen (0 = to "
+                    "the right, 90 = up)",
+                )
+            )
             fixed_direction = None
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
             roi = _points(raw["roi"], "roi")
         except ValueError as exc:
-            problems.append(SettingProblem("roi", str(exc), "write roi as [x0, y0, x1, y1] or [[x, y], [x, y], [x, y], ...] in pixels"))
+            problems.append(
+                SettingProblem(
+                    "roi",
+                    str(exc),
+                    "write roi as [x0, y0, x1, y1] or [[x, y], [x, y], [x, y], ...] in pixels",
+                )
+            )
     exclude: list[Polygon] = []
     ex = raw.get("exclude")
     if not is_missing(ex):
@@ -405,34 +538,66 @@ def settings_problems(
             try:
                 exclude.append(_points(item, f"exclude[{i}]"))
             except ValueError as exc:
-                problems.append(SettingProblem("exclude", str(exc), "write exclude as a list of polygons [[[x, y], [x, y], [x, y]], ...] or boxes [[x0, y0, x1, y1], ...]"))
+                problems.append(
+                    SettingProblem(
+                        "exclude",
+                        str(exc),
+                        "write exclude as a list of polygons [[[x, y], [x, y], [x, y]], ...] or "
+                        "boxes [[x0, y0, x1, y1], ...]",
+                    )
+                )
     method: str | None = None
     if not is_missing(raw.get("method")):
         from pipeline.measure.estimators import METHODS
 
         method = str(raw["method"]).strip()
         if method not in METHODS:
-            problems.append(SettingProblem("method", f"method = {raw['method']!r} is unknown", f"use one of {', '.join(METHODS)}"))
+            problems.append(
+                SettingProblem(
+                    "method",
+                    f"method = {raw['method']!r} is unknown",
+                    f"use one of {', '.join(METHODS)}",
+                )
+            )
     background: str | None = None
     if not is_missing(raw.get("background")):
         path = Path(str(raw["background"]))
         if folder is not None and not path.is_absolute():
             path = Path(folder) / path
         if not path.is_file():
-            problems.append(SettingProblem("background", f"background photo {str(raw['background'])!r} does not exist", "put a photo of the empty scene in the photo-set folder and name it in 'background'"))
+            problems.append(
+                SettingProblem(
+                    "background",
+                    f"background photo {str(raw['background'])!r} does not exist",
+                    "put a photo of the empty scene in the photo-set folder and name it in "
+                    "'background'",
+                )
+            )
         background = str(path)
     calibration = _calibration(raw, folder, problems, calibrations)
     if problems or l0 is None:
         return None, problems
     return MeasureSettings(
-        l0_mm=l0, mm_per_px=mpp, color=color, fixed_end_px=fixed_end, positive_turn=turn, target=target,
-        background_path=background, roi=roi, exclude=tuple(exclude), fixed_direction_deg=fixed_direction,
-        method=method, calibration=calibration,
+        l0_mm=l0,
+        mm_per_px=mpp,
+        color=color,
+        fixed_end_px=fixed_end,
+        positive_turn=turn,
+        target=target,
+        background_path=background,
+        roi=roi,
+        exclude=tuple(exclude),
+        fixed_direction_deg=fixed_direction,
+        method=method,
+        calibration=calibration,
     ), []
 
 
 def resolve_settings(
-    raw: Mapping[str, Any] | None = None, *, folder: Any = None, calibrations: CalibrationCache | None = None,
+    raw: Mapping[str, Any] | None = None,
+    *,
+    folder: Any = None,
+    calibrations: CalibrationCache | None = None,
     **values: Any,
 ) -> MeasureSettings:
     """Resolve settings given as a mapping and/or keywords; raise :class:`SettingsError` if bad.
@@ -442,7 +607,9 @@ def resolve_settings(
     >>> resolve_settings(l0_mm=150, line_color="red", fixed_end=[10, 20]).fixed_end_px
     (10.0, 20.0)
     """
-    settings, problems = settings_problems({**(raw or {}), **values}, folder=folder, calibrations=calibrations)
+    settings, problems = settings_problems(
+        {**(raw or {}), **values}, folder=folder, calibrations=calibrations
+    )
     if settings is None:
         raise SettingsError(problems)
     return settings

@@ -13,7 +13,14 @@ from typing import Any
 import cv2
 import numpy as np
 
-from pipeline.measure.core import DEFAULT_METHOD, AngleResult, decode_for_work, decodes_grey, failed, measure_decoded
+from pipeline.measure.core import (
+    DEFAULT_METHOD,
+    AngleResult,
+    decode_for_work,
+    decodes_grey,
+    failed,
+    measure_decoded,
+)
 from pipeline.measure.settings import MeasureSettings
 
 
@@ -51,7 +58,7 @@ def run_task(task: Task) -> dict[str, Any]:
             )
     except OSError as exc:
         res = failed(task.method, f"unreadable image: {task.path}: {exc.strerror or exc}")
-    except Exception as exc:  # one bad photo never stops the set
+    except Exception as exc:  # noqa: BLE001 - one bad photo never stops the set
         res = failed(task.method, f"internal error on this photo: {type(exc).__name__}: {exc}")
     seconds = time.perf_counter() - t0
     if task.overlay_path is not None:
@@ -59,8 +66,11 @@ def run_task(task: Task) -> dict[str, Any]:
     return result_fields(res, seconds)
 
 
-def write_overlay(path: str, img: np.ndarray | None, factor: int, res: AngleResult, title: str) -> None:
-    """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR) and write a JPEG."""
+def write_overlay(
+    path: str, img: np.ndarray | None, factor: int, res: AngleResult, title: str
+) -> None:
+    """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR) and write a
+    JPEG."""
     from pipeline.measure.overlay import draw_overlay
 
     base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)

@@ -36,9 +36,9 @@ MATERIAL_NAMES: tuple[str, ...] = ("DS20", "DS30", "SS40", "SS50")
 
 __all__ = [
     "CHOICES",
-    "PROTOCOL",
     "DEFAULT_MATERIALS_PATH",
     "MATERIAL_NAMES",
+    "PROTOCOL",
     "REASONS",
     "Material",
     "ModelOptions",

@@ -321,7 +321,7 @@ def fit_l0(
             "they may fix at most one parameter, so pass l0_mm instead of fitting it"
         )
     lo, hi = bounds
-    grid = np.linspace(lo, hi, max(2, int(round((hi - lo) / 10.0)) + 1))
+    grid = np.linspace(lo, hi, max(2, int(round((hi - lo) / 10.0)) + 1))  # noqa: RUF046 (numpy scalar)
     values = [_model_worst(table, opts, float(v)) for v in grid]
     i = int(np.argmin(values))
     if not math.isfinite(values[i]):

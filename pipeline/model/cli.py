@@ -1,4 +1,5 @@
-"""``python -m pipeline model ...``: P(psi) curves, single values, anchor table, benchmark."""
+"""``python -m pipeline model ...``: P(psi) curves, single values, anchor table (its benchmark:
+``python -m pipeline bench model``)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import write_table
 from pipeline.model.materials import Material, load_materials
 from pipeline.model.options import CHOICES, ModelOptions, make_options
 
@@ -102,7 +104,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="output CSV: material, psi_deg, pressure_kpa, reason",
     )
     p.add_argument(
-        "--psi-max", type=float, default=None, help="first angle (deg); default psi0 = 210"
+        "--psi-max", type=float, default=None, help="first angle (deg); default the material's psi0"
     )
     p.add_argument("--psi-min", type=float, default=-360.0, help="last angle (deg); default -360")
     p.add_argument("--n", type=int, default=400, help="number of angles (default 400)")
@@ -146,16 +148,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "snaps", parents=[parent], help="print snap-through regions of P(psi) per material"
     )
     p.add_argument("--material", default=None, help="one material (default: all)")
-    p = sub.add_parser(
-        "bench", help="print time (ms) per quadrature grid size and convergence error"
-    )
-    p.add_argument(
-        "--grid-sizes",
-        type=int,
-        nargs="+",
-        default=[2, 3, 4, 6, 8, 12],
-        help="grid sizes n (n_tau = n, n_phi = 2n nodes); default 2 3 4 6 8 12",
-    )
 
 
 def _material(args: argparse.Namespace, name: str) -> Material:
@@ -173,12 +165,6 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.model import model_curve, pressure_kpa, psi_deg, snap_regions
 
     cmd = args.model_command
-    if cmd == "bench":
-        from pipeline.model.bench import benchmark_model, format_benchmark
-
-        df = benchmark_model(grid_sizes=args.grid_sizes)
-        print(format_benchmark(df))
-        return 0
     opts = reading_options(args)
     if cmd == "curve":
         mat = _material(args, args.material)
@@ -186,8 +172,7 @@ def run(args: argparse.Namespace) -> int:
             raise UserInputError("--n must be at least 2")
         top = mat.psi0_deg if args.psi_max is None else args.psi_max
         df = model_curve(mat, np.linspace(top, args.psi_min, args.n), **opts)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(args.out, index=False)
+        write_table(df, args.out, float_format=None)
         print(
             f"wrote {len(df)} angles to {args.out} ({int(df.pressure_kpa.isna().sum())} undefined)"
         )
@@ -351,8 +336,8 @@ def format_calibration(
         fixed = {k: v for k, v in options.items() if k not in keys and k != "l0_mm"}
         res = search_readings(keys, materials=table, **fixed)
         passing = res[res["passes"]]
-        out += ["", f"Search (steps 1-4): {len(res)} derived readings, {len(passing)} meet "
-                f"+-{MODEL_BAR_PCT:g} % on both model results at their l0:"]
+        out += ["", (f"Search (steps 1-4): {len(res)} derived readings, {len(passing)} meet "
+                     f"+-{MODEL_BAR_PCT:g} % on both model results at their l0:")]
         cols = [*keys, "departures", "l0_fit_mm", "ss50_pct", "ss40_pct",
                 "exp_pressure_rms_pct", "exp_psi_rms_deg", "exp_range_rms_pct"]
         shown = (passing if len(passing) else res.head(5))[cols]

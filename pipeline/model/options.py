@@ -135,7 +135,7 @@ _POSITIVE_OR_NONE = ("eq12_scale", "l0_mm", "k_p")
 
 def _number(key: str, value: Any) -> float:
     """``value`` as a finite float, or a UserInputError naming the option (strings refused)."""
-    if isinstance(value, (str, bytes)) or isinstance(value, bool):
+    if isinstance(value, (str, bytes, bool)):
         raise UserInputError(
             f"model options: {key} must be a number, got the text {value!r}; pass a number"
         )

@@ -10,7 +10,8 @@ pages      the overview, one page per material and the comparison page
 strip      the Fig. 5-style photo strip of one ramp
 provenance the last page: software, config and the sha256 of every input
 reasons    flag and failure reasons in words
-style      A4 pages, fonts, one colour per material (used by the bench and force pages too)
-typeset    text and typeset tables placed in points (``Flow``, ``Table``, ``fmt``)
 textcheck  the texts a page draws, with their extents (tests check overlaps and sizes)
+
+The page style and typeset tables are in :mod:`pipeline.layout` (shared with the pages of the
+study, force and video datasets, which this package draws through their ``figures``).
 """

@@ -23,19 +23,20 @@ from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from pipeline import __version__
-from pipeline.bench import pages as bench_pages
 from pipeline.fileio import atomic_write_bytes
 from pipeline.force import pages as force_pages
+from pipeline.layout.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.data import ReportData, ReportInputs, load_report_data
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
-from pipeline.video import pages as video_pages
 from pipeline.report.provenance import provenance_pages
-from pipeline.report.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.summary import summary_page
 from pipeline.report.textcheck import FOOTER_GID
+from pipeline.study import pages as study_pages
+from pipeline.video import pages as video_pages
 
-#: what each page is, for the contents list on page 1 (by figure label; first page of a run of pages)
+#: what each page is, for the contents list on page 1 (by figure label; first page of a run of
+#: pages)
 CONTENTS: dict[str, str] = {
     "overview": "All materials (as Fig. 6)",
     "material": "One page per material: curves, table, photos",
@@ -94,7 +95,8 @@ def pdf_float_decimals(decimals: int = PDF_FLOAT_DECIMALS) -> Iterator[None]:
 
 
 def render_pdf(figures: list[Figure], title: str) -> bytes:
-    """Save figures as pages of one PDF with a footer; no timestamps, so the bytes depend on the figures only."""
+    """Save figures as pages of one PDF with a footer; no timestamps, so the bytes depend on the
+    figures only."""
     buf = io.BytesIO()
     metadata = {"Title": title, "Creator": f"pipeline {__version__}", "CreationDate": None}
     saved_epoch = os.environ.pop("SOURCE_DATE_EPOCH", None)  # would re-introduce a date
@@ -111,8 +113,16 @@ def render_pdf(figures: list[Figure], title: str) -> bytes:
 
 def add_footer(fig: Figure, text: str) -> None:
     """The page line, bottom right, inside the footer band (nothing else is drawn there)."""
-    fig.text(1.0 - 30.0 / (72.0 * fig.get_figwidth()), 0.45 * FOOTER_PT / (72.0 * fig.get_figheight()), text,
-             ha="right", va="center", fontsize=7.0, color="0.4", gid=FOOTER_GID)
+    fig.text(
+        1.0 - 30.0 / (72.0 * fig.get_figwidth()),
+        0.45 * FOOTER_PT / (72.0 * fig.get_figheight()),
+        text,
+        ha="right",
+        va="center",
+        fontsize=7.0,
+        color="0.4",
+        gid=FOOTER_GID,
+    )
 
 
 def contents(figures: list[Figure]) -> list[tuple[str, int]]:
@@ -133,9 +143,12 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     infos: list[str] = []
     extra: list[Figure] = []
     colors = material_colors(data.materials)
-    sources = [("--bench-dir", data.inputs.bench_dir, bench_pages.figures),
-               ("--force-dir", data.inputs.force_dir, lambda d: force_pages.figures(d, colors=colors))]
-    sources += [("--video-dirs", d, video_pages.figures) for d in data.inputs.video_dirs]  # a page per video dataset
+    sources = [
+        ("--bench-dir", data.inputs.bench_dir, study_pages.figures),
+        ("--force-dir", data.inputs.force_dir, lambda d: force_pages.figures(d, colors=colors)),
+    ]
+    # a page per video dataset
+    sources += [("--video-dirs", d, video_pages.figures) for d in data.inputs.video_dirs]
     for name, folder, build in sources:
         if folder is None:
             continue
@@ -148,7 +161,9 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
-                warnings.append(f"{m}: no model curve in --model-curves; its plot has no dashed model line")
+                warnings.append(
+                    f"{m}: no model curve in --model-curves; its plot has no dashed model line"
+                )
     for m in data.materials:
         if not (data.rms["material"].astype(str) == m).any():
             warnings.append(f"{m}: no row in --rms; its comparison values show n/a")
@@ -156,7 +171,11 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
-    body = [overview_page(data)] + [material_page(data, m) for m in data.materials] + [comparison_page(data)]
+    body = (
+        [overview_page(data)]
+        + [material_page(data, m) for m in data.materials]
+        + [comparison_page(data)]
+    )
     body += [f for f in [model_provenance_page(data)] if f is not None]  # which l0, what was fitted
     body += extra + provenance_pages(data, __version__, infos, warnings)
     return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
@@ -185,5 +204,12 @@ def build_report(inputs: ReportInputs, out: str | os.PathLike[str]) -> ReportRes
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(path, pdf)
-    return ReportResult(path=path, pages=len(figures), materials=tuple(data.materials), warnings=tuple(warnings),
-                        load_s=t1 - t0, pages_s=t2 - t1, pdf_s=time.perf_counter() - t2)
+    return ReportResult(
+        path=path,
+        pages=len(figures),
+        materials=tuple(data.materials),
+        warnings=tuple(warnings),
+        load_s=t1 - t0,
+        pages_s=t2 - t1,
+        pdf_s=time.perf_counter() - t2,
+    )

@@ -55,18 +55,43 @@ def _dataset_lines(angles: pd.DataFrame, datasets: Sequence[str]) -> list[tuple[
     for name in datasets:
         rows = angles[angles["dataset"] == name]
         if "calibration_px" not in rows.columns:
-            lines.append(("b", f"{name}: unknown (angles.csv written before calibration was recorded)"))
+            lines.append(
+                ("b", f"{name}: unknown (angles.csv written before calibration was recorded)")
+            )
             continue
         px = pd.to_numeric(rows["calibration_px"], errors="coerce")
-        mm = pd.to_numeric(rows.get("calibration_mm", pd.Series(index=rows.index, dtype=float)), errors="coerce")
+        mm = pd.to_numeric(
+            rows.get("calibration_mm", pd.Series(index=rows.index, dtype=float)), errors="coerce"
+        )
         n = int(px.notna().sum())
         if n == 0:
-            lines.append(("b", f"{name}: not calibrated: psi measured in the image (mm_per_px or the line's own length)"))
+            lines.append(
+                (
+                    "b",
+                    (
+                        f"{name}: not calibrated: psi measured in the image (mm_per_px or the "
+                        "line's own length)"
+                    ),
+                )
+            )
             continue
-        errors = sorted({(round(float(p), 3), round(float(m), 4)) for p, m in zip(px[px.notna()], mm[px.notna()])})
+        errors = sorted(
+            {
+                (round(float(p), 3), round(float(m), 4))
+                for p, m in zip(px[px.notna()], mm[px.notna()])
+            }
+        )
         text = ", ".join(f"{p:.2f} px ({m:.3f} mm on the plane)" for p, m in errors)
         worst = max(p for p, _ in errors)
-        lines.append(("w" if worst > MAX_RMS_PX else "b",
-                      f"{name}: calibrated, {n} of {len(rows)} photos; reprojection error {text}"
-                      + (f" -- above {MAX_RMS_PX:g} px, those rows are flagged" if worst > MAX_RMS_PX else "")))
+        lines.append(
+            (
+                "w" if worst > MAX_RMS_PX else "b",
+                f"{name}: calibrated, {n} of {len(rows)} photos; reprojection error {text}"
+                + (
+                    f" -- above {MAX_RMS_PX:g} px, those rows are flagged"
+                    if worst > MAX_RMS_PX
+                    else ""
+                ),
+            )
+        )
     return lines

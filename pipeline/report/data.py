@@ -25,11 +25,11 @@ from pipeline.aggregate import (
     read_angles,
 )
 from pipeline.compare import check_hysteresis
-from pipeline.bench.pages import TABLES as BENCH_TABLES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 from pipeline.force.pages import FILES as FORCE_FILES
 from pipeline.photoset import MANIFEST, SETTINGS, TRUTH
+from pipeline.study.pages import TABLES as BENCH_TABLES
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
 EXIF_IFD, EXIF_DATETIME_ORIGINAL, EXIF_DATETIME = 0x8769, 36867, 306
@@ -169,7 +169,9 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
 TIMING_COLUMNS: tuple[str, ...] = ("seconds",)
 
 
-def sha256_measurements(path: str | os.PathLike[str], timing: Sequence[str] = TIMING_COLUMNS) -> str:
+def sha256_measurements(
+    path: str | os.PathLike[str], timing: Sequence[str] = TIMING_COLUMNS
+) -> str:
     """Hex sha256 of a CSV table without its run-time columns (``seconds``).
 
     A measure job records how long each photo took; two runs on the same photos (on a
@@ -238,27 +240,52 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         hysteresis = pool_hysteresis(pd.concat(parts, ignore_index=True))
     else:
         hysteresis = aggregate_hysteresis(angles)
-        notes.append("hysteresis recomputed from the angles (setpoint levels, ok rows only): no --hysteresis given")
+        notes.append(
+            "hysteresis recomputed from the angles (setpoint levels, ok rows only): no "
+            "--hysteresis given"
+        )
     per_actuator = aggregate_per_actuator(angles)
-    rms = pd.concat(
-        [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms], ignore_index=True
-    ) if inputs.rms else pd.DataFrame(columns=["material"])
+    rms = (
+        pd.concat(
+            [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms],
+            ignore_index=True,
+        )
+        if inputs.rms
+        else pd.DataFrame(columns=["material"])
+    )
     key = "curve" if "curve" in rms.columns else "material"  # one row per material and l0
     if rms[key].duplicated().any():
         dup = rms.loc[rms[key].duplicated(), key].iloc[0]
         raise UserInputError(f"--rms: {key} {dup!r} appears twice; pass one rms.csv row per {key}")
-    curves = pd.concat(
-        [_read_csv(p, "model curve CSV from 'model curve'", ("material", "psi_deg", "pressure_kpa"))
-         for p in inputs.model_curves], ignore_index=True
-    ) if inputs.model_curves else pd.DataFrame(columns=["material", "psi_deg", "pressure_kpa"])
+    curves = (
+        pd.concat(
+            [
+                _read_csv(
+                    p, "model curve CSV from 'model curve'", ("material", "psi_deg", "pressure_kpa")
+                )
+                for p in inputs.model_curves
+            ],
+            ignore_index=True,
+        )
+        if inputs.model_curves
+        else pd.DataFrame(columns=["material", "psi_deg", "pressure_kpa"])
+    )
     if not inputs.model_curves:
         notes.append("no --model-curves given: plots show the measurements only")
     if inputs.config is not None:
         notes.append(model_readings_note(inputs.config))
     return ReportData(
-        inputs=inputs, angles=angles, hysteresis=hysteresis, per_actuator=per_actuator, rms=rms,
-        model_curves=curves, files=input_files(inputs), notes=notes,
-        datasets=tuple(dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets),
+        inputs=inputs,
+        angles=angles,
+        hysteresis=hysteresis,
+        per_actuator=per_actuator,
+        rms=rms,
+        model_curves=curves,
+        files=input_files(inputs),
+        notes=notes,
+        datasets=tuple(
+            dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets
+        ),
     )
 
 
@@ -269,31 +296,46 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
     for d in inputs.datasets:
         files.append((f"{d.name}: angles", d.angles_csv))
         if d.photoset_dir is not None:
-            files += [(f"{d.name}: photo set", d.photoset_dir / n) for n in (MANIFEST, SETTINGS)
-                      if (d.photoset_dir / n).is_file()]
+            files += [
+                (f"{d.name}: photo set", d.photoset_dir / n)
+                for n in (MANIFEST, SETTINGS)
+                if (d.photoset_dir / n).is_file()
+            ]
     files += [("hysteresis", p) for p in inputs.hysteresis]
     files += [("comparison", p) for p in inputs.rms]
     files += [("model curve", p) for p in inputs.model_curves]
     files += [("materials file", p) for p in inputs.materials_files]
-    for role, folder, names in (("bench", inputs.bench_dir, BENCH_TABLES), ("force", inputs.force_dir, FORCE_FILES)):
+    for role, folder, names in (
+        ("bench", inputs.bench_dir, BENCH_TABLES),
+        ("force", inputs.force_dir, FORCE_FILES),
+    ):
         if folder is not None:
             files += [(role, folder / n) for n in names if (folder / n).is_file()]
     if inputs.config is not None:
         files.append(("config", inputs.config))
-    return tuple(InputFile(role, str(p), sha256_measurements(p) if role.endswith(": angles") else sha256_file(p))
-                 for role, p in files)
+    return tuple(
+        InputFile(
+            role, str(p), sha256_measurements(p) if role.endswith(": angles") else sha256_file(p)
+        )
+        for role, p in files
+    )
 
 
 def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
     """Source (synthetic, real or unknown) and photo dates of one dataset."""
     folder = dataset.photoset_dir
-    source = "unknown" if folder is None or not folder.is_dir() else (
-        "synthetic" if (folder / TRUTH).is_file() else "real")
+    source = (
+        "unknown"
+        if folder is None or not folder.is_dir()
+        else ("synthetic" if (folder / TRUTH).is_file() else "real")
+    )
     first, last, where = dataset_dates(angles, folder)
     return DatasetInfo(dataset.name, source, first, last, where)
 
 
-def dataset_dates(angles: pd.DataFrame, photoset_dir: Path | None) -> tuple[str | None, str | None, str]:
+def dataset_dates(
+    angles: pd.DataFrame, photoset_dir: Path | None
+) -> tuple[str | None, str | None, str]:
     """First and last date (``YYYY-MM-DD``) the photos of a dataset were taken.
 
     From the ``timestamp`` column when it holds dates, else from the EXIF date of the first and
@@ -301,9 +343,15 @@ def dataset_dates(angles: pd.DataFrame, photoset_dir: Path | None) -> tuple[str 
     no date).  Never the clock or file times, so the same inputs give the same report.
     """
     if "timestamp" in angles.columns:
-        stamps = pd.to_datetime(angles["timestamp"], errors="coerce", utc=True, format="mixed").dropna()
+        stamps = pd.to_datetime(
+            angles["timestamp"], errors="coerce", utc=True, format="mixed"
+        ).dropna()
         if len(stamps):
-            return stamps.min().strftime("%Y-%m-%d"), stamps.max().strftime("%Y-%m-%d"), "timestamps"
+            return (
+                stamps.min().strftime("%Y-%m-%d"),
+                stamps.max().strftime("%Y-%m-%d"),
+                "timestamps",
+            )
     if photoset_dir is None or angles.empty:
         return None, None, ""
     dates = [exif_date(photoset_dir / str(angles["image"].iloc[i])) for i in (0, -1)]
@@ -340,13 +388,21 @@ def model_readings_note(config_path: Path) -> str:
     try:
         cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
     except (OSError, yaml.YAMLError) as exc:
-        raise UserInputError(f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config") from None
+        raise UserInputError(
+            f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config"
+        ) from None
     readings = ((cfg.get("model") or {}) if isinstance(cfg, dict) else {}).get("readings") or {}
     if not readings:
-        return ("model: the paper's Eqs. 1-13 with the default readings (docs/model.md: derived, no "
-                "constant fitted to the paper's numbers; l0 is the one parameter its two model results fix)")
+        return (
+            "model: the paper's Eqs. 1-13 with the default readings (docs/model.md: derived, no "
+            "constant fitted to the paper's numbers; l0 is the one parameter its two model results "
+            "fix)"
+        )
     given = ", ".join(f"{k}={v}" for k, v in sorted(readings.items()))
-    return f"model: the paper's Eqs. 1-13 with readings set in the config: {given} (others default; docs/model.md)"
+    return (
+        f"model: the paper's Eqs. 1-13 with readings set in the config: {given} "
+        "(others default; docs/model.md)"
+    )
 
 
 def rms_row(data: ReportData, material: str) -> dict[str, float]:

@@ -1,7 +1,7 @@
 """The report's own result pages: the Fig. 6 overview, one page per material, the comparison.
 
 Each function returns one A4 :class:`~matplotlib.figure.Figure` (call inside
-:func:`pipeline.report.style.report_style`).
+:func:`pipeline.layout.style.report_style`).
 """
 
 from __future__ import annotations
@@ -15,10 +15,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from pipeline.report.data import ReportData, comparisons, rms_row
-from pipeline.report.model_page import comparison_note
-from pipeline.report.strip import Strip, build_strip, strip_image
-from pipeline.report.style import (
+from pipeline.constants import DIRECTIONS
+from pipeline.layout.style import (
     A4_PORTRAIT_IN,
     P_LABEL,
     PSI_LABEL,
@@ -28,7 +26,10 @@ from pipeline.report.style import (
     material_colors,
     page,
 )
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.report.data import ReportData, comparisons, rms_row
+from pipeline.report.model_page import comparison_note
+from pipeline.report.strip import Strip, build_strip, strip_image
 
 #: height kept for the legend under the overview panels (pt)
 LEGEND_BAND_PT = 44.0
@@ -54,7 +55,9 @@ def own_file_label(curve: pd.DataFrame) -> str:
     return suffix if str(curve["curve"].iloc[0]).endswith(suffix) else ""
 
 
-def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple[str, np.ndarray, np.ndarray, object]]:
+def model_lines(
+    data: ReportData, material: str, p_max_kpa: float
+) -> list[tuple[str, np.ndarray, np.ndarray, object]]:
     """Model curves of ``material`` to draw: ``(label, pressure, psi, linestyle)``, psi order.
 
     The curves ``compare`` used (``curve`` column: one per l0 and materials file, labelled with
@@ -63,8 +66,10 @@ def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple
     """
     c = data.model_curves[data.model_curves["material"].astype(str) == material]
     if "curve" in c.columns and c["curve"].notna().any():
-        groups = [(g, f"model, l0 {float(g['l0_mm'].iloc[0]):g} mm" + own_file_label(g))
-                  for _, g in c[c["curve"].notna()].groupby("curve", sort=False)]
+        groups = [
+            (g, f"model, l0 {float(g['l0_mm'].iloc[0]):g} mm" + own_file_label(g))
+            for _, g in c[c["curve"].notna()].groupby("curve", sort=False)
+        ]
     else:
         groups = [(c, "analytical model")] if len(c) else []
     out = []
@@ -78,13 +83,20 @@ def model_lines(data: ReportData, material: str, p_max_kpa: float) -> list[tuple
     return out
 
 
-def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, legend: bool = True,
-                    title: str | None = None) -> None:
+def plot_hysteresis(
+    ax: Axes,
+    data: ReportData,
+    material: str,
+    color: Color,
+    *,
+    legend: bool = True,
+    title: str | None = None,
+) -> None:
     """Fig. 6 style: mean +- 1 sd shaded (darker increasing, lighter decreasing), model dashed."""
     h = data.hysteresis[data.hysteresis["material"] == material]
     p_max = float(h["pressure_kpa"].max()) if len(h) else 1.0
     styles = {"up": (color, 0.35, "increasing P"), "down": (lighter(color), 0.35, "decreasing P")}
-    for direction in ("up", "down"):
+    for direction in DIRECTIONS:
         b = h[h["direction"] == direction].sort_values("pressure_kpa")
         if b.empty:
             continue
@@ -92,7 +104,9 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, 
         p = b["pressure_kpa"].to_numpy(float)
         m = b["psi_mean_deg"].to_numpy(float)
         sd = np.nan_to_num(b["psi_sd_deg"].to_numpy(float))
-        ax.fill_between(p, m - sd, m + sd, color=col, alpha=alpha, linewidth=0, label=f"± 1 sd, {label}")
+        ax.fill_between(
+            p, m - sd, m + sd, color=col, alpha=alpha, linewidth=0, label=f"± 1 sd, {label}"
+        )
         ax.plot(p, m, color=col, marker="o", markersize=2.5, label=f"mean, {label}")
     for label, mp, ms, style in model_lines(data, material, p_max * 1.02):
         ax.plot(mp, ms, linestyle=style, color="0.15", linewidth=1.2, label=label)
@@ -100,8 +114,11 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, 
     ax.set_xlim(left=0.0, right=max(p_max, 1.0) * 1.03)
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
-    ax.set_title(material if title is None else title, color=color if title is None else "black",
-                 fontweight="bold" if title is None else "normal")
+    ax.set_title(
+        material if title is None else title,
+        color=color if title is None else "black",
+        fontweight="bold" if title is None else "normal",
+    )
     if legend:
         ax.legend(loc="best", frameon=False)
 
@@ -109,11 +126,22 @@ def plot_hysteresis(ax: Axes, data: ReportData, material: str, color: Color, *, 
 def legend_proxies() -> tuple[list[object], list[str]]:
     """Neutral legend entries for the hysteresis plots of every material."""
     dark, light = (0.3, 0.3, 0.3), lighter((0.3, 0.3, 0.3))
-    return ([Line2D([], [], color=dark, marker="o", markersize=2.5), Patch(color=dark, alpha=0.35, linewidth=0),
-             Line2D([], [], color=light, marker="o", markersize=2.5), Patch(color=light, alpha=0.35, linewidth=0),
-             Line2D([], [], color="0.15", linestyle="--", linewidth=1.2)],
-            ["mean, increasing P", "± 1 sd, increasing P", "mean, decreasing P", "± 1 sd, decreasing P",
-             "analytical model"])
+    return (
+        [
+            Line2D([], [], color=dark, marker="o", markersize=2.5),
+            Patch(color=dark, alpha=0.35, linewidth=0),
+            Line2D([], [], color=light, marker="o", markersize=2.5),
+            Patch(color=light, alpha=0.35, linewidth=0),
+            Line2D([], [], color="0.15", linestyle="--", linewidth=1.2),
+        ],
+        [
+            "mean, increasing P",
+            "± 1 sd, increasing P",
+            "mean, decreasing P",
+            "± 1 sd, decreasing P",
+            "analytical model",
+        ],
+    )
 
 
 def overview_page(data: ReportData) -> Figure:
@@ -128,12 +156,19 @@ def overview_page(data: ReportData) -> Figure:
     axes = fig.subplots(nrows, ncols, squeeze=False)
     for ax, m in zip(axes.flat, materials, strict=False):
         plot_hysteresis(ax, data, m, colors[m], legend=False)
-    for ax in list(axes.flat)[len(materials):]:
+    for ax in list(axes.flat)[len(materials) :]:
         ax.set_axis_off()
     handles, labels = legend_proxies()
-    fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, footer_fraction(A4_PORTRAIT_IN)),
-               ncols=3, frameon=False,
-               title="Each panel in its material's colour; shading: ± 1 standard deviation over actuators and trials")
+    fig.legend(
+        handles,
+        labels,
+        loc="lower center",
+        bbox_to_anchor=(0.5, footer_fraction(A4_PORTRAIT_IN)),
+        ncols=3,
+        frameon=False,
+        title="Each panel in its material's colour; shading: ± 1 standard deviation over actuators "
+        "and trials",
+    )
     return fig
 
 
@@ -141,29 +176,72 @@ def overview_page(data: ReportData) -> Figure:
 # one material
 
 
-def metric_table(row: dict[str, object], *, title: str = "", extra_notes: tuple[str, ...] = ()) -> Table:
+def metric_table(
+    row: dict[str, object], *, title: str = "", extra_notes: tuple[str, ...] = ()
+) -> Table:
     """The comparison figures of one material, this run beside the paper."""
     g = row.get
-    k_ci = NA if fmt(g("k_p_fit"), 2) == NA else (
-        f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+    k_ci = (
+        NA
+        if fmt(g("k_p_fit"), 2) == NA
+        else (f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+    )
     width = fmt(g("hysteresis_width_deg"), 0)
     if width != NA:
         width += f" at {fmt(g('hysteresis_width_at_kpa'), 0)} kPa"
     rows = (
-        ("RMS against the model (deg)", fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1), fmt(g("rms_deg"), 1),
-         fmt(g("paper_rms_deg"), 1)),
-        ("P at ψ = 0 (kPa)", fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0), "", fmt(g("paper_p_zero_kpa"), 0)),
-        ("P at ψ = -ψ0 (kPa)", fmt(g("p_minus_psi0_up_kpa"), 0), fmt(g("p_minus_psi0_down_kpa"), 0), "", NA),
+        (
+            "RMS against the model (deg)",
+            fmt(g("rms_up_deg"), 1),
+            fmt(g("rms_down_deg"), 1),
+            fmt(g("rms_deg"), 1),
+            fmt(g("paper_rms_deg"), 1),
+        ),
+        (
+            "P at ψ = 0 (kPa)",
+            fmt(g("p_zero_up_kpa"), 0),
+            fmt(g("p_zero_down_kpa"), 0),
+            "",
+            fmt(g("paper_p_zero_kpa"), 0),
+        ),
+        (
+            "P at ψ = -ψ0 (kPa)",
+            fmt(g("p_minus_psi0_up_kpa"), 0),
+            fmt(g("p_minus_psi0_down_kpa"), 0),
+            "",
+            NA,
+        ),
         ("Range of motion (deg)", "", "", fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0)),
-        ("... over a pressure span of (kPa)", "", "", fmt(g("range_kpa"), 0), fmt(g("paper_range_kpa"), 0)),
+        (
+            "... over a pressure span of (kPa)",
+            "",
+            "",
+            fmt(g("range_kpa"), 0),
+            fmt(g("paper_range_kpa"), 0),
+        ),
         ("Hysteresis width, max |ψ_up - ψ_down| (deg)", "", "", width, NA),
         ("k_P fitted to these photos [95 % CI] (-)", "", "", k_ci, fmt(g("k_p_paper"), 1)),
     )
-    return Table(columns=(Column("Quantity", "left"), Column("increasing P"), Column("decreasing P"),
-                          Column("both"), Column("paper")),
-                 rows=rows, title=title, size=8.0,
-                 notes=("paper n/a: the paper reports no such value.  k_P is fitted, not predicted: the paper's "
-                        "value stands beside it for reference only.", *extra_notes))
+    return Table(
+        columns=(
+            Column("Quantity", "left"),
+            Column("increasing P"),
+            Column("decreasing P"),
+            Column("both"),
+            Column("paper"),
+        ),
+        rows=rows,
+        title=title,
+        size=8.0,
+        notes=(
+            (
+                "paper n/a: the paper reports no such value.  k_P is fitted, not predicted: the "
+                "paper's "
+                "value stands beside it for reference only."
+            ),
+            *extra_notes,
+        ),
+    )
 
 
 def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -> None:
@@ -175,63 +253,119 @@ def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -
             b = g[g["direction"] == direction].sort_values("pressure_kpa")
             if b.empty:
                 continue
-            ax.plot(b["pressure_kpa"], b["psi_mean_deg"], linestyle=ls, marker=markers[i % len(markers)],
-                    markersize=2.5, linewidth=0.9, color=color if direction == "up" else lighter(color, 0.4),
-                    label=f"{actuator}" if direction == "up" else None)
+            ax.plot(
+                b["pressure_kpa"],
+                b["psi_mean_deg"],
+                linestyle=ls,
+                marker=markers[i % len(markers)],
+                markersize=2.5,
+                linewidth=0.9,
+                color=color if direction == "up" else lighter(color, 0.4),
+                label=f"{actuator}" if direction == "up" else None,
+            )
     ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=0)
     ax.set_xlim(left=0.0)
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
     ax.set_title("Per actuator, mean over its trials (solid: increasing, dashed: decreasing P)")
     if len(per):
-        ax.legend(title="actuator", loc="best", frameon=False, ncols=2 if per["actuator"].nunique() > 4 else 1)
+        ax.legend(
+            title="actuator",
+            loc="best",
+            frameon=False,
+            ncols=2 if per["actuator"].nunique() > 4 else 1,
+        )
 
 
 def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
-    """Photos of one ramp in a row at the flow's position (down to its bottom), captioned with pressure
-    and measured psi."""
+    """Photos of one ramp in a row at the flow's position (down to its bottom), captioned with
+    pressure and measured psi."""
     if strip is None or not strip.photos:
-        flow.text("No photos for this material (pass --photosets / --overlays to show a ramp).", size=8.0)
+        flow.text(
+            "No photos for this material (pass --photosets / --overlays to show a ramp).", size=8.0
+        )
         return
     direction = "increasing" if strip.direction == "up" else "decreasing"
     names = f"{strip.images[0]} to {strip.images[-1]}" if len(strip.images) > 1 else strip.images[0]
-    flow.text(f"Photos across one ramp (as Fig. 5): actuator {strip.actuator_label}, trial {strip.trial}, "
-              f"{direction} pressure; files {names}; {strip.note}.", size=7.5)
+    flow.text(
+        f"Photos across one ramp (as Fig. 5): actuator {strip.actuator_label}, trial "
+        f"{strip.trial}, "
+        f"{direction} pressure; files {names}; {strip.note}.",
+        size=7.5,
+    )
     flow.space(2.0)
     caption = 2 * 7.5 * 1.32
     image, spans = strip_image(strip.photos, STRIP_PHOTO_PX, STRIP_GAP_PX)
-    scale = min(flow.width / image.shape[1], max(flow.remaining_pt - caption, 20.0) / image.shape[0])  # pt per px
+    # pt per px
+    scale = min(
+        flow.width / image.shape[1], max(flow.remaining_pt - caption, 20.0) / image.shape[0]
+    )
     top = flow.y
     for (x0, x1), photo in zip(spans, strip.photos, strict=True):
         x = flow.x + scale * (x0 + x1) / 2
         psi = "ψ: none" if not math.isfinite(photo.psi_deg) else f"ψ = {photo.psi_deg:.0f}°"
         flag = "" if photo.status == "ok" else f" ({photo.status})"
-        fig.text(x, top, f"{photo.pressure_kpa:g} kPa", transform=flow.transform, fontsize=7.5, ha="center", va="top")
-        fig.text(x, top + 7.5 * 1.32, psi + flag + (", photo not found" if photo.image is None else ""),
-                 transform=flow.transform, fontsize=7.5, ha="center", va="top",
-                 color="black" if photo.status == "ok" else "#b00000")
+        fig.text(
+            x,
+            top,
+            f"{photo.pressure_kpa:g} kPa",
+            transform=flow.transform,
+            fontsize=7.5,
+            ha="center",
+            va="top",
+        )
+        fig.text(
+            x,
+            top + 7.5 * 1.32,
+            psi + flag + (", photo not found" if photo.image is None else ""),
+            transform=flow.transform,
+            fontsize=7.5,
+            ha="center",
+            va="top",
+            color="black" if photo.status == "ok" else "#b00000",
+        )
     width, height = scale * image.shape[1], scale * image.shape[0]
-    ax = fig.add_axes((flow.x / flow.page_w, (flow.page_h - top - caption - height) / flow.page_h,
-                       width / flow.page_w, height / flow.page_h))
+    ax = fig.add_axes(
+        (
+            flow.x / flow.page_w,
+            (flow.page_h - top - caption - height) / flow.page_h,
+            width / flow.page_w,
+            height / flow.page_h,
+        )
+    )
     ax.set_axis_off()
     ax.imshow(image, interpolation="none", aspect="auto")
     flow.y = top + caption + height
 
 
 def material_page(data: ReportData, material: str) -> Figure:
-    """One material: Fig. 6 plot, per-actuator curves, comparison table, Fig. 5-style photo strip."""
+    """One material: Fig. 6 plot, per-actuator curves, comparison table, Fig. 5-style photo
+    strip."""
     color = material_colors(data.materials)[material]
     mine = [(label, row) for m, label, row in comparisons(data) if m == material]
     label, row = mine[0]
-    others = [f"{lab}: RMS {fmt(r.get('rms_deg'), 1)} deg, k_P fitted {fmt(r.get('k_p_fit'), 2)}" for lab, r in mine[1:]]
-    table = metric_table(row, title=f"{label}: this run beside the paper (rms.csv)",
-                         extra_notes=tuple(f"Also compared: {o} (all comparisons: the model-curve page)." for o in others))
+    others = [
+        f"{lab}: RMS {fmt(r.get('rms_deg'), 1)} deg, k_P fitted {fmt(r.get('k_p_fit'), 2)}"
+        for lab, r in mine[1:]
+    ]
+    table = metric_table(
+        row,
+        title=f"{label}: this run beside the paper (rms.csv)",
+        extra_notes=tuple(
+            f"Also compared: {o} (all comparisons: the model-curve page)." for o in others
+        ),
+    )
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)
     fig.suptitle(f"{material}: bending angle versus pressure", color=color, fontweight="bold")
     top, bottom = fig.subfigures(2, 1, height_ratios=[1.45, 1.0])
-    plot_hysteresis(top.subplots(), data, material, color,
-                    title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: analytical model")
+    plot_hysteresis(
+        top.subplots(),
+        data,
+        material,
+        color,
+        title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: analytical model",
+    )
     plot_per_actuator(bottom.subplots(), data, material, color)
     flow = Flow(fig, top_pt=72.0 * fig.get_figheight() - (22.0 + table_h + STRIP_BAND_PT + 6.0))
     flow.table(table)
@@ -245,12 +379,18 @@ def material_page(data: ReportData, material: str) -> Figure:
 
 
 def comparison_notes(data: ReportData) -> list[str]:
-    """Sentences under the comparison table (what each figure is; what is fitted; self-checks named)."""
+    """Sentences under the comparison table (what each figure is; what is fitted; self-checks
+    named)."""
     notes = [
-        "RMS: the model's loading branch at the measured pressure levels against the mean curve.  Crossings: "
-        "interpolated linearly along each ramp.  n/a: not reached by the mean curve, or not reported by the paper.",
-        "k_P is fitted to this run's photos (bootstrap interval over actuators): a fitted value, so its closeness "
-        "to the paper's k_P is not evidence for the model.",
+        (
+            "RMS: the model's loading branch at the measured pressure levels against the mean "
+            "curve.  Crossings: interpolated linearly along each ramp.  n/a: not reached by the "
+            "mean curve, or not reported by the paper."
+        ),
+        (
+            "k_P is fitted to this run's photos (bootstrap interval over actuators): a fitted "
+            "value, so its closeness to the paper's k_P is not evidence for the model."
+        ),
     ]
     note = comparison_note(data)
     return notes + ([note] if note else [])
@@ -263,25 +403,68 @@ def comparison_table(data: ReportData) -> Table:
     for m, label, row in comparisons(data):
         g = row.get
         row_colors.append(colors[m])
-        ci = NA if fmt(g("k_p_fit"), 2) == NA else (
-            f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+        ci = (
+            NA
+            if fmt(g("k_p_fit"), 2) == NA
+            else (f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]")
+        )
         width = fmt(g("hysteresis_width_deg"), 0)
-        rows.append((label, fmt(g("rms_deg"), 1), fmt(g("rms_up_deg"), 1), fmt(g("rms_down_deg"), 1),
-                     fmt(g("paper_rms_deg"), 1), fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0),
-                     fmt(g("paper_p_zero_kpa"), 0), fmt(g("p_minus_psi0_up_kpa"), 0),
-                     fmt(g("p_minus_psi0_down_kpa"), 0), fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0),
-                     fmt(g("range_kpa"), 0), fmt(g("paper_range_kpa"), 0),
-                     width if width == NA else f"{width} at {fmt(g('hysteresis_width_at_kpa'), 0)}",
-                     ci, fmt(g("k_p_paper"), 1)))
+        rows.append(
+            (
+                label,
+                fmt(g("rms_deg"), 1),
+                fmt(g("rms_up_deg"), 1),
+                fmt(g("rms_down_deg"), 1),
+                fmt(g("paper_rms_deg"), 1),
+                fmt(g("p_zero_up_kpa"), 0),
+                fmt(g("p_zero_down_kpa"), 0),
+                fmt(g("paper_p_zero_kpa"), 0),
+                fmt(g("p_minus_psi0_up_kpa"), 0),
+                fmt(g("p_minus_psi0_down_kpa"), 0),
+                fmt(g("range_deg"), 0),
+                fmt(g("paper_range_deg"), 0),
+                fmt(g("range_kpa"), 0),
+                fmt(g("paper_range_kpa"), 0),
+                width if width == NA else f"{width} at {fmt(g('hysteresis_width_at_kpa'), 0)}",
+                ci,
+                fmt(g("k_p_paper"), 1),
+            )
+        )
     return Table(
-        columns=(Column("Material", "left"), Column("both"), Column("incr."), Column("decr."), Column("paper"),
-                 Column("incr."), Column("decr."), Column("paper"), Column("incr."), Column("decr."),
-                 Column("run"), Column("paper"), Column("run"), Column("paper"), Column("deg at kPa"),
-                 Column("fitted [95 % CI]"), Column("paper")),
-        groups=(("", 1), ("RMS vs model (deg)", 4), ("P at ψ = 0 (kPa)", 3), ("P at ψ = -ψ0 (kPa)", 2),
-                ("Range (deg)", 2), ("Span (kPa)", 2), ("Hysteresis", 1), ("k_P (-)", 2)),
-        rows=tuple(rows), title="Every figure of rms.csv, one row per comparison (material and l0)",
-        notes=tuple(comparison_notes(data)), size=8.0, row_colors=tuple(row_colors),
+        columns=(
+            Column("Material", "left"),
+            Column("both"),
+            Column("incr."),
+            Column("decr."),
+            Column("paper"),
+            Column("incr."),
+            Column("decr."),
+            Column("paper"),
+            Column("incr."),
+            Column("decr."),
+            Column("run"),
+            Column("paper"),
+            Column("run"),
+            Column("paper"),
+            Column("deg at kPa"),
+            Column("fitted [95 % CI]"),
+            Column("paper"),
+        ),
+        groups=(
+            ("", 1),
+            ("RMS vs model (deg)", 4),
+            ("P at ψ = 0 (kPa)", 3),
+            ("P at ψ = -ψ0 (kPa)", 2),
+            ("Range (deg)", 2),
+            ("Span (kPa)", 2),
+            ("Hysteresis", 1),
+            ("k_P (-)", 2),
+        ),
+        rows=tuple(rows),
+        title="Every figure of rms.csv, one row per comparison (material and l0)",
+        notes=tuple(comparison_notes(data)),
+        size=8.0,
+        row_colors=tuple(row_colors),
     )
 
 
@@ -294,15 +477,24 @@ def comparison_page(data: ReportData) -> Figure:
     table_h = table_height_pt(table, width)
     fig = page(landscape=True, label="comparison", top_pt=36.0 + 22.0 + table_h + 8.0)
     flow = Flow(fig, top_pt=36.0, width_pt=width)
-    flow.text("Model versus measurements, beside the values reported in the paper (Section III.A)", size=12.0,
-              weight="bold")
+    flow.text(
+        "Model versus measurements, beside the values reported in the paper (Section III.A)",
+        size=12.0,
+        weight="bold",
+    )
     flow.space(3.0)
     flow.table(table)
     axes = fig.subplots(1, 3)
     x = np.arange(len(materials))
     bars = (
         ("RMS against the model, both directions", "RMS (deg)", "rms_deg", "paper_rms_deg", 1),
-        ("Pressure at ψ = 0 (increasing P)", "P at ψ = 0 (kPa)", "p_zero_up_kpa", "paper_p_zero_kpa", 0),
+        (
+            "Pressure at ψ = 0 (increasing P)",
+            "P at ψ = 0 (kPa)",
+            "p_zero_up_kpa",
+            "paper_p_zero_kpa",
+            0,
+        ),
         ("Total range of motion", "Range of motion (deg)", "range_deg", "paper_range_deg", 0),
     )
     for ax, (title, ylabel, ours_key, paper_key, _digits) in zip(axes, bars, strict=True):
@@ -310,10 +502,19 @@ def comparison_page(data: ReportData) -> Figure:
         paper = np.array([float(rms_row(data, m).get(paper_key, math.nan)) for m in materials])
         c = [colors[m] for m in materials]
         ax.bar(x - 0.2, np.nan_to_num(ours), width=0.4, color=c)
-        ax.bar(x + 0.2, np.nan_to_num(paper), width=0.4, color=[lighter(v, 0.6) for v in c], hatch="///",
-               edgecolor=[lighter(v, 0.2) for v in c], linewidth=0)
+        ax.bar(
+            x + 0.2,
+            np.nan_to_num(paper),
+            width=0.4,
+            color=[lighter(v, 0.6) for v in c],
+            hatch="///",
+            edgecolor=[lighter(v, 0.2) for v in c],
+            linewidth=0,
+        )
         top = np.nanmax(np.concatenate([ours, paper, [1.0]]))
-        for xi, v in zip(np.concatenate([x - 0.2, x + 0.2]), np.concatenate([ours, paper]), strict=True):
+        for xi, v in zip(
+            np.concatenate([x - 0.2, x + 0.2]), np.concatenate([ours, paper]), strict=True
+        ):
             if not math.isfinite(v):
                 ax.text(xi, 0.02 * top, NA, ha="center", va="bottom", fontsize=7.5, color="0.25")
         ax.set_ylim(0.0, top * 1.08)

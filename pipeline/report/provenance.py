@@ -1,4 +1,5 @@
-"""The last page(s): what the report was made from (software, configuration, every input's sha256)."""
+"""The last page(s): what the report was made from (software, configuration, every input's
+sha256)."""
 
 from __future__ import annotations
 
@@ -9,13 +10,20 @@ from importlib import metadata
 
 from matplotlib.figure import Figure
 
+from pipeline.layout.style import text_page
+from pipeline.layout.typeset import MONO, Column, Flow, Table, rows_that_fit
 from pipeline.report.data import ReportData
-from pipeline.report.style import text_page
 from pipeline.report.summary import calibration_summary
-from pipeline.report.typeset import MONO, Column, Flow, Table, rows_that_fit
 
 #: libraries whose versions can change a number or a pixel of the report
-LIBRARIES: tuple[str, ...] = ("numpy", "pandas", "scipy", "opencv-python-headless", "opencv-python", "matplotlib")
+LIBRARIES: tuple[str, ...] = (
+    "numpy",
+    "pandas",
+    "scipy",
+    "opencv-python-headless",
+    "opencv-python",
+    "matplotlib",
+)
 
 
 def library_versions() -> list[str]:
@@ -29,30 +37,51 @@ def library_versions() -> list[str]:
     return out
 
 
-def provenance_pages(data: ReportData, version: str, infos: Sequence[str], warnings: Sequence[str] = ()) -> list[Figure]:
-    """Software, configuration and the sha256 of every input file (portrait A4, as many pages as needed)."""
+def provenance_pages(
+    data: ReportData, version: str, infos: Sequence[str], warnings: Sequence[str] = ()
+) -> list[Figure]:
+    """Software, configuration and the sha256 of every input file (portrait A4, as many pages as
+    needed)."""
     fig = text_page(label="provenance")
     flow = Flow(fig, top_pt=36.0)
     flow.text("Provenance", size=14.0, weight="bold")
     flow.space(2.0)
-    flow.text(f"pipeline {version}, Python {platform.python_version()}; " + ", ".join(library_versions()) + ".",
-              size=8.0)
-    flow.text("The same inputs give the same PDF, byte for byte: nothing on any page comes from the clock or the "
-              "machine.  Photos are covered by the sha256 of their photo set's manifest.csv and photoset.yaml.",
-              size=8.0, color="0.25")
+    flow.text(
+        f"pipeline {version}, Python {platform.python_version()}; "
+        + ", ".join(library_versions())
+        + ".",
+        size=8.0,
+    )
+    flow.text(
+        "The same inputs give the same PDF, byte for byte: nothing on any page comes from the "
+        "clock or the "
+        "machine.  Photos are covered by the sha256 of their photo set's manifest.csv and "
+        "photoset.yaml.",
+        size=8.0,
+        color="0.25",
+    )
     for line in list(data.notes) + list(infos):
         flow.text(line, size=8.0, color="0.25")
     for line in warnings:
         flow.text(f"WARNING: {line}", size=8.0, color="#b00000")
     for style, line in calibration_summary(data):
-        flow.text(f"Camera calibration: {line}", size=8.0, color="#b00000" if style == "w" else "0.25")
+        flow.text(
+            f"Camera calibration: {line}", size=8.0, color="#b00000" if style == "w" else "0.25"
+        )
     flow.space(4.0)
     rows = tuple((f.role, f.path, f.sha256) for f in data.files)
     pages = [fig]
     while True:
-        table = Table(columns=(Column("Input", "left"), Column("File", "left", wrap_pt=150.0),
-                               Column("sha256", "left", family=MONO)),
-                      rows=rows, title="Input files" + ("" if len(pages) == 1 else " (continued)"), size=7.0)
+        table = Table(
+            columns=(
+                Column("Input", "left"),
+                Column("File", "left", wrap_pt=150.0),
+                Column("sha256", "left", family=MONO),
+            ),
+            rows=rows,
+            title="Input files" + ("" if len(pages) == 1 else " (continued)"),
+            size=7.0,
+        )
         k = rows_that_fit(table, flow.width, flow.remaining_pt)
         flow.table(dataclasses.replace(table, rows=rows[:k]))
         rows = rows[k:]

@@ -77,7 +77,9 @@ def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[st
     bad = angles[angles["status"].astype(str) != "ok"]
     for dataset, g in bad.groupby("dataset", sort=True):
         counts: Counter[str] = Counter()
-        for status, reason in zip(g["status"].astype(str), g["reason"].fillna("").astype(str), strict=True):
+        for status, reason in zip(
+            g["status"].astype(str), g["reason"].fillna("").astype(str), strict=True
+        ):
             causes = [reason] if status == "failed" else reason.split(";")
             counts.update({words(part) for part in causes})
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))

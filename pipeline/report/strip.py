@@ -19,7 +19,8 @@ from pipeline.report.data import Dataset, ReportData
 
 #: photos per strip
 STRIP_PHOTOS = 6
-#: widest thumbnail kept (px): twice its printed width at 150 dpi; larger photos are reduced (area averaging)
+#: widest thumbnail kept (px): twice its printed width at 150 dpi; larger photos are reduced (area
+#: averaging)
 THUMB_MAX_WIDTH_PX = 240
 
 
@@ -71,9 +72,14 @@ class Strip:
         if sources == {"overlay"}:
             return "extracted line and psi drawn by 'measure --overlays'"
         if "overlay" in sources:
-            return "overlays where available, raw photos elsewhere (no overlay file for some images)"
+            return (
+                "overlays where available, raw photos elsewhere (no overlay file for some images)"
+            )
         if "raw" in sources:
-            return "raw photos: no overlays found (run 'measure --overlays DIR' to draw the extracted line)"
+            return (
+                "raw photos: no overlays found "
+                "(run 'measure --overlays DIR' to draw the extracted line)"
+            )
         return "no photos found (pass --photosets / --overlays)"
 
 
@@ -97,7 +103,9 @@ def crop_banner(bgr: np.ndarray) -> np.ndarray:
     return bgr[n:] if 3 <= n <= 0.3 * h else bgr
 
 
-def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX, *, banner: bool = False) -> np.ndarray | None:
+def load_thumbnail(
+    path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX, *, banner: bool = False
+) -> np.ndarray | None:
     """RGB thumbnail of an image file, at most ``max_width_px`` wide; ``None`` if unreadable.
 
     ``banner=True`` removes an overlay's text band first (:func:`crop_banner`).
@@ -110,13 +118,17 @@ def load_thumbnail(path: Path, max_width_px: int = THUMB_MAX_WIDTH_PX, *, banner
         return None
     h, w = bgr.shape[:2]
     if w > max_width_px:
-        bgr = cv2.resize(bgr, (max_width_px, max(1, round(h * max_width_px / w))), interpolation=cv2.INTER_AREA)
+        bgr = cv2.resize(
+            bgr, (max_width_px, max(1, round(h * max_width_px / w))), interpolation=cv2.INTER_AREA
+        )
     if banner:
         bgr = crop_banner(bgr)
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
 
 
-def strip_image(photos: tuple[StripPhoto, ...], height_px: int, gap_px: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
+def strip_image(
+    photos: tuple[StripPhoto, ...], height_px: int, gap_px: int
+) -> tuple[np.ndarray, list[tuple[int, int]]]:
     """The photos side by side at a common height, white between them (one image, drawn once).
 
     Missing photos are light grey tiles of 4:3.
@@ -142,7 +154,13 @@ def strip_image(photos: tuple[StripPhoto, ...], height_px: int, gap_px: int) -> 
         else:
             h, w = photo.image.shape[:2]
             size = (max(1, round(w * height_px / h)), height_px)
-            tiles.append(cv2.resize(photo.image, size, interpolation=cv2.INTER_AREA if h > height_px else cv2.INTER_LINEAR))
+            tiles.append(
+                cv2.resize(
+                    photo.image,
+                    size,
+                    interpolation=cv2.INTER_AREA if h > height_px else cv2.INTER_LINEAR,
+                )
+            )
     spans, x = [], 0
     parts = []
     for k, tile in enumerate(tiles):
@@ -168,7 +186,11 @@ def pick_ramp(angles: pd.DataFrame, material: str) -> pd.DataFrame:
     direction = "up" if (m["direction"] == "up").any() else "down"
     m = m[m["direction"] == direction]
     first = m.sort_values(["dataset", "actuator", "trial"], kind="stable").iloc[0]
-    ramp = m[(m["dataset"] == first["dataset"]) & (m["actuator"] == first["actuator"]) & (m["trial"] == first["trial"])]
+    ramp = m[
+        (m["dataset"] == first["dataset"])
+        & (m["actuator"] == first["actuator"])
+        & (m["trial"] == first["trial"])
+    ]
     return ramp.sort_values("pressure_kpa", ascending=(direction == "up"), kind="stable")
 
 
@@ -191,7 +213,9 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
         row = ramp.iloc[int(i)]
         image, source = None, "missing"
         if dataset.overlays_dir is not None:
-            image = load_thumbnail(dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"), banner=True)
+            image = load_thumbnail(
+                dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"), banner=True
+            )
             source = "overlay" if image is not None else source
         if image is None and dataset.photoset_dir is not None:
             image = load_thumbnail(dataset.photoset_dir / str(row["image"]))
@@ -203,7 +227,12 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
             )
         )
     return Strip(
-        material=material, dataset=str(first["dataset"]), actuator=str(first["actuator"]),
-        trial=str(first["trial"]), direction=str(first["direction"]), photos=tuple(photos),
-        images=tuple(str(ramp.iloc[int(i)]["image"]) for i in idx), qualified=data.angles["dataset"].nunique() > 1,
+        material=material,
+        dataset=str(first["dataset"]),
+        actuator=str(first["actuator"]),
+        trial=str(first["trial"]),
+        direction=str(first["direction"]),
+        photos=tuple(photos),
+        images=tuple(str(ramp.iloc[int(i)]["image"]) for i in idx),
+        qualified=data.angles["dataset"].nunique() > 1,
     )

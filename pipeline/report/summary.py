@@ -14,11 +14,11 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
+from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import ReportData, comparisons, rms_row
 from pipeline.report.reasons import top_reasons
-from pipeline.report.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
-from pipeline.report.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 
 #: least height (pt) worth giving the overview plot on page 1
 MIN_PLOT_PT = 170.0
@@ -33,7 +33,11 @@ def material_sources(data: ReportData) -> dict[str, str]:
     by_dataset = {d.name: d.source for d in data.datasets}
     out = {}
     for m in data.materials:
-        names = sorted(data.angles.loc[data.angles["material"].astype(str) == m, "dataset"].astype(str).unique())
+        names = sorted(
+            data.angles.loc[data.angles["material"].astype(str) == m, "dataset"]
+            .astype(str)
+            .unique()
+        )
         kinds = sorted({by_dataset[n] for n in names if n in by_dataset})
         out[m] = " + ".join(kinds) if kinds else "unknown"
     return out
@@ -64,28 +68,64 @@ def results_table(data: ReportData) -> Table:
         # one comparison: the material's datasets; several (one per l0): the photos of this one
         source = sources[m] if label == m else str(g("data_source", NA)).replace("measured", "real")
         row_colors.append(colors[m])
-        rows.append((label, source, fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0),
-                     fmt(g("p_zero_up_kpa"), 0), fmt(g("p_zero_down_kpa"), 0), fmt(g("paper_p_zero_kpa"), 0),
-                     fmt(g("rms_deg"), 1), fmt(g("paper_rms_deg"), 1),
-                     ci if fmt(g("k_p_fit"), 2) != NA else NA, fmt(g("k_p_paper"), 1)))
+        rows.append(
+            (
+                label,
+                source,
+                fmt(g("range_deg"), 0),
+                fmt(g("paper_range_deg"), 0),
+                fmt(g("p_zero_up_kpa"), 0),
+                fmt(g("p_zero_down_kpa"), 0),
+                fmt(g("paper_p_zero_kpa"), 0),
+                fmt(g("rms_deg"), 1),
+                fmt(g("paper_rms_deg"), 1),
+                ci if fmt(g("k_p_fit"), 2) != NA else NA,
+                fmt(g("k_p_paper"), 1),
+            )
+        )
     notes = [
-        "Range: the range of motion, largest minus smallest mean ψ over both directions.  P at ψ = 0: where the "
-        "mean curve crosses ψ = 0 (linear between levels).  RMS: the model (loading branch) against the mean "
-        "curve at the measured levels, both directions.  k_P: fitted to this run's photos (both directions), "
-        "95 % bootstrap interval over actuators; a fitted value, so its closeness to the paper's k_P "
-        "tests nothing.",
+        ("Range: the range of motion, largest minus smallest mean ψ over both directions.  P at ψ "
+         "= 0: where the "
+        "mean curve crosses ψ = 0 (linear between levels).  RMS: the model (loading branch) "
+        "against the mean "
+        "curve at the measured levels, both directions.  k_P: fitted to this run's photos (both "
+        "directions), "
+        "95 % bootstrap interval over actuators; a fitted value, so its closeness to the paper's "
+        "k_P "
+        "tests nothing."),
     ]
     notes += missing_notes(data)
     if any("synthetic" in s for s in sources.values()):
-        notes.append("synthetic: the photos were rendered from this model, so their RMS against the model "
-                     "checks the angle measurement, not the model.")
+        notes.append(
+            "synthetic: the photos were rendered from this model, so their RMS against the model "
+            "checks the angle measurement, not the model."
+        )
     return Table(
-        columns=(Column("Material", "left"), Column("Data", "left"), Column("run"), Column("paper"),
-                 Column("rising"), Column("falling"), Column("paper"), Column("run"), Column("paper"),
-                 Column("fitted [95 % CI]"), Column("paper")),
-        groups=(("", 2), ("Range (deg)", 2), ("P at ψ = 0 (kPa)", 3), ("RMS (deg)", 2), ("k_P (-)", 2)),
-        rows=tuple(rows), title="Results per material, beside the paper (Section III.A)", notes=tuple(notes),
-        row_colors=tuple(row_colors), size=8.0,
+        columns=(
+            Column("Material", "left"),
+            Column("Data", "left"),
+            Column("run"),
+            Column("paper"),
+            Column("rising"),
+            Column("falling"),
+            Column("paper"),
+            Column("run"),
+            Column("paper"),
+            Column("fitted [95 % CI]"),
+            Column("paper"),
+        ),
+        groups=(
+            ("", 2),
+            ("Range (deg)", 2),
+            ("P at ψ = 0 (kPa)", 3),
+            ("RMS (deg)", 2),
+            ("k_P (-)", 2),
+        ),
+        rows=tuple(rows),
+        title="Results per material, beside the paper (Section III.A)",
+        notes=tuple(notes),
+        row_colors=tuple(row_colors),
+        size=8.0,
     )
 
 
@@ -101,13 +141,22 @@ def missing_notes(data: ReportData) -> list[str]:
             h = data.hysteresis[data.hysteresis["material"] == m]
             low = fmt(h["psi_mean_deg"].min(), 0)
             top = fmt(h["pressure_kpa"].max(), 0)
-            paper = " (the paper gives none either)" if not np.isfinite(float(g.get("paper_p_zero_kpa", np.nan))) else ""
-            out.append(f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ {low}°), "
-                       f"so P at ψ = 0 reads n/a{paper}.")
+            paper = (
+                " (the paper gives none either)"
+                if not np.isfinite(float(g.get("paper_p_zero_kpa", np.nan)))
+                else ""
+            )
+            out.append(
+                f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ "
+                f"{low}°), "
+                f"so P at ψ = 0 reads n/a{paper}."
+            )
     return out
 
 
-def quality_table(data: ReportData, *, width_pt: float = 511.0, height_pt: float | None = None) -> Table:
+def quality_table(
+    data: ReportData, *, width_pt: float = 511.0, height_pt: float | None = None
+) -> Table:
     """Per dataset: real or synthetic, dates, photo counts by status and the top reasons in words.
 
     When the rows do not fit in ``height_pt``, the datasets with the most flagged and failed photos
@@ -118,7 +167,14 @@ def quality_table(data: ReportData, *, width_pt: float = 511.0, height_pt: float
     for info in data.datasets:
         a = data.angles[data.angles["dataset"] == info.name]
         status = a["status"].astype(str)
-        c = np.array([len(a), (status == "ok").sum(), (status == "flagged").sum(), (status == "failed").sum()])
+        c = np.array(
+            [
+                len(a),
+                (status == "ok").sum(),
+                (status == "flagged").sum(),
+                (status == "failed").sum(),
+            ]
+        )
         counts.append(c)
         materials = ", ".join(sorted(a["material"].astype(str).unique()))
         dates = NA if not info.first_date else (info.first_date if info.first_date == info.last_date
@@ -132,19 +188,41 @@ def quality_table(data: ReportData, *, width_pt: float = 511.0, height_pt: float
         rest = [i for i in range(len(rows)) if i not in kept]
         if rest:
             other = sum((counts[i] for i in rest), np.zeros(4, dtype=int))
-            body.append((f"{len(rest)} more", "", "", "", *(str(int(v)) for v in other), "fewest flagged/failed"))
+            body.append(
+                (
+                    f"{len(rest)} more",
+                    "",
+                    "",
+                    "",
+                    *(str(int(v)) for v in other),
+                    "fewest flagged/failed",
+                )
+            )
         total = sum(counts, np.zeros(4, dtype=int))
         body.append(("all", "", "", "", *(str(int(v)) for v in total), ""))
-        columns = (Column("Dataset", "left"), Column("Data", "left"), Column("Material", "left"),
-                   Column("Photos taken", "left"), Column("photos"), Column("ok"), Column("flagged"),
-                   Column("failed"), Column("Top reasons (photos)", "left", wrap_pt=200.0))
+        columns = (
+            Column("Dataset", "left"),
+            Column("Data", "left"),
+            Column("Material", "left"),
+            Column("Photos taken", "left"),
+            Column("photos"),
+            Column("ok"),
+            Column("flagged"),
+            Column("failed"),
+            Column("Top reasons (photos)", "left", wrap_pt=200.0),
+        )
         if not dated:  # the date line above says so once
             columns = columns[:3] + columns[4:]
             body = [r[:3] + r[4:] for r in body]
         return Table(
-            columns=columns, rows=tuple(body), title="Data quality: every photo is ok, flagged or failed",
-            notes=("Flagged and failed photos are left out of the curves and fits; the reasons are counted once "
-                   "per photo.  Data: synthetic = the photo set holds the renderer's truth.csv.",),
+            columns=columns,
+            rows=tuple(body),
+            title="Data quality: every photo is ok, flagged or failed",
+            notes=(
+                ("Flagged and failed photos are left out of the curves and fits; the reasons are "
+                 "counted once "
+                "per photo.  Data: synthetic = the photo set holds the renderer's truth.csv."),
+            ),
             size=8.0,
         )
 
@@ -161,7 +239,8 @@ def calibration_summary(data: ReportData) -> list[tuple[str, str]]:
     one line per dataset, or one for all when they are alike.  ``("w", text)`` is a warning."""
     names = [d.name for d in data.datasets]
     lines: list[tuple[str, str]] = []
-    for style, text in calibration_lines(data.angles, names)[1:]:  # after its heading; rejoin wrapped lines
+    # after its heading; rejoin wrapped lines
+    for style, text in calibration_lines(data.angles, names)[1:]:
         if text.startswith(" ") and lines:
             lines[-1] = (lines[-1][0], f"{lines[-1][1]} {text.strip()}")
         else:
@@ -192,22 +271,34 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     flow.text(data.inputs.title, size=16.0, weight="bold")
     flow.space(2.0)
     photos = len(data.angles)
-    flow.text(f"Summary of {len(data.datasets)} dataset(s), {photos} photos, {len(data.materials)} material(s); "
-              f"pipeline {version}.  {date_line(data)}.", size=8.5, color="0.2")
+    flow.text(
+        f"Summary of {len(data.datasets)} dataset(s), {photos} photos, {len(data.materials)} "
+        "material(s); "
+        f"pipeline {version}.  {date_line(data)}.",
+        size=8.5,
+        color="0.2",
+    )
     flow.space(4.0)
     flow.table(results_table(data))
     flow.space(4.0)
     notes = list(data.notes)
     shown = list(warnings[:MAX_WARNINGS])
     if len(warnings) > MAX_WARNINGS:
-        shown.append(f"... and {len(warnings) - MAX_WARNINGS} more warning(s), listed on the provenance page")
+        shown.append(
+            f"... and {len(warnings) - MAX_WARNINGS} more warning(s), listed on the provenance page"
+        )
     contents_h = 9.0 * 1.32 * (1 + int(np.ceil(len(contents) / 2))) + 14.0
     notes_h = sum(8.0 * 1.32 * (1 + len(n) // 110) for n in notes) + 16.0
     warnings_h = sum(8.0 * 1.32 * (1 + len(w) // 100) for w in shown) + (16.0 if shown else 0.0)
     calibration = calibration_summary(data)
     calibration_h = sum(8.0 * 1.32 * (1 + len(t) // 110) for _, t in calibration) + 16.0
-    flow.table(quality_table(data, width_pt=flow.width,
-                             height_pt=flow.remaining_pt - contents_h - notes_h - warnings_h - calibration_h - 8.0))
+    flow.table(
+        quality_table(
+            data,
+            width_pt=flow.width,
+            height_pt=flow.remaining_pt - contents_h - notes_h - warnings_h - calibration_h - 8.0,
+        )
+    )
     flow.heading("Camera calibration", size=9.5)
     for style, text in calibration:
         flow.text(text, size=8.0, color="#b00000" if style == "w" else "black", hanging_pt=9.0)
@@ -227,7 +318,9 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     for k, (title, number) in enumerate(contents):
         flow.y = top + (k % half) * 9.0 * 1.32 if half else top
         x = flow.x + (0.0 if k < half else flow.width / 2)
-        fig.text(x, flow.y, f"p. {number}", transform=flow.transform, fontsize=8.0, va="top", color="0.3")
+        fig.text(
+            x, flow.y, f"p. {number}", transform=flow.transform, fontsize=8.0, va="top", color="0.3"
+        )
         fig.text(x + 30.0, flow.y, title, transform=flow.transform, fontsize=8.0, va="top")
     return fig
 
@@ -247,6 +340,9 @@ def overview_axes(ax, data: ReportData) -> None:  # type: ignore[no-untyped-def]
     ax.set_xlim(left=0.0)
     ax.set_xlabel(P_LABEL)
     ax.set_ylabel(PSI_LABEL)
-    ax.set_title("Mean bending angle of every material (solid: rising, dashed: falling pressure)", fontsize=9.0)
+    ax.set_title(
+        "Mean bending angle of every material (solid: rising, dashed: falling pressure)",
+        fontsize=9.0,
+    )
     ax.legend(loc="best", frameon=False, ncols=2)
 

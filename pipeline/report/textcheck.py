@@ -83,9 +83,14 @@ def drawn_texts(fig: Figure, dpi: float = 100.0) -> list[DrawnText]:
             out = []
             for t in renderer.drawn.values():
                 b = t.get_window_extent(renderer)
-                out.append(DrawnText(t.get_text(), float(t.get_fontsize()),
-                                     Bbox.from_extents(b.x0 * scale, b.y0 * scale, b.x1 * scale, b.y1 * scale),
-                                     t.get_gid()))
+                out.append(
+                    DrawnText(
+                        t.get_text(),
+                        float(t.get_fontsize()),
+                        Bbox.from_extents(b.x0 * scale, b.y0 * scale, b.x1 * scale, b.y1 * scale),
+                        t.get_gid(),
+                    )
+                )
             return out
     finally:
         fig.dpi = saved_dpi

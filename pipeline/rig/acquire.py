@@ -27,7 +27,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 from tqdm import tqdm
@@ -38,6 +38,9 @@ from pipeline.photoset import MANIFEST, append_manifest_rows, write_manifest, wr
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
 from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +130,7 @@ class _Interrupts:
             return
         raise KeyboardInterrupt(signal.Signals(signum).name)
 
-    def __enter__(self) -> _Interrupts:
+    def __enter__(self) -> Self:
         for sig in (signal.SIGINT, signal.SIGTERM):
             try:
                 self._old[sig] = signal.signal(sig, self._handler)
@@ -152,7 +155,8 @@ class _Interrupts:
 
 
 def trial_plans(cfg: SessionConfig) -> list[tuple[int, list[session.StepPlan], set[int]]]:
-    """Per trial: the full sequence (peak as far as known from the folder) and the steps recorded."""
+    """Per trial: the full sequence (peak as far as known from the folder) and the steps
+    recorded."""
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     rec = session.recorded_steps(cfg.out_dir, cfg.material, cfg.actuator)
     out = []
@@ -163,12 +167,17 @@ def trial_plans(cfg: SessionConfig) -> list[tuple[int, list[session.StepPlan], s
     return out
 
 
-def describe_plan(cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = "", port: str = "") -> str:
+def describe_plan(
+    cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = "", port: str = ""
+) -> str:
     """The ``--dry-run`` text: ramp, what is recorded, where each trial resumes, time estimate."""
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     lines = [
-        (f"acquire plan: {cfg.material} actuator {cfg.actuator}, {cfg.trials} trial(s), mode {cfg.mode}, "
-         f"port {port or '-'}, camera {camera_spec or '-'}"),
+        (
+            f"acquire plan: {cfg.material} actuator {cfg.actuator}, {cfg.trials} trial(s), mode "
+            f"{cfg.mode}, "
+            f"port {port or '-'}, camera {camera_spec or '-'}"
+        ),
         f"  out: {cfg.out_dir}",
         f"  ramp (kPa): up {' '.join(f'{p:g}' for p in up)}; then down the same steps to 0",
         f"  settle {cfg.settle_s:g} s per step"
@@ -183,14 +192,24 @@ def describe_plan(cfg: SessionConfig, *, stop_at_psi0: bool, camera_spec: str = 
             lines.append(f"  trial {trial}: complete ({len(seq)} photos recorded)")
             continue
         todo += len(seq) - k
-        where = f"resume at step {seq[k].step} ({seq[k].pressure_kpa:g} kPa {seq[k].direction})" if k else "start at step 0"
+        where = (
+            f"resume at step {seq[k].step} ({seq[k].pressure_kpa:g} kPa {seq[k].direction})"
+            if k
+            else "start at step 0"
+        )
         approach = session.approach_path(seq, k)
         lines.append(
             f"  trial {trial}: {len(seq)} steps, {k} recorded, {where}"
-            + (f" after passing {' '.join(f'{p:g}' for p in approach)} kPa without photos" if approach else "")
+            + (
+                f" after passing {' '.join(f'{p:g}' for p in approach)} kPa without photos"
+                if approach
+                else ""
+            )
         )
     minutes = todo * (cfg.settle_s + 0.5) / 60.0
-    lines.append(f"  to do: {todo} photo(s), about {minutes:.1f} min (at most; settle + ~0.5 s per photo)")
+    lines.append(
+        f"  to do: {todo} photo(s), about {minutes:.1f} min (at most; settle + ~0.5 s per photo)"
+    )
     return "\n".join(lines)
 
 
@@ -211,13 +230,22 @@ def unused_features(driver: PicoDriver, cfg: SessionConfig) -> list[str]:
     name = f"{driver.info.name} {driver.info.version}" if driver.info else "the device"
     out = []
     if not driver.supports("CFG"):
-        out.append(f"firmware {name} has no CFG: its own pressure limit is unknown, so only the host limit "
-                   f"--max-kpa {driver.max_kpa:g} kPa guards the setpoints")
+        out.append(
+            f"firmware {name} has no CFG: its own pressure limit is unknown, so only the host "
+            "limit "
+            f"--max-kpa {driver.max_kpa:g} kPa guards the setpoints"
+        )
     if cfg.watchdog_s > 0 and not driver.supports("WDOG"):
-        out.append(f"firmware {name} has no WDOG: the device cannot vent by itself if the host stops talking "
-                   "(pulled cable, crashed host); keep the emergency stop at hand")
+        out.append(
+            f"firmware {name} has no WDOG: the device cannot vent by itself if the host stops "
+            "talking "
+            "(pulled cable, crashed host); keep the emergency stop at hand"
+        )
     if cfg.mode == "blocked" and not driver.supports("LOAD"):
-        out.append(f"firmware {name} has no load-cell commands (LOAD/TARE/SCALE), which --mode blocked needs")
+        out.append(
+            f"firmware {name} has no load-cell commands (LOAD/TARE/SCALE), which --mode blocked "
+            "needs"
+        )
     return out
 
 
@@ -241,8 +269,8 @@ def run_session(
     cfg : SessionConfig
         The run.
     stop_up : callable, optional
-        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached -psi0);
-        ``settings`` are the photo set's, resolved once.
+        ``stop_up(image_bytes, settings) -> bool``: end the up leg at this photo (psi reached
+        -psi0); ``settings`` are the photo set's, resolved once.
     progress : bool or None
         Show the tqdm bar (``None``: only on a terminal).
     stream : text stream, optional
@@ -258,9 +286,14 @@ def run_session(
     for note in result.unused:
         print(f"acquire: not used: {note}", file=stream)
     if cfg.mode == "blocked" and not driver.supports("LOAD"):
-        result.status, result.message = "error", (
-            "blocked mode needs the load cell, which this firmware does not speak; nothing was done "
-            "(flash the firmware of pipeline/rig/firmware or use --mode bending)")
+        result.status, result.message = (
+            "error",
+            (
+                "blocked mode needs the load cell, which this firmware does not speak; nothing was "
+                "done "
+                "(flash the firmware of pipeline/rig/firmware or use --mode bending)"
+            ),
+        )
         print(f"acquire: {result.message}", file=stream)
         return result
     cfg.out_dir.mkdir(parents=True, exist_ok=True)
@@ -270,22 +303,46 @@ def run_session(
     settings: MeasureSettings | None = None
     if stop_up is not None:
         try:
-            settings = resolve_settings({k: v for k, v in raw_settings.items() if v is not None}, folder=cfg.out_dir)
+            settings = resolve_settings(
+                {k: v for k, v in raw_settings.items() if v is not None}, folder=cfg.out_dir
+            )
         except SettingsError as exc:
-            result.status, result.message = "error", f"the psi0 stop needs valid photo-set settings: {exc}; nothing was done"
+            result.status, result.message = (
+                "error",
+                f"the psi0 stop needs valid photo-set settings: {exc}; nothing was done",
+            )
             print(f"acquire: {result.message}", file=stream)
             return result
     up = session.ramp_pressures(cfg.step_kpa, cfg.max_kpa)
     if up[-1] > driver.max_kpa + 1e-9:
-        result.status, result.message = "limit", f"--max-kpa {cfg.max_kpa:g} is above the driver limit {driver.max_kpa:g} kPa (calibration max_kpa); nothing was done"
+        result.status, result.message = (
+            "limit",
+            (
+                f"--max-kpa {cfg.max_kpa:g} is above the driver limit {driver.max_kpa:g} kPa "
+                "(calibration max_kpa); nothing was done"
+            ),
+        )
         print(f"acquire: {result.message}", file=stream)
         return result
     plans = trial_plans(cfg)
-    total = sum(len(seq) - (session.first_missing(seq, rec) if session.first_missing(seq, rec) is not None else len(seq))
-                for _, seq, rec in plans)
+    total = sum(
+        len(seq)
+        - (
+            session.first_missing(seq, rec)
+            if session.first_missing(seq, rec) is not None
+            else len(seq)
+        )
+        for _, seq, rec in plans
+    )
     result.steps_skipped = sum(len(rec) for _, _, rec in plans)
-    bar = tqdm(total=total, unit="photo", desc=f"{cfg.material} {cfg.actuator}", disable=(not progress) if progress is not None else None,
-               file=sys.stderr, dynamic_ncols=True)
+    bar = tqdm(
+        total=total,
+        unit="photo",
+        desc=f"{cfg.material} {cfg.actuator}",
+        disable=(not progress) if progress is not None else None,
+        file=sys.stderr,
+        dynamic_ncols=True,
+    )
     interrupts = _Interrupts()
     try:
         with interrupts:
@@ -295,7 +352,20 @@ def run_session(
                 driver.set_watchdog(cfg.watchdog_s)
             driver.sleep(cfg.settle_s)
             for trial, seq, recorded in plans:
-                _run_trial(driver, camera, cfg, trial, seq, recorded, up, stop_up, settings, bar, interrupts, result)
+                _run_trial(
+                    driver,
+                    camera,
+                    cfg,
+                    trial,
+                    seq,
+                    recorded,
+                    up,
+                    stop_up,
+                    settings,
+                    bar,
+                    interrupts,
+                    result,
+                )
             driver.vent()
             if watchdog:
                 driver.set_watchdog(0.0)
@@ -321,9 +391,20 @@ def run_session(
     return result
 
 
-def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: int, seq: list[session.StepPlan],
-               recorded: set[int], up: list[float], stop_up: StopCriterion | None, settings: MeasureSettings | None,
-               bar: tqdm, interrupts: _Interrupts, result: SessionResult) -> None:
+def _run_trial(
+    driver: PicoDriver,
+    camera: Camera,
+    cfg: SessionConfig,
+    trial: int,
+    seq: list[session.StepPlan],
+    recorded: set[int],
+    up: list[float],
+    stop_up: StopCriterion | None,
+    settings: MeasureSettings | None,
+    bar: tqdm,
+    interrupts: _Interrupts,
+    result: SessionResult,
+) -> None:
     """Run one trial from its first missing step."""
     start = session.first_missing(seq, recorded)
     if start is None:
@@ -332,7 +413,12 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
     if stop_up is not None and not peak_known and start > 0:
         # the up leg may already have ended early: re-check the recorded up photos
         for plan in seq[:start]:
-            if plan.direction == "up" and 0 < plan.step and settings is not None and _recorded_image_stops(cfg, plan, stop_up, settings):
+            if (
+                plan.direction == "up"
+                and 0 < plan.step
+                and settings is not None
+                and _recorded_image_stops(cfg, plan, stop_up, settings)
+            ):
                 seq = session.trial_sequence(trial, up, plan.step)
                 bar.total -= len(session.trial_sequence(trial, up)) - len(seq)
                 start = session.first_missing(seq, recorded)
@@ -351,12 +437,21 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
     while i < len(seq):
         plan = seq[i]
         result.last_step = plan
-        bar.set_postfix_str(f"trial {trial}/{cfg.trials} step {plan.step} {plan.direction} {plan.pressure_kpa:g} kPa", refresh=False)
+        bar.set_postfix_str(
+            f"trial {trial}/{cfg.trials} step {plan.step} {plan.direction} {plan.pressure_kpa:g} "
+            "kPa",
+            refresh=False,
+        )
         image_bytes = _record_step(driver, camera, cfg, plan, interrupts)
         result.photos_taken += 1
         bar.update(1)
-        if (stop_up is not None and settings is not None and plan.direction == "up" and 0 < plan.step < len(up) - 1
-                and stop_up(image_bytes, settings)):
+        if (
+            stop_up is not None
+            and settings is not None
+            and plan.direction == "up"
+            and 0 < plan.step < len(up) - 1
+            and stop_up(image_bytes, settings)
+        ):
             new_seq = session.trial_sequence(trial, up, plan.step)
             bar.total -= len(seq) - len(new_seq)
             bar.refresh()
@@ -366,13 +461,24 @@ def _run_trial(driver: PicoDriver, camera: Camera, cfg: SessionConfig, trial: in
 
 def _record_step(driver: PicoDriver, camera: Camera, cfg: SessionConfig, plan: session.StepPlan,
                  interrupts: _Interrupts) -> bytes:
-    """Set, settle, measure, photograph (and sample the load cell), then write photo and row atomically."""
+    """Set, settle, measure, photograph (and sample the load cell), then write photo and row
+    atomically."""
     driver.set_kpa(plan.pressure_kpa)
     driver.sleep(cfg.settle_s)
     reading = driver.get()
-    data, suffix = camera.capture(Shot(plan.pressure_kpa, reading.measured_kpa, plan.direction, plan.trial, plan.step))
+    data, suffix = camera.capture(
+        Shot(plan.pressure_kpa, reading.measured_kpa, plan.direction, plan.trial, plan.step)
+    )
     row: dict[str, Any] = {
-        "image": session.image_name(cfg.material, cfg.actuator, plan.trial, plan.step, plan.pressure_kpa, plan.direction, suffix),
+        "image": session.image_name(
+            cfg.material,
+            cfg.actuator,
+            plan.trial,
+            plan.step,
+            plan.pressure_kpa,
+            plan.direction,
+            suffix,
+        ),
         "pressure_kpa": f"{plan.pressure_kpa:g}",
         "direction": plan.direction,
         "material": cfg.material,
@@ -395,14 +501,20 @@ def _record_step(driver: PicoDriver, camera: Camera, cfg: SessionConfig, plan: s
 
 
 def _append_row(cfg: SessionConfig, row: dict[str, Any]) -> None:
-    """Append ``row``, first dropping any row of the same material/actuator/trial/step (a re-take)."""
+    """Append ``row``, first dropping any row of the same material/actuator/trial/step (a
+    re-take)."""
     path = cfg.out_dir / MANIFEST
     if path.is_file():
         import pandas as pd
 
         old = pd.read_csv(path, dtype=str)
-        same = ((old["material"] == row["material"]) & (old["actuator"] == row["actuator"])
-                & (old["trial"] == row["trial"]) & (old.get("step") == row["step"]) & (old["image"] != row["image"]))
+        same = (
+            (old["material"] == row["material"])
+            & (old["actuator"] == row["actuator"])
+            & (old["trial"] == row["trial"])
+            & (old.get("step") == row["step"])
+            & (old["image"] != row["image"])
+        )
         if same.any():
             for stale in old.loc[same, "image"]:
                 (cfg.out_dir / stale).unlink(missing_ok=True)
@@ -424,24 +536,37 @@ def _final_message(cfg: SessionConfig, result: SessionResult) -> str:
     if (cfg.out_dir / MANIFEST).is_file():
         with open(cfg.out_dir / MANIFEST) as fh:
             n_rows = max(sum(1 for _ in fh) - 1, 0)
-    garbage = f"; ignored {result.garbage_lines} garbage line(s) from the device" if result.garbage_lines else ""
+    garbage = (
+        f"; ignored {result.garbage_lines} garbage line(s) from the device"
+        if result.garbage_lines
+        else ""
+    )
     garbage += "".join(f"\nacquire: not used: {note}" for note in result.unused)
     if result.status == "done":
-        return (f"acquire: done: {result.photos_taken} photo(s) taken, {result.steps_skipped} already recorded; "
-                f"{n_rows} row(s) in {cfg.out_dir / MANIFEST}{garbage}")
+        return (
+            f"acquire: done: {result.photos_taken} photo(s) taken, {result.steps_skipped} already "
+            "recorded; "
+            f"{n_rows} row(s) in {cfg.out_dir / MANIFEST}{garbage}"
+        )
     where = ""
     if result.last_step is not None:
         s = result.last_step
         where = f" at trial {s.trial} step {s.step} ({s.pressure_kpa:g} kPa {s.direction})"
-    vent = ("vented to 0 kPa" if result.vented else
-            "COULD NOT VENT: the port is not answering -- press the emergency stop / open the relief valve")
+    vent = (
+        "vented to 0 kPa"
+        if result.vented
+        else "COULD NOT VENT: the port is not answering -- press the emergency stop / open the "
+             "relief valve"
+    )
     return (f"acquire: STOPPED{where}: {result.message}\n"
             f"acquire: {vent}; kept {n_rows} recorded row(s) in {cfg.out_dir / MANIFEST} "
             f"({result.photos_taken} taken in this run){garbage}\n"
             f"acquire: re-run the same command to resume at the first missing step")
 
 
-def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | None = None) -> StopCriterion:
+def psi0_stop_criterion(
+    psi0_deg: float, measure_image: Callable[..., Any] | None = None
+) -> StopCriterion:
     """A ``stop_up`` callable: True when the photo's measured psi is at or below ``-psi0_deg``.
 
     Uses :func:`pipeline.measure.measure_image` unless another function is given; failed
@@ -459,7 +584,11 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
         try:
             r = measure_image(image, settings)
         except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
-            log.warning("live psi measurement failed (%s: %s); the ramp continues to --max-kpa", type(exc).__name__, exc)
+            log.warning(
+                "live psi measurement failed (%s: %s); the ramp continues to --max-kpa",
+                type(exc).__name__,
+                exc,
+            )
             return False
         return getattr(r, "status", "failed") != "failed" and float(r.psi_deg) <= -abs(psi0_deg)
 
@@ -468,12 +597,24 @@ def psi0_stop_criterion(psi0_deg: float, measure_image: Callable[..., Any] | Non
 
 def summarise(result: SessionResult) -> dict[str, Any]:
     """Small dict of the result (for logs and tests)."""
-    return {"status": result.status, "photos_taken": result.photos_taken, "steps_skipped": result.steps_skipped,
-            "vented": result.vented, "exit_code": result.exit_code}
+    return {
+        "status": result.status,
+        "photos_taken": result.photos_taken,
+        "steps_skipped": result.steps_skipped,
+        "vented": result.vented,
+        "exit_code": result.exit_code,
+    }
 
 
 __all__ = [
-    "EXIT_CODES", "SessionConfig", "SessionResult", "describe_plan", "psi0_stop_criterion", "run_session",
-    "summarise", "trial_plans", "unused_features",
+    "EXIT_CODES",
+    "SessionConfig",
+    "SessionResult",
+    "describe_plan",
+    "psi0_stop_criterion",
+    "run_session",
+    "summarise",
+    "trial_plans",
+    "unused_features",
 ]
 

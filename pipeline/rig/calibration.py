@@ -69,7 +69,9 @@ class Calibration:
     device: str = ""
 
     def _line(self) -> tuple[float, float]:
-        slope, intercept = np.polyfit(np.asarray(self.dac_code, float), np.asarray(self.pressure_kpa, float), 1)
+        slope, intercept = np.polyfit(
+            np.asarray(self.dac_code, float), np.asarray(self.pressure_kpa, float), 1
+        )
         return float(slope), float(intercept)
 
     def code_to_kpa(self, code: float) -> float:
@@ -124,26 +126,34 @@ def fit_calibration(
     codes = np.asarray(dac_code, dtype=float)
     kpa = np.asarray(pressure_kpa, dtype=float)
     if codes.shape != kpa.shape or codes.size < 2:
-        raise UserInputError("calibration needs at least two (dac_code, pressure_kpa) points of equal count")
+        raise UserInputError(
+            "calibration needs at least two (dac_code, pressure_kpa) points of equal count"
+        )
     if not (np.all(np.isfinite(codes)) and np.all(np.isfinite(kpa))):
         raise UserInputError("calibration points must be finite numbers")
     order = np.argsort(codes)
     codes, kpa = codes[order], kpa[order]
     if np.any(np.diff(codes) <= 0):
-        raise UserInputError("calibration points repeat a dac_code; keep one reading per code (or average them)")
+        raise UserInputError(
+            "calibration points repeat a dac_code; keep one reading per code (or average them)"
+        )
     method = method or ("linear" if codes.size == 2 else "piecewise")
     if method not in METHODS:
         raise UserInputError(f"calibration method {method!r} is unknown; use one of {METHODS}")
     if method == "piecewise" and np.any(np.diff(kpa) <= 0):
         bad = int(np.argmax(np.diff(kpa) <= 0))
         raise UserInputError(
-            f"calibration pressure does not increase between codes {int(codes[bad])} and {int(codes[bad + 1])} "
-            f"({kpa[bad]:.1f} -> {kpa[bad + 1]:.1f} kPa); points at the supply limit cannot be calibrated: "
+            f"calibration pressure does not increase between codes {int(codes[bad])} and "
+            f"{int(codes[bad + 1])} "
+            f"({kpa[bad]:.1f} -> {kpa[bad + 1]:.1f} kPa); points at the supply limit cannot be "
+            "calibrated: "
             "drop them or use method linear"
         )
     cal = Calibration(tuple(int(c) for c in codes), tuple(float(p) for p in kpa), method, **extra)
     if method == "linear" and cal._line()[0] <= 0:
-        raise UserInputError("calibration slope is not positive: the pressure must rise with the DAC code")
+        raise UserInputError(
+            "calibration slope is not positive: the pressure must rise with the DAC code"
+        )
     return cal
 
 
@@ -157,7 +167,10 @@ def read_calibration(path: str | os.PathLike[str]) -> Calibration:
     """
     path = Path(path)
     if not path.is_file():
-        raise UserInputError(f"{path}: calibration file not found; create it with 'python -m pipeline rig calibrate --port PORT --out {path}'")
+        raise UserInputError(
+            f"{path}: calibration file not found; create it with 'python -m pipeline rig calibrate "
+            f"--port PORT --out {path}'"
+        )
     try:
         raw = yaml.safe_load(path.read_text()) or {}
         points = raw["points"]
@@ -165,14 +178,17 @@ def read_calibration(path: str | os.PathLike[str]) -> Calibration:
         kpa = [p["pressure_kpa"] for p in points]
     except (yaml.YAMLError, KeyError, TypeError) as exc:
         raise UserInputError(
-            f"{path}: not a calibration file ({exc!r}); it needs 'points: [{{dac_code: ..., pressure_kpa: ...}}, ...]'"
+            f"{path}: not a calibration file ({exc!r}); it needs 'points: [{{dac_code: ..., "
+            f"pressure_kpa: ...}}, ...]'"
         ) from exc
     extra = {k: raw.get(k) for k in ("max_kpa", "load_counts_per_newton")}
     for key, value in extra.items():
         if value is not None and not (isinstance(value, (int, float)) and value > 0):
             raise UserInputError(f"{path}: {key} = {value!r} must be a positive number or absent")
     try:
-        return fit_calibration(codes, kpa, raw.get("method"), device=str(raw.get("device", "")), **extra)
+        return fit_calibration(
+            codes, kpa, raw.get("method"), device=str(raw.get("device", "")), **extra
+        )
     except UserInputError as exc:
         raise UserInputError(f"{path}: {exc}") from exc
 
@@ -181,7 +197,10 @@ def write_calibration(path: str | os.PathLike[str], cal: Calibration) -> None:
     """Write a calibration file atomically."""
     data: dict[str, Any] = {
         "method": cal.method,
-        "points": [{"dac_code": int(c), "pressure_kpa": round(float(p), 4)} for c, p in zip(cal.dac_code, cal.pressure_kpa)],
+        "points": [
+            {"dac_code": int(c), "pressure_kpa": round(float(p), 4)}
+            for c, p in zip(cal.dac_code, cal.pressure_kpa)
+        ],
         "max_kpa": cal.max_kpa,
         "load_counts_per_newton": cal.load_counts_per_newton,
         "device": cal.device,

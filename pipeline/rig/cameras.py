@@ -71,10 +71,12 @@ class Camera(Protocol):
     """What the acquisition needs from a camera."""
 
     def capture(self, shot: Shot) -> tuple[bytes, str]:
-        """Take one photo; return the encoded bytes and the file suffix (``.jpg``, ``.png``, ...)."""
+        """Take one photo; return the encoded bytes and the file suffix (``.jpg``, ``.png``,
+        ...)."""
 
     def photoset_settings(self) -> dict[str, Any]:
-        """``photoset.yaml`` values the camera knows better than the user (empty for real cameras)."""
+        """``photoset.yaml`` values the camera knows better than the user (empty for real
+        cameras)."""
 
     def close(self) -> None:
         """Release the device."""
@@ -100,7 +102,8 @@ def image_suffix(data: bytes) -> str:
 
 
 class OpenCVCamera:
-    """OpenCV ``VideoCapture`` on a device index or stream URL; frames saved as JPEG (quality 95)."""
+    """OpenCV ``VideoCapture`` on a device index or stream URL; frames saved as JPEG (quality
+    95)."""
 
     def __init__(self, source: int | str, *, flush_frames: int = 2, jpeg_quality: int = 95) -> None:
         import cv2
@@ -109,7 +112,10 @@ class OpenCVCamera:
         self.source = source
         self.cap = cv2.VideoCapture(source)
         if not self.cap.isOpened():
-            raise CameraError(f"OpenCV cannot open camera {source!r}; check the index/URL (try --camera 0, 1, ...)")
+            raise CameraError(
+                f"OpenCV cannot open camera {source!r}; check the index/URL (try --camera 0, 1, "
+                "...)"
+            )
         self.flush_frames = flush_frames
         self.jpeg_quality = jpeg_quality
 
@@ -119,7 +125,9 @@ class OpenCVCamera:
         ok, frame = self.cap.read()
         if not ok or frame is None:
             raise CameraError(f"camera {self.source!r} returned no frame")
-        ok, buf = self._cv2.imencode(".jpg", frame, [self._cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality])
+        ok, buf = self._cv2.imencode(
+            ".jpg", frame, [self._cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality]
+        )
         if not ok:
             raise CameraError("JPEG encoding failed")
         return buf.tobytes(), ".jpg"
@@ -136,7 +144,10 @@ class CommandCamera:
 
     def __init__(self, template: str, *, timeout_s: float = 60.0) -> None:
         if "{path}" not in template:
-            raise UserInputError(f"--camera 'cmd:{template}' has no {{path}}; the command must write the photo to {{path}}")
+            raise UserInputError(
+                f"--camera 'cmd:{template}' has no {{path}}; the command must write the photo to "
+                f"{{path}}"
+            )
         self.template = template
         self.timeout_s = timeout_s
         self._tmp = tempfile.TemporaryDirectory(prefix="acquire-cmd-")
@@ -146,11 +157,18 @@ class CommandCamera:
         path.unlink(missing_ok=True)
         command = self.template.replace("{path}", shlex.quote(str(path)))
         try:
-            done = subprocess.run(command, shell=True, capture_output=True, timeout=self.timeout_s, check=False)
+            done = subprocess.run(
+                command, shell=True, capture_output=True, timeout=self.timeout_s, check=False
+            )
         except subprocess.TimeoutExpired as exc:
-            raise CameraError(f"camera command timed out after {self.timeout_s:g} s: {command}") from exc
+            raise CameraError(
+                f"camera command timed out after {self.timeout_s:g} s: {command}"
+            ) from exc
         if done.returncode != 0:
-            raise CameraError(f"camera command failed (exit {done.returncode}): {command}\n{done.stderr.decode(errors='replace')[-500:]}")
+            raise CameraError(
+                f"camera command failed (exit {done.returncode}): "
+                f"{command}\n{done.stderr.decode(errors='replace')[-500:]}"
+            )
         if not path.is_file() or path.stat().st_size == 0:
             raise CameraError(f"camera command wrote nothing to {path}: {command}")
         data = path.read_bytes()
@@ -172,11 +190,20 @@ class FolderCamera:
     counts as complete when its size has stayed the same for ``stable_s``.
     """
 
-    def __init__(self, folder: str | os.PathLike[str], *, timeout_s: float = 30.0, poll_s: float = 0.02,
-                 stable_s: float = 0.05) -> None:
+    def __init__(
+        self,
+        folder: str | os.PathLike[str],
+        *,
+        timeout_s: float = 30.0,
+        poll_s: float = 0.02,
+        stable_s: float = 0.05,
+    ) -> None:
         self.folder = Path(folder)
         if not self.folder.is_dir():
-            raise UserInputError(f"--camera dir:{folder}: not a folder; create it or point to the camera's save folder")
+            raise UserInputError(
+                f"--camera dir:{folder}: not a folder; create it or point to the camera's save "
+                "folder"
+            )
         self.timeout_s, self.poll_s, self.stable_s = timeout_s, poll_s, stable_s
         self._seen = set(self._images())
 
@@ -209,7 +236,8 @@ class FolderCamera:
 
 
 class SyntheticCamera:
-    """Renders the actuator at the pressure the rig reports (a complete virtual rig with the emulator).
+    """Renders the actuator at the pressure the rig reports (a complete virtual rig with the
+    emulator).
 
     psi comes from :func:`pipeline.model.psi_deg` at the *measured* pressure (``loading`` branch
     going up, ``unloading`` going down); the image from :func:`pipeline.synth.render_actuator`.
@@ -235,7 +263,10 @@ class SyntheticCamera:
         try:
             self.scene = synth.scene_from(preset, **(scene_overrides or {}))
         except KeyError as exc:
-            raise UserInputError(f"--camera synthetic:{preset}: unknown scene preset; use one of {sorted(synth.SCENE_PRESETS)}") from exc
+            raise UserInputError(
+                f"--camera synthetic:{preset}: unknown scene preset; use one of "
+                f"{sorted(synth.SCENE_PRESETS)}"
+            ) from exc
         # one static scene (camera placement, table, clamp, lighting) for the whole session, framed
         # to hold every shape from -psi_frame to +psi_frame, so the fixed end stays put on screen
         self.mode = mode
@@ -244,9 +275,15 @@ class SyntheticCamera:
             from pipeline.force import synth_blocked
 
             self._blocked = synth_blocked
-            curves = [synth_blocked.blocked_arc_mm(float(e), self.l0_mm).points_mm for e in (0.0, 0.45, 0.9)]
+            curves = [
+                synth_blocked.blocked_arc_mm(float(e), self.l0_mm).points_mm
+                for e in (0.0, 0.45, 0.9)
+            ]
         else:
-            curves = [synth.centreline_mm(float(p), self.l0_mm, n=400) for p in np.linspace(-psi_frame_deg, psi_frame_deg, 17)]
+            curves = [
+                synth.centreline_mm(float(p), self.l0_mm, n=400)
+                for p in np.linspace(-psi_frame_deg, psi_frame_deg, 17)
+            ]
         # zoom out just enough (as render_photoset does) and turn the clamp so every shape fits
         from pipeline.synth.photoset_writer import choose_layout
 
@@ -254,15 +291,25 @@ class SyntheticCamera:
         if need > 1.0:
             mm_per_px = float(np.ceil(self.scene.mm_per_px * need * 1000) / 1000)
             self.scene = dataclasses.replace(self.scene, mm_per_px=mm_per_px)
-        camera = synth.make_camera(self.scene, rotation_deg=rotation_deg, extent_mm=np.vstack(curves))
-        self.backdrop = synth.make_backdrop(self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=curves)
-        probe = synth.render_actuator(0.0, self.l0_mm, self.scene, seed=0, backdrop=self.backdrop, n=400)
+        camera = synth.make_camera(
+            self.scene, rotation_deg=rotation_deg, extent_mm=np.vstack(curves)
+        )
+        self.backdrop = synth.make_backdrop(
+            self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=curves
+        )
+        probe = synth.render_actuator(
+            0.0, self.l0_mm, self.scene, seed=0, backdrop=self.backdrop, n=400
+        )
         self._fixed_end = (float(probe.fixed_end_px[0]), float(probe.fixed_end_px[1]))
 
     def psi_deg(self, pressure_kpa: float, direction: str) -> float:
         """Model bending angle (deg) at ``pressure_kpa`` on the branch of ``direction``."""
         branch = "loading" if direction == "up" else "unloading"
-        return float(np.asarray(self.psi_fn(self.material, np.array([max(pressure_kpa, 0.0)]), branch=branch)).ravel()[0])
+        return float(
+            np.asarray(
+                self.psi_fn(self.material, np.array([max(pressure_kpa, 0.0)]), branch=branch)
+            ).ravel()[0]
+        )
 
     def _seed(self, trial: int, step: int) -> int:
         digest = hashlib.sha256(f"{self.seed}/{self.material}/{trial}/{step}".encode()).digest()
@@ -270,17 +317,31 @@ class SyntheticCamera:
 
     def capture(self, shot: Shot) -> tuple[bytes, str]:
         if self._blocked is not None:
-            e = float(self._blocked.blocked_eccentricity(self.material, max(shot.measured_kpa, 0.0)))
+            e = float(
+                self._blocked.blocked_eccentricity(self.material, max(shot.measured_kpa, 0.0))
+            )
             shape = self._blocked.blocked_arc_mm(min(e, 0.95), self.l0_mm)
-            rendered = self._synth.render_curve(shape.points_mm, self.scene, seed=self._seed(shot.trial, shot.step),
-                                                backdrop=self.backdrop)
+            rendered = self._synth.render_curve(
+                shape.points_mm,
+                self.scene,
+                seed=self._seed(shot.trial, shot.step),
+                backdrop=self.backdrop,
+            )
             return bytes(rendered.jpeg_bytes), ".jpg"
-        rendered = self._synth.render_actuator(self.psi_deg(shot.measured_kpa, shot.direction), self.l0_mm,
-                                               self.scene, seed=self._seed(shot.trial, shot.step), backdrop=self.backdrop)
+        rendered = self._synth.render_actuator(
+            self.psi_deg(shot.measured_kpa, shot.direction),
+            self.l0_mm,
+            self.scene,
+            seed=self._seed(shot.trial, shot.step),
+            backdrop=self.backdrop,
+        )
         return bytes(rendered.jpeg_bytes), ".jpg"
 
     def photoset_settings(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"positive_turn": "ccw", "fixed_end": [round(v, 1) for v in self._fixed_end]}
+        out: dict[str, Any] = {
+            "positive_turn": "ccw",
+            "fixed_end": [round(v, 1) for v in self._fixed_end],
+        }
         for key, attr in (("mm_per_px", "mm_per_px"), ("line_color", "line_color")):
             value = getattr(self.scene, attr, None)
             if value is not None:
@@ -298,7 +359,7 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
     Raises
     ------
     UserInputError
-        On a spec that names no backend, or ``synthetic`` when :mod:`pipeline.synth` is missing.
+        On a spec that names no backend.
     """
     spec = spec.strip()
     if spec.startswith("cmd:"):
@@ -307,10 +368,7 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
         return FolderCamera(spec[4:], timeout_s=timeout_s)
     if spec == "synthetic" or spec.startswith("synthetic:"):
         preset = spec.partition(":")[2] or "lab"
-        try:
-            return SyntheticCamera(material, l0_mm, preset=preset, seed=seed, mode=mode)
-        except ImportError as exc:
-            raise UserInputError(f"--camera synthetic needs pipeline.synth, pipeline.model (and pipeline.force in blocked mode): {exc}") from exc
+        return SyntheticCamera(material, l0_mm, preset=preset, seed=seed, mode=mode)
     if spec.isdigit():
         return OpenCVCamera(int(spec))
     if "://" in spec:
@@ -319,8 +377,3 @@ def open_camera(spec: str, *, material: str, l0_mm: float, seed: int = 0, timeou
         f"--camera {spec!r} is not understood; use a device index (0), a stream URL (rtsp://...), "
         "'cmd:COMMAND {path}', 'dir:FOLDER' or 'synthetic[:clean|lab|hard]'"
     )
-
-
-def is_synthetic(camera: Camera) -> bool:
-    """Whether ``camera`` renders synthetic images."""
-    return isinstance(camera, SyntheticCamera)

@@ -1,4 +1,5 @@
-"""pyserial driver for the Pico pressure controller (protocol in :mod:`pipeline.rig.firmware.rigcore`).
+"""pyserial driver for the Pico pressure controller (protocol in
+:mod:`pipeline.rig.firmware.rigcore`).
 
 The driver refuses a setpoint above its ``max_kpa`` *before* sending anything, converts
 pressures through a :class:`~pipeline.rig.calibration.Calibration` when one is given, skips
@@ -22,11 +23,14 @@ Against the emulator (a real pseudo-terminal)::
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import sys
 import time
 from dataclasses import dataclass
 from types import TracebackType
+from typing import TYPE_CHECKING
 
 import numpy as np
 import serial
@@ -35,14 +39,17 @@ from pipeline.errors import UserInputError
 from pipeline.rig.calibration import Calibration
 from pipeline.rig.protocol import BAUDRATE, EXTENSIONS, Reply, encode, parse_reply
 
+if TYPE_CHECKING:
+    from typing_extensions import Self
+
 log = logging.getLogger(__name__)
 
-try:  # POSIX: a hung-up tty raises termios.error (not an OSError) from tcdrain/tcsetattr
+_PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+# POSIX: a hung-up tty raises termios.error (not an OSError) from tcdrain/tcsetattr
+if sys.platform != "win32":
     import termios
 
-    _PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, termios.error)
-except ImportError:  # pragma: no cover - Windows
-    _PORT_ERRORS = (serial.SerialException, OSError)
+    _PORT_ERRORS = (*_PORT_ERRORS, termios.error)
 
 #: garbage lines tolerated while waiting for one reply
 MAX_GARBAGE_PER_REPLY = 20
@@ -111,7 +118,8 @@ class DeviceInfo:
 
     @property
     def missing(self) -> tuple[str, ...]:
-        """Extensions the firmware does not have, in :data:`~pipeline.rig.protocol.EXTENSIONS` order."""
+        """Extensions the firmware does not have, in :data:`~pipeline.rig.protocol.EXTENSIONS`
+        order."""
         return tuple(name for name in EXTENSIONS if name not in self.extensions)
 
 
@@ -126,7 +134,8 @@ class PressureReading:
 
 @dataclass(frozen=True)
 class SetResult:
-    """One ``SET``: the pressure asked for (kPa), the nominal value sent and the DAC code applied."""
+    """One ``SET``: the pressure asked for (kPa), the nominal value sent and the DAC code
+    applied."""
 
     pressure_kpa: float
     sent_kpa: float
@@ -149,8 +158,14 @@ class PicoDriver:
         Longest wait for one reply before the port counts as lost (s).
     """
 
-    def __init__(self, link: serial.Serial, *, max_kpa: float, calibration: Calibration | None = None,
-                 timeout_s: float = 2.0) -> None:
+    def __init__(
+        self,
+        link: serial.Serial,
+        *,
+        max_kpa: float,
+        calibration: Calibration | None = None,
+        timeout_s: float = 2.0,
+    ) -> None:
         self.link = link
         self.calibration = calibration
         limits = [max_kpa] + ([calibration.max_kpa] if calibration and calibration.max_kpa else [])
@@ -158,7 +173,6 @@ class PicoDriver:
         self.timeout_s = timeout_s
         self.info: DeviceInfo | None = None
         self.garbage_lines = 0
-        self.commands_sent = 0
         self._estop_seen = False
         self._watchdog_seen = False
         self._buf = b""
@@ -168,7 +182,8 @@ class PicoDriver:
     @classmethod
     def open(cls, port: str, *, max_kpa: float, calibration: Calibration | None = None,
              timeout_s: float = 2.0) -> PicoDriver:
-        """Open ``port`` (a device path such as ``/dev/ttyACM0`` or a pyserial URL), identify the device.
+        """Open ``port`` (a device path such as ``/dev/ttyACM0`` or a pyserial URL), identify the
+        device.
 
         Raises
         ------
@@ -176,9 +191,13 @@ class PicoDriver:
             If the port cannot be opened or the device does not answer ``ID``.
         """
         try:
-            link = serial.serial_for_url(port, baudrate=BAUDRATE, timeout=0.05, write_timeout=timeout_s)
+            link = serial.serial_for_url(
+                port, baudrate=BAUDRATE, timeout=0.05, write_timeout=timeout_s
+            )
         except (*_PORT_ERRORS, ValueError) as exc:
-            raise PortLostError(f"cannot open serial port {port!r}: {exc}; check the cable and the --port name") from exc
+            raise PortLostError(
+                f"cannot open serial port {port!r}: {exc}; check the cable and the --port name"
+            ) from exc
         driver = cls(link, max_kpa=max_kpa, calibration=calibration, timeout_s=timeout_s)
         try:
             driver.connect()
@@ -188,7 +207,8 @@ class PicoDriver:
         return driver
 
     def connect(self) -> DeviceInfo:
-        """Discard stale input, read ``ID``, probe the extensions, send the calibration's load-cell scale.
+        """Discard stale input, read ``ID``, probe the extensions, send the calibration's load-cell
+        scale.
 
         Raises
         ------
@@ -211,9 +231,12 @@ class PicoDriver:
         )
         if self.calibration is not None and cfg is None:
             raise UnsupportedError(
-                f"firmware {name} {version} does not report its DAC scaling (no CFG command), so the "
-                "calibration (kPa <-> DAC code) cannot be applied; run without --calibration (the firmware's "
-                "own scaling; measured_pressure_kpa still records the regulator's monitor) or flash the "
+                f"firmware {name} {version} does not report its DAC scaling (no CFG command), so "
+                "the "
+                "calibration (kPa <-> DAC code) cannot be applied; run without --calibration (the "
+                "firmware's "
+                "own scaling; measured_pressure_kpa still records the regulator's monitor) or "
+                "flash the "
                 "firmware of pipeline/rig/firmware"
             )
         if self.calibration and self.calibration.load_counts_per_newton and "LOAD" in found:
@@ -221,15 +244,18 @@ class PicoDriver:
         return self.info
 
     def supports(self, extension: str) -> bool:
-        """Whether the firmware answered the probe of ``extension`` (a key of ``EXTENSIONS``) at connect."""
+        """Whether the firmware answered the probe of ``extension`` (a key of ``EXTENSIONS``) at
+        connect."""
         return self.info is not None and extension in self.info.extensions
 
     def _require(self, extension: str, what: str) -> None:
         if self.info is not None and extension not in self.info.extensions:
             commands = "/".join(EXTENSIONS[extension])
             raise UnsupportedError(
-                f"firmware {self.info.name} {self.info.version} does not speak {commands} (an extension of the "
-                f"protocol), which {what} needs; flash the firmware of pipeline/rig/firmware to use it"
+                f"firmware {self.info.name} {self.info.version} does not speak {commands} (an "
+                "extension of the "
+                f"protocol), which {what} needs; flash the firmware of pipeline/rig/firmware to "
+                "use it"
             )
 
     def _probe(self, command: str, *args: float) -> Reply | None:
@@ -242,15 +268,15 @@ class PicoDriver:
 
     def close(self) -> None:
         """Close the port (never raises)."""
-        try:
+        with contextlib.suppress(Exception):  # closing a dead port must not mask the real error
             self.link.close()
-        except Exception:  # noqa: BLE001 - closing a dead port must not mask the real error
-            pass
 
-    def __enter__(self) -> PicoDriver:
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None) -> None:
+    def __exit__(
+        self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
+    ) -> None:
         self.safe_vent()
         self.close()
 
@@ -268,15 +294,23 @@ class PicoDriver:
         """
         p = float(pressure_kpa)
         if not math.isfinite(p) or p < 0:
-            raise LimitError(f"refused setpoint {pressure_kpa!r} kPa: must be a number >= 0 (nothing sent)", sent=False)
+            raise LimitError(
+                f"refused setpoint {pressure_kpa!r} kPa: must be a number >= 0 (nothing sent)",
+                sent=False,
+            )
         if p > self.max_kpa + 1e-9:
             raise LimitError(
-                f"refused setpoint {p:g} kPa: above the host limit max_kpa = {self.max_kpa:g} kPa (nothing sent)",
+                f"refused setpoint {p:g} kPa: above the host limit max_kpa = {self.max_kpa:g} kPa "
+                "(nothing sent)",
                 sent=False,
             )
         want_code = None
         sent = p
-        if self.calibration is not None and self.info is not None and self.info.kpa_per_code is not None:
+        if (
+            self.calibration is not None
+            and self.info is not None
+            and self.info.kpa_per_code is not None
+        ):
             want_code = self.calibration.kpa_to_code(p)
             sent = want_code * self.info.kpa_per_code
         r = self._command("SET", sent)
@@ -389,7 +423,9 @@ class PicoDriver:
             )
         if self._estop_seen:
             self._estop_seen = False
-            raise EStopError("emergency stop pressed: the device vented; release the button and re-run to resume")
+            raise EStopError(
+                "emergency stop pressed: the device vented; release the button and re-run to resume"
+            )
 
     def _drain(self) -> None:
         try:
@@ -403,10 +439,15 @@ class PicoDriver:
         while b"\n" not in self._buf:
             try:
                 waiting = self.link.in_waiting
-                chunk = self.link.read(max(1, waiting)) if waiting or time.monotonic() < deadline else b""
+                chunk = (
+                    self.link.read(max(1, waiting))
+                    if waiting or time.monotonic() < deadline
+                    else b""
+                )
             except _PORT_ERRORS as exc:
                 raise PortLostError(
-                    f"serial port {self.link.port!r} lost ({exc}); reconnect the rig and re-run the same command to resume"
+                    f"serial port {self.link.port!r} lost ({exc}); reconnect the rig and re-run "
+                    "the same command to resume"
                 ) from exc
             if chunk:
                 self._buf += chunk
@@ -423,7 +464,9 @@ class PicoDriver:
             self.garbage_lines += 1
             log.debug("ignored line from device: %r", line[:80])
 
-    def _command(self, command: str, *args: float, raise_estop: bool = True, retries: int = 1) -> Reply:
+    def _command(
+        self, command: str, *args: float, raise_estop: bool = True, retries: int = 1
+    ) -> Reply:
         for attempt in range(retries + 1):
             try:
                 self.link.write(encode(command, *args))
@@ -433,7 +476,6 @@ class PicoDriver:
                     f"serial port {self.link.port!r} lost while sending {command} ({exc}); "
                     "reconnect the rig and re-run the same command to resume"
                 ) from exc
-            self.commands_sent += 1
             reply = self._await_reply(command)
             if reply.kind == "ERR" and reply.command == "PARSE" and attempt < retries:
                 log.warning("device answered ERR PARSE to %s; sending it again", command)
@@ -442,11 +484,20 @@ class PicoDriver:
         if reply.kind == "ERR":
             if reply.command == "ESTOP":
                 self._estop_seen = False
-                raise EStopError("emergency stop pressed: the device refused the setpoint and vented; "
-                                 "release the button and re-run to resume")
+                raise EStopError(
+                    "emergency stop pressed: the device refused the setpoint and vented; "
+                    "release the button and re-run to resume"
+                )
             if reply.command == "LIMIT":
-                limit = f" ({self.info.max_kpa:g} kPa)" if self.info and self.info.max_kpa is not None else ""
-                raise LimitError(f"device refused {command} {args[0] if args else ''}: above its limit{limit}", sent=True)
+                limit = (
+                    f" ({self.info.max_kpa:g} kPa)"
+                    if self.info and self.info.max_kpa is not None
+                    else ""
+                )
+                raise LimitError(
+                    f"device refused {command} {args[0] if args else ''}: above its limit{limit}",
+                    sent=True,
+                )
             kind = ParseError if reply.command == "PARSE" else DeviceError
             raise kind(f"device answered {reply.line!r} to {command}")
         if raise_estop:
@@ -460,7 +511,8 @@ class PicoDriver:
             line = self._read_line(deadline)
             if line is None:
                 raise PortLostError(
-                    f"no reply to {command} within {self.timeout_s:g} s from {self.link.port!r}: the device is not "
+                    f"no reply to {command} within {self.timeout_s:g} s from {self.link.port!r}: "
+                    "the device is not "
                     "answering; check power and cable, then re-run the same command to resume"
                 )
             reply = parse_reply(line)
@@ -470,7 +522,10 @@ class PicoDriver:
                     self.garbage_lines += 1
                     log.debug("ignored garbage line from device: %r", line[:80])
                     if garbage > MAX_GARBAGE_PER_REPLY:
-                        raise DeviceError(f"more than {MAX_GARBAGE_PER_REPLY} garbage lines while waiting for {command}; check the baud rate ({BAUDRATE}) and the port")
+                        raise DeviceError(
+                            f"more than {MAX_GARBAGE_PER_REPLY} garbage lines while waiting for "
+                            f"{command}; check the baud rate ({BAUDRATE}) and the port"
+                        )
                 continue
             if reply.kind == "EVT":
                 self._note_event(reply)

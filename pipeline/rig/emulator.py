@@ -1,4 +1,5 @@
-"""The Pico over a pseudo-terminal: the real firmware logic on a simulated rig, with fault injection.
+"""The Pico over a pseudo-terminal: the real firmware logic on a simulated rig, with fault
+injection.
 
 The emulator runs :class:`pipeline.rig.firmware.rigcore.Controller` (the code the Pico runs)
 against a plant model of the regulator (gain, offset, supply limit, first-order lag, monitor
@@ -44,12 +45,16 @@ import tty
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pipeline.errors import UserInputError
 from pipeline.rig.firmware import rigcore
 from pipeline.rig.protocol import BASE_COMMANDS
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 #: what the emulated firmware speaks: everything ``rigcore`` does, or the base protocol only
 PROTOCOLS = ("full", "base")
@@ -119,12 +124,16 @@ def parse_faults(specs: list[str] | None) -> Faults:
     for spec in specs or []:
         name, _, value = spec.partition("=")
         if name not in keys:
-            raise UserInputError(f"--fault {spec!r}: unknown fault; use one of {', '.join(k + '=N' for k in keys)}")
+            raise UserInputError(
+                f"--fault {spec!r}: unknown fault; use one of {', '.join(k + '=N' for k in keys)}"
+            )
         attr, kind = keys[name]
         try:
             v = kind(value)
         except ValueError as exc:
-            raise UserInputError(f"--fault {spec!r}: {value!r} is not a valid {kind.__name__}") from exc
+            raise UserInputError(
+                f"--fault {spec!r}: {value!r} is not a valid {kind.__name__}"
+            ) from exc
         if v < 0 or (kind is int and v == 0 and name != "drop-after"):
             raise UserInputError(f"--fault {spec!r}: the value must be positive")
         values[attr] = v
@@ -146,7 +155,9 @@ class EmulatedHardware:
         if code == 0:
             return 0.0
         nominal = rigcore.code_to_kpa(code, self.cfg)
-        return float(min(max(self.plant.gain * nominal + self.plant.offset_kpa, 0.0), self.plant.supply_kpa))
+        return float(
+            min(max(self.plant.gain * nominal + self.plant.offset_kpa, 0.0), self.plant.supply_kpa)
+        )
 
     def pressure_kpa(self) -> float:
         """True pressure in the actuator now (kPa)."""
@@ -172,8 +183,10 @@ class EmulatedHardware:
         return self.estop
 
     def read_load_counts(self) -> int:
-        force = self.plant.force_n(self.pressure_kpa()) + self.rng.normal(0.0, self.plant.force_noise_n)
-        return int(round(self.plant.load_offset_counts + force * self.plant.load_counts_per_newton))
+        force = self.plant.force_n(self.pressure_kpa()) + self.rng.normal(
+            0.0, self.plant.force_noise_n
+        )
+        return int(round(self.plant.load_offset_counts + force * self.plant.load_counts_per_newton))  # noqa: RUF046 (numpy scalar)
 
 
 @dataclass
@@ -205,11 +218,20 @@ class Emulator:
         ``ID``, ``SET``, ``GET``, ``VENT`` and ``EVT ESTOP``).
     """
 
-    def __init__(self, *, plant: PlantParams | None = None, faults: Faults | None = None, seed: int = 0,
-                 cfg: rigcore.Config | None = None, link: str | os.PathLike[str] | None = None,
-                 protocol: str = "full") -> None:
+    def __init__(
+        self,
+        *,
+        plant: PlantParams | None = None,
+        faults: Faults | None = None,
+        seed: int = 0,
+        cfg: rigcore.Config | None = None,
+        link: str | os.PathLike[str] | None = None,
+        protocol: str = "full",
+    ) -> None:
         if protocol not in PROTOCOLS:
-            raise UserInputError(f"emulator protocol {protocol!r}: use one of {', '.join(PROTOCOLS)}")
+            raise UserInputError(
+                f"emulator protocol {protocol!r}: use one of {', '.join(PROTOCOLS)}"
+            )
         self.protocol = protocol
         self.plant = plant or PlantParams()
         self.faults = faults or Faults()
@@ -254,7 +276,9 @@ class Emulator:
 
     def start(self) -> Emulator:
         """Start serving in a daemon thread."""
-        self._thread = threading.Thread(target=self.serve_forever, name="pico-emulator", daemon=True)
+        self._thread = threading.Thread(
+            target=self.serve_forever, name="pico-emulator", daemon=True
+        )
         self._thread.start()
         return self
 
@@ -267,10 +291,13 @@ class Emulator:
         if self.link is not None:
             self.link.unlink(missing_ok=True)
 
-    def __enter__(self) -> Emulator:
-        return self.start()
+    def __enter__(self) -> Self:
+        self.start()
+        return self
 
-    def __exit__(self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None) -> None:
+    def __exit__(
+        self, et: type[BaseException] | None, ev: BaseException | None, tb: TracebackType | None
+    ) -> None:
         self.stop()
 
     def serve_forever(self) -> None:
@@ -297,7 +324,11 @@ class Emulator:
     def _serve_line(self, line: bytes) -> bool:
         """Answer one line; ``False`` when the connection was dropped instead."""
         text = line.decode("ascii", "replace").strip()
-        if self.faults.drop_after is not None and self.stats.drops == 0 and len(self.stats.received) >= self.faults.drop_after:
+        if (
+            self.faults.drop_after is not None
+            and self.stats.drops == 0
+            and len(self.stats.received) >= self.faults.drop_after
+        ):
             self.stats.drops += 1
             self._drop()
             return False

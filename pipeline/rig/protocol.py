@@ -22,7 +22,16 @@ EOL = b"\n"
 KINDS = ("OK", "ERR", "EVT")
 #: number of fields after ``OK <COMMAND>`` for each command
 OK_FIELDS: dict[str, int] = {
-    "ID": 2, "SET": 2, "GET": 3, "VENT": 0, "CFG": 3, "LOAD": 1, "LOADRAW": 1, "TARE": 1, "SCALE": 1, "WDOG": 1,
+    "ID": 2,
+    "SET": 2,
+    "GET": 3,
+    "VENT": 0,
+    "CFG": 3,
+    "LOAD": 1,
+    "LOADRAW": 1,
+    "TARE": 1,
+    "SCALE": 1,
+    "WDOG": 1,
 }
 ERRORS = ("LIMIT", "ESTOP", "PARSE", "HW")
 #: the documented protocol every firmware speaks (plus the unsolicited ``EVT ESTOP``)

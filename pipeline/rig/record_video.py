@@ -95,9 +95,15 @@ def recorded_trials(cfg: VideoSessionConfig) -> set[int]:
         return set()
     df = pd.read_csv(path, dtype=str)
     if not is_video_manifest(df):
-        raise UserInputError(f"{path}: lists photos, not videos; record videos into a new --out folder")
+        raise UserInputError(
+            f"{path}: lists photos, not videos; record videos into a new --out folder"
+        )
     mine = df[(df["material"] == cfg.material) & (df["actuator"] == cfg.actuator)]
-    return {int(t) for t, v in zip(mine["trial"], mine["video"]) if str(t).isdigit() and (cfg.out_dir / str(v)).is_file()}
+    return {
+        int(t)
+        for t, v in zip(mine["trial"], mine["video"])
+        if str(t).isdigit() and (cfg.out_dir / str(v)).is_file()
+    }
 
 
 def describe_video_plan(cfg: VideoSessionConfig, *, camera_spec: str = "", port: str = "") -> str:
@@ -108,15 +114,22 @@ def describe_video_plan(cfg: VideoSessionConfig, *, camera_spec: str = "", port:
     done = recorded_trials(cfg)
     todo = [t for t in range(1, cfg.trials + 1) if t not in done]
     seconds = len(todo) * (p.duration_s + 2 * cfg.rest_s)
-    return "\n".join([
-        f"acquire plan (video): {cfg.material} actuator {cfg.actuator}, {cfg.trials} trial(s), port {port or '-'}, "
-        f"camera {camera_spec or '-'} at {cfg.fps:g} fps",
-        f"  out: {cfg.out_dir}",
-        f"  profile: {shape}, x{p.cycles} ({p.duration_s:g} s), {cfg.rest_s:g} s at rest before and after; "
-        f"pressure logged at {cfg.log_hz:g} Hz",
-        "  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items()),
-        f"  recorded: {sorted(done) or 'none'}; to do: trials {todo or 'none'}, about {seconds / 60:.1f} min",
-    ])
+    return "\n".join(
+        [
+            (f"acquire plan (video): {cfg.material} actuator {cfg.actuator}, {cfg.trials} "
+             f"trial(s), port {port or '-'}, "
+            f"camera {camera_spec or '-'} at {cfg.fps:g} fps"),
+            f"  out: {cfg.out_dir}",
+            (f"  profile: {shape}, x{p.cycles} ({p.duration_s:g} s), {cfg.rest_s:g} s at rest "
+             "before and after; "
+            f"pressure logged at {cfg.log_hz:g} Hz"),
+            "  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items()),
+            (
+                f"  recorded: {sorted(done) or 'none'}; to do: trials {todo or 'none'}, about "
+                f"{seconds / 60:.1f} min"
+            ),
+        ]
+    )
 
 
 def _record_trial(driver: PicoDriver, recorder: VideoRecorder, cfg: VideoSessionConfig, trial: int,
@@ -162,28 +175,55 @@ def _record_trial(driver: PicoDriver, recorder: VideoRecorder, cfg: VideoSession
         raise
     driver.vent()
     with interrupts.held():
-        write_table(pd.DataFrame(log_rows, columns=["time_s", "pressure_kpa", "measured_kpa"]), partial[1],
-                    float_format="%.4f")
-        write_table(pd.DataFrame({"frame": range(len(times)), "time_s": times}), partial[2], float_format="%.4f")
+        write_table(
+            pd.DataFrame(log_rows, columns=["time_s", "pressure_kpa", "measured_kpa"]),
+            partial[1],
+            float_format="%.4f",
+        )
+        write_table(
+            pd.DataFrame({"frame": range(len(times)), "time_s": times}),
+            partial[2],
+            float_format="%.4f",
+        )
         for src, name in zip(partial, (video, log_name, frames_name)):
             os.replace(src, cfg.out_dir / name)
-        append_manifest_rows(cfg.out_dir, [{"video": video, "pressure_log": log_name, "frame_times": frames_name,
-                                            "clock_offset_s": "0", "material": cfg.material, "actuator": cfg.actuator,
-                                            "trial": str(trial)}])
+        append_manifest_rows(
+            cfg.out_dir,
+            [
+                {
+                    "video": video,
+                    "pressure_log": log_name,
+                    "frame_times": frames_name,
+                    "clock_offset_s": "0",
+                    "material": cfg.material,
+                    "actuator": cfg.actuator,
+                    "trial": str(trial),
+                }
+            ],
+        )
     result.photos_taken += len(times)
 
 
-def _keep_interrupted(recorder: VideoRecorder, partial: list[Path], log_rows: list[tuple[float, float, float]],
-                      cfg: VideoSessionConfig) -> None:
+def _keep_interrupted(
+    recorder: VideoRecorder,
+    partial: list[Path],
+    log_rows: list[tuple[float, float, float]],
+    cfg: VideoSessionConfig,
+) -> None:
     """After a stop: close the recording, keep what was recorded as ``*.interrupted.*`` files."""
     try:
         times = recorder.stop()
     except CameraError:
         times = []
     if log_rows:
-        write_table(pd.DataFrame(log_rows, columns=["time_s", "pressure_kpa", "measured_kpa"]), partial[1],
-                    float_format="%.4f")
-    write_table(pd.DataFrame({"frame": range(len(times)), "time_s": times}), partial[2], float_format="%.4f")
+        write_table(
+            pd.DataFrame(log_rows, columns=["time_s", "pressure_kpa", "measured_kpa"]),
+            partial[1],
+            float_format="%.4f",
+        )
+    write_table(
+        pd.DataFrame({"frame": range(len(times)), "time_s": times}), partial[2], float_format="%.4f"
+    )
     for p in partial:
         if p.is_file():
             os.replace(p, p.with_name(p.name.replace(".partial", ".interrupted")))
@@ -207,8 +247,13 @@ def run_video_session(driver: PicoDriver, recorder: VideoRecorder, cfg: VideoSes
     if session.check_settings(cfg.out_dir, raw_settings):
         write_settings(cfg.out_dir, raw_settings)
     if cfg.profile.max_kpa > driver.max_kpa + 1e-9:
-        result.status, result.message = "limit", (f"--max-kpa {cfg.profile.max_kpa:g} is above the driver limit "
-                                                  f"{driver.max_kpa:g} kPa (calibration max_kpa); nothing was done")
+        result.status, result.message = (
+            "limit",
+            (
+                f"--max-kpa {cfg.profile.max_kpa:g} is above the driver limit "
+                f"{driver.max_kpa:g} kPa (calibration max_kpa); nothing was done"
+            ),
+        )
         print(f"acquire: {result.message}", file=stream)
         return result
     result.steps_skipped = len(done)
@@ -244,13 +289,25 @@ def run_video_session(driver: PicoDriver, recorder: VideoRecorder, cfg: VideoSes
             result.vented = driver.safe_vent()
         result.garbage_lines = driver.garbage_lines
     if result.status == "done":
-        print(f"acquire: done: {result.photos_taken} frame(s) recorded, {result.steps_skipped} trial(s) already recorded; "
-              f"manifest {cfg.out_dir / MANIFEST}", file=stream)
+        print(
+            f"acquire: done: {result.photos_taken} frame(s) recorded, {result.steps_skipped} "
+            "trial(s) already recorded; "
+            f"manifest {cfg.out_dir / MANIFEST}",
+            file=stream,
+        )
     else:
-        vent = ("vented to 0 kPa" if result.vented else
-                "COULD NOT VENT: the port is not answering -- press the emergency stop / open the relief valve")
-        print(f"acquire: STOPPED during trial {current}: {result.message}\n"
-              f"acquire: {vent}; finished trials are kept in {cfg.out_dir / MANIFEST}; what trial {current} recorded is "
-              f"kept as {cfg.names(current)[0].replace('.avi', '')}*.interrupted.* (not listed)\n"
-              f"acquire: re-run the same command to record trial {current} again", file=stream)
+        vent = (
+            "vented to 0 kPa"
+            if result.vented
+            else "COULD NOT VENT: the port is not answering -- press the emergency stop / open the "
+                 "relief valve"
+        )
+        print(
+            f"acquire: STOPPED during trial {current}: {result.message}\n"
+            f"acquire: {vent}; finished trials are kept in {cfg.out_dir / MANIFEST}; what trial "
+            f"{current} recorded is "
+            f"kept as {cfg.names(current)[0].replace('.avi', '')}*.interrupted.* (not listed)\n"
+            f"acquire: re-run the same command to record trial {current} again",
+            file=stream,
+        )
     return result

@@ -70,10 +70,18 @@ def pressure_label(pressure_kpa: float) -> str:
     return f"{pressure_kpa:g}".replace(".", "p")
 
 
-def image_name(material: str, actuator: str, trial: int, step: int, pressure_kpa: float, direction: str,
-               suffix: str) -> str:
+def image_name(
+    material: str,
+    actuator: str,
+    trial: int,
+    step: int,
+    pressure_kpa: float,
+    direction: str,
+    suffix: str,
+) -> str:
     """File name of one photo (unique per material, actuator, trial and step)."""
-    return f"{material}_{actuator}_t{trial}_s{step:03d}_{direction}_{pressure_label(pressure_kpa)}kPa{suffix}"
+    pressure = pressure_label(pressure_kpa)
+    return f"{material}_{actuator}_t{trial}_s{step:03d}_{direction}_{pressure}kPa{suffix}"
 
 
 def recorded_steps(folder: str | os.PathLike[str], material: str, actuator: str) -> pd.DataFrame:
@@ -96,12 +104,17 @@ def recorded_steps(folder: str | os.PathLike[str], material: str, actuator: str)
         return pd.DataFrame(columns=["image", "direction", "trial_n", "step_n"])
     df = pd.read_csv(path, dtype=str)
     if "step" not in df.columns:
-        raise UserInputError(f"{path}: has no 'step' column, so it was not written by acquire; use a new --out folder")
+        raise UserInputError(
+            f"{path}: has no 'step' column, so it was not written by acquire; use a new --out "
+            "folder"
+        )
     df = df[(df["material"] == material) & (df["actuator"] == actuator)].copy()
     df["trial_n"] = pd.to_numeric(df["trial"], errors="coerce")
     df["step_n"] = pd.to_numeric(df["step"], errors="coerce")
     exists = df["image"].map(lambda name: isinstance(name, str) and (folder / name).is_file())
-    return df[exists & df["trial_n"].notna() & df["step_n"].notna()].astype({"trial_n": int, "step_n": int})
+    return df[exists & df["trial_n"].notna() & df["step_n"].notna()].astype(
+        {"trial_n": int, "step_n": int}
+    )
 
 
 def known_peak(rows: pd.DataFrame, n_levels: int) -> int | None:
@@ -113,7 +126,8 @@ def known_peak(rows: pd.DataFrame, n_levels: int) -> int | None:
 
 
 def first_missing(sequence: list[StepPlan], recorded: set[int]) -> int | None:
-    """Index in ``sequence`` of the first step not recorded, or ``None`` when the trial is complete."""
+    """Index in ``sequence`` of the first step not recorded, or ``None`` when the trial is
+    complete."""
     for i, plan in enumerate(sequence):
         if plan.step not in recorded:
             return i
@@ -151,12 +165,15 @@ def check_settings(folder: str | os.PathLike[str], settings: dict[str, Any]) -> 
         if value is None:
             continue
         have = old.get(key)
-        same = (np.allclose(np.asarray(have, float), np.asarray(value, float), rtol=1e-6)
-                if isinstance(value, (int, float, list, tuple)) and have is not None and have != "auto"
-                else have == value)
+        same = (
+            np.allclose(np.asarray(have, float), np.asarray(value, float), rtol=1e-6)
+            if isinstance(value, (int, float, list, tuple)) and have is not None and have != "auto"
+            else have == value
+        )
         if not same:
             raise UserInputError(
-                f"{path}: {key} is {have!r} but this run gives {value!r}; use the same options as the run that "
+                f"{path}: {key} is {have!r} but this run gives {value!r}; use the same options as "
+                "the run that "
                 "created the folder (to resume) or a new --out folder"
             )
     return False

@@ -12,7 +12,8 @@ spec                           recorder
                                when the host receives it (a camera's own latency, typically tens
                                of ms, then shows as a constant offset: measure it once and set
                                ``clock_offset_s`` in the manifest)
-``synthetic[:PRESET]``         renders the virtual actuator (:class:`pipeline.synth.video.LiveActuator`:
+``synthetic[:PRESET]``         renders the virtual actuator
+(:class:`pipeline.synth.video.LiveActuator`:
                                the model with hysteresis and a first-order lag) at the pressure the
                                rig last reported, at ``fps`` as far as the machine keeps up: the
                                frame-times file records when each frame really was taken
@@ -43,7 +44,8 @@ class VideoRecorder(Protocol):
         """The pressure the rig reports now (used by the synthetic camera)."""
 
     def stop(self) -> list[float]:
-        """Stop, close the file; return the frame times (s). Raises CameraError if recording failed."""
+        """Stop, close the file; return the frame times (s). Raises CameraError if recording
+        failed."""
 
     def photoset_settings(self) -> dict[str, Any]:
         """``photoset.yaml`` values the camera knows (empty for real cameras)."""
@@ -65,7 +67,9 @@ class _Threaded:
     def start(self, path: Path, t0: float) -> None:
         self._stop.clear()
         self._times, self._error, self._t0 = [], None, t0
-        self._thread = threading.Thread(target=self._guarded, args=(Path(path),), name="video-recorder", daemon=True)
+        self._thread = threading.Thread(
+            target=self._guarded, args=(Path(path),), name="video-recorder", daemon=True
+        )
         self._thread.start()
 
     def _guarded(self, path: Path) -> None:
@@ -82,13 +86,17 @@ class _Threaded:
         if self._thread is not None:
             self._thread.join(timeout=30)
         if self._error is not None:
-            raise CameraError(f"video recording failed: {type(self._error).__name__}: {self._error}")
+            raise CameraError(
+                f"video recording failed: {type(self._error).__name__}: {self._error}"
+            )
         return list(self._times)
 
     def check(self) -> None:
         """Raise :class:`CameraError` now if the recording thread has failed."""
         if self._error is not None:
-            raise CameraError(f"video recording failed: {type(self._error).__name__}: {self._error}")
+            raise CameraError(
+                f"video recording failed: {type(self._error).__name__}: {self._error}"
+            )
 
 
 class OpenCVRecorder(_Threaded):
@@ -101,7 +109,10 @@ class OpenCVRecorder(_Threaded):
         self.source, self.fps = source, fps
         self.cap = cv2.VideoCapture(source)
         if not self.cap.isOpened():
-            raise CameraError(f"OpenCV cannot open camera {source!r}; check the index/URL (try --camera 0, 1, ...)")
+            raise CameraError(
+                f"OpenCV cannot open camera {source!r}; check the index/URL (try --camera 0, 1, "
+                "...)"
+            )
         self.cap.set(cv2.CAP_PROP_FPS, float(fps))
 
     def observe(self, pressure_kpa: float) -> None:
@@ -135,8 +146,17 @@ class OpenCVRecorder(_Threaded):
 class SyntheticRecorder(_Threaded):
     """The virtual actuator filmed at the pressure the rig reports (see the module docstring)."""
 
-    def __init__(self, material: str, l0_mm: float, *, fps: float, max_kpa: float, preset: str = "lab",
-                 size: tuple[int, int] = (480, 360), seed: int = 0) -> None:
+    def __init__(
+        self,
+        material: str,
+        l0_mm: float,
+        *,
+        fps: float,
+        max_kpa: float,
+        preset: str = "lab",
+        size: tuple[int, int] = (480, 360),
+        seed: int = 0,
+    ) -> None:
         from pipeline import synth
         from pipeline.synth.actuator import TrialActuator, behaviour_for, loading_curve
         from pipeline.synth.video import LiveActuator, fit_scene
@@ -149,15 +169,24 @@ class SyntheticRecorder(_Threaded):
         try:
             scene = synth.scene_from(preset, width=size[0], height=size[1])
         except KeyError as exc:
-            raise UserInputError(f"--camera synthetic:{preset}: unknown scene preset; use one of {sorted(synth.SCENE_PRESETS)}") from exc
+            raise UserInputError(
+                f"--camera synthetic:{preset}: unknown scene preset; use one of "
+                f"{sorted(synth.SCENE_PRESETS)}"
+            ) from exc
         psi = self.trial.psi_loading_deg(np.linspace(0.0, max_kpa, 50))
         psi = psi[np.isfinite(psi)]
-        self.scene, rotation = fit_scene(scene, self.l0_mm, (float(psi.min()) - 10.0, float(psi.max()) + 5.0))
+        self.scene, rotation = fit_scene(
+            scene, self.l0_mm, (float(psi.min()) - 10.0, float(psi.max()) + 5.0)
+        )
         extent = np.vstack([synth.centreline_mm(float(p), self.l0_mm, n=241)
                             for p in np.linspace(psi.min() - 10.0, psi.max() + 5.0, 9)])
         camera = synth.make_camera(self.scene, rotation_deg=rotation, extent_mm=extent)
-        self.backdrop = synth.make_backdrop(self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=[extent])
-        probe = synth.render_actuator(float(psi.max()), self.l0_mm, self.scene, seed=0, backdrop=self.backdrop)
+        self.backdrop = synth.make_backdrop(
+            self.scene, camera, seed=synth.child_seed(seed, 0), keepout_mm=[extent]
+        )
+        probe = synth.render_actuator(
+            float(psi.max()), self.l0_mm, self.scene, seed=0, backdrop=self.backdrop
+        )
         self._fixed_end = probe.fixed_end_px
         self._lock = threading.Lock()
         self._pressure = 0.0
@@ -183,8 +212,13 @@ class SyntheticRecorder(_Threaded):
                 with self._lock:
                     pressure = self._pressure
                 psi = live.psi_deg(now, pressure)
-                frame = synth.render_actuator(psi, self.l0_mm, self.scene, seed=synth.child_seed(self.seed, 1, len(self._times)),
-                                              backdrop=self.backdrop)
+                frame = synth.render_actuator(
+                    psi,
+                    self.l0_mm,
+                    self.scene,
+                    seed=synth.child_seed(self.seed, 1, len(self._times)),
+                    backdrop=self.backdrop,
+                )
                 writer.write(frame.image)
                 self._times.append(now)
                 next_t = max(next_t + period, now - period / 2)  # a late frame is not made up for
@@ -210,14 +244,24 @@ def parse_size(text: str) -> tuple[int, int]:
     try:
         w, h = (int(v) for v in text.lower().split("x"))
     except ValueError:
-        raise UserInputError(f"--video-size {text!r}: write WIDTHxHEIGHT in pixels, e.g. 640x480") from None
+        raise UserInputError(
+            f"--video-size {text!r}: write WIDTHxHEIGHT in pixels, e.g. 640x480"
+        ) from None
     if w < 16 or h < 16:
         raise UserInputError(f"--video-size {text!r}: at least 16x16 pixels")
     return w, h
 
 
-def open_recorder(spec: str, *, material: str, l0_mm: float, fps: float, max_kpa: float, seed: int = 0,
-                  size: tuple[int, int] = (480, 360)) -> VideoRecorder:
+def open_recorder(
+    spec: str,
+    *,
+    material: str,
+    l0_mm: float,
+    fps: float,
+    max_kpa: float,
+    seed: int = 0,
+    size: tuple[int, int] = (480, 360),
+) -> VideoRecorder:
     """The video recorder named by ``spec`` (table in the module docstring).
 
     Raises
@@ -229,14 +273,24 @@ def open_recorder(spec: str, *, material: str, l0_mm: float, fps: float, max_kpa
     if not (math.isfinite(fps) and fps > 0):
         raise UserInputError(f"--fps {fps!r} must be a positive number of frames per second")
     if spec == "synthetic" or spec.startswith("synthetic:"):
-        return SyntheticRecorder(material, l0_mm, fps=fps, max_kpa=max_kpa, preset=spec.partition(":")[2] or "lab",
-                                 size=size, seed=seed)
+        return SyntheticRecorder(
+            material,
+            l0_mm,
+            fps=fps,
+            max_kpa=max_kpa,
+            preset=spec.partition(":")[2] or "lab",
+            size=size,
+            seed=seed,
+        )
     if spec.isdigit():
         return OpenCVRecorder(int(spec), fps=fps)
     if "://" in spec:
         return OpenCVRecorder(spec, fps=fps)
-    raise UserInputError(f"--camera {spec!r} cannot record video; with --record video use a device index (0), a stream "
-                         "URL (rtsp://...) or 'synthetic[:clean|lab|hard]'")
+    raise UserInputError(
+        f"--camera {spec!r} cannot record video; with --record video use a device index (0), a "
+        "stream "
+        "URL (rtsp://...) or 'synthetic[:clean|lab|hard]'"
+    )
 
 
 __all__ = ["OpenCVRecorder", "SyntheticRecorder", "VideoRecorder", "open_recorder", "parse_size"]

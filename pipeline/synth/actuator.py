@@ -13,8 +13,10 @@ Examples
 >>> def toy(material, p, branch="loading"):
 ...     return 210.0 - 2.0 * np.asarray(p, float)
 >>> curve = loading_curve("DS20", max_kpa=300, psi_fn=toy)
->>> trial = TrialActuator("DS20", curve, psi0_deg=210.0, stiffness=1.0, behaviour=BEHAVIOURS["DS20"])
->>> ramp = plan_ramp(trial, step_kpa=50, max_kpa=260, rng=np.random.default_rng(0), photo_noise=False)
+>>> trial = TrialActuator("DS20", curve, psi0_deg=210.0, stiffness=1.0,
+...                       behaviour=BEHAVIOURS["DS20"])
+>>> ramp = plan_ramp(trial, step_kpa=50, max_kpa=260, rng=np.random.default_rng(0),
+...                  photo_noise=False)
 >>> ramp["pressure_kpa"].tolist()
 [0.0, 50.0, 100.0, 150.0, 200.0, 250.0, 200.0, 150.0, 100.0, 50.0, 0.0]
 >>> ramp["stop_reason"].iloc[0], bool(ramp["psi_deg"].iloc[7] < ramp["psi_deg"].iloc[3])
@@ -83,14 +85,36 @@ class ActuatorBehaviour:
 
 #: softer silicones: more hysteresis, less repeatable, bulge past psi = 0 (paper Section III.A)
 BEHAVIOURS: dict[str, ActuatorBehaviour] = {
-    "DS20": ActuatorBehaviour(hysteresis=0.15, psi0_sd_deg=4.0, stiffness_sd=0.05, trial_stiffness_sd=0.03,
-                              photo_sd_deg=1.5, bulge_max=0.35),
-    "DS30": ActuatorBehaviour(hysteresis=0.12, psi0_sd_deg=3.5, stiffness_sd=0.05, trial_stiffness_sd=0.025,
-                              photo_sd_deg=1.2, bulge_max=0.25),
-    "SS40": ActuatorBehaviour(hysteresis=0.06, psi0_sd_deg=3.0, stiffness_sd=0.03, trial_stiffness_sd=0.01,
-                              photo_sd_deg=0.6),
-    "SS50": ActuatorBehaviour(hysteresis=0.03, psi0_sd_deg=2.0, stiffness_sd=0.02, trial_stiffness_sd=0.008,
-                              photo_sd_deg=0.4),
+    "DS20": ActuatorBehaviour(
+        hysteresis=0.15,
+        psi0_sd_deg=4.0,
+        stiffness_sd=0.05,
+        trial_stiffness_sd=0.03,
+        photo_sd_deg=1.5,
+        bulge_max=0.35,
+    ),
+    "DS30": ActuatorBehaviour(
+        hysteresis=0.12,
+        psi0_sd_deg=3.5,
+        stiffness_sd=0.05,
+        trial_stiffness_sd=0.025,
+        photo_sd_deg=1.2,
+        bulge_max=0.25,
+    ),
+    "SS40": ActuatorBehaviour(
+        hysteresis=0.06,
+        psi0_sd_deg=3.0,
+        stiffness_sd=0.03,
+        trial_stiffness_sd=0.01,
+        photo_sd_deg=0.6,
+    ),
+    "SS50": ActuatorBehaviour(
+        hysteresis=0.03,
+        psi0_sd_deg=2.0,
+        stiffness_sd=0.02,
+        trial_stiffness_sd=0.008,
+        photo_sd_deg=0.4,
+    ),
 }
 
 
@@ -126,14 +150,14 @@ class LoadingCurve:
 
 
 def _model_psi_fn() -> PsiFunction:
-    try:
-        from pipeline.model import psi_deg
-    except ImportError as exc:  # pragma: no cover - the model ships with the package
-        raise UserInputError("pipeline.model is not available; pass psi_fn= to the synthetic renderer") from exc
+    from pipeline.model import psi_deg  # imported when first needed: the model loads its tables
+
     return psi_deg
 
 
-def loading_curve(material: str, *, max_kpa: float, psi_fn: PsiFunction | None = None) -> LoadingCurve:
+def loading_curve(
+    material: str, *, max_kpa: float, psi_fn: PsiFunction | None = None
+) -> LoadingCurve:
     """Tabulate the loading branch psi(P) of ``material`` from 0 to ``max_kpa``.
 
     Parameters
@@ -155,11 +179,15 @@ def loading_curve(material: str, *, max_kpa: float, psi_fn: PsiFunction | None =
     psi = np.asarray(fn(material, grid, branch="loading"), dtype=float)
     finite = np.isfinite(psi)
     if not finite[0]:
-        raise UserInputError(f"material {material!r}: the model gives no angle at 0 kPa; check the material name")
+        raise UserInputError(
+            f"material {material!r}: the model gives no angle at 0 kPa; check the material name"
+        )
     last = int(np.flatnonzero(finite)[-1])
     grid, psi, finite = grid[: last + 1], psi[: last + 1], finite[: last + 1]
     psi = np.interp(grid, grid[finite], psi[finite])  # bridge snap-through gaps
-    return LoadingCurve(pressure_kpa=grid, psi_deg=psi, limit_kpa=float(grid[-1]), psi0_deg=float(psi[0]))
+    return LoadingCurve(
+        pressure_kpa=grid, psi_deg=psi, limit_kpa=float(grid[-1]), psi0_deg=float(psi[0])
+    )
 
 
 @dataclass(frozen=True)
@@ -185,10 +213,15 @@ class TrialActuator:
 
     def psi_loading_deg(self, pressure_kpa: ArrayLike) -> NDArray[np.float64]:
         """Angle on the loading branch (rising pressure), deg; NaN beyond the model."""
-        return self.psi0_deg / self.curve.psi0_deg * self.curve(np.asarray(pressure_kpa, float) / self.stiffness)
+        return (
+            self.psi0_deg
+            / self.curve.psi0_deg
+            * self.curve(np.asarray(pressure_kpa, float) / self.stiffness)
+        )
 
     def psi_unloading_deg(self, pressure_kpa: ArrayLike, peak_kpa: float) -> NDArray[np.float64]:
-        """Angle on the way down from ``peak_kpa``: the loading angle at a higher equivalent pressure."""
+        """Angle on the way down from ``peak_kpa``: the loading angle at a higher equivalent
+        pressure."""
         p = np.asarray(pressure_kpa, float)
         if peak_kpa <= 0:
             return self.psi_loading_deg(p)
@@ -201,22 +234,31 @@ class TrialActuator:
         return self.behaviour.bulge_max * frac
 
 
-def draw_actuator(material: str, curve: LoadingCurve, behaviour: ActuatorBehaviour, rng: np.random.Generator) -> tuple[float, float]:
+def draw_actuator(
+    material: str, curve: LoadingCurve, behaviour: ActuatorBehaviour, rng: np.random.Generator
+) -> tuple[float, float]:
     """Draw one actuator's (psi0_deg, stiffness) around the model's values."""
     psi0 = curve.psi0_deg + rng.normal(0.0, behaviour.psi0_sd_deg)
     stiffness = float(np.exp(rng.normal(0.0, behaviour.stiffness_sd)))
     return float(psi0), stiffness
 
 
-def draw_trial(material: str, curve: LoadingCurve, behaviour: ActuatorBehaviour, actuator: tuple[float, float],
-               rng: np.random.Generator) -> TrialActuator:
+def draw_trial(
+    material: str,
+    curve: LoadingCurve,
+    behaviour: ActuatorBehaviour,
+    actuator: tuple[float, float],
+    rng: np.random.Generator,
+) -> TrialActuator:
     """One trial of an actuator: its (psi0, stiffness) plus trial-to-trial scatter."""
     psi0 = actuator[0] + rng.normal(0.0, behaviour.trial_psi0_sd_deg)
     stiffness = actuator[1] * float(np.exp(rng.normal(0.0, behaviour.trial_stiffness_sd)))
     return TrialActuator(material, curve, float(psi0), stiffness, behaviour)
 
 
-def ramp_pressures(trial: TrialActuator, *, step_kpa: float, max_kpa: float) -> tuple[NDArray[np.float64], str]:
+def ramp_pressures(
+    trial: TrialActuator, *, step_kpa: float, max_kpa: float
+) -> tuple[NDArray[np.float64], str]:
     """Pressures of the rising half of the protocol and why it stopped.
 
     Pressure rises from 0 in ``step_kpa`` steps up to ``max_kpa`` (the last step is clipped to
@@ -231,7 +273,9 @@ def ramp_pressures(trial: TrialActuator, *, step_kpa: float, max_kpa: float) -> 
         ``"max_pressure"``, ``"minus_psi0"`` or ``"model_limit"``.
     """
     if not step_kpa > 0 or not max_kpa > 0:
-        raise UserInputError(f"step_kpa = {step_kpa!r} and max_kpa = {max_kpa!r} must be positive pressures in kPa")
+        raise UserInputError(
+            f"step_kpa = {step_kpa!r} and max_kpa = {max_kpa!r} must be positive pressures in kPa"
+        )
     n = int(np.ceil(max_kpa / step_kpa - 1e-9))
     levels = np.minimum(np.arange(n + 1, dtype=float) * float(step_kpa), float(max_kpa))
     psi = trial.psi_loading_deg(levels)

@@ -48,7 +48,8 @@ _STYLE_KEY = 7
 
 
 def child_seed(seed: int | np.random.SeedSequence, *keys: int) -> np.random.SeedSequence:
-    """A seed derived from ``seed`` and integer ``keys`` (pure: the same inputs give the same seed)."""
+    """A seed derived from ``seed`` and integer ``keys`` (pure: the same inputs give the same
+    seed)."""
     if isinstance(seed, np.random.SeedSequence):
         return np.random.SeedSequence(seed.entropy, spawn_key=tuple(seed.spawn_key) + tuple(keys))
     return np.random.SeedSequence(int(seed), spawn_key=tuple(keys))
@@ -87,9 +88,17 @@ class Backdrop:
 def clamp_outline_mm(body_width_mm: float, style: str = "block") -> NDArray[np.float64]:
     """Corners of the clamp (block, white clamp or plate) in world mm; its front edge is x = 0."""
     if style == "plate":
-        x0, y0, y1 = -PLATE_DEPTH_MM, body_width_mm / 2 - PLATE_HALF_WIDTH_MM, body_width_mm / 2 + PLATE_HALF_WIDTH_MM
+        x0, y0, y1 = (
+            -PLATE_DEPTH_MM,
+            body_width_mm / 2 - PLATE_HALF_WIDTH_MM,
+            body_width_mm / 2 + PLATE_HALF_WIDTH_MM,
+        )
     elif style == "white":
-        x0, y0, y1 = -WHITE_CLAMP_LENGTH_MM, -WHITE_CLAMP_OVERHANG_MM, body_width_mm + WHITE_CLAMP_OVERHANG_MM
+        x0, y0, y1 = (
+            -WHITE_CLAMP_LENGTH_MM,
+            -WHITE_CLAMP_OVERHANG_MM,
+            body_width_mm + WHITE_CLAMP_OVERHANG_MM,
+        )
     else:
         x0, y0, y1 = -CLAMP_LENGTH_MM, -CLAMP_OVERHANG_MM, body_width_mm + CLAMP_OVERHANG_MM
     return np.array([[x0, y0], [0.0, y0], [0.0, y1], [x0, y1]])
@@ -102,7 +111,10 @@ def light_gain(scene: SceneParams, rng: np.random.Generator) -> NDArray[np.float
     cx, cy = (w - 1) / 2, (h - 1) / 2
     half_diag = float(np.hypot(cx, cy))
     a = rng.uniform(0, 2 * np.pi)
-    gain = 1.0 + 0.5 * scene.lighting_gradient * ((x - cx) * np.cos(a) + (y - cy) * np.sin(a)) / half_diag
+    gain = (
+        1.0
+        + 0.5 * scene.lighting_gradient * ((x - cx) * np.cos(a) + (y - cy) * np.sin(a)) / half_diag
+    )
     if scene.vignetting > 0:
         gain *= 1.0 - scene.vignetting * (((x - cx) ** 2 + (y - cy) ** 2) / half_diag**2)
     return gain.astype(np.float32)
@@ -121,18 +133,43 @@ def _table(scene: SceneParams, rng: np.random.Generator) -> NDArray[np.float32]:
     return table
 
 
-def _keepout_mask(scene: SceneParams, camera: Camera, keepout_mm: Sequence[NDArray[np.float64]], margin_mm: float) -> NDArray[np.uint8]:
+def _keepout_mask(
+    scene: SceneParams, camera: Camera, keepout_mm: Sequence[NDArray[np.float64]], margin_mm: float
+) -> NDArray[np.uint8]:
     mask = np.zeros((scene.height, scene.width), np.uint8)
     thick = max(1, round(2 * margin_mm / scene.mm_per_px))
     for pts in keepout_mm:
         px = camera.to_px(pts)
-        cv2.polylines(mask, [np.round(px * (1 << SHIFT)).astype(np.int32)], False, 255, thick, cv2.LINE_8, SHIFT)
-    cv2.fillPoly(mask, [np.round(camera.to_px(clamp_outline_mm(scene.body_width_mm, scene.clamp_style)) * (1 << SHIFT)).astype(np.int32)],
-                 255, cv2.LINE_8, SHIFT)
+        cv2.polylines(
+            mask,
+            [np.round(px * (1 << SHIFT)).astype(np.int32)],
+            False,
+            255,
+            thick,
+            cv2.LINE_8,
+            SHIFT,
+        )
+    cv2.fillPoly(
+        mask,
+        [
+            np.round(
+                camera.to_px(clamp_outline_mm(scene.body_width_mm, scene.clamp_style))
+                * (1 << SHIFT)
+            ).astype(np.int32)
+        ],
+        255,
+        cv2.LINE_8,
+        SHIFT,
+    )
     return mask
 
 
-def _distractors(img: NDArray[np.float32], scene: SceneParams, keepout: NDArray[np.uint8], rng: np.random.Generator) -> None:
+def _distractors(
+    img: NDArray[np.float32],
+    scene: SceneParams,
+    keepout: NDArray[np.uint8],
+    rng: np.random.Generator,
+) -> None:
     h, w = keepout.shape
     ink = np.asarray(LINE_INK_BGR[scene.line_color], np.float32)
     drawn = 0
@@ -156,7 +193,15 @@ def _distractors(img: NDArray[np.float32], scene: SceneParams, keepout: NDArray[
             colour, opacity = np.full(3, rng.uniform(70, 140), np.float32), rng.uniform(0.3, 0.7)
         thick = max(1, round(rng.uniform(0.4, 1.6) / scene.mm_per_px))
         mask = np.zeros((h, w), np.uint8)
-        cv2.polylines(mask, [np.round(pts * (1 << SHIFT)).astype(np.int32)], False, 255, thick, cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            mask,
+            [np.round(pts * (1 << SHIFT)).astype(np.int32)],
+            False,
+            255,
+            thick,
+            cv2.LINE_AA,
+            SHIFT,
+        )
         x0, y0, bw, bh = cv2.boundingRect(mask)
         if bw == 0:
             continue
@@ -166,7 +211,9 @@ def _distractors(img: NDArray[np.float32], scene: SceneParams, keepout: NDArray[
         drawn += 1
 
 
-def _poly(img: NDArray[np.float32], camera: Camera, pts_mm: ArrayLike, colour: tuple[float, float, float]) -> None:
+def _poly(
+    img: NDArray[np.float32], camera: Camera, pts_mm: ArrayLike, colour: tuple[float, float, float]
+) -> None:
     px = np.round(camera.to_px(pts_mm) * (1 << SHIFT)).astype(np.int32)
     cv2.fillPoly(img, [px], colour, cv2.LINE_AA, SHIFT)
 
@@ -179,19 +226,34 @@ def _screw(img: NDArray[np.float32], camera: Camera, at_mm: tuple[float, float],
     cv2.circle(img, c, max(1, radius_px // 2) * s, socket, -1, cv2.LINE_AA, SHIFT)
 
 
-def _clamp_mask(scene: SceneParams, camera: Camera, tube_px: NDArray[np.float64] | None, tube_width: int) -> NDArray[np.uint8]:
+def _clamp_mask(
+    scene: SceneParams, camera: Camera, tube_px: NDArray[np.float64] | None, tube_width: int
+) -> NDArray[np.uint8]:
     mask = np.zeros((scene.height, scene.width), np.uint8)
     s = 1 << SHIFT
     if tube_px is not None:
-        cv2.polylines(mask, [np.round(tube_px * s).astype(np.int32)], False, 255, tube_width, cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            mask,
+            [np.round(tube_px * s).astype(np.int32)],
+            False,
+            255,
+            tube_width,
+            cv2.LINE_AA,
+            SHIFT,
+        )
     if scene.clamp:
         outline = camera.to_px(clamp_outline_mm(scene.body_width_mm, scene.clamp_style))
         cv2.fillPoly(mask, [np.round(outline * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT)
     return mask
 
 
-def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: Camera, rng: np.random.Generator,
-                         style: BodyStyle | None = None) -> None:
+def _draw_tube_and_clamp(
+    img: NDArray[np.float32],
+    scene: SceneParams,
+    camera: Camera,
+    rng: np.random.Generator,
+    style: BodyStyle | None = None,
+) -> None:
     s = 1 << SHIFT
     bw = scene.body_width_mm
     px = None
@@ -206,24 +268,46 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         img *= (1.0 - scene.shadow * shadow_of(cast, style, scene.mm_per_px))[..., None]
     if px is not None:
         mask = np.zeros(img.shape[:2], np.uint8)
-        cv2.polylines(mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT
+        )
         edge = np.zeros_like(mask)
-        cv2.polylines(edge, [np.round(px * s).astype(np.int32)], False, 255, width + 2, cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            edge, [np.round(px * s).astype(np.int32)], False, 255, width + 2, cv2.LINE_AA, SHIFT
+        )
         edge = cv2.subtract(edge, cv2.erode(mask, np.ones((3, 3), np.uint8)))
         bx, by, bw_, bh = cv2.boundingRect(cv2.bitwise_or(mask, edge))  # only where the tube is
         if bw_ > 0:
-            win, m, e = img[by:by + bh, bx:bx + bw_], mask[by:by + bh, bx:bx + bw_], edge[by:by + bh, bx:bx + bw_]
-            win += (np.asarray((215, 222, 225), np.float32) - win) * (m[..., None].astype(np.float32) * (0.55 / 255))
-            win += (np.asarray((120, 125, 128), np.float32) - win) * (e[..., None].astype(np.float32) * (0.35 / 255))
+            win, m, e = (
+                img[by : by + bh, bx : bx + bw_],
+                mask[by : by + bh, bx : bx + bw_],
+                edge[by : by + bh, bx : bx + bw_],
+            )
+            win += (np.asarray((215, 222, 225), np.float32) - win) * (
+                m[..., None].astype(np.float32) * (0.55 / 255)
+            )
+            win += (np.asarray((120, 125, 128), np.float32) - win) * (
+                e[..., None].astype(np.float32) * (0.35 / 255)
+            )
     if not scene.clamp:
         return
     outline_mm = clamp_outline_mm(bw, scene.clamp_style)
     r = max(2, round(2.5 / scene.mm_per_px))
     if scene.clamp_style == "block":
         outline = camera.to_px(outline_mm)
-        cv2.fillPoly(img, [np.round(outline * s).astype(np.int32)], (72, 74, 78), cv2.LINE_AA, SHIFT)
+        cv2.fillPoly(
+            img, [np.round(outline * s).astype(np.int32)], (72, 74, 78), cv2.LINE_AA, SHIFT
+        )
         inner = camera.to_px(outline_mm * 0.8 + np.array([-0.1 * CLAMP_LENGTH_MM, 0.1 * bw]))
-        cv2.polylines(img, [np.round(inner * s).astype(np.int32)], True, (105, 108, 112), 2, cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            img,
+            [np.round(inner * s).astype(np.int32)],
+            True,
+            (105, 108, 112),
+            2,
+            cv2.LINE_AA,
+            SHIFT,
+        )
         for y in (0.1 * bw, 0.9 * bw):
             _screw(img, camera, (-CLAMP_LENGTH_MM / 2, y), r, (150, 152, 155), (55, 56, 58))
     elif scene.clamp_style == "white":
@@ -231,15 +315,32 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         _poly(img, camera, outline_mm, (196, 199, 202))
         inset = 1.5  # mm
         x0, y0, y1 = outline_mm[0, 0], outline_mm[0, 1], outline_mm[2, 1]
-        _poly(img, camera, [[x0 + inset, y0 + inset], [-inset, y0 + inset], [-inset, y1 - inset], [x0 + inset, y1 - inset]],
-              (228, 231, 233))
+        _poly(
+            img,
+            camera,
+            [
+                [x0 + inset, y0 + inset],
+                [-inset, y0 + inset],
+                [-inset, y1 - inset],
+                [x0 + inset, y1 - inset],
+            ],
+            (228, 231, 233),
+        )
         for y in (-0.5 * WHITE_CLAMP_OVERHANG_MM, bw + 0.5 * WHITE_CLAMP_OVERHANG_MM):
-            _screw(img, camera, (-WHITE_CLAMP_LENGTH_MM / 2, y), max(2, round(2.0 / scene.mm_per_px)),
-                   (168, 172, 176), (70, 72, 75))
+            _screw(
+                img,
+                camera,
+                (-WHITE_CLAMP_LENGTH_MM / 2, y),
+                max(2, round(2.0 / scene.mm_per_px)),
+                (168, 172, 176),
+                (70, 72, 75),
+            )
     else:
         # a black anodised plate, lit unevenly, a bevel along its front edge and a clamp bar
         mask = np.zeros(img.shape[:2], np.uint8)
-        cv2.fillPoly(mask, [np.round(camera.to_px(outline_mm) * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT)
+        cv2.fillPoly(
+            mask, [np.round(camera.to_px(outline_mm) * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT
+        )
         h, w = mask.shape
         ang = rng.uniform(0, 2 * np.pi)
         bx, by, bw_, bh = cv2.boundingRect(mask)
@@ -253,14 +354,26 @@ def _draw_tube_and_clamp(img: NDArray[np.float32], scene: SceneParams, camera: C
         bevel = camera.to_px([[0.0, outline_mm[1, 1]], [0.0, outline_mm[2, 1]]])
         cv2.polylines(img, [np.round(bevel * s).astype(np.int32)], False, (68, 69, 73),
                       max(1, round(0.8 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
-        bar = np.array([[-PLATE_BAR_LENGTH_MM, -PLATE_BAR_OVERHANG_MM], [0.0, -PLATE_BAR_OVERHANG_MM],
-                        [0.0, bw + PLATE_BAR_OVERHANG_MM], [-PLATE_BAR_LENGTH_MM, bw + PLATE_BAR_OVERHANG_MM]])
+        bar = np.array(
+            [
+                [-PLATE_BAR_LENGTH_MM, -PLATE_BAR_OVERHANG_MM],
+                [0.0, -PLATE_BAR_OVERHANG_MM],
+                [0.0, bw + PLATE_BAR_OVERHANG_MM],
+                [-PLATE_BAR_LENGTH_MM, bw + PLATE_BAR_OVERHANG_MM],
+            ]
+        )
         _poly(img, camera, bar, (44, 44, 48))
         cv2.polylines(img, [np.round(camera.to_px(bar) * s).astype(np.int32)], True, (60, 61, 65),
                       max(1, round(0.5 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
         for y in (-0.5 * PLATE_BAR_OVERHANG_MM, bw + 0.5 * PLATE_BAR_OVERHANG_MM):
-            _screw(img, camera, (-PLATE_BAR_LENGTH_MM / 2, y), max(2, round(2.2 / scene.mm_per_px)), (92, 94, 98),
-                   (35, 35, 38))
+            _screw(
+                img,
+                camera,
+                (-PLATE_BAR_LENGTH_MM / 2, y),
+                max(2, round(2.2 / scene.mm_per_px)),
+                (92, 94, 98),
+                (35, 35, 38),
+            )
 
 
 def _lit(colour: ArrayLike, gain: NDArray[np.float32]) -> NDArray[np.uint8]:
@@ -294,7 +407,11 @@ def make_backdrop(
     """
     rng = np.random.default_rng(seed)
     style = make_body_style(scene, np.random.default_rng(child_seed(seed, _STYLE_KEY)))
-    gain = light_gain(scene, rng) if scene.background != "plain" else np.ones((scene.height, scene.width), np.float32)
+    gain = (
+        light_gain(scene, rng)
+        if scene.background != "plain"
+        else np.ones((scene.height, scene.width), np.float32)
+    )
     albedo = _table(scene, rng)
     if scene.distractor_marks:
         keepout = _keepout_mask(scene, camera, keepout_mm, scene.body_width_mm + 8.0)
@@ -306,5 +423,7 @@ def make_backdrop(
     pool = None
     if scene.noise_sigma > 0:
         shape = (scene.height + NOISE_PAD, scene.width + NOISE_PAD, 3)
-        pool = np.rint(rng.standard_normal(shape, dtype=np.float32) * scene.noise_sigma).astype(np.int16)
+        pool = np.rint(rng.standard_normal(shape, dtype=np.float32) * scene.noise_sigma).astype(
+            np.int16
+        )
     return Backdrop(camera=camera, image=image, noise_pool=pool, gain=gain, style=style)

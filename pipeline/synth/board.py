@@ -10,7 +10,8 @@ Examples
 --------
 >>> from pipeline.synth import make_camera, scene_from
 >>> scene = scene_from("clean", width=640, height=480, tilt_deg=5.0, lens_k1=-0.1)
->>> board = render_board(scene, make_camera(scene, rotation_deg=0.0, fixed_end_px=(320.0, 240.0)), seed=1)
+>>> camera = make_camera(scene, rotation_deg=0.0, fixed_end_px=(320.0, 240.0))
+>>> board = render_board(scene, camera, seed=1)
 >>> board.image.shape, board.corners_px.shape, board.square_mm
 ((480, 640, 3), (54, 2), 27.0)
 """
@@ -90,12 +91,17 @@ def _polygon(corners_uv: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.vstack([a + t * (b - a) for a, b in zip(corners_uv, np.roll(corners_uv, -1, axis=0))])
 
 
-def _mask(polys_px: list[NDArray[np.float64]], shape: tuple[int, int], blur_px: float) -> NDArray[np.float32]:
+def _mask(
+    polys_px: list[NDArray[np.float64]], shape: tuple[int, int], blur_px: float
+) -> NDArray[np.float32]:
     f = _SUPERSAMPLING
     big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
     pts = [np.round((p * f + (f - 1) / 2) * (1 << SHIFT)).astype(np.int32) for p in polys_px]
     cv2.fillPoly(big, pts, 255, cv2.LINE_AA, SHIFT)
-    alpha = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32) / 255.0
+    alpha = (
+        cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32)
+        / 255.0
+    )
     return cv2.GaussianBlur(alpha, (0, 0), blur_px) if blur_px > 0 else alpha
 
 
@@ -135,7 +141,9 @@ def render_board(
     cols, rows = inner_corners
     sq = board_square_mm(scene, inner_corners) if square_mm is None else float(square_mm)
     h, w = scene.height, scene.width
-    centre = camera.from_px([[w / 2, h / 2]])[0] if centre_mm is None else np.asarray(centre_mm, float)
+    centre = (
+        camera.from_px([[w / 2, h / 2]])[0] if centre_mm is None else np.asarray(centre_mm, float)
+    )
     a = np.radians(angle_deg - camera.rotation_deg)
     # board frame: u right, v down as seen (world y is up), origin at the board centre
     axes = np.array([[np.cos(a), np.sin(a)], [np.sin(a), -np.cos(a)]]) * sq
@@ -144,10 +152,30 @@ def render_board(
         return centre + (np.asarray(uv, float) - [(cols + 1) / 2, (rows + 1) / 2]) @ axes
 
     m = PAPER_MARGIN_SQUARES
-    paper = [camera.to_px(world(_polygon(np.array([[-m, -m], [cols + 1 + m, -m], [cols + 1 + m, rows + 1 + m],
-                                                      [-m, rows + 1 + m]]))))]
-    squares = [camera.to_px(world(_polygon(np.array([[i, j], [i + 1, j], [i + 1, j + 1], [i, j + 1]], float))))
-               for j in range(rows + 1) for i in range(cols + 1) if (i + j) % 2 == 0]
+    paper = [
+        camera.to_px(
+            world(
+                _polygon(
+                    np.array(
+                        [
+                            [-m, -m],
+                            [cols + 1 + m, -m],
+                            [cols + 1 + m, rows + 1 + m],
+                            [-m, rows + 1 + m],
+                        ]
+                    )
+                )
+            )
+        )
+    ]
+    squares = [
+        camera.to_px(
+            world(_polygon(np.array([[i, j], [i + 1, j], [i + 1, j + 1], [i, j + 1]], float)))
+        )
+        for j in range(rows + 1)
+        for i in range(cols + 1)
+        if (i + j) % 2 == 0
+    ]
     backdrop = make_backdrop(scene, camera, seed=seed)
     rng = np.random.default_rng(seed)
     gain = light_gain(scene, rng)[..., None]
@@ -159,8 +187,13 @@ def render_board(
         img += rng.standard_normal(img.shape, dtype=np.float32) * scene.noise_sigma
     grid = np.array([[i, j] for j in range(1, rows + 1) for i in range(1, cols + 1)], float)
     corners_mm = world(grid)
-    return BoardPhoto(np.clip(np.rint(img), 0, 255).astype(np.uint8), camera.to_px(corners_mm), corners_mm,
-                      (cols, rows), sq)
+    return BoardPhoto(
+        np.clip(np.rint(img), 0, 255).astype(np.uint8),
+        camera.to_px(corners_mm),
+        corners_mm,
+        (cols, rows),
+        sq,
+    )
 
 
 def write_board_photo(path: str | os.PathLike[str], scene: SceneParams, camera: Camera, *,
@@ -171,4 +204,8 @@ def write_board_photo(path: str | os.PathLike[str], scene: SceneParams, camera: 
     if not ok:  # pragma: no cover - OpenCV always encodes a valid uint8 image
         raise RuntimeError("JPEG encoding failed")
     atomic_write_bytes(Path(path), buf.tobytes())
-    return {"board": Path(path).name, "square_mm": board.square_mm, "inner_corners": list(board.inner_corners)}
+    return {
+        "board": Path(path).name,
+        "square_mm": board.square_mm,
+        "inner_corners": list(board.inner_corners),
+    }

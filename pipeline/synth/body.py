@@ -91,9 +91,17 @@ def make_body_style(scene: SceneParams, rng: np.random.Generator) -> BodyStyle:
     side = rng.uniform(-0.55, 0.55)
     a = rng.uniform(0, 2 * np.pi)
     pitch = scene.texture_pitch_mm
-    warp = np.column_stack([rng.uniform(0.08, 0.2, 3) * pitch, rng.uniform(4, 14, 3) * pitch, rng.uniform(0, 2 * np.pi, 3)])
+    warp = np.column_stack(
+        [
+            rng.uniform(0.08, 0.2, 3) * pitch,
+            rng.uniform(4, 14, 3) * pitch,
+            rng.uniform(0, 2 * np.pi, 3),
+        ]
+    )
     strength = np.clip(rng.normal(1.0, 0.22, _TABLE), 0.4, 1.5)
-    streak = np.column_stack([rng.uniform(0.15, 0.35, 4), rng.uniform(25, 120, 4), rng.uniform(0, 2 * np.pi, 4)])
+    streak = np.column_stack(
+        [rng.uniform(0.15, 0.35, 4), rng.uniform(25, 120, 4), rng.uniform(0, 2 * np.pi, 4)]
+    )
     n = scene.dots
     if n:
         u = np.linspace(0.12, 0.94, n) + rng.uniform(-0.25, 0.25, n) * (0.82 / max(n, 1))
@@ -102,11 +110,20 @@ def make_body_style(scene: SceneParams, rng: np.random.Generator) -> BodyStyle:
             v += DOT_EDGE_V * np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
     else:
         u = v = np.zeros(0)
-    return BodyStyle(light=(float(np.sin(side)), float(np.cos(side))), shadow_dir=(float(np.cos(a)), float(np.sin(a))),
-                     warp=warp, strength=strength, streak=streak, dot_u=np.sort(u), dot_v=v)
+    return BodyStyle(
+        light=(float(np.sin(side)), float(np.cos(side))),
+        shadow_dir=(float(np.cos(a)), float(np.sin(a))),
+        warp=warp,
+        strength=strength,
+        streak=streak,
+        dot_u=np.sort(u),
+        dot_v=v,
+    )
 
 
-def relief_mm(s_mm: NDArray[np.float64], scene: SceneParams, style: BodyStyle, l0_mm: float) -> NDArray[np.float64]:
+def relief_mm(
+    s_mm: NDArray[np.float64], scene: SceneParams, style: BodyStyle, l0_mm: float
+) -> NDArray[np.float64]:
     """Outward displacement of both long edges at arc length ``s_mm`` (ribs bulge, joints pinch)."""
     d = np.zeros_like(s_mm)
     w = scene.body_width_mm
@@ -136,9 +153,15 @@ def _groove(s_mm: NDArray[np.float64], scene: SceneParams, style: BodyStyle) -> 
     return (0.5 + 0.5 * np.cos(2 * np.pi * phase)) ** 4 * np.minimum(style.strength[k], 1.2)
 
 
-def _strands(s_mm: NDArray[np.float64], v: NDArray[np.float64], scene: SceneParams, style: BodyStyle,
-             mm_per_px: float) -> NDArray[np.float64]:
-    """Coverage (0-1) of the two fibre helices at body coordinates (anti-aliased to the pixel size)."""
+def _strands(
+    s_mm: NDArray[np.float64],
+    v: NDArray[np.float64],
+    scene: SceneParams,
+    style: BodyStyle,
+    mm_per_px: float,
+) -> NDArray[np.float64]:
+    """Coverage (0-1) of the two fibre helices at body coordinates (anti-aliased to the pixel
+    size)."""
     p = scene.texture_pitch_mm
     sw = _warped(s_mm, style)
     turn = p * np.arcsin(np.clip(v, -1, 1)) / (2 * np.pi)
@@ -181,8 +204,13 @@ class BodyFrame:
     s_mm: NDArray[np.float64]
 
 
-def nearest_sample(frame: BodyFrame, ys: NDArray[np.intp], xs: NDArray[np.intp], shape: tuple[int, int],
-                   offset: NDArray[np.float64]) -> NDArray[np.intp]:
+def nearest_sample(
+    frame: BodyFrame,
+    ys: NDArray[np.intp],
+    xs: NDArray[np.intp],
+    shape: tuple[int, int],
+    offset: NDArray[np.float64],
+) -> NDArray[np.intp]:
     """Index of the centre-line sample nearest to each pixel ``(ys, xs)`` of a region.
 
     One labelled distance transform of the region (each sample's pixel a seed), so the cost is
@@ -195,13 +223,17 @@ def nearest_sample(frame: BodyFrame, ys: NDArray[np.intp], xs: NDArray[np.intp],
     if len(k) == 0:
         return np.zeros(len(ys), np.intp)
     seeds[ij[k, 1], ij[k, 0]] = 0
-    _, labels = cv2.distanceTransformWithLabels(seeds, cv2.DIST_L2, 5, labelType=cv2.DIST_LABEL_PIXEL)
+    _, labels = cv2.distanceTransformWithLabels(
+        seeds, cv2.DIST_L2, 5, labelType=cv2.DIST_LABEL_PIXEL
+    )
     lut = np.zeros(int(labels.max()) + 1, np.intp)
     lut[labels[ij[k, 1], ij[k, 0]]] = k
     return lut[labels[ys, xs]]
 
 
-def body_coordinates(frame: BodyFrame, pixels: NDArray[np.float64], nearest: NDArray[np.intp]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def body_coordinates(
+    frame: BodyFrame, pixels: NDArray[np.float64], nearest: NDArray[np.intp]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Body coordinates (``s`` in mm, ``v`` in -1..1) of image points inside the body.
 
     Each point is projected on the local frame of its nearest centre-line sample ``nearest``
@@ -292,12 +324,19 @@ def paint_body(
     a = rim * rim_a + a * (1 - rim)
     if scene.texture == "fibre":
         f = _strands(s, v, scene, style, scene.mm_per_px) * scene.texture_contrast
-        fc = np.asarray(scene.texture_bgr, np.float64)[None, :] * g * (0.75 + 0.25 * bright[:, None])
+        fc = (
+            np.asarray(scene.texture_bgr, np.float64)[None, :] * g * (0.75 + 0.25 * bright[:, None])
+        )
         pm = fc * f[:, None] + pm * (1 - f)[:, None]
         a = f + a * (1 - f)
     if scene.specular > 0:
         v_h = 0.55 * style.light[0] - 0.2
-        spot = np.exp(-0.5 * ((v - v_h) / 0.13) ** 2) * _streak(s, style) * (1 - 0.8 * groove) * (1 - joint)
+        spot = (
+            np.exp(-0.5 * ((v - v_h) / 0.13) ** 2)
+            * _streak(s, style)
+            * (1 - 0.8 * groove)
+            * (1 - joint)
+        )
         pm = pm + (scene.specular * 235.0 * spot * g[:, 0])[:, None]
     cov = coverage[ys, xs].astype(np.float64)
     prem[ys, xs] = (pm * cov[:, None]).astype(np.float32)
@@ -307,7 +346,8 @@ def paint_body(
 
 def over(prem: NDArray[np.float32], alpha: NDArray[np.float32], colour: NDArray[np.float32],
          layer_alpha: NDArray[np.float32]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """Put a layer (straight colour ``colour``, opacity ``layer_alpha``) over premultiplied ``prem``."""
+    """Put a layer (straight colour ``colour``, opacity ``layer_alpha``) over premultiplied
+    ``prem``."""
     la = layer_alpha[..., None]
     return colour * la + prem * (1 - la), layer_alpha + alpha * (1 - layer_alpha)
 
@@ -336,7 +376,9 @@ def paint_cap(
         v = np.clip(((pts - mid) @ (across / (2 * half))) / half, -1, 1)
         lam = np.clip(v * style.light[0] + np.sqrt(1 - v * v) * style.light[1], 0, 1)
         bright = 0.55 + 0.5 * lam
-        colour[ys, xs] = (np.asarray(scene.tip_cap_bgr, np.float64)[None, :] * (gain[ys, xs] * bright)[:, None]).astype(np.float32)
+        colour[ys, xs] = (
+            np.asarray(scene.tip_cap_bgr, np.float64)[None, :] * (gain[ys, xs] * bright)[:, None]
+        ).astype(np.float32)
     return colour, coverage
 
 
@@ -366,8 +408,10 @@ def paint_dots(
     for c in centres_px:
         cc = tuple(int(x) for x in np.round((c - offset) * f))
         if scene.dot_color == "white":
-            cv2.circle(ring, cc, int(round((r + max(0.6, 0.12 * r)) * f)), 255, -1, cv2.LINE_AA, shift_bits)
-        cv2.circle(disc, cc, int(round(r * f)), 255, -1, cv2.LINE_AA, shift_bits)
+            cv2.circle(
+                ring, cc, int(round((r + max(0.6, 0.12 * r)) * f)), 255, -1, cv2.LINE_AA, shift_bits  # noqa: RUF046 (numpy scalar)
+            )
+        cv2.circle(disc, cc, int(round(r * f)), 255, -1, cv2.LINE_AA, shift_bits)  # noqa: RUF046 (numpy scalar)
     a = disc.astype(np.float32) / 255.0
     colour = np.zeros((h, w, 3), np.float32)
     if scene.dot_color == "white":
@@ -379,17 +423,22 @@ def paint_dots(
     return colour, a, ring.astype(np.float32) / 255.0 * 0.7
 
 
-def shadow_of(alpha: NDArray[np.float32], style: BodyStyle, mm_per_px: float) -> NDArray[np.float32]:
+def shadow_of(
+    alpha: NDArray[np.float32], style: BodyStyle, mm_per_px: float
+) -> NDArray[np.float32]:
     """Soft shadow (0-1) cast by an opacity mask: shifted along ``style.shadow_dir`` and blurred.
 
-    The blur is wide, so it is done on a copy reduced to about 3 px per blur sigma and enlarged back.
+    The blur is wide, so it is done on a copy reduced to about 3 px per blur sigma and enlarged
+    back.
     """
     sigma = SHADOW_BLUR_MM / mm_per_px
     f = max(1.0, sigma / 3.0)
     h, w = alpha.shape
     small = np.minimum(alpha * 2.0, 1.0)
     if f > 1.0:
-        small = cv2.resize(small, (max(1, round(w / f)), max(1, round(h / f))), interpolation=cv2.INTER_AREA)
+        small = cv2.resize(
+            small, (max(1, round(w / f)), max(1, round(h / f))), interpolation=cv2.INTER_AREA
+        )
     sh, sw = small.shape
     fx, fy = sw / w, sh / h
     d = SHADOW_OFFSET_MM / mm_per_px

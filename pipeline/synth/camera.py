@@ -92,8 +92,11 @@ class Camera:
         return float(x), float(y)
 
 
-def distort(points_px: ArrayLike, k1: float, focal_px: float, centre_px: tuple[float, float]) -> NDArray[np.float64]:
-    """Radial lens distortion of ideal image points: ``x_d = x (1 + k1 r^2)``, r normalised by focal.
+def distort(
+    points_px: ArrayLike, k1: float, focal_px: float, centre_px: tuple[float, float]
+) -> NDArray[np.float64]:
+    """Radial lens distortion of ideal image points: ``x_d = x (1 + k1 r^2)``, r normalised by
+    focal.
 
     For barrel distortion (``k1 < 0``) the radius is capped where the mapping stops growing
     (``r^2 = 1 / (3 |k1|)``, far outside any photo), so points never fold back into the frame.
@@ -114,14 +117,18 @@ def distort(points_px: ArrayLike, k1: float, focal_px: float, centre_px: tuple[f
     return c + n * (1.0 + k1 * r2)[:, None] * focal_px
 
 
-def undistort(points_px: ArrayLike, k1: float, focal_px: float, centre_px: tuple[float, float]) -> NDArray[np.float64]:
+def undistort(
+    points_px: ArrayLike, k1: float, focal_px: float, centre_px: tuple[float, float]
+) -> NDArray[np.float64]:
     """The inverse of :func:`distort` (OpenCV's iterative undistortion, run to convergence)."""
     p = np.asarray(points_px, dtype=np.float64).reshape(-1, 1, 2)
     if k1 == 0:
         return p.reshape(-1, 2)
     k = np.array([[focal_px, 0, centre_px[0]], [0, focal_px, centre_px[1]], [0, 0, 1.0]])
     crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
-    return cv2.undistortPoints(p, k, np.array([k1, 0, 0, 0, 0.0]), P=k, criteria=crit).reshape(-1, 2)
+    return cv2.undistortPoints(p, k, np.array([k1, 0, 0, 0, 0.0]), P=k, criteria=crit).reshape(
+        -1, 2
+    )
 
 
 def apply_homography(h: NDArray[np.float64], points_px: ArrayLike) -> NDArray[np.float64]:
@@ -168,14 +175,23 @@ def make_camera(
     h = tilt_homography(scene)
     if fixed_end_px is None:
         pts = np.zeros((1, 2)) if extent_mm is None else np.asarray(extent_mm, dtype=float)
-        probe = Camera(scene.width, scene.height, scene.mm_per_px, rotation_deg, (0.0, 0.0), np.eye(3))
+        probe = Camera(
+            scene.width, scene.height, scene.mm_per_px, rotation_deg, (0.0, 0.0), np.eye(3)
+        )
         flat = probe.flat_px(pts)
         centre = (flat.min(axis=0) + flat.max(axis=0)) / 2
         origin = (scene.width / 2 - centre[0], scene.height / 2 - centre[1])
     else:
-        ideal = undistort([fixed_end_px], scene.lens_k1, scene_focal_px(scene), (scene.width / 2, scene.height / 2))
+        ideal = undistort(
+            [fixed_end_px],
+            scene.lens_k1,
+            scene_focal_px(scene),
+            (scene.width / 2, scene.height / 2),
+        )
         origin = tuple(apply_homography(np.linalg.inv(h), ideal)[0])
-    return camera_for(scene, rotation_deg=rotation_deg, origin_px=(float(origin[0]), float(origin[1])))
+    return camera_for(
+        scene, rotation_deg=rotation_deg, origin_px=(float(origin[0]), float(origin[1]))
+    )
 
 
 def scene_focal_px(scene: SceneParams) -> float:
@@ -183,8 +199,18 @@ def scene_focal_px(scene: SceneParams) -> float:
     return float(scene.focal_px_per_width * scene.width)
 
 
-def camera_for(scene: SceneParams, *, rotation_deg: float, origin_px: tuple[float, float]) -> Camera:
-    """The camera of ``scene`` (its tilt and lens) with the world origin at ``origin_px`` before the tilt."""
-    return Camera(scene.width, scene.height, scene.mm_per_px, float(rotation_deg),
-                  (float(origin_px[0]), float(origin_px[1])), tilt_homography(scene), float(scene.lens_k1),
-                  scene_focal_px(scene))
+def camera_for(
+    scene: SceneParams, *, rotation_deg: float, origin_px: tuple[float, float]
+) -> Camera:
+    """The camera of ``scene`` (its tilt and lens) with the world origin at ``origin_px`` before the
+    tilt."""
+    return Camera(
+        scene.width,
+        scene.height,
+        scene.mm_per_px,
+        float(rotation_deg),
+        (float(origin_px[0]), float(origin_px[1])),
+        tilt_homography(scene),
+        float(scene.lens_k1),
+        scene_focal_px(scene),
+    )

@@ -50,13 +50,17 @@ def tangent_angle_rad(u: ArrayLike, psi_deg: float, bulge: float = 0.0) -> NDArr
     return np.radians(psi_deg) * (u - bulge * np.sin(2 * np.pi * u) / (2 * np.pi))
 
 
-def curvature_per_mm(u: ArrayLike, psi_deg: float, l0_mm: float, bulge: float = 0.0) -> NDArray[np.float64]:
+def curvature_per_mm(
+    u: ArrayLike, psi_deg: float, l0_mm: float, bulge: float = 0.0
+) -> NDArray[np.float64]:
     """Curvature kappa(u) in 1/mm (signed, ccw positive) at normalised arc length ``u``."""
     u = np.asarray(u, dtype=float)
     return np.radians(psi_deg) / l0_mm * (1.0 - bulge * np.cos(2 * np.pi * u))
 
 
-def centreline_mm(psi_deg: float, l0_mm: float, *, bulge: float = 0.0, n: int = DEFAULT_N) -> NDArray[np.float64]:
+def centreline_mm(
+    psi_deg: float, l0_mm: float, *, bulge: float = 0.0, n: int = DEFAULT_N
+) -> NDArray[np.float64]:
     """Points of the exact centreline, fixed end first, in mm (x along the clamp, y up).
 
     Parameters
@@ -152,7 +156,9 @@ def curvature_weights(
         return np.ones_like(u)
     if shape == "distal":
         u0 = straight_base_fraction
-        return _smoothstep((u - u0) / DISTAL_RAMP) * (1.0 + DISTAL_GROWTH * np.clip(u - u0, 0, None) / max(1 - u0, 1e-9))
+        return _smoothstep((u - u0) / DISTAL_RAMP) * (
+            1.0 + DISTAL_GROWTH * np.clip(u - u0, 0, None) / max(1 - u0, 1e-9)
+        )
     if shape == "chambers":
         b = np.asarray(chamber_bend, dtype=float)
         w = np.full_like(u, b[0])
@@ -218,11 +224,19 @@ def actuator_centreline_mm(
     return weighted_centreline_mm(psi_deg, l0_mm, w)
 
 
-def peak_curvature_per_mm(psi_deg: float, l0_mm: float, scene: SceneParams, *, bulge: float = 0.0) -> float:
-    """Largest signed curvature (1/mm, ccw positive) of :func:`actuator_centreline_mm` (psi > 0: max; < 0: min)."""
+def peak_curvature_per_mm(
+    psi_deg: float, l0_mm: float, scene: SceneParams, *, bulge: float = 0.0
+) -> float:
+    """Largest signed curvature (1/mm, ccw positive) of :func:`actuator_centreline_mm` (psi > 0:
+    max; < 0: min)."""
     u = np.linspace(0.0, 1.0, 2001)
-    w = curvature_weights(u, scene.shape, bulge=bulge, straight_base_fraction=scene.straight_base_fraction,
-                          chamber_bend=scene.chamber_bend)
+    w = curvature_weights(
+        u,
+        scene.shape,
+        bulge=bulge,
+        straight_base_fraction=scene.straight_base_fraction,
+        chamber_bend=scene.chamber_bend,
+    )
     k = np.radians(psi_deg) / l0_mm * w / np.trapezoid(w, u)
     return float(k.max() if psi_deg >= 0 else k.min())
 

@@ -15,7 +15,8 @@ Examples
 >>> import tempfile, numpy as np
 >>> toy = lambda material, p, branch="loading": 210.0 - 3.0 * np.asarray(p, float)
 >>> truth = render_photoset(tempfile.mkdtemp(), "DS20", actuators=1, trials=1, step_kpa=70,
-...                         scene="clean", scene_overrides={"width": 320, "height": 240}, psi_fn=toy)
+...                         scene="clean", scene_overrides={"width": 320, "height": 240},
+...                         psi_fn=toy)
 >>> truth[["pressure_kpa", "direction"]].values.tolist()[:3]
 [[0.0, 'up'], [70.0, 'up'], [140.0, 'up']]
 """
@@ -36,7 +37,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.folders import staged_folder
 from pipeline.photoset import MANIFEST, TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
@@ -52,7 +53,14 @@ from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import Camera, camera_for, make_camera
 from pipeline.synth.centreline import actuator_centreline_mm
 from pipeline.synth.presets import SceneParams, scene_from
-from pipeline.synth.scene import _compose, check_body_fits, child_seed, encode_jpeg, render_background, world_extent_mm
+from pipeline.synth.scene import (
+    check_body_fits,
+    child_seed,
+    compose_photo,
+    encode_jpeg,
+    render_background,
+    world_extent_mm,
+)
 
 #: seed streams (second key after the material)
 _TABLE, _ACTUATOR, _TRIAL, _RAMP, _IMAGE, _LAYOUT, _BACKGROUND, _BOARD = range(8)
@@ -69,7 +77,9 @@ def material_key(material: str) -> int:
     return zlib.crc32(material.encode()) & 0x7FFFFFFF
 
 
-def image_name(material: str, actuator: str, trial: str, step: int, direction: str, pressure_kpa: float) -> str:
+def image_name(
+    material: str, actuator: str, trial: str, step: int, direction: str, pressure_kpa: float
+) -> str:
     """File name of one photo, e.g. ``DS20_A1_t1_s003_up_30kPa.jpg``."""
     p = f"{pressure_kpa:g}".replace(".", "p")
     return f"{material}_{actuator}_t{trial}_s{step:03d}_{direction}_{p}kPa.jpg"
@@ -77,13 +87,10 @@ def image_name(material: str, actuator: str, trial: str, step: int, direction: s
 
 def default_l0_mm(material: str) -> float:
     """l0 of the material from ``pipeline.model.load_materials`` (195 mm if unknown)."""
-    try:
-        from pipeline.model import load_materials
+    from pipeline.model import load_materials
 
-        mats = load_materials()
-        return float(mats[material].l0_mm) if material in mats else DEFAULT_L0_MM
-    except ImportError:  # pragma: no cover
-        return DEFAULT_L0_MM
+    mats = load_materials()
+    return float(mats[material].l0_mm) if material in mats else DEFAULT_L0_MM
 
 
 def plan_photoset(
@@ -113,7 +120,9 @@ def plan_photoset(
     mk = material_key(material)
     ramps = []
     for a in range(1, actuators + 1):
-        act = draw_actuator(material, curve, beh, np.random.default_rng(child_seed(seed, mk, _ACTUATOR, a)))
+        act = draw_actuator(
+            material, curve, beh, np.random.default_rng(child_seed(seed, mk, _ACTUATOR, a))
+        )
         for t in range(1, trials + 1):
             rng = np.random.default_rng(child_seed(seed, mk, _TRIAL, a, t))
             trial = draw_trial(material, curve, beh, act, rng)
@@ -123,18 +132,35 @@ def plan_photoset(
             ramp.insert(0, "material", material)
             ramps.append(ramp)
     df = pd.concat(ramps, ignore_index=True)
-    df.insert(0, "image", [image_name(r.material, r.actuator, r.trial, int(r.step), r.direction, float(r.pressure_kpa))
-                           for r in df.itertuples()])
+    df.insert(
+        0,
+        "image",
+        [
+            image_name(
+                r.material, r.actuator, r.trial, int(r.step), r.direction, float(r.pressure_kpa)
+            )
+            for r in df.itertuples()
+        ],
+    )
     return df
 
 
-def _sample_extents(plan: pd.DataFrame, l0_mm: float, scene: SceneParams, n_curves: int = 48) -> list[np.ndarray]:
+def _sample_extents(
+    plan: pd.DataFrame, l0_mm: float, scene: SceneParams, n_curves: int = 48
+) -> list[np.ndarray]:
     order = plan.sort_values("psi_deg")
-    pick = np.unique(np.round(np.linspace(0, len(order) - 1, min(n_curves, len(order)))).astype(int))
+    pick = np.unique(
+        np.round(np.linspace(0, len(order) - 1, min(n_curves, len(order)))).astype(int)
+    )
     rows = order.iloc[pick]
-    return [world_extent_mm(actuator_centreline_mm(float(r.psi_deg), l0_mm, scene, bulge=float(r.bulge), n=241),
-                            scene.body_width_mm, scene.tip_cap_mm)
-            for r in rows.itertuples()]
+    return [
+        world_extent_mm(
+            actuator_centreline_mm(float(r.psi_deg), l0_mm, scene, bulge=float(r.bulge), n=241),
+            scene.body_width_mm,
+            scene.tip_cap_mm,
+        )
+        for r in rows.itertuples()
+    ]
 
 
 def _rotate(points: np.ndarray, deg: float) -> np.ndarray:
@@ -142,7 +168,9 @@ def _rotate(points: np.ndarray, deg: float) -> np.ndarray:
     return points @ np.array([[c, s], [-s, c]])
 
 
-def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[float, tuple[float, float], float]:
+def choose_layout(
+    extents_mm: list[np.ndarray], scene: SceneParams
+) -> tuple[float, tuple[float, float], float]:
     """Clamp direction and fixed-end position that frame every shape of the campaign best.
 
     Tries clamp directions every 15 deg, keeps the one needing the least field of view (shapes
@@ -163,7 +191,10 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
         cam = Camera(scene.width, scene.height, scene.mm_per_px, float(rot), (0.0, 0.0), np.eye(3))
         px = cam.flat_px(pts)
         size = px.max(axis=0) - px.min(axis=0)
-        need = max(size[0] / (scene.width - 2 * LAYOUT_MARGIN_PX), size[1] / (scene.height - 2 * LAYOUT_MARGIN_PX))
+        need = max(
+            size[0] / (scene.width - 2 * LAYOUT_MARGIN_PX),
+            size[1] / (scene.height - 2 * LAYOUT_MARGIN_PX),
+        )
         if best is None or need < best[0] - 1e-9:
             best = (need, float(rot), (px.max(axis=0) + px.min(axis=0)) / 2)
     _, rot, centre = best
@@ -173,7 +204,10 @@ def choose_layout(extents_mm: list[np.ndarray], scene: SceneParams) -> tuple[flo
         lo, hi = px.min(axis=0), px.max(axis=0)
         origin = origin + np.array([scene.width / 2, scene.height / 2]) - (lo + hi) / 2
     size = hi - lo
-    need = max(size[0] / (scene.width - 2 * LAYOUT_MARGIN_PX), size[1] / (scene.height - 2 * LAYOUT_MARGIN_PX))
+    need = max(
+        size[0] / (scene.width - 2 * LAYOUT_MARGIN_PX),
+        size[1] / (scene.height - 2 * LAYOUT_MARGIN_PX),
+    )
     return rot, (float(origin[0]), float(origin[1])), float(need)
 
 
@@ -188,26 +222,47 @@ def _render_ramp(task: dict[str, Any]) -> list[dict[str, Any]]:
 
     cv2.setNumThreads(1)
     scene: SceneParams = task["scene"]
-    camera = make_camera(scene, rotation_deg=task["rotation_deg"], fixed_end_px=task["fixed_end_px"])
-    backdrop = _static_scene(scene, task["base_rotation_deg"], task["fixed_end_px"], task["table_seed"], task["keepout_mm"])
+    camera = make_camera(
+        scene, rotation_deg=task["rotation_deg"], fixed_end_px=task["fixed_end_px"]
+    )
+    backdrop = _static_scene(
+        scene,
+        task["base_rotation_deg"],
+        task["fixed_end_px"],
+        task["table_seed"],
+        task["keepout_mm"],
+    )
     out_dir = Path(task["out_dir"])
     results = []
     for row in task["rows"]:
         pts = actuator_centreline_mm(row["psi_deg"], task["l0_mm"], scene, bulge=row["bulge"])
         rng = np.random.default_rng(child_seed(*task["image_seed"], row["step"]))
-        r = _compose(pts, scene, camera, backdrop, scene.body_width_mm, rng)
+        r = compose_photo(pts, scene, camera, backdrop, scene.body_width_mm, rng)
         tmp = out_dir / f".{row['image']}.tmp"
         tmp.write_bytes(r.jpeg_bytes)
         os.replace(tmp, out_dir / row["image"])
-        results.append({"image": row["image"], "psi_image_deg": r.psi_image_deg, "line_in_frame": r.line_in_frame,
-                        "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1],
-                        "fixed_direction_deg": r.fixed_direction_deg})
+        results.append(
+            {
+                "image": row["image"],
+                "psi_image_deg": r.psi_image_deg,
+                "line_in_frame": r.line_in_frame,
+                "fixed_end_x": r.fixed_end_px[0],
+                "fixed_end_y": r.fixed_end_px[1],
+                "fixed_direction_deg": r.fixed_direction_deg,
+            }
+        )
     return results
 
 
-def _static_scene(scene: SceneParams, rotation_deg: float, fixed_end_px: tuple[float, float], seed: Any,
-                  keepout_mm: list[np.ndarray]) -> Any:
-    """The backdrop every ramp shares (clamp at the base mounting angle), as a background photo shows it."""
+def _static_scene(
+    scene: SceneParams,
+    rotation_deg: float,
+    fixed_end_px: tuple[float, float],
+    seed: Any,
+    keepout_mm: list[np.ndarray],
+) -> Any:
+    """The backdrop every ramp shares (clamp at the base mounting angle), as a background photo
+    shows it."""
     camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px)
     return make_backdrop(scene, camera, seed=seed, keepout_mm=keepout_mm)
 
@@ -280,7 +335,9 @@ def render_photoset(
     """
     out = Path(out_dir)
     if (out / MANIFEST).exists() and not overwrite:
-        raise UserInputError(f"{out / MANIFEST} exists; choose an empty OUT_DIR or pass --overwrite")
+        raise UserInputError(
+            f"{out / MANIFEST} exists; choose an empty OUT_DIR or pass --overwrite"
+        )
     if jobs < 1:
         raise UserInputError(f"jobs = {jobs} must be at least 1")
     sc = scene_from(scene, **dict(scene_overrides or {}))
@@ -290,7 +347,9 @@ def render_photoset(
                          max_kpa=max_kpa, psi_fn=psi_fn, behaviour=behaviour)
     if sc.target == "body":  # refuse before writing anything: a folded body has no centre line
         for r in plan.loc[[plan["psi_deg"].idxmax(), plan["psi_deg"].idxmin()]].itertuples():
-            check_body_fits(actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001), sc)
+            check_body_fits(
+                actuator_centreline_mm(float(r.psi_deg), l0, sc, bulge=float(r.bulge), n=4001), sc
+            )
     extents = _sample_extents(plan, l0, sc)
     base_rot, fixed_flat, need = choose_layout(extents, sc)
     if need > 1.0 and fit_view:
@@ -306,18 +365,32 @@ def render_photoset(
         tasks = []
         for (act, trial), g in plan.groupby(["actuator", "trial"], sort=False):
             a, t = int(act[1:]), int(trial)
-            rot = base_rot + float(np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(0, sc.rotation_jitter_deg))
-            tasks.append({
-                "scene": sc, "rotation_deg": rot, "base_rotation_deg": base_rot, "fixed_end_px": fixed_end_px,
-                "keepout_mm": keepout, "table_seed": child_seed(seed, mk, _TABLE), "out_dir": str(tmp), "l0_mm": l0,
-                "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
-                "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
-            })
+            rot = base_rot + float(
+                np.random.default_rng(child_seed(seed, mk, _RAMP, a, t)).normal(
+                    0, sc.rotation_jitter_deg
+                )
+            )
+            tasks.append(
+                {
+                    "scene": sc,
+                    "rotation_deg": rot,
+                    "base_rotation_deg": base_rot,
+                    "fixed_end_px": fixed_end_px,
+                    "keepout_mm": keepout,
+                    "table_seed": child_seed(seed, mk, _TABLE),
+                    "out_dir": str(tmp),
+                    "l0_mm": l0,
+                    "image_seed": (child_seed(seed, mk, _IMAGE, a, t),),
+                    "rows": g[["image", "psi_deg", "bulge", "step"]].to_dict("records"),
+                }
+            )
         if jobs == 1 or len(tasks) == 1:
             results = [_render_ramp(task) for task in tasks]
         else:
             ctx = multiprocessing.get_context("spawn")
-            pool = concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+            pool = concurrent.futures.ProcessPoolExecutor(
+                max_workers=jobs, mp_context=ctx, initializer=_worker_init
+            )
             try:
                 results = list(pool.map(_render_ramp, tasks))
             finally:  # on Ctrl-C/SIGTERM: drop the ramps not started, wait for the (dead) workers
@@ -325,18 +398,43 @@ def render_photoset(
         rendered = pd.DataFrame([r for res in results for r in res])
         truth = plan.merge(rendered, on="image", how="left", validate="one_to_one")
         truth = truth.assign(
-            scene=scene_name, l0_mm=l0, mm_per_px=sc.mm_per_px, line_color=sc.line_color, noise_sigma=sc.noise_sigma,
-            blur_sigma_px=sc.blur_sigma_px, tilt_deg=sc.tilt_deg, jpeg_quality=sc.jpeg_quality,
-            occluded_fraction=sc.occluded_fraction, seed=seed, target=sc.target, shape=sc.shape,
-            marker_line=sc.marker_line, body_width_mm=sc.body_width_mm, body_translucency=sc.body_translucency,
-            texture=sc.texture, dots=sc.dots, clamp_style=sc.clamp_style, lens_k1=sc.lens_k1,
+            scene=scene_name,
+            l0_mm=l0,
+            mm_per_px=sc.mm_per_px,
+            line_color=sc.line_color,
+            noise_sigma=sc.noise_sigma,
+            blur_sigma_px=sc.blur_sigma_px,
+            tilt_deg=sc.tilt_deg,
+            jpeg_quality=sc.jpeg_quality,
+            occluded_fraction=sc.occluded_fraction,
+            seed=seed,
+            target=sc.target,
+            shape=sc.shape,
+            marker_line=sc.marker_line,
+            body_width_mm=sc.body_width_mm,
+            body_translucency=sc.body_translucency,
+            texture=sc.texture,
+            dots=sc.dots,
+            clamp_style=sc.clamp_style,
+            lens_k1=sc.lens_k1,
         )
-        first = ["image", "psi_deg", "psi_image_deg", "material", "actuator", "trial", "step", "pressure_kpa", "direction",
-                 "bulge"]
+        first = [
+            "image",
+            "psi_deg",
+            "psi_image_deg",
+            "material",
+            "actuator",
+            "trial",
+            "step",
+            "pressure_kpa",
+            "direction",
+            "bulge",
+        ]
         truth = truth[first + [c for c in truth.columns if c not in first]]
         columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
-        manifest = truth[columns + (["fixed_direction_deg"] if sc.known_fixed_direction else [])].round(
-            {"fixed_direction_deg": 3})
+        manifest = truth[
+            columns + (["fixed_direction_deg"] if sc.known_fixed_direction else [])
+        ].round({"fixed_direction_deg": 3})
         write_manifest(tmp, manifest)
         settings: dict[str, Any] = {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px)}
         if sc.target == "body":
@@ -346,9 +444,16 @@ def render_photoset(
             settings["target"] = "body"
         else:
             settings["line_color"] = sc.line_color
-        settings.update({"fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)], "positive_turn": "ccw"})
+        settings.update(
+            {
+                "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)],
+                "positive_turn": "ccw",
+            }
+        )
         if sc.background_photo:
-            backdrop = _static_scene(sc, base_rot, tasks[0]["fixed_end_px"], child_seed(seed, mk, _TABLE), keepout)
+            backdrop = _static_scene(
+                sc, base_rot, tasks[0]["fixed_end_px"], child_seed(seed, mk, _TABLE), keepout
+            )
             image = render_background(backdrop, sc, seed=child_seed(seed, mk, _BACKGROUND))
             atomic_write_bytes(tmp / BACKGROUND_IMAGE, encode_jpeg(image, sc.jpeg_quality))
             settings["background"] = BACKGROUND_IMAGE
@@ -356,8 +461,12 @@ def render_photoset(
             from pipeline.synth.board import write_board_photo
 
             del settings["mm_per_px"]  # the board gives the scale (truth.csv keeps the scene's)
-            settings["calibration"] = write_board_photo(tmp / BOARD_PHOTO, sc, make_camera(
-                sc, rotation_deg=base_rot, fixed_end_px=tasks[0]["fixed_end_px"]), seed=child_seed(seed, mk, _BOARD))
+            settings["calibration"] = write_board_photo(
+                tmp / BOARD_PHOTO,
+                sc,
+                make_camera(sc, rotation_deg=base_rot, fixed_end_px=tasks[0]["fixed_end_px"]),
+                seed=child_seed(seed, mk, _BOARD),
+            )
         write_settings(tmp, settings)
-        atomic_write_bytes(tmp / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+        write_table(truth, tmp / TRUTH)
     return truth

@@ -237,9 +237,17 @@ class SceneParams:
 
     @property
     def plain_body(self) -> bool:
-        """The body is today's flat translucent band (no relief, texture, highlights, dots or cap)."""
-        return (self.body_shading == 0 and self.texture == "none" and self.specular == 0 and self.dots == 0
-                and self.tip_cap_mm == 0 and len(self.chamber_bend) == 1 and self.shadow == 0)
+        """The body is today's flat translucent band (no relief, texture, highlights, dots or
+        cap)."""
+        return (
+            self.body_shading == 0
+            and self.texture == "none"
+            and self.specular == 0
+            and self.dots == 0
+            and self.tip_cap_mm == 0
+            and len(self.chamber_bend) == 1
+            and self.shadow == 0
+        )
 
     def __post_init__(self) -> None:
         problems = _problems(self)
@@ -251,21 +259,44 @@ def _problems(s: SceneParams) -> list[str]:
     out = []
     if not (16 <= s.width <= 20000 and 16 <= s.height <= 20000):
         out.append(f"width/height = {s.width}x{s.height} px must be 16..20000")
-    for key in ("mm_per_px", "line_width_px", "body_width_mm", "focal_px_per_width", "texture_pitch_mm",
-                "dot_diameter_mm"):
+    for key in (
+        "mm_per_px",
+        "line_width_px",
+        "body_width_mm",
+        "focal_px_per_width",
+        "texture_pitch_mm",
+        "dot_diameter_mm",
+    ):
         if not getattr(s, key) > 0:
             out.append(f"{key} = {getattr(s, key)!r} must be > 0")
-    for key in ("texture_strength", "noise_sigma", "blur_sigma_px", "lighting_gradient", "vignetting",
-                "tilt_deg", "rotation_jitter_deg", "tip_cap_mm"):
+    for key in (
+        "texture_strength",
+        "noise_sigma",
+        "blur_sigma_px",
+        "lighting_gradient",
+        "vignetting",
+        "tilt_deg",
+        "rotation_jitter_deg",
+        "tip_cap_mm",
+    ):
         if not getattr(s, key) >= 0:
             out.append(f"{key} = {getattr(s, key)!r} must be >= 0")
-    for key in ("line_contrast", "body_translucency", "body_shading", "texture_contrast", "specular", "shadow"):
+    for key in (
+        "line_contrast",
+        "body_translucency",
+        "body_shading",
+        "texture_contrast",
+        "specular",
+        "shadow",
+    ):
         if not 0 <= getattr(s, key) <= 1:
             out.append(f"{key} = {getattr(s, key)!r} must be between 0 and 1")
     if s.background not in BACKGROUNDS:
         out.append(f"background = {s.background!r}: use one of {list(BACKGROUNDS)}")
     if s.distractor_color not in DISTRACTOR_COLORS:
-        out.append(f"distractor_color = {s.distractor_color!r}: use one of {list(DISTRACTOR_COLORS)}")
+        out.append(
+            f"distractor_color = {s.distractor_color!r}: use one of {list(DISTRACTOR_COLORS)}"
+        )
     if s.line_color not in LINE_INK_BGR:
         out.append(f"line_color = {s.line_color!r}: the renderer draws {sorted(LINE_INK_BGR)}")
     if s.distractor_marks < 0:
@@ -275,85 +306,221 @@ def _problems(s: SceneParams) -> list[str]:
     if not 0 <= s.occluded_fraction <= 0.5:
         out.append(f"occluded_fraction = {s.occluded_fraction!r} must be 0..0.5")
     if not abs(s.lens_k1) <= 0.3:
-        out.append(f"lens_k1 = {s.lens_k1!r} must be within -0.3..0.3 (a phone or action camera is about -0.1)")
+        out.append(
+            f"lens_k1 = {s.lens_k1!r} must be within -0.3..0.3 (a phone or action camera is about "
+            "-0.1)"
+        )
     if s.tilt_deg > 20:
-        out.append(f"tilt_deg = {s.tilt_deg} is more than 20 deg; a copy stand is never that far off")
+        out.append(
+            f"tilt_deg = {s.tilt_deg} is more than 20 deg; a copy stand is never that far off"
+        )
     for key in COLOR_KEYS:
         v = getattr(s, key)
         if len(v) != 3 or any(not 0 <= int(c) <= 255 for c in v):
-            out.append(f"{key} = {v!r} must be three integers 0-255 (B, G, R) or a colour name {sorted(NAMED_BGR)}")
-    for key, allowed in (("target", TARGETS), ("shape", SHAPES), ("texture", TEXTURES), ("clamp_style", CLAMP_STYLES),
-                         ("dot_color", DOT_COLORS), ("dot_layout", DOT_LAYOUTS)):
+            out.append(
+                f"{key} = {v!r} must be three integers 0-255 (B, G, R) or a colour name "
+                f"{sorted(NAMED_BGR)}"
+            )
+    for key, allowed in (
+        ("target", TARGETS),
+        ("shape", SHAPES),
+        ("texture", TEXTURES),
+        ("clamp_style", CLAMP_STYLES),
+        ("dot_color", DOT_COLORS),
+        ("dot_layout", DOT_LAYOUTS),
+    ):
         if getattr(s, key) not in allowed:
             out.append(f"{key} = {getattr(s, key)!r}: use one of {list(allowed)}")
     if s.target == "line" and not s.marker_line:
-        out.append("target = 'line' needs marker_line = true (a body without a drawn line is measured as target = 'body')")
+        out.append(
+            "target = 'line' needs marker_line = true (a body without a drawn line is measured as "
+            "target = 'body')"
+        )
     if not 0 <= s.straight_base_fraction <= 0.8:
         out.append(f"straight_base_fraction = {s.straight_base_fraction!r} must be 0..0.8")
     bend = s.chamber_bend
-    if not 1 <= len(bend) <= 8 or any(not (np.isfinite(b) and b >= 0) for b in bend) or not sum(bend) > 0:
+    if (
+        not 1 <= len(bend) <= 8
+        or any(not (np.isfinite(b) and b >= 0) for b in bend)
+        or not sum(bend) > 0
+    ):
         out.append(f"chamber_bend = {bend!r} must be 1 to 8 weights >= 0, not all 0 (e.g. 0,1,1)")
     if not 0 <= s.dots <= 60:
         out.append(f"dots = {s.dots!r} must be 0..60")
     if s.body_width_mm > 60:
-        out.append(f"body_width_mm = {s.body_width_mm} mm is wider than any actuator this renders (<= 60 mm)")
+        out.append(
+            f"body_width_mm = {s.body_width_mm} mm is wider than any actuator this renders (<= 60 "
+            "mm)"
+        )
     return out
 
 
 #: named scenes: ``clean`` (ideal photo), ``lab`` (a realistic bench photo), ``hard`` (worst case)
 SCENE_PRESETS: dict[str, SceneParams] = {
     "clean": SceneParams(
-        background="plain", lighting_gradient=0.0, vignetting=0.0, body_translucency=0.6,
-        noise_sigma=0.0, blur_sigma_px=0.0, jpeg_quality=95, tilt_deg=0.0, rotation_jitter_deg=0.0,
+        background="plain",
+        lighting_gradient=0.0,
+        vignetting=0.0,
+        body_translucency=0.6,
+        noise_sigma=0.0,
+        blur_sigma_px=0.0,
+        jpeg_quality=95,
+        tilt_deg=0.0,
+        rotation_jitter_deg=0.0,
     ),
     "lab": SceneParams(
-        background="textured", texture_strength=6.0, lighting_gradient=0.15, vignetting=0.18,
-        distractor_marks=5, distractor_color="grey", line_contrast=0.95, body_translucency=0.45,
-        tilt_deg=1.0, noise_sigma=2.5, blur_sigma_px=0.8, jpeg_quality=90, rotation_jitter_deg=1.5,
+        background="textured",
+        texture_strength=6.0,
+        lighting_gradient=0.15,
+        vignetting=0.18,
+        distractor_marks=5,
+        distractor_color="grey",
+        line_contrast=0.95,
+        body_translucency=0.45,
+        tilt_deg=1.0,
+        noise_sigma=2.5,
+        blur_sigma_px=0.8,
+        jpeg_quality=90,
+        rotation_jitter_deg=1.5,
     ),
     "hard": SceneParams(
-        background="textured", texture_strength=12.0, lighting_gradient=0.35, vignetting=0.35,
-        distractor_marks=12, distractor_color="line", line_width_px=4.0, line_contrast=0.85,
-        body_translucency=0.3, tilt_deg=3.0, noise_sigma=6.0, blur_sigma_px=1.5, jpeg_quality=75,
-        occluded_fraction=0.05, rotation_jitter_deg=3.0,
+        background="textured",
+        texture_strength=12.0,
+        lighting_gradient=0.35,
+        vignetting=0.35,
+        distractor_marks=12,
+        distractor_color="line",
+        line_width_px=4.0,
+        line_contrast=0.85,
+        body_translucency=0.3,
+        tilt_deg=3.0,
+        noise_sigma=6.0,
+        blur_sigma_px=1.5,
+        jpeg_quality=75,
+        occluded_fraction=0.05,
+        rotation_jitter_deg=3.0,
     ),
     # (A) a translucent fibre-wound segment of three chambers on a green chroma backdrop (cloth),
     # white printed clamp and its supply tube; the base chamber bends little
     "green_fibre": SceneParams(
-        background="textured", table_bgr=NAMED_BGR["green"], texture_strength=5.0, lighting_gradient=0.2,
-        vignetting=0.22, marker_line=False, target="body", shape="chambers", chamber_bend=(0.25, 1.0, 1.0),
-        body_width_mm=16.0, body_bgr=NAMED_BGR["clear"], body_translucency=0.5, body_shading=0.6,
-        texture="fibre", texture_pitch_mm=2.5, texture_contrast=0.55, texture_bgr=(55, 75, 95), specular=0.5,
-        tip_cap_mm=6.0, tip_cap_bgr=(228, 230, 232), clamp_style="white", tube=True, shadow=0.25,
-        tilt_deg=1.0, noise_sigma=2.5, blur_sigma_px=0.8, jpeg_quality=90, rotation_jitter_deg=1.5,
+        background="textured",
+        table_bgr=NAMED_BGR["green"],
+        texture_strength=5.0,
+        lighting_gradient=0.2,
+        vignetting=0.22,
+        marker_line=False,
+        target="body",
+        shape="chambers",
+        chamber_bend=(0.25, 1.0, 1.0),
+        body_width_mm=16.0,
+        body_bgr=NAMED_BGR["clear"],
+        body_translucency=0.5,
+        body_shading=0.6,
+        texture="fibre",
+        texture_pitch_mm=2.5,
+        texture_contrast=0.55,
+        texture_bgr=(55, 75, 95),
+        specular=0.5,
+        tip_cap_mm=6.0,
+        tip_cap_bgr=(228, 230, 232),
+        clamp_style="white",
+        tube=True,
+        shadow=0.25,
+        tilt_deg=1.0,
+        noise_sigma=2.5,
+        blur_sigma_px=0.8,
+        jpeg_quality=90,
+        rotation_jitter_deg=1.5,
         background_photo=True,
     ),
     # (B) an opaque pigmented silicone actuator with retro-reflective motion-capture dots, clamped
     # in a black plate on a grey board; curvature concentrated towards the tip
     "grey_dots": SceneParams(
-        background="textured", table_bgr=NAMED_BGR["grey"], texture_strength=3.0, lighting_gradient=0.25,
-        vignetting=0.25, marker_line=False, target="body", shape="distal", straight_base_fraction=0.3,
-        body_width_mm=20.0, body_bgr=NAMED_BGR["pink"], body_translucency=0.08, body_shading=0.7,
-        specular=0.35, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
-        shadow=0.2, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
+        background="textured",
+        table_bgr=NAMED_BGR["grey"],
+        texture_strength=3.0,
+        lighting_gradient=0.25,
+        vignetting=0.25,
+        marker_line=False,
+        target="body",
+        shape="distal",
+        straight_base_fraction=0.3,
+        body_width_mm=20.0,
+        body_bgr=NAMED_BGR["pink"],
+        body_translucency=0.08,
+        body_shading=0.7,
+        specular=0.35,
+        dots=8,
+        dot_color="white",
+        dot_diameter_mm=5.0,
+        clamp_style="plate",
+        tube=True,
+        shadow=0.2,
+        tilt_deg=1.0,
+        noise_sigma=3.0,
+        blur_sigma_px=0.8,
+        jpeg_quality=88,
+        rotation_jitter_deg=1.5,
         known_fixed_direction=True,
     ),
-    # (B) the same rig with a translucent (clear) silicone actuator: the body over the plate is faint
+    # (B) the same rig with a translucent (clear) silicone actuator: the body over the plate is
+    # faint
     "grey_dots_clear": SceneParams(
-        background="textured", table_bgr=NAMED_BGR["grey"], texture_strength=3.0, lighting_gradient=0.25,
-        vignetting=0.25, marker_line=False, target="body", shape="distal", straight_base_fraction=0.3,
-        body_width_mm=18.0, body_bgr=NAMED_BGR["clear"], body_translucency=0.7, body_shading=0.7,
-        specular=0.5, dots=8, dot_color="white", dot_diameter_mm=5.0, clamp_style="plate", tube=True,
-        shadow=0.15, tilt_deg=1.0, noise_sigma=3.0, blur_sigma_px=0.8, jpeg_quality=88, rotation_jitter_deg=1.5,
-        known_fixed_direction=True, background_photo=True,
+        background="textured",
+        table_bgr=NAMED_BGR["grey"],
+        texture_strength=3.0,
+        lighting_gradient=0.25,
+        vignetting=0.25,
+        marker_line=False,
+        target="body",
+        shape="distal",
+        straight_base_fraction=0.3,
+        body_width_mm=18.0,
+        body_bgr=NAMED_BGR["clear"],
+        body_translucency=0.7,
+        body_shading=0.7,
+        specular=0.5,
+        dots=8,
+        dot_color="white",
+        dot_diameter_mm=5.0,
+        clamp_style="plate",
+        tube=True,
+        shadow=0.15,
+        tilt_deg=1.0,
+        noise_sigma=3.0,
+        blur_sigma_px=0.8,
+        jpeg_quality=88,
+        rotation_jitter_deg=1.5,
+        known_fixed_direction=True,
+        background_photo=True,
     ),
     # (B) a translucent ribbed silicone actuator over a black backdrop, with a printed tip cap
     "dark_translucent": SceneParams(
-        background="textured", table_bgr=NAMED_BGR["black"], texture_strength=2.0, lighting_gradient=0.15,
-        vignetting=0.3, marker_line=False, target="body", body_width_mm=14.0, body_bgr=NAMED_BGR["white"],
-        body_translucency=0.6, body_shading=0.8, texture="ribs", texture_pitch_mm=6.0, texture_contrast=0.4,
-        specular=0.7, tip_cap_mm=8.0, tip_cap_bgr=(190, 192, 196), clamp_style="block", tube=True, shadow=0.0,
-        tilt_deg=1.0, noise_sigma=3.5, blur_sigma_px=0.8, jpeg_quality=90, rotation_jitter_deg=1.5,
+        background="textured",
+        table_bgr=NAMED_BGR["black"],
+        texture_strength=2.0,
+        lighting_gradient=0.15,
+        vignetting=0.3,
+        marker_line=False,
+        target="body",
+        body_width_mm=14.0,
+        body_bgr=NAMED_BGR["white"],
+        body_translucency=0.6,
+        body_shading=0.8,
+        texture="ribs",
+        texture_pitch_mm=6.0,
+        texture_contrast=0.4,
+        specular=0.7,
+        tip_cap_mm=8.0,
+        tip_cap_bgr=(190, 192, 196),
+        clamp_style="block",
+        tube=True,
+        shadow=0.0,
+        tilt_deg=1.0,
+        noise_sigma=3.5,
+        blur_sigma_px=0.8,
+        jpeg_quality=90,
+        rotation_jitter_deg=1.5,
     ),
 }
 
@@ -388,7 +555,9 @@ def scene_from(preset: str | SceneParams = "lab", **overrides: Any) -> ScenePara
         base = preset
     else:
         if preset not in SCENE_PRESETS:
-            raise UserInputError(f"scene preset {preset!r} is unknown; use one of {sorted(SCENE_PRESETS)}")
+            raise UserInputError(
+                f"scene preset {preset!r} is unknown; use one of {sorted(SCENE_PRESETS)}"
+            )
         base = SCENE_PRESETS[preset]
     unknown = sorted(set(overrides) - set(_FIELD_TYPES))
     if unknown:

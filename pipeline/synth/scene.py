@@ -70,8 +70,15 @@ _GLARE_OPACITY = 0.93
 #: centre of curvature is refused (its outline would fold over itself)
 FOLD_LIMIT = 0.92
 
-__all__ = ["RenderedImage", "child_seed", "encode_jpeg", "render_actuator", "render_background", "render_curve",
-           "world_extent_mm"]
+__all__ = [
+    "RenderedImage",
+    "child_seed",
+    "encode_jpeg",
+    "render_actuator",
+    "render_background",
+    "render_curve",
+    "world_extent_mm",
+]
 
 
 def encode_jpeg(image: NDArray[np.uint8], quality: int) -> bytes:
@@ -151,20 +158,34 @@ def _chunks(points: NDArray[np.float64], max_turn_deg: float = 90.0) -> list[sli
     bins = np.floor((ang - ang[0]) / np.radians(max_turn_deg)).astype(int)
     starts = np.flatnonzero(np.diff(bins)) + 1
     edges = [0, *starts.tolist(), len(points) - 1]
-    return [slice(max(a - 1, 0), min(b + 2, len(points))) for a, b in itertools.pairwise(edges) if b > a]
+    return [
+        slice(max(a - 1, 0), min(b + 2, len(points))) for a, b in itertools.pairwise(edges) if b > a
+    ]
 
 
-def _band_polygons(inner: NDArray[np.float64], outer: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+def _band_polygons(
+    inner: NDArray[np.float64], outer: NDArray[np.float64]
+) -> list[NDArray[np.float64]]:
     return [np.vstack([inner[c], outer[c][::-1]]) for c in _chunks((inner + outer) / 2)]
 
 
-def _fill(mask: NDArray[np.uint8], polys: list[NDArray[np.float64]], offset: NDArray[np.float64], factor: int = 1) -> None:
-    scaled = [np.round(((p - offset) * factor + (factor - 1) / 2) * (1 << SHIFT)).astype(np.int32) for p in polys]
+def _fill(
+    mask: NDArray[np.uint8],
+    polys: list[NDArray[np.float64]],
+    offset: NDArray[np.float64],
+    factor: int = 1,
+) -> None:
+    scaled = [
+        np.round(((p - offset) * factor + (factor - 1) / 2) * (1 << SHIFT)).astype(np.int32)
+        for p in polys
+    ]
     for poly in scaled:
         cv2.fillPoly(mask, [poly], 255, cv2.LINE_AA, SHIFT)
 
 
-def _roi(polys: list[NDArray[np.float64]], margin: float, width: int, height: int) -> tuple[int, int, int, int] | None:
+def _roi(
+    polys: list[NDArray[np.float64]], margin: float, width: int, height: int
+) -> tuple[int, int, int, int] | None:
     allp = np.vstack(polys)
     x0 = max(int(np.floor(allp[:, 0].min() - margin)), 0)
     y0 = max(int(np.floor(allp[:, 1].min() - margin)), 0)
@@ -175,8 +196,11 @@ def _roi(polys: list[NDArray[np.float64]], margin: float, width: int, height: in
     return x0, y0, x1, y1
 
 
-def world_extent_mm(points_mm: NDArray[np.float64], body_width_mm: float, tip_mm: float = 0.0) -> NDArray[np.float64]:
-    """World points bounding the actuator (line, body, its end and tip cap, clamp block) for framing.
+def world_extent_mm(
+    points_mm: NDArray[np.float64], body_width_mm: float, tip_mm: float = 0.0
+) -> NDArray[np.float64]:
+    """World points bounding the actuator (line, body, its end and tip cap, clamp block) for
+    framing.
 
     A clamp plate is left out: it is meant to reach the border.
     """
@@ -187,7 +211,14 @@ def world_extent_mm(points_mm: NDArray[np.float64], body_width_mm: float, tip_mm
         t = points_mm[-1] - points_mm[-2]
         t = t / np.hypot(*t)
         reach, over_mm = END_CAP_MM + tip_mm, CAP_OVERHANG * body_width_mm + 0.5
-        parts.append(np.array([points_mm[-1] + t * reach - nrm[-1] * over_mm, body[-1] + t * reach + nrm[-1] * over_mm]))
+        parts.append(
+            np.array(
+                [
+                    points_mm[-1] + t * reach - nrm[-1] * over_mm,
+                    body[-1] + t * reach + nrm[-1] * over_mm,
+                ]
+            )
+        )
     return np.vstack(parts)
 
 
@@ -199,7 +230,9 @@ def _fixed_direction_deg(camera: Camera, curve_mm: NDArray[np.float64]) -> float
     return float(np.degrees(np.arctan2(-d[1], d[0])))
 
 
-def check_body_fits(points_mm: NDArray[np.float64], scene: SceneParams, body_width_mm: float | None = None) -> None:
+def check_body_fits(
+    points_mm: NDArray[np.float64], scene: SceneParams, body_width_mm: float | None = None
+) -> None:
     """Refuse a body whose outline would fold over itself on the inside of a bend.
 
     The body lies on the left of the layer (ccw side), so where the layer turns ccw with
@@ -219,9 +252,12 @@ def check_body_fits(points_mm: NDArray[np.float64], scene: SceneParams, body_wid
     k_max = float(k.max()) if len(k) else 0.0
     if k_max * width >= FOLD_LIMIT:
         raise UserInputError(
-            f"the body would fold over itself: curvature {k_max:.4f} /mm (radius {1 / k_max:.1f} mm) on the side of a "
-            f"{width:g} mm wide body; use a smaller |psi|, a narrower body (body_width_mm), a longer l0 or a "
-            "gentler shape (straight_base_fraction, chamber_bend)")
+            f"the body would fold over itself: curvature {k_max:.4f} /mm (radius {1 / k_max:.1f} "
+            "mm) on the side of a "
+            f"{width:g} mm wide body; use a smaller |psi|, a narrower body (body_width_mm), a "
+            "longer l0 or a "
+            "gentler shape (straight_base_fraction, chamber_bend)"
+        )
 
 
 def render_curve(
@@ -268,7 +304,9 @@ def render_curve(
     """
     pts = np.asarray(points_mm, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.isfinite(pts).all():
-        raise UserInputError("points_mm must be a finite (N, 2) array of centreline points with N >= 3")
+        raise UserInputError(
+            "points_mm must be a finite (N, 2) array of centreline points with N >= 3"
+        )
     body_w = scene.body_width_mm if body_width_mm is None else float(body_width_mm)
     if backdrop is None:
         camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px,
@@ -276,11 +314,17 @@ def render_curve(
         backdrop = make_backdrop(scene, camera, seed=child_seed(seed, 0), keepout_mm=[pts])
     camera = backdrop.camera
     rng = np.random.default_rng(child_seed(seed, 1))
-    return _compose(pts, scene, camera, backdrop, body_w, rng)
+    return compose_photo(pts, scene, camera, backdrop, body_w, rng)
 
 
-def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
-             body_w: float, rng: np.random.Generator) -> RenderedImage:
+def compose_photo(
+    pts_mm: NDArray[np.float64],
+    scene: SceneParams,
+    camera: Camera,
+    backdrop: Backdrop,
+    body_w: float,
+    rng: np.random.Generator,
+) -> RenderedImage:
     """One photo of the actuator whose layer is ``pts_mm`` over ``backdrop``, seen by ``camera``."""
     if scene.target == "body":
         check_body_fits(pts_mm, scene, body_w)
@@ -313,20 +357,33 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
         opacity = 1.0 - scene.body_translucency
         a_body = body.astype(np.float32) * (opacity / 255.0)
         edge = np.zeros(shape, np.uint8)
-        cv2.polylines(edge, [np.round((body_outer_px - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
-                      max(1, round(0.6 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)
+        cv2.polylines(
+            edge,
+            [np.round((body_outer_px - off) * (1 << SHIFT)).astype(np.int32)],
+            False,
+            255,
+            max(1, round(0.6 / scene.mm_per_px)),
+            cv2.LINE_AA,
+            SHIFT,
+        )
         a_body = np.maximum(a_body, edge.astype(np.float32) * (min(1.0, opacity + 0.3) / 255.0))
         f = LINE_SUPERSAMPLING
         big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
         _fill(big, line_polys, off, f)
         ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
-        a_ink = ink.astype(np.float32) * ((scene.line_contrast if scene.marker_line else 0.0) / 255.0)
+        a_ink = ink.astype(np.float32) * (
+            (scene.line_contrast if scene.marker_line else 0.0) / 255.0
+        )
         a_glare = _glare(centre_px, scene, rng, shape, off)
         if blur > 0:
             a_body = cv2.GaussianBlur(a_body, (0, 0), blur)
             a_ink = cv2.GaussianBlur(a_ink, (0, 0), blur)
         out = image[y0:y1, x0:x1]
-        for colour, alpha in ((scene.body_bgr, a_body), (LINE_INK_BGR[scene.line_color], a_ink), (GLARE_BGR, a_glare)):
+        for colour, alpha in (
+            (scene.body_bgr, a_body),
+            (LINE_INK_BGR[scene.line_color], a_ink),
+            (GLARE_BGR, a_glare),
+        ):
             if alpha is not None:
                 out = cv2.blendLinear(out, backdrop.lit(colour, roi), 1.0 - alpha, alpha)
         image[y0:y1, x0:x1] = out
@@ -336,8 +393,13 @@ def _compose(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, ba
     return _result(image, scene, camera, pts_mm, nrm_mm, body_w, centre_px)
 
 
-def _glare(centre_px: NDArray[np.float64], scene: SceneParams, rng: np.random.Generator, shape: tuple[int, int],
-           off: NDArray[np.float64]) -> NDArray[np.float32] | None:
+def _glare(
+    centre_px: NDArray[np.float64],
+    scene: SceneParams,
+    rng: np.random.Generator,
+    shape: tuple[int, int],
+    off: NDArray[np.float64],
+) -> NDArray[np.float32] | None:
     """Opacity of a glare spot hiding ``occluded_fraction`` of the layer (None without one)."""
     if scene.occluded_fraction <= 0:
         return None
@@ -347,13 +409,23 @@ def _glare(centre_px: NDArray[np.float64], scene: SceneParams, rng: np.random.Ge
     glare = np.zeros(shape, np.uint8)
     cv2.polylines(glare, [np.round((seg - off) * (1 << SHIFT)).astype(np.int32)], False, 255,
                   round(2.5 * scene.line_width_px + 4), cv2.LINE_AA, SHIFT)
-    return cv2.GaussianBlur(glare, (0, 0), 1.0 + scene.line_width_px / 4).astype(np.float32) * (_GLARE_OPACITY / 255.0)
+    return cv2.GaussianBlur(glare, (0, 0), 1.0 + scene.line_width_px / 4).astype(np.float32) * (
+        _GLARE_OPACITY / 255.0
+    )
 
 
-def _result(image: NDArray[np.uint8], scene: SceneParams, camera: Camera, pts_mm: NDArray[np.float64],
-            nrm_mm: NDArray[np.float64], body_w: float, layer_px: NDArray[np.float64],
-            dots_px: NDArray[np.float64] | None = None) -> RenderedImage:
-    """The photo with its truth: the target's exact centre line through the camera and its turning."""
+def _result(
+    image: NDArray[np.uint8],
+    scene: SceneParams,
+    camera: Camera,
+    pts_mm: NDArray[np.float64],
+    nrm_mm: NDArray[np.float64],
+    body_w: float,
+    layer_px: NDArray[np.float64],
+    dots_px: NDArray[np.float64] | None = None,
+) -> RenderedImage:
+    """The photo with its truth: the target's exact centre line through the camera and its
+    turning."""
     h, w = scene.height, scene.width
     curve_mm = pts_mm if scene.target == "line" else pts_mm + nrm_mm * (body_w / 2)
     curve = layer_px if scene.target == "line" else camera.to_px(curve_mm)
@@ -372,8 +444,14 @@ def _result(image: NDArray[np.uint8], scene: SceneParams, camera: Camera, pts_mm
     )
 
 
-def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camera, backdrop: Backdrop,
-                  body_w: float, rng: np.random.Generator) -> RenderedImage:
+def _compose_body(
+    pts_mm: NDArray[np.float64],
+    scene: SceneParams,
+    camera: Camera,
+    backdrop: Backdrop,
+    body_w: float,
+    rng: np.random.Generator,
+) -> RenderedImage:
     """One photo of a rounded / textured / dotted body (see :mod:`pipeline.synth.body`)."""
     h, w = scene.height, scene.width
     mpp = scene.mm_per_px
@@ -402,8 +480,14 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
     if scene.tip_cap_mm > 0:
         base = c_ax[-1]
         half_cap = hw + CAP_OVERHANG * body_w + 0.5
-        cap_mm = np.array([base - nrm_mm[-1] * half_cap, base - nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm,
-                           base + nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm, base + nrm_mm[-1] * half_cap])
+        cap_mm = np.array(
+            [
+                base - nrm_mm[-1] * half_cap,
+                base - nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm,
+                base + nrm_mm[-1] * half_cap + tang * scene.tip_cap_mm,
+                base + nrm_mm[-1] * half_cap,
+            ]
+        )
         cap_px = camera.to_px(cap_mm)
         polys.append(cap_px)
     dots_px = np.zeros((0, 2))
@@ -429,7 +513,9 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
         gain = gain_full[y0:y1, x0:x1]
         cover = np.zeros(shape, np.uint8)
         _fill(cover, body_polys, off)
-        prem, alpha = paint_body(scene, style, frame, cover.astype(np.float32) / 255.0, gain, off, l0)
+        prem, alpha = paint_body(
+            scene, style, frame, cover.astype(np.float32) / 255.0, gain, off, l0
+        )
         if cap_px is not None:
             cm = np.zeros(shape, np.uint8)
             _fill(cm, [cap_px], off)
@@ -438,15 +524,23 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
         if len(dots_px):
             radius = scene.dot_diameter_mm / 2 / mpp
             colour, a, ring = paint_dots(scene, dots_px, radius, shape, off, gain, SHIFT)
-            prem, alpha = over(prem, alpha, np.zeros_like(colour) + np.float32(40) * gain[..., None], ring)
+            prem, alpha = over(
+                prem, alpha, np.zeros_like(colour) + np.float32(40) * gain[..., None], ring
+            )
             prem, alpha = over(prem, alpha, colour, a)
         if line_polys:
             f = LINE_SUPERSAMPLING
             big = np.zeros((shape[0] * f, shape[1] * f), np.uint8)
             _fill(big, line_polys, off, f)
-            a_ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32) * (
-                scene.line_contrast / 255.0)
-            prem, alpha = over(prem, alpha, backdrop.lit(LINE_INK_BGR[scene.line_color], roi).astype(np.float32), a_ink)
+            a_ink = cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(
+                np.float32
+            ) * (scene.line_contrast / 255.0)
+            prem, alpha = over(
+                prem,
+                alpha,
+                backdrop.lit(LINE_INK_BGR[scene.line_color], roi).astype(np.float32),
+                a_ink,
+            )
         out = image[y0:y1, x0:x1].astype(np.float32)
         if scene.shadow > 0:
             out *= (1.0 - scene.shadow * shadow_of(alpha, style, mpp))[..., None]
@@ -464,8 +558,11 @@ def _compose_body(pts_mm: NDArray[np.float64], scene: SceneParams, camera: Camer
     return _result(image, scene, camera, pts_mm, nrm_mm, body_w, layer_px, dots_px)
 
 
-def render_background(backdrop: Backdrop, scene: SceneParams, *, seed: int | np.random.SeedSequence) -> NDArray[np.uint8]:
-    """The empty scene: the backdrop (table, light, clamp, tube) with its own sensor noise, no actuator.
+def render_background(
+    backdrop: Backdrop, scene: SceneParams, *, seed: int | np.random.SeedSequence
+) -> NDArray[np.uint8]:
+    """The empty scene: the backdrop (table, light, clamp, tube) with its own sensor noise, no
+    actuator.
 
     Same camera, lighting and clamp as the photos rendered on ``backdrop``; the noise window is
     drawn from ``seed`` (a real background photo has its own noise too).
@@ -473,7 +570,11 @@ def render_background(backdrop: Backdrop, scene: SceneParams, *, seed: int | np.
     image = backdrop.image.copy()
     if backdrop.noise_pool is not None:
         dy, dx = np.random.default_rng(seed).integers(0, NOISE_PAD, size=2)
-        image = cv2.add(image, backdrop.noise_pool[dy:dy + scene.height, dx:dx + scene.width], dtype=cv2.CV_8U)
+        image = cv2.add(
+            image,
+            backdrop.noise_pool[dy : dy + scene.height, dx : dx + scene.width],
+            dtype=cv2.CV_8U,
+        )
     return image
 
 

@@ -46,7 +46,7 @@ import pandas as pd
 from scipy.signal import lfilter
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes
+from pipeline.fileio import write_table
 from pipeline.photoset import TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
@@ -90,12 +90,16 @@ class Dynamics:
 
 
 def toy_actuator(psi0_deg: float = 210.0, kpa_per_deg: float = 1 / 2.0) -> TrialActuator:
-    """A linear actuator (psi = psi0 - P / kpa_per_deg) with 10 % hysteresis, for examples and tests."""
+    """A linear actuator (psi = psi0 - P / kpa_per_deg) with 10 % hysteresis, for examples and
+    tests."""
+
     def fn(material: str, p: Any, branch: str = "loading") -> np.ndarray:
         return psi0_deg - np.asarray(p, float) / kpa_per_deg
 
     curve = loading_curve("toy", max_kpa=600.0, psi_fn=fn)
-    return TrialActuator("toy", curve, psi0_deg, 1.0, ActuatorBehaviour(hysteresis=0.1, photo_sd_deg=0.0))
+    return TrialActuator(
+        "toy", curve, psi0_deg, 1.0, ActuatorBehaviour(hysteresis=0.1, photo_sd_deg=0.0)
+    )
 
 
 def _lag(x: np.ndarray, tau_s: float, dt_s: float) -> np.ndarray:
@@ -121,8 +125,15 @@ def static_psi_deg(trial: TrialActuator, pressure_kpa: np.ndarray) -> tuple[np.n
     return trial.psi_loading_deg(equivalent), loading
 
 
-def simulate(profile: PressureProfile, trial: TrialActuator, dynamics: Dynamics, *, start_s: float, end_s: float,
-             dt_s: float = SIM_DT_S) -> pd.DataFrame:
+def simulate(
+    profile: PressureProfile,
+    trial: TrialActuator,
+    dynamics: Dynamics,
+    *,
+    start_s: float,
+    end_s: float,
+    dt_s: float = SIM_DT_S,
+) -> pd.DataFrame:
     """The virtual rig on a fine time grid (log clock): setpoint, pressure, static and lagged psi.
 
     Parameters
@@ -149,20 +160,34 @@ def simulate(profile: PressureProfile, trial: TrialActuator, dynamics: Dynamics,
     pressure = _lag(setpoint, dynamics.tau_pressure_s, dt_s)
     psi_static, loading = static_psi_deg(trial, pressure)
     if not np.isfinite(psi_static).all():
-        raise UserInputError(f"max_kpa {profile.max_kpa:g} is beyond what the model describes for {trial.material} "
-                             f"(up to {trial.curve.limit_kpa * trial.stiffness:.0f} kPa for this actuator); lower it")
-    return pd.DataFrame({"time_s": t, "setpoint_kpa": setpoint, "pressure_kpa": pressure,
-                         "psi_static_deg": psi_static, "psi_deg": _lag(psi_static, dynamics.tau_psi_s, dt_s),
-                         "loading": loading})
+        raise UserInputError(
+            f"max_kpa {profile.max_kpa:g} is beyond what the model describes for {trial.material} "
+            f"(up to {trial.curve.limit_kpa * trial.stiffness:.0f} kPa for this actuator); lower it"
+        )
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "setpoint_kpa": setpoint,
+            "pressure_kpa": pressure,
+            "psi_static_deg": psi_static,
+            "psi_deg": _lag(psi_static, dynamics.tau_psi_s, dt_s),
+            "loading": loading,
+        }
+    )
 
 
-def fit_scene(scene: SceneParams, l0_mm: float, psi_range: tuple[float, float]) -> tuple[SceneParams, float]:
-    """Zoom out (as the experimenter would) until every shape of the recording fits; the clamp direction."""
+def fit_scene(
+    scene: SceneParams, l0_mm: float, psi_range: tuple[float, float]
+) -> tuple[SceneParams, float]:
+    """Zoom out (as the experimenter would) until every shape of the recording fits; the clamp
+    direction."""
     curves = [world_extent_mm(centreline_mm(float(p), l0_mm, n=241), scene.body_width_mm)
               for p in np.linspace(psi_range[0], psi_range[1], 17)]
     rotation, _, need = choose_layout(curves, scene)
     if need > 1.0:
-        scene = dataclasses.replace(scene, mm_per_px=float(np.ceil(scene.mm_per_px * need * 1000) / 1000))
+        scene = dataclasses.replace(
+            scene, mm_per_px=float(np.ceil(scene.mm_per_px * need * 1000) / 1000)
+        )
         rotation, _, need = choose_layout(curves, scene)
     return scene, rotation
 
@@ -189,7 +214,8 @@ def render_video(
     trial_actuator: TrialActuator | None = None,
     progress: bool | None = None,
 ) -> pd.DataFrame:
-    """Render a video photo set of one actuator going through ``profile`` (see the module docstring).
+    """Render a video photo set of one actuator going through ``profile`` (see the module
+    docstring).
 
     Parameters
     ----------
@@ -231,7 +257,13 @@ def render_video(
     """
     from tqdm import tqdm
 
-    if not (fps > 0 and log_hz > 0 and rest_s >= 0 and math.isfinite(clock_offset_s) and clock_offset_s >= 0):
+    if not (
+        fps > 0
+        and log_hz > 0
+        and rest_s >= 0
+        and math.isfinite(clock_offset_s)
+        and clock_offset_s >= 0
+    ):
         raise UserInputError("fps and log_hz must be positive, rest_s and clock_offset_s >= 0")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -241,9 +273,13 @@ def render_video(
     if trial_actuator is None:
         beh = behaviour or behaviour_for(material)
         curve = loading_curve(material, max_kpa=profile.max_kpa * 1.6, psi_fn=psi_fn)
-        act = draw_actuator(material, curve, beh, np.random.default_rng(child_seed(seed, mk, _ACTUATOR)))
-        trial_actuator = draw_trial(material, curve, beh, act, np.random.default_rng(child_seed(seed, mk, _TRIAL)))
-    n_frames = int(round((profile.duration_s + 2 * rest_s) * fps))
+        act = draw_actuator(
+            material, curve, beh, np.random.default_rng(child_seed(seed, mk, _ACTUATOR))
+        )
+        trial_actuator = draw_trial(
+            material, curve, beh, act, np.random.default_rng(child_seed(seed, mk, _TRIAL))
+        )
+    n_frames = round((profile.duration_s + 2 * rest_s) * fps)
     video_end_s = clock_offset_s + (n_frames - 1) / fps
     log_end_s = video_end_s + 0.5
     sim = simulate(profile, trial_actuator, dyn, start_s=clock_offset_s + rest_s, end_s=log_end_s)
@@ -251,7 +287,9 @@ def render_video(
     psi = np.interp(frame_t, sim["time_s"], sim["psi_deg"])
     sc = scene_from(scene, **dict(scene_overrides or {}))
     sc, rotation = fit_scene(sc, l0, (float(psi.min()), float(psi.max())))
-    extent = np.vstack([centreline_mm(float(p), l0, n=241) for p in np.linspace(psi.min(), psi.max(), 9)])
+    extent = np.vstack(
+        [centreline_mm(float(p), l0, n=241) for p in np.linspace(psi.min(), psi.max(), 9)]
+    )
     camera = make_camera(sc, rotation_deg=rotation, extent_mm=extent)
     backdrop = make_backdrop(sc, camera, seed=child_seed(seed, mk, _TABLE), keepout_mm=[extent])
     name = f"{material}_{actuator}_t{trial}_{profile.kind}{CODECS.get(codec, ('', ''))[1]}"
@@ -259,8 +297,13 @@ def render_video(
     writer = open_writer(tmp, codec, fps, (sc.width, sc.height))
     seen, fixed_end = np.empty(n_frames), (math.nan, math.nan)
     try:
-        for k in tqdm(range(n_frames), desc=f"render {name}", unit="frame", disable=None if progress is None else not progress,
-                      leave=False):
+        for k in tqdm(
+            range(n_frames),
+            desc=f"render {name}",
+            unit="frame",
+            disable=None if progress is None else not progress,
+            leave=False,
+        ):
             r = render_actuator(float(psi[k]), l0, sc, seed=child_seed(seed, mk, _FRAME, k),
                                 bulge=float(trial_actuator.bulge(psi[k])), backdrop=backdrop)
             seen[k] = r.psi_image_deg
@@ -270,27 +313,74 @@ def render_video(
         writer.release()
     os.replace(tmp, out / name)
     log_t = np.round(np.arange(0.0, log_end_s + 1e-9, 1.0 / log_hz), 6)
-    noise = np.random.default_rng(child_seed(seed, mk, _LOG)).normal(0.0, dyn.monitor_noise_kpa, len(log_t))
-    log = pd.DataFrame({"time_s": log_t,
-                        "pressure_kpa": np.interp(log_t, sim["time_s"], sim["setpoint_kpa"]),
-                        "measured_kpa": np.interp(log_t, sim["time_s"], sim["pressure_kpa"]) + noise})
+    noise = np.random.default_rng(child_seed(seed, mk, _LOG)).normal(
+        0.0, dyn.monitor_noise_kpa, len(log_t)
+    )
+    log = pd.DataFrame(
+        {
+            "time_s": log_t,
+            "pressure_kpa": np.interp(log_t, sim["time_s"], sim["setpoint_kpa"]),
+            "measured_kpa": np.interp(log_t, sim["time_s"], sim["pressure_kpa"]) + noise,
+        }
+    )
     log_name = f"{Path(name).stem}_pressure.csv"
-    atomic_write_bytes(out / log_name, log.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
-    write_manifest(out, pd.DataFrame([{"video": name, "pressure_log": log_name, "clock_offset_s": f"{clock_offset_s:g}",
-                                       "material": material, "actuator": actuator, "trial": trial}]))
-    write_settings(out, {"l0_mm": l0, "mm_per_px": float(sc.mm_per_px), "line_color": sc.line_color,
-                         "fixed_end": [round(fixed_end[0], 2), round(fixed_end[1], 2)], "positive_turn": "ccw"})
-    truth = pd.DataFrame({
-        "image": name, "frame": np.arange(n_frames), "time_s": frame_t, "psi_deg": psi, "psi_image_deg": seen,
-        "psi_static_deg": np.interp(frame_t, sim["time_s"], sim["psi_static_deg"]),
-        "pressure_true_kpa": np.interp(frame_t, sim["time_s"], sim["pressure_kpa"]),
-        "setpoint_kpa": np.interp(frame_t, sim["time_s"], sim["setpoint_kpa"]),
-        "loading": np.interp(frame_t, sim["time_s"], sim["loading"].astype(float)) > 0.5,
-    }).assign(material=material, actuator=actuator, trial=trial, fps=fps, codec=codec, profile=profile.kind,
-              tau_pressure_s=dyn.tau_pressure_s, tau_psi_s=dyn.tau_psi_s, psi0_deg=trial_actuator.psi0_deg,
-              stiffness=trial_actuator.stiffness, hysteresis=trial_actuator.behaviour.hysteresis, l0_mm=l0,
-              mm_per_px=sc.mm_per_px, width=sc.width, height=sc.height, seed=seed)
-    atomic_write_bytes(out / TRUTH, truth.to_csv(index=False, lineterminator="\n", float_format="%.6g").encode())
+    write_table(log, out / log_name)
+    write_manifest(
+        out,
+        pd.DataFrame(
+            [
+                {
+                    "video": name,
+                    "pressure_log": log_name,
+                    "clock_offset_s": f"{clock_offset_s:g}",
+                    "material": material,
+                    "actuator": actuator,
+                    "trial": trial,
+                }
+            ]
+        ),
+    )
+    write_settings(
+        out,
+        {
+            "l0_mm": l0,
+            "mm_per_px": float(sc.mm_per_px),
+            "line_color": sc.line_color,
+            "fixed_end": [round(fixed_end[0], 2), round(fixed_end[1], 2)],
+            "positive_turn": "ccw",
+        },
+    )
+    truth = pd.DataFrame(
+        {
+            "image": name,
+            "frame": np.arange(n_frames),
+            "time_s": frame_t,
+            "psi_deg": psi,
+            "psi_image_deg": seen,
+            "psi_static_deg": np.interp(frame_t, sim["time_s"], sim["psi_static_deg"]),
+            "pressure_true_kpa": np.interp(frame_t, sim["time_s"], sim["pressure_kpa"]),
+            "setpoint_kpa": np.interp(frame_t, sim["time_s"], sim["setpoint_kpa"]),
+            "loading": np.interp(frame_t, sim["time_s"], sim["loading"].astype(float)) > 0.5,
+        }
+    ).assign(
+        material=material,
+        actuator=actuator,
+        trial=trial,
+        fps=fps,
+        codec=codec,
+        profile=profile.kind,
+        tau_pressure_s=dyn.tau_pressure_s,
+        tau_psi_s=dyn.tau_psi_s,
+        psi0_deg=trial_actuator.psi0_deg,
+        stiffness=trial_actuator.stiffness,
+        hysteresis=trial_actuator.behaviour.hysteresis,
+        l0_mm=l0,
+        mm_per_px=sc.mm_per_px,
+        width=sc.width,
+        height=sc.height,
+        seed=seed,
+    )
+    write_table(truth, out / TRUTH)
     return truth
 
 
@@ -326,6 +416,8 @@ class LiveActuator:
         if self._t is None or self.tau_psi_s <= 0:
             self._psi = static
         else:
-            self._psi = static + (self._psi - static) * math.exp(-max(t_s - self._t, 0.0) / self.tau_psi_s)
+            self._psi = static + (self._psi - static) * math.exp(
+                -max(t_s - self._t, 0.0) / self.tau_psi_s
+            )
         self._t = t_s
         return self._psi

@@ -15,5 +15,4 @@ Modules (each imports only what its job needs; the worker side imports no pandas
 ``measure``     a video photo set -> angles.csv rows (chunks, pressure per frame, failed rows)
 ``continuous``  continuous aggregation: binned loops, settling curves, step-response figures
 ``pages``       the report page of a video dataset
-``bench``       the camera-speed benchmark (``python -m pipeline.video.bench``)
 """

@@ -17,9 +17,15 @@ import cv2
 import numpy as np
 
 from pipeline.measure.settings import is_missing
-from pipeline.photoset import MANIFEST, PhotoSet, Problem, _geometry_problems
+from pipeline.photoset import MANIFEST, PhotoSet, Problem, geometry_problems
 from pipeline.video.reader import VideoInfo, probe_video, read_frames
-from pipeline.video.timeline import PressureLog, covers, read_frame_times, read_pressure_log, span_text
+from pipeline.video.timeline import (
+    PressureLog,
+    covers,
+    read_frame_times,
+    read_pressure_log,
+    span_text,
+)
 
 
 @dataclass(frozen=True)
@@ -59,7 +65,8 @@ class Clip:
         return len(self.frame_times_s) if self.frame_times_s is not None else self.info.frame_count
 
     def nominal_video_times_s(self) -> np.ndarray:
-        """Video-clock time of every expected frame before reading it (frame times, else k / fps)."""
+        """Video-clock time of every expected frame before reading it (frame times, else k /
+        fps)."""
         if self.frame_times_s is not None:
             return self.frame_times_s
         return np.arange(self.n_frames) * self.info.frame_period_s
@@ -102,7 +109,11 @@ def resolve_clips(ps: PhotoSet) -> tuple[Clip, ...]:
         row = m.iloc[i]
         video = "" if is_missing(row["video"]) else str(row["video"])
         problems: list[str] = []
-        info = probe_video(ps.image_path(video)) if video else VideoInfo("", False, problem="video name is empty")
+        info = (
+            probe_video(ps.image_path(video))
+            if video
+            else VideoInfo("", False, problem="video name is empty")
+        )
         if not info.opened:
             problems.append(info.problem)
         elif info.frame_count == 0:
@@ -117,8 +128,13 @@ def resolve_clips(ps: PhotoSet) -> tuple[Clip, ...]:
             problems += time_problems
         offset = _offset(row["clock_offset_s"]) if "clock_offset_s" in m.columns else 0.0
         if info.opened and times is None and not math.isfinite(info.fps):
-            problems.append(f"video {video} does not say its frame rate; give a frame_times file (frame, time_s)")
-        clips.append(Clip(i, int(row["manifest_line"]), video, info, log, times, offset, tuple(problems)))
+            problems.append(
+                f"video {video} does not say its frame rate; give a frame_times file (frame, "
+                "time_s)"
+            )
+        clips.append(
+            Clip(i, int(row["manifest_line"]), video, info, log, times, offset, tuple(problems))
+        )
     return tuple(clips)
 
 
@@ -129,9 +145,13 @@ def span_problem(clip: Clip) -> str:
     video_span = clip.span_s()
     if math.isnan(video_span[0]) or covers(clip.log.span_s, video_span, slack_s=1e-6):
         return ""
-    return (f"video {clip.video} spans {span_text(video_span)} on the log clock (frames 0-{clip.n_frames - 1}, "
-            f"clock_offset_s {clip.clock_offset_s:g}) but its pressure log {Path(clip.log.path).name} covers "
-            f"{span_text(clip.log.span_s)}: frames outside the log would have no pressure")
+    return (
+        f"video {clip.video} spans {span_text(video_span)} on the log clock (frames "
+        f"0-{clip.n_frames - 1}, "
+        f"clock_offset_s {clip.clock_offset_s:g}) but its pressure log {Path(clip.log.path).name} "
+        "covers "
+        f"{span_text(clip.log.span_s)}: frames outside the log would have no pressure"
+    )
 
 
 def readable_frames(info: VideoInfo) -> int:
@@ -147,7 +167,9 @@ def readable_frames(info: VideoInfo) -> int:
     return n
 
 
-def clip_problems(ps: PhotoSet, *, decode: bool = True, require_files: bool = True) -> list[Problem]:
+def clip_problems(
+    ps: PhotoSet, *, decode: bool = True, require_files: bool = True
+) -> list[Problem]:
     """Every problem of the files of a video photo set (``photoset check``), one per thing wrong.
 
     Parameters
@@ -165,24 +187,50 @@ def clip_problems(ps: PhotoSet, *, decode: bool = True, require_files: bool = Tr
         for message in clip.problems:
             if "does not exist" in message and not require_files:
                 continue
-            fix = ("copy the file into the photo-set folder or fix its name in manifest.csv" if "does not exist" in message
-                   else "fix the file named (see message)")
+            fix = (
+                "copy the file into the photo-set folder or fix its name in manifest.csv"
+                if "does not exist" in message
+                else "fix the file named (see message)"
+            )
             out.append(Problem(mpath, clip.line, message, fix))
         span = span_problem(clip)
         if span:
-            out.append(Problem(mpath, clip.line, span, "give the pressure log of the whole recording, or correct clock_offset_s"))
+            out.append(
+                Problem(
+                    mpath,
+                    clip.line,
+                    span,
+                    "give the pressure log of the whole recording, or correct clock_offset_s",
+                )
+            )
         if not clip.info.opened:
             continue
         if clip.frame_times_s is not None and len(clip.frame_times_s) != clip.info.frame_count:
-            out.append(Problem(mpath, clip.line, f"frame_times lists {len(clip.frame_times_s)} frames but video {clip.video} "
-                               f"announces {clip.info.frame_count}", "use the frame-times file written with this video",
-                               warning=len(clip.frame_times_s) < clip.info.frame_count))
+            out.append(
+                Problem(
+                    mpath,
+                    clip.line,
+                    f"frame_times lists {len(clip.frame_times_s)} frames but video {clip.video} "
+                    f"announces {clip.info.frame_count}",
+                    "use the frame-times file written with this video",
+                    warning=len(clip.frame_times_s) < clip.info.frame_count,
+                )
+            )
         if settings is not None:
-            out += _geometry_problems(mpath, clip.line, settings, (clip.info.width, clip.info.height))
+            out += geometry_problems(
+                mpath, clip.line, settings, (clip.info.width, clip.info.height)
+            )
         if decode:
             n = readable_frames(clip.info)
             if n < clip.n_frames:
-                out.append(Problem(mpath, clip.line, f"only frames 0-{n - 1} of the {clip.n_frames} of video {clip.video} can be "
-                                   "read (truncated or corrupt); the others will be failed rows",
-                                   "copy the whole file again from the camera, or accept the failed frames"))
+                out.append(
+                    Problem(
+                        mpath,
+                        clip.line,
+                        f"only frames 0-{n - 1} of the {clip.n_frames} of video {clip.video} can "
+                        "be "
+                        "read (truncated or corrupt); the others will be failed rows",
+                        "copy the whole file again from the camera, or accept the failed frames",
+                    )
+                )
     return out

@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.aggregate import is_used, measured_pressure
 from pipeline.errors import UserInputError
 from pipeline.fileio import write_table
 
@@ -69,28 +70,34 @@ FILES: tuple[str, ...] = ("loops.csv", "cycles.csv", "steps.csv", "settling.csv"
 
 
 def _frames(angles: pd.DataFrame, include_flagged: bool) -> pd.DataFrame:
-    missing = [c for c in ("frame", "time_s", "psi_deg", "status", "pressure_kpa", "direction", *RAMP_KEYS)
-               if c not in angles.columns]
+    missing = [
+        c
+        for c in ("frame", "time_s", "psi_deg", "status", "pressure_kpa", "direction", *RAMP_KEYS)
+        if c not in angles.columns
+    ]
     if missing:
-        raise UserInputError(f"angles table lacks {missing}: continuous aggregation needs the frames of a video "
-                             "photo set (measure a folder whose manifest lists videos)")
+        raise UserInputError(
+            f"angles table lacks {missing}: continuous aggregation needs the frames of a video "
+            "photo set (measure a folder whose manifest lists videos)"
+        )
     df = angles[angles["frame"].notna()].copy()
     for key in RAMP_KEYS:
         df[key] = df[key].astype(str)
     for column in ("time_s", "psi_deg", "pressure_kpa", "measured_pressure_kpa", "since_step_s"):
         if column in df.columns:
             df[column] = pd.to_numeric(df[column], errors="coerce")
-    allowed = {"ok", "flagged"} if include_flagged else {"ok"}
-    df["_used"] = df["status"].isin(allowed) & np.isfinite(df["psi_deg"])
-    df["_pressure"] = (df["measured_pressure_kpa"] if "measured_pressure_kpa" in df.columns else df["pressure_kpa"])
-    df["_pressure"] = df["_pressure"].where(np.isfinite(df["_pressure"]), df["pressure_kpa"])
+    df["_used"] = is_used(df, include_flagged) & np.isfinite(df["psi_deg"])
+    df["_pressure"] = measured_pressure(df)
     return df.sort_values([*RAMP_KEYS, "time_s"], kind="stable")
 
 
 def _legs(ramp: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
-    """Cycle number (1-based: a rise and the fall after it) and leg number of each frame of a ramp."""
+    """Cycle number (1-based: a rise and the fall after it) and leg number of each frame of a
+    ramp."""
     leg = (ramp["direction"] != ramp["direction"].shift()).cumsum().to_numpy()
-    rises = np.cumsum(((ramp["direction"] == "up") & (ramp["direction"] != ramp["direction"].shift())).to_numpy())
+    rises = np.cumsum(
+        ((ramp["direction"] == "up") & (ramp["direction"] != ramp["direction"].shift())).to_numpy()
+    )
     return np.maximum(rises, 1), leg
 
 
@@ -103,7 +110,9 @@ def _rate(time_s: np.ndarray, pressure: np.ndarray) -> float:
     return float((p.max() - p.min()) / (t[-1] - t[0]))
 
 
-def loops(angles: pd.DataFrame, *, bin_kpa: float = BIN_KPA, include_flagged: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
+def loops(
+    angles: pd.DataFrame, *, bin_kpa: float = BIN_KPA, include_flagged: bool = False
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Binned hysteresis loops and their per-cycle summary (see the module docstring).
 
     Returns
@@ -121,33 +130,76 @@ def loops(angles: pd.DataFrame, *, bin_kpa: float = BIN_KPA, include_flagged: bo
     rows, summary = [], []
     for key, ramp in df.groupby(list(RAMP_KEYS), sort=False):
         cycle, leg = _legs(ramp)
-        ramp = ramp.assign(_cycle=cycle, _leg=leg, _bin=np.floor(ramp["_pressure"].to_numpy() / bin_kpa + 0.5) * bin_kpa)
+        ramp = ramp.assign(
+            _cycle=cycle,
+            _leg=leg,
+            _bin=np.floor(ramp["_pressure"].to_numpy() / bin_kpa + 0.5) * bin_kpa,
+        )
         for (c, direction), g in ramp.groupby(["_cycle", "direction"], sort=False):
             rate = _rate(g["time_s"].to_numpy(), g["pressure_kpa"].to_numpy())
             for level, b in g.groupby("_bin", sort=True):
                 psi = b.loc[b["_used"], "psi_deg"].to_numpy(float)
-                rows.append(dict(zip(RAMP_KEYS, key), cycle=int(c), direction=direction, pressure_kpa=float(level),
-                                 psi_mean_deg=float(psi.mean()) if psi.size else math.nan,
-                                 psi_sd_deg=float(psi.std(ddof=1)) if psi.size > 1 else math.nan,
-                                 n=int(psi.size), n_excluded=int(len(b) - psi.size), rate_kpa_s=rate))
-    out = pd.DataFrame(rows, columns=[*RAMP_KEYS, "cycle", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg",
-                                      "n", "n_excluded", "rate_kpa_s"])
+                rows.append(
+                    dict(
+                        zip(RAMP_KEYS, key),
+                        cycle=int(c),
+                        direction=direction,
+                        pressure_kpa=float(level),
+                        psi_mean_deg=float(psi.mean()) if psi.size else math.nan,
+                        psi_sd_deg=float(psi.std(ddof=1)) if psi.size > 1 else math.nan,
+                        n=int(psi.size),
+                        n_excluded=int(len(b) - psi.size),
+                        rate_kpa_s=rate,
+                    )
+                )
+    out = pd.DataFrame(
+        rows,
+        columns=[
+            *RAMP_KEYS,
+            "cycle",
+            "direction",
+            "pressure_kpa",
+            "psi_mean_deg",
+            "psi_sd_deg",
+            "n",
+            "n_excluded",
+            "rate_kpa_s",
+        ],
+    )
     for key, g in out.groupby([*RAMP_KEYS, "cycle"], sort=False):
         up = g[(g["direction"] == "up") & (g["n"] > 0)].set_index("pressure_kpa")
         down = g[(g["direction"] == "down") & (g["n"] > 0)].set_index("pressure_kpa")
         common = up.index.intersection(down.index).sort_values()
         width = (up.loc[common, "psi_mean_deg"] - down.loc[common, "psi_mean_deg"]).to_numpy(float)
         big = int(np.argmax(np.abs(width))) if width.size else -1
-        summary.append(dict(zip([*RAMP_KEYS, "cycle"], key),
-                            rate_up_kpa_s=float(up["rate_kpa_s"].iloc[0]) if len(up) else math.nan,
-                            rate_down_kpa_s=float(down["rate_kpa_s"].iloc[0]) if len(down) else math.nan,
-                            width_mean_deg=float(width.mean()) if width.size else math.nan,
-                            width_max_deg=float(width[big]) if width.size else math.nan,
-                            width_max_at_kpa=float(common[big]) if width.size else math.nan,
-                            area_deg_kpa=float(np.trapezoid(width, common.to_numpy(float))) if width.size > 1 else math.nan,
-                            bins_compared=int(width.size)))
-    cycles = pd.DataFrame(summary, columns=[*RAMP_KEYS, "cycle", "rate_up_kpa_s", "rate_down_kpa_s", "width_mean_deg",
-                                            "width_max_deg", "width_max_at_kpa", "area_deg_kpa", "bins_compared"])
+        summary.append(
+            dict(
+                zip([*RAMP_KEYS, "cycle"], key),
+                rate_up_kpa_s=float(up["rate_kpa_s"].iloc[0]) if len(up) else math.nan,
+                rate_down_kpa_s=float(down["rate_kpa_s"].iloc[0]) if len(down) else math.nan,
+                width_mean_deg=float(width.mean()) if width.size else math.nan,
+                width_max_deg=float(width[big]) if width.size else math.nan,
+                width_max_at_kpa=float(common[big]) if width.size else math.nan,
+                area_deg_kpa=float(np.trapezoid(width, common.to_numpy(float)))
+                if width.size > 1
+                else math.nan,
+                bins_compared=int(width.size),
+            )
+        )
+    cycles = pd.DataFrame(
+        summary,
+        columns=[
+            *RAMP_KEYS,
+            "cycle",
+            "rate_up_kpa_s",
+            "rate_down_kpa_s",
+            "width_mean_deg",
+            "width_max_deg",
+            "width_max_at_kpa",
+            "area_deg_kpa",
+            "bins_compared",
+        ],
+    )
     return out, cycles
 
 
@@ -169,7 +221,8 @@ def noise_sd(values: np.ndarray) -> float:
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, level: float, rising: bool) -> float:
-    """First time (interpolated between frames) ``y`` reaches ``level`` going the way of the change."""
+    """First time (interpolated between frames) ``y`` reaches ``level`` going the way of the
+    change."""
     reached = (y >= level) if rising else (y <= level)
     idx = np.flatnonzero(reached)
     if not idx.size:
@@ -178,7 +231,9 @@ def _crossing(t: np.ndarray, y: np.ndarray, level: float, rising: bool) -> float
     if i == 0:
         return float(t[0])
     y0, y1 = y[i - 1], y[i]
-    return float(t[i - 1] + (t[i] - t[i - 1]) * (level - y0) / (y1 - y0)) if y1 != y0 else float(t[i])
+    return (
+        float(t[i - 1] + (t[i] - t[i - 1]) * (level - y0) / (y1 - y0)) if y1 != y0 else float(t[i])
+    )
 
 
 def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float, before_deg: float,
@@ -207,12 +262,19 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     keep = np.isfinite(y) & (t >= step_time_s)
     t, y = t[keep], y[keep]
     nan = math.nan
-    out: dict[str, float | str] = {"final": nan, "change": nan, "rise_time_s": nan, "overshoot_pct": nan,
-                                   "settling_time_s": nan, "noise_sd": nan, "note": ""}
+    out: dict[str, float | str] = {
+        "final": nan,
+        "change": nan,
+        "rise_time_s": nan,
+        "overshoot_pct": nan,
+        "settling_time_s": nan,
+        "noise_sd": nan,
+        "note": "",
+    }
     if t.size < 5 or not math.isfinite(before_deg):
         out["note"] = "too few frames around the step"
         return out
-    tail = max(3, int(round(FINAL_FRACTION * t.size)))
+    tail = max(3, round(FINAL_FRACTION * t.size))
     final = float(np.mean(y[-tail:]))
     change = final - before_deg
     sd = noise_sd(y) if noise is None else noise
@@ -225,7 +287,8 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     t90 = _crossing(t, y, before_deg + 0.9 * change, rising)
     three_sd = 3.0 * (sd if math.isfinite(sd) else 0.0)
     band = max(SETTLING_BAND * abs(change), three_sd)
-    # settled: the final window itself no longer drifts (its straight-line fit moves less than the band)
+    # settled: the final window itself no longer drifts (its straight-line fit moves less than the
+    # band)
     slope = float(np.polyfit(t[-tail:], y[-tail:], 1)[0])
     drift = abs(slope) * float(t[-1] - t[-tail])
     beyond = float(np.max((y - final) * np.sign(change)))
@@ -242,7 +305,9 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     return out
 
 
-def steps(angles: pd.DataFrame, *, include_flagged: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
+def steps(
+    angles: pd.DataFrame, *, include_flagged: bool = False
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Step-response figures per step and the settling curves (see the module docstring)."""
     df = _frames(angles, include_flagged)
     rows, curves = [], []
@@ -256,40 +321,80 @@ def steps(angles: pd.DataFrame, *, include_flagged: bool = False) -> tuple[pd.Da
             if first.empty:
                 continue
             t_step = float((first["time_s"] - first["since_step_s"]).iloc[0])
-            before_rows = used[(used["time_s"] < t_step) & (used["time_s"] >= t_step - BEFORE_WINDOW_S)]
+            before_rows = used[
+                (used["time_s"] < t_step) & (used["time_s"] >= t_step - BEFORE_WINDOW_S)
+            ]
             before = float(before_rows["psi_deg"].mean()) if len(before_rows) else math.nan
             mine = hold[hold["_used"]]
-            r = step_response(mine["time_s"].to_numpy(), mine["psi_deg"].to_numpy(), step_time_s=t_step, before_deg=before,
-                              noise=sd)
+            r = step_response(
+                mine["time_s"].to_numpy(),
+                mine["psi_deg"].to_numpy(),
+                step_time_s=t_step,
+                before_deg=before,
+                noise=sd,
+            )
             prev = ramp[ramp["time_s"] < t_step]
-            row = dict(zip(RAMP_KEYS, key), step=int(k), time_s=t_step,
-                       from_kpa=float(prev["pressure_kpa"].iloc[-1]) if len(prev) else math.nan,
-                       to_kpa=float(hold["pressure_kpa"].median()), direction=str(hold["direction"].iloc[-1]),
-                       hold_s=float(hold["time_s"].iloc[-1] - t_step), psi_before_deg=before, psi_final_deg=r["final"],
-                       change_deg=r["change"], rise_time_s=r["rise_time_s"], overshoot_pct=r["overshoot_pct"],
-                       settling_time_s=r["settling_time_s"], noise_sd_deg=r["noise_sd"], n_frames=len(mine),
-                       note=r["note"])
-            if "measured_pressure_kpa" in hold.columns and hold["measured_pressure_kpa"].notna().any():
-                p_before = prev["measured_pressure_kpa"].tail(max(1, int(BEFORE_WINDOW_S * 10))).mean()
-                rp = step_response(hold["time_s"].to_numpy(), hold["measured_pressure_kpa"].to_numpy(),
-                                   step_time_s=t_step, before_deg=float(p_before))
-                row.update(pressure_rise_time_s=rp["rise_time_s"], pressure_settling_time_s=rp["settling_time_s"])
+            row = dict(
+                zip(RAMP_KEYS, key),
+                step=int(k),
+                time_s=t_step,
+                from_kpa=float(prev["pressure_kpa"].iloc[-1]) if len(prev) else math.nan,
+                to_kpa=float(hold["pressure_kpa"].median()),
+                direction=str(hold["direction"].iloc[-1]),
+                hold_s=float(hold["time_s"].iloc[-1] - t_step),
+                psi_before_deg=before,
+                psi_final_deg=r["final"],
+                change_deg=r["change"],
+                rise_time_s=r["rise_time_s"],
+                overshoot_pct=r["overshoot_pct"],
+                settling_time_s=r["settling_time_s"],
+                noise_sd_deg=r["noise_sd"],
+                n_frames=len(mine),
+                note=r["note"],
+            )
+            if (
+                "measured_pressure_kpa" in hold.columns
+                and hold["measured_pressure_kpa"].notna().any()
+            ):
+                p_before = (
+                    prev["measured_pressure_kpa"].tail(max(1, int(BEFORE_WINDOW_S * 10))).mean()
+                )
+                rp = step_response(
+                    hold["time_s"].to_numpy(),
+                    hold["measured_pressure_kpa"].to_numpy(),
+                    step_time_s=t_step,
+                    before_deg=float(p_before),
+                )
+                row.update(
+                    pressure_rise_time_s=rp["rise_time_s"],
+                    pressure_settling_time_s=rp["settling_time_s"],
+                )
             rows.append(row)
             change = r["change"]
             if len(mine) and isinstance(change, float) and math.isfinite(change) and change != 0:
                 since = mine["time_s"].to_numpy() - t_step
                 psi = mine["psi_deg"].to_numpy(float)
-                edges = np.linspace(since.min(), since.max() + 1e-9, min(CURVE_POINTS, len(since)) + 1)
+                edges = np.linspace(
+                    since.min(), since.max() + 1e-9, min(CURVE_POINTS, len(since)) + 1
+                )
                 which = np.digitize(since, edges) - 1
                 for b in np.unique(which):
                     sel = which == b
-                    curves.append(dict(zip(RAMP_KEYS, key), step=int(k), since_step_s=float(np.median(since[sel])),
-                                       psi_deg=float(np.median(psi[sel])),
-                                       response=float((np.median(psi[sel]) - before) / change)))
+                    curves.append(
+                        dict(
+                            zip(RAMP_KEYS, key),
+                            step=int(k),
+                            since_step_s=float(np.median(since[sel])),
+                            psi_deg=float(np.median(psi[sel])),
+                            response=float((np.median(psi[sel]) - before) / change),
+                        )
+                    )
     return pd.DataFrame(rows), pd.DataFrame(curves)
 
 
-def timeline(angles: pd.DataFrame, *, include_flagged: bool = False, points: int = TIMELINE_POINTS) -> pd.DataFrame:
+def timeline(
+    angles: pd.DataFrame, *, include_flagged: bool = False, points: int = TIMELINE_POINTS
+) -> pd.DataFrame:
     """psi and pressure against time, medians of at most ``points`` equal time bins per ramp."""
     df = _frames(angles, include_flagged)
     out = []
@@ -299,8 +404,17 @@ def timeline(angles: pd.DataFrame, *, include_flagged: bool = False, points: int
             continue
         edges = np.linspace(np.nanmin(t), np.nanmax(t) + 1e-9, min(points, len(t)) + 1)
         ramp = ramp.assign(_b=np.digitize(t, edges) - 1, _psi=ramp["psi_deg"].where(ramp["_used"]))
-        agg = {"time_s": "median", "_psi": "median", "pressure_kpa": "median", "_pressure": "median"}
-        g = ramp.groupby("_b").agg(agg).rename(columns={"_psi": "psi_deg", "_pressure": "measured_pressure_kpa"})
+        agg = {
+            "time_s": "median",
+            "_psi": "median",
+            "pressure_kpa": "median",
+            "_pressure": "median",
+        }
+        g = (
+            ramp.groupby("_b")
+            .agg(agg)
+            .rename(columns={"_psi": "psi_deg", "_pressure": "measured_pressure_kpa"})
+        )
         g["n_failed"] = ramp.groupby("_b")["status"].apply(lambda s: int((s == "failed").sum()))
         for k, v in zip(RAMP_KEYS, key):
             g.insert(0, k, v)
@@ -309,13 +423,23 @@ def timeline(angles: pd.DataFrame, *, include_flagged: bool = False, points: int
     return pd.concat(out, ignore_index=True)[cols] if out else pd.DataFrame(columns=cols)
 
 
-def write_continuous(angles: pd.DataFrame, out_dir: str | os.PathLike[str], *, bin_kpa: float = BIN_KPA,
-                     include_flagged: bool = False) -> dict[str, pd.DataFrame]:
+def write_continuous(
+    angles: pd.DataFrame,
+    out_dir: str | os.PathLike[str],
+    *,
+    bin_kpa: float = BIN_KPA,
+    include_flagged: bool = False,
+) -> dict[str, pd.DataFrame]:
     """Compute every table and write them (:data:`FILES`) into ``out_dir`` atomically."""
     loop_table, cycle_table = loops(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
     step_table, curves = steps(angles, include_flagged=include_flagged)
-    tables = {"loops.csv": loop_table, "cycles.csv": cycle_table, "steps.csv": step_table, "settling.csv": curves,
-              "timeline.csv": timeline(angles, include_flagged=include_flagged)}
+    tables = {
+        "loops.csv": loop_table,
+        "cycles.csv": cycle_table,
+        "steps.csv": step_table,
+        "settling.csv": curves,
+        "timeline.csv": timeline(angles, include_flagged=include_flagged),
+    }
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     for name, table in tables.items():

@@ -38,7 +38,9 @@ def frame_overlay_name(video: str, frame: int) -> str:
     return f"{Path(video).stem}_f{int(frame):06d}.jpg"
 
 
-def chunk_ranges(n_frames: int, *, seekable: bool, jobs: int, chunk_frames: int = CHUNK_FRAMES) -> list[tuple[int, int]]:
+def chunk_ranges(
+    n_frames: int, *, seekable: bool, jobs: int, chunk_frames: int = CHUNK_FRAMES
+) -> list[tuple[int, int]]:
     """``(first, count)`` of each chunk of a video.
 
     Examples
@@ -54,20 +56,43 @@ def chunk_ranges(n_frames: int, *, seekable: bool, jobs: int, chunk_frames: int 
     return [(a, min(size, n_frames - a)) for a in range(0, n_frames, size)]
 
 
-def _tasks(ps: PhotoSet, clips: tuple[Clip, ...], method: str, jobs: int, overlays_dir: Path | None) -> list[tuple[int, FrameChunk]]:
+def _tasks(
+    ps: PhotoSet, clips: tuple[Clip, ...], method: str, jobs: int, overlays_dir: Path | None
+) -> list[tuple[int, FrameChunk]]:
     tasks = []
     for clip in clips:
         settings = ps.rows[clip.position]
         reasons = [r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r]
         reason = "; ".join(reasons)
         n = clip.n_frames
-        picks = np.unique(np.round(np.linspace(0, n - 1, min(OVERLAYS_PER_VIDEO, n))).astype(int)) if n else []
-        overlays = {int(k): str(overlays_dir / frame_overlay_name(clip.video, int(k))) for k in picks} if overlays_dir else {}
+        picks = (
+            np.unique(np.round(np.linspace(0, n - 1, min(OVERLAYS_PER_VIDEO, n))).astype(int))
+            if n
+            else []
+        )
+        overlays = (
+            {int(k): str(overlays_dir / frame_overlay_name(clip.video, int(k))) for k in picks}
+            if overlays_dir
+            else {}
+        )
         title = f"{clip.video}"
         for first, count in chunk_ranges(n, seekable=clip.info.seekable, jobs=jobs):
             mine = tuple((k, p) for k, p in overlays.items() if first <= k < first + count)
-            tasks.append((clip.position, FrameChunk(clip.info, first, count, None if reason else settings, method,
-                                                    reason, mine, title)))
+            tasks.append(
+                (
+                    clip.position,
+                    FrameChunk(
+                        clip.info,
+                        first,
+                        count,
+                        None if reason else settings,
+                        method,
+                        reason,
+                        mine,
+                        title,
+                    ),
+                )
+            )
     return tasks
 
 
@@ -76,9 +101,16 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
     if parts:
         df = pd.DataFrame({c: [v for p in parts for v in p[c]] for c in CHUNK_COLUMNS})
     else:  # unopened and no frame count: one row says why
-        reason = "; ".join(r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r) or "video holds no frame"
-        df = pd.DataFrame([{c: np.nan for c in CHUNK_COLUMNS} | {"frame": pd.NA, "method": method, "status": "failed",
-                                                                  "reason": reason}])
+        reason = (
+            "; ".join(r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r)
+            or "video holds no frame"
+        )
+        df = pd.DataFrame(
+            [
+                {c: np.nan for c in CHUNK_COLUMNS}
+                | {"frame": pd.NA, "method": method, "status": "failed", "reason": reason}
+            ]
+        )
     frames = pd.array(df["frame"], dtype="Int64")
     pts = df["pts_s"].to_numpy(float)
     time_s = clip.log_times_s(pts) if parts else np.array([np.nan])
@@ -89,13 +121,28 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
     if clip.log is not None:
         cond = frame_conditions(clip.log, time_s)
     else:
-        cond = pd.DataFrame({"pressure_kpa": np.nan, "direction": "up", "step": 0, "since_step_s": np.nan,
-                             "in_log": False}, index=range(len(df)))
+        cond = pd.DataFrame(
+            {
+                "pressure_kpa": np.nan,
+                "direction": "up",
+                "step": 0,
+                "since_step_s": np.nan,
+                "in_log": False,
+            },
+            index=range(len(df)),
+        )
     outside = ~cond.pop("in_log").to_numpy(bool) & (df["status"] != "failed").to_numpy()
     if clip.log is not None and outside.any():
         why = (f"no pressure: the frame lies outside the pressure log {Path(clip.log.path).name} "
                f"({span_text(clip.log.span_s)} on the log clock; fix the log or clock_offset_s)")
-        for column in ("psi_deg", "kappa_per_mm", "length_mm", "length_px", "residual_px", "degree"):
+        for column in (
+            "psi_deg",
+            "kappa_per_mm",
+            "length_mm",
+            "length_px",
+            "residual_px",
+            "degree",
+        ):
             df.loc[outside, column] = np.nan
         df.loc[outside, "status"] = "failed"
         df.loc[outside, "reason"] = why
@@ -105,14 +152,23 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
         df[key] = row[key]
     settings = ps.rows[clip.position]
     df["l0_mm"] = np.nan if settings is None else settings.l0_mm
-    drop = {"video", "pressure_log", "manifest_line", *VIDEO_OPTIONAL_COLUMNS, *OVERRIDE_COLUMNS, *df.columns}
+    drop = {
+        "video",
+        "pressure_log",
+        "manifest_line",
+        *VIDEO_OPTIONAL_COLUMNS,
+        *OVERRIDE_COLUMNS,
+        *df.columns,
+    }
     for column in ps.manifest.columns:
         if column not in drop:
             df[column] = row[column]
     return df
 
 
-def measure_video_set(ps: PhotoSet, *, method: str, jobs: int = 1, overlays_dir: Path | None = None) -> pd.DataFrame:
+def measure_video_set(
+    ps: PhotoSet, *, method: str, jobs: int = 1, overlays_dir: Path | None = None
+) -> pd.DataFrame:
     """Measure every frame of every video of a video photo set.
 
     Parameters
@@ -140,7 +196,13 @@ def measure_video_set(ps: PhotoSet, *, method: str, jobs: int = 1, overlays_dir:
         if span:  # measured anyway: frames outside the log become failed rows
             print(f"warning: manifest line {clip.line}: {span}", file=sys.stderr)
     tasks = _tasks(ps, clips, method, jobs, overlays_dir)
-    results = map_photos(run_chunk, [t for _, t in tasks], jobs=jobs, preload=["pipeline.video.worker"], desc="frame chunks")
+    results = map_photos(
+        run_chunk,
+        [t for _, t in tasks],
+        jobs=jobs,
+        preload=["pipeline.video.worker"],
+        desc="frame chunks",
+    )
     parts: dict[int, list[dict[str, list]]] = {clip.position: [] for clip in clips}
     for (position, _), result in zip(tasks, results):
         parts[position].append(result)

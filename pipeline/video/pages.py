@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.report.style import A4_PORTRAIT_IN, footer_fraction, text_page
+from pipeline.layout.style import A4_PORTRAIT_IN, footer_fraction, text_page
 
 #: step rows shown in the table (the rest are counted)
 MAX_TABLE_ROWS = 12
@@ -32,8 +32,11 @@ STRIP = "strip.jpg"
 STRIP_FRAMES = 6
 
 
-def write_strip(angles: pd.DataFrame, overlays_dir: Path, out_dir: Path, n: int = STRIP_FRAMES) -> Path | None:
-    """Write ``strip.jpg``: ``n`` frame overlays evenly spread over the recording (None: no overlay found)."""
+def write_strip(
+    angles: pd.DataFrame, overlays_dir: Path, out_dir: Path, n: int = STRIP_FRAMES
+) -> Path | None:
+    """Write ``strip.jpg``: ``n`` frame overlays evenly spread over the recording (None: no overlay
+    found)."""
     import cv2
 
     from pipeline.fileio import atomic_write_bytes
@@ -41,12 +44,22 @@ def write_strip(angles: pd.DataFrame, overlays_dir: Path, out_dir: Path, n: int 
     from pipeline.video.measure import frame_overlay_name
 
     frames = angles[angles["frame"].notna()].sort_values("time_s", kind="stable")
-    paths = [Path(overlays_dir) / frame_overlay_name(str(i), int(k)) for i, k in zip(frames["image"], frames["frame"])]
+    paths = [
+        Path(overlays_dir) / frame_overlay_name(str(i), int(k))
+        for i, k in zip(frames["image"], frames["frame"])
+    ]
     paths = [p for p in paths if p.is_file()]
     if not paths:
         return None
-    pick = [paths[int(i)] for i in np.unique(np.round(np.linspace(0, len(paths) - 1, min(n, len(paths)))).astype(int))]
-    ok, buf = cv2.imencode(".jpg", contact_sheet(pick, columns=len(pick), tile_width_px=320), [cv2.IMWRITE_JPEG_QUALITY, 85])
+    pick = [
+        paths[int(i)]
+        for i in np.unique(np.round(np.linspace(0, len(paths) - 1, min(n, len(paths)))).astype(int))
+    ]
+    ok, buf = cv2.imencode(
+        ".jpg",
+        contact_sheet(pick, columns=len(pick), tile_width_px=320),
+        [cv2.IMWRITE_JPEG_QUALITY, 85],
+    )
     if not ok:
         return None
     atomic_write_bytes(Path(out_dir) / STRIP, buf.tobytes())
@@ -78,26 +91,56 @@ def _fmt(value: object, digits: int = 2) -> str:
 def figures(folder: Path) -> list[Figure]:
     """One page for the video dataset whose continuous tables are in ``folder`` (none if empty)."""
     folder = Path(folder)
-    timeline, loops, cycles = _read(folder, "timeline.csv"), _read(folder, "loops.csv"), _read(folder, "cycles.csv")
+    timeline, loops, cycles = (
+        _read(folder, "timeline.csv"),
+        _read(folder, "loops.csv"),
+        _read(folder, "cycles.csv"),
+    )
     steps, settling = _read(folder, "steps.csv"), _read(folder, "settling.csv")
     if timeline.empty:
         return []
     fig = text_page(label=f"video {folder.name}")  # A4 portrait, hand-placed axes
-    fig.suptitle(f"Video dataset {folder.name}: every frame against the pressure log", x=0.06, ha="left")
-    grid = fig.add_gridspec(5, 2, height_ratios=[1.0, 1.2, 0.15, 0.9, 0.55], hspace=0.5, wspace=0.28,
-                            left=0.08, right=0.97, top=0.93, bottom=footer_fraction(A4_PORTRAIT_IN) + 0.03)
+    fig.suptitle(
+        f"Video dataset {folder.name}: every frame against the pressure log", x=0.06, ha="left"
+    )
+    grid = fig.add_gridspec(
+        5,
+        2,
+        height_ratios=[1.0, 1.2, 0.15, 0.9, 0.55],
+        hspace=0.5,
+        wspace=0.28,
+        left=0.08,
+        right=0.97,
+        top=0.93,
+        bottom=footer_fraction(A4_PORTRAIT_IN) + 0.03,
+    )
     ax_t = fig.add_subplot(grid[0, :])
     ax_p = ax_t.twinx()
     ramps = timeline.groupby(["material", "actuator", "trial"], sort=False)
     psi_floor = float(np.nanmin(timeline["psi_deg"])) if timeline["psi_deg"].notna().any() else 0.0
     for j, (_, r) in enumerate(ramps):
-        ax_t.plot(r["time_s"], r["psi_deg"], color=f"C{j}", lw=1.0, label=f"psi {_label(r.iloc[0])}")
+        ax_t.plot(
+            r["time_s"], r["psi_deg"], color=f"C{j}", lw=1.0, label=f"psi {_label(r.iloc[0])}"
+        )
         bad = r[r["n_failed"] > 0]
         ax_t.plot(bad["time_s"], np.full(len(bad), psi_floor), "x", color="C3", ms=3,
                   label="failed frames" if j == 0 and len(bad) else None)
-        ax_p.plot(r["time_s"], r["pressure_kpa"], color="0.55", lw=0.8, ls="--", label="setpoint" if j == 0 else None)
+        ax_p.plot(
+            r["time_s"],
+            r["pressure_kpa"],
+            color="0.55",
+            lw=0.8,
+            ls="--",
+            label="setpoint" if j == 0 else None,
+        )
         if r["measured_pressure_kpa"].notna().any():
-            ax_p.plot(r["time_s"], r["measured_pressure_kpa"], color="0.3", lw=0.6, label="measured" if j == 0 else None)
+            ax_p.plot(
+                r["time_s"],
+                r["measured_pressure_kpa"],
+                color="0.3",
+                lw=0.6,
+                label="measured" if j == 0 else None,
+            )
     ax_t.set_xlabel("time on the pressure log's clock (s)")
     ax_t.set_ylabel("psi (deg)")
     ax_p.set_ylabel("pressure (kPa)")
@@ -108,11 +151,20 @@ def figures(folder: Path) -> list[Figure]:
     ax_t.set_title("Every frame measured (medians of short time bins)", fontsize=9)
 
     ax_l = fig.add_subplot(grid[1, 0])
-    for j, (key, g) in enumerate(loops.groupby(["material", "actuator", "trial", "cycle"], sort=False)):
+    for j, (key, g) in enumerate(
+        loops.groupby(["material", "actuator", "trial", "cycle"], sort=False)
+    ):
         for direction, d in g.groupby("direction", sort=False):
             d = d[d["n"] > 0].sort_values("pressure_kpa")
-            ax_l.plot(d["pressure_kpa"], d["psi_mean_deg"], "-" if direction == "up" else "--", color=f"C{j}", lw=1.0,
-                      label=f"{key[0]} {key[1]} t{key[2]} c{key[3]} {'rising' if direction == 'up' else 'falling'}")
+            ax_l.plot(
+                d["pressure_kpa"],
+                d["psi_mean_deg"],
+                "-" if direction == "up" else "--",
+                color=f"C{j}",
+                lw=1.0,
+                label=f"{key[0]} {key[1]} t{key[2]} c{key[3]} "
+                      f"{'rising' if direction == 'up' else 'falling'}",
+            )
     ax_l.set_xlabel("pressure (kPa; measured when logged)")
     ax_l.set_ylabel("psi (deg)")
     ax_l.set_title("Hysteresis loops (binned by pressure)", fontsize=9)
@@ -121,18 +173,29 @@ def figures(folder: Path) -> list[Figure]:
 
     ax_s = fig.add_subplot(grid[1, 1])
     if len(settling):
-        for (key, g), j in zip(settling.groupby(["material", "actuator", "trial", "step"], sort=False), range(10**6)):
+        for (key, g), j in zip(
+            settling.groupby(["material", "actuator", "trial", "step"], sort=False), range(10**6)
+        ):
             direction = steps.loc[steps["step"] == key[3], "direction"]
             up = not len(direction) or direction.iloc[0] == "up"
-            ax_s.plot(g["since_step_s"], g["response"], color="C0" if up else "C1", lw=0.8, alpha=0.8)
+            ax_s.plot(
+                g["since_step_s"], g["response"], color="C0" if up else "C1", lw=0.8, alpha=0.8
+            )
         ax_s.axhline(1.0, color="0.5", lw=0.6)
         ax_s.plot([], [], color="C0", label="steps up")
         ax_s.plot([], [], color="C1", label="steps down")
         ax_s.legend(fontsize=6.5, loc="lower right")
         ax_s.set_title("Settling after each step", fontsize=9)
     else:
-        ax_s.text(0.5, 0.5, "no pressure steps in this recording\n(a continuous ramp)", ha="center", va="center",
-                  transform=ax_s.transAxes, fontsize=8)
+        ax_s.text(
+            0.5,
+            0.5,
+            "no pressure steps in this recording\n(a continuous ramp)",
+            ha="center",
+            va="center",
+            transform=ax_s.transAxes,
+            fontsize=8,
+        )
         ax_s.set_title("Settling after each step", fontsize=9)
     ax_s.set_xlabel("time since the step (s)")
     ax_s.set_ylabel("(psi - psi before) / change")
@@ -140,30 +203,62 @@ def figures(folder: Path) -> list[Figure]:
     ax_c = fig.add_subplot(grid[2, :])
     ax_c.axis("off")
     if len(cycles):
-        text = "; ".join(f"{_label(c)} cycle {int(c['cycle'])}: rising {_fmt(c['rate_up_kpa_s'], 1)} kPa/s, falling "
-                         f"{_fmt(c['rate_down_kpa_s'], 1)} kPa/s, loop width mean {_fmt(c['width_mean_deg'], 1)} deg "
-                         f"(largest {_fmt(c['width_max_deg'], 1)} deg at {_fmt(c['width_max_at_kpa'], 0)} kPa), area "
-                         f"{_fmt(c['area_deg_kpa'], 0)} deg kPa" for _, c in cycles.iterrows())
+        text = "; ".join(
+            f"{_label(c)} cycle {int(c['cycle'])}: rising {_fmt(c['rate_up_kpa_s'], 1)} kPa/s, "
+            "falling "
+            f"{_fmt(c['rate_down_kpa_s'], 1)} kPa/s, loop width mean "
+            f"{_fmt(c['width_mean_deg'], 1)} deg "
+            f"(largest {_fmt(c['width_max_deg'], 1)} deg at {_fmt(c['width_max_at_kpa'], 0)} kPa), "
+            "area "
+            f"{_fmt(c['area_deg_kpa'], 0)} deg kPa"
+            for _, c in cycles.iterrows()
+        )
         ax_c.text(0.0, 1.0, text, va="top", fontsize=7, wrap=True, transform=ax_c.transAxes)
 
     ax_tab = fig.add_subplot(grid[3, :])
     ax_tab.axis("off")
     if len(steps):
         shown = steps.head(MAX_TABLE_ROWS)
-        cells = [[_label(s), str(int(s["step"])), f"{_fmt(s['from_kpa'], 0)} -> {_fmt(s['to_kpa'], 0)}",
-                  _fmt(s["change_deg"], 1), _fmt(s["rise_time_s"]), _fmt(s["overshoot_pct"], 1), _fmt(s["settling_time_s"]),
-                  _fmt(s.get("pressure_rise_time_s", np.nan)), str(s["note"]) if isinstance(s["note"], str) else ""]
-                 for _, s in shown.iterrows()]
-        table = ax_tab.table(cellText=cells, colLabels=["ramp", "step", "kPa", "change (deg)", "rise (s)", "overshoot (%)",
-                                                         "settling (s)", "pressure rise (s)", "note"],
-                             colWidths=[0.11, 0.05, 0.09, 0.09, 0.07, 0.09, 0.08, 0.1, 0.32],
-                             loc="upper center", cellLoc="center")
+        cells = [
+            [
+                _label(s),
+                str(int(s["step"])),
+                f"{_fmt(s['from_kpa'], 0)} -> {_fmt(s['to_kpa'], 0)}",
+                _fmt(s["change_deg"], 1),
+                _fmt(s["rise_time_s"]),
+                _fmt(s["overshoot_pct"], 1),
+                _fmt(s["settling_time_s"]),
+                _fmt(s.get("pressure_rise_time_s", np.nan)),
+                str(s["note"]) if isinstance(s["note"], str) else "",
+            ]
+            for _, s in shown.iterrows()
+        ]
+        table = ax_tab.table(
+            cellText=cells,
+            colLabels=[
+                "ramp",
+                "step",
+                "kPa",
+                "change (deg)",
+                "rise (s)",
+                "overshoot (%)",
+                "settling (s)",
+                "pressure rise (s)",
+                "note",
+            ],
+            colWidths=[0.11, 0.05, 0.09, 0.09, 0.07, 0.09, 0.08, 0.1, 0.32],
+            loc="upper center",
+            cellLoc="center",
+        )
         table.auto_set_font_size(False)
         table.set_fontsize(6.5)
         table.scale(1.0, 1.15)
         more_rows = len(steps) - len(shown)
-        ax_tab.set_title("Step responses: rise 10-90 % of the change; settling into 2 % of it (or 3 noise sd)"
-                         + (f"; {more_rows} more step(s) in steps.csv" if more_rows > 0 else ""), fontsize=8)
+        ax_tab.set_title(
+            "Step responses: rise 10-90 % of the change; settling into 2 % of it (or 3 noise sd)"
+            + (f"; {more_rows} more step(s) in steps.csv" if more_rows > 0 else ""),
+            fontsize=8,
+        )
     else:
         ax_tab.set_title("No pressure steps: no step-response figures", fontsize=8)
     strip = folder / STRIP
@@ -175,5 +270,8 @@ def figures(folder: Path) -> list[Figure]:
             ax_f = fig.add_subplot(grid[4, :])
             ax_f.imshow(cv2.cvtColor(img, cv2.COLOR_BGR2RGB), interpolation="none")
             ax_f.set_axis_off()
-            ax_f.set_title("Frames across the recording, extracted line drawn ('measure --overlays')", fontsize=8)
+            ax_f.set_title(
+                "Frames across the recording, extracted line drawn ('measure --overlays')",
+                fontsize=8,
+            )
     return [fig]

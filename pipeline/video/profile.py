@@ -70,8 +70,9 @@ class PressureProfile:
             raise UserInputError("; ".join(problems))
 
     def levels_kpa(self) -> NDArray[np.float64]:
-        """Setpoints of one ``steps`` cycle in order: up to ``max_kpa`` (reached exactly) and back."""
-        n = int(math.floor(self.max_kpa / self.step_kpa + 1e-9))
+        """Setpoints of one ``steps`` cycle in order: up to ``max_kpa`` (reached exactly) and
+        back."""
+        n = math.floor(self.max_kpa / self.step_kpa + 1e-9)
         up = [i * self.step_kpa for i in range(n + 1)]
         if self.max_kpa - up[-1] > 1e-6:
             up.append(self.max_kpa)
@@ -90,7 +91,8 @@ class PressureProfile:
         return float(self.cycles * self.cycle_s)
 
     def setpoint_kpa(self, t_s: ArrayLike) -> NDArray[np.float64]:
-        """Setpoint (kPa) at times ``t_s`` (s from the start); 0 before the start and after the end."""
+        """Setpoint (kPa) at times ``t_s`` (s from the start); 0 before the start and after the
+        end."""
         t = np.asarray(t_s, float)
         inside = (t >= 0) & (t < self.duration_s)
         u = np.mod(np.where(inside, t, 0.0), self.cycle_s)
@@ -107,4 +109,6 @@ class PressureProfile:
         if self.kind != "steps":
             return np.empty(0)
         n = len(self.levels_kpa())
-        return np.array([c * self.cycle_s + i * self.hold_s for c in range(self.cycles) for i in range(1, n)])
+        return np.array(
+            [c * self.cycle_s + i * self.hold_s for c in range(self.cycles) for i in range(1, n)]
+        )

@@ -120,7 +120,8 @@ def _pts_s(cap: cv2.VideoCapture) -> float:
 
 
 def _lands_on(cap: cv2.VideoCapture, index: int, fps: float) -> bool:
-    """Seek to ``index`` and check with the presentation time that it got there (cap is left after it)."""
+    """Seek to ``index`` and check with the presentation time that it got there (cap is left after
+    it)."""
     if not cap.set(cv2.CAP_PROP_POS_FRAMES, float(index)):
         return False
     ok = cap.grab()
@@ -137,13 +138,20 @@ def probe_video(path: str | Path) -> VideoInfo:
         return VideoInfo(path, False, problem=f"video {Path(path).name} does not exist")
     cap = _open(path, packets=False)
     if not cap.isOpened():
-        return VideoInfo(path, False, problem=f"video {Path(path).name} cannot be opened by OpenCV (not a video, "
-                                              "an unsupported codec, or truncated before its header was complete)")
+        return VideoInfo(
+            path,
+            False,
+            problem=f"video {Path(path).name} cannot be opened by OpenCV (not a video, "
+            "an unsupported codec, or truncated before its header was complete)",
+        )
     try:
-        count = int(round(cap.get(cv2.CAP_PROP_FRAME_COUNT)))
+        count = round(cap.get(cv2.CAP_PROP_FRAME_COUNT))
         fps = float(cap.get(cv2.CAP_PROP_FPS))
         fps = fps if math.isfinite(fps) and fps > 0 else math.nan
-        width, height = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        width, height = (
+            int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)),
+            int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)),
+        )
         fourcc = _fourcc(cap)
     finally:
         cap.release()
@@ -152,11 +160,21 @@ def probe_video(path: str | Path) -> VideoInfo:
         cap = _open(path, packets=True)
         ok, data = cap.read()
         cap.release()
-        packets = bool(ok) and data is not None and data.size > 4 and bytes(data.ravel()[:2]) == b"\xff\xd8" and (
-            cv2.imdecode(data.ravel(), cv2.IMREAD_REDUCED_GRAYSCALE_8) is not None)
+        packets = (
+            bool(ok)
+            and data is not None
+            and data.size > 4
+            and bytes(data.ravel()[:2]) == b"\xff\xd8"
+            and (cv2.imdecode(data.ravel(), cv2.IMREAD_REDUCED_GRAYSCALE_8) is not None)
+        )
     if count <= 0:  # the container does not say: count by reading (slow for long non-MJPEG videos)
-        count = sum(1 for f in read_frames(VideoInfo(path, True, 0, fps, width, height, fourcc, packets), 0, None)
-                    if f.data is not None)
+        count = sum(
+            1
+            for f in read_frames(
+                VideoInfo(path, True, 0, fps, width, height, fourcc, packets), 0, None
+            )
+            if f.data is not None
+        )
     seekable = False
     if count > 2 and math.isfinite(fps):
         cap = _open(path, packets)
@@ -192,8 +210,11 @@ def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Fram
                 while skipped < first and cap.grab():
                     skipped += 1
                 if skipped < first:
-                    reason = (f"frame could not be read from {name}: the video ends or is corrupt after frame "
-                              f"{skipped - 1} (the container announces {info.frame_count} frames)")
+                    reason = (
+                        f"frame could not be read from {name}: the video ends or is corrupt after "
+                        "frame "
+                        f"{skipped - 1} (the container announces {info.frame_count} frames)"
+                    )
                     for j in range(first, end if end is not None else first):
                         yield Frame(j, math.nan, None, reason)
                     return
@@ -204,8 +225,13 @@ def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Fram
                 if end is None:
                     return
                 failures += 1
-                yield Frame(k, math.nan, None, f"frame {k} could not be read from {name}: the video is truncated or "
-                                              f"corrupt here (the container announces {info.frame_count} frames)")
+                yield Frame(
+                    k,
+                    math.nan,
+                    None,
+                    f"frame {k} could not be read from {name}: the video is truncated or "
+                    f"corrupt here (the container announces {info.frame_count} frames)",
+                )
                 k += 1
                 continue
             failures = 0

@@ -18,9 +18,9 @@ For each frame this module gives (:func:`frame_conditions`):
 ``step``, ``since_step_s``
     Steps are jumps of ``pressure_kpa`` of at least :data:`STEP_MIN_KPA` between consecutive
     log rows, between two holds (within :data:`HOLD_TOLERANCE_KPA`) of at least
-    :data:`STEP_HOLD_MIN_S` each (so the end of a fast ramp is no step); ``step`` counts the steps up to the frame (0 before the first) and
-    ``since_step_s`` is the time since the last one (NaN before the first).  A continuous ramp
-    has no steps.
+    :data:`STEP_HOLD_MIN_S` each (so the end of a fast ramp is no step); ``step`` counts the steps
+    up to the frame (0 before the first) and ``since_step_s`` is the time since the last one (NaN
+    before the first).  A continuous ramp has no steps.
 
 Examples
 --------
@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import VACUUM_KPA
+from pipeline.constants import DIRECTIONS, VACUUM_KPA
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
@@ -90,8 +90,9 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     >>> import tempfile, pathlib
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
     >>> _ = p.write_text("time_s,pressure_kpa\\n0,0\\n1,5\\n1,6\\n")
-    >>> read_pressure_log(p)[1]
-    ['log.csv line 4: time_s 1 does not increase (previous row 1); sort the log by time or drop the repeated row']
+    >>> print(*read_pressure_log(p)[1])  # doctest: +NORMALIZE_WHITESPACE
+    log.csv line 4: time_s 1 does not increase (previous row 1); sort the log by time or drop the
+    repeated row
     """
     path = Path(path)
     name = path.name
@@ -103,10 +104,15 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
-        return None, [f"pressure log {name} lacks column(s) {missing}; it needs time_s (s) and pressure_kpa (kPa), "
-                      "optionally measured_kpa"]
+        return None, [
+            (f"pressure log {name} lacks column(s) {missing}; it needs time_s (s) and pressure_kpa "
+             "(kPa), "
+            "optionally measured_kpa")
+        ]
     if len(df) < 2:
-        return None, [f"pressure log {name} has {len(df)} row(s); at least 2 are needed to interpolate"]
+        return None, [
+            f"pressure log {name} has {len(df)} row(s); at least 2 are needed to interpolate"
+        ]
     problems: list[str] = []
     t = _numbers(df, "time_s", name, problems)
     p = _numbers(df, "pressure_kpa", name, problems)
@@ -120,8 +126,10 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         for column, values in (("pressure_kpa", p), ("measured_kpa", m)):
             if values is not None and (values < VACUUM_KPA).any():
                 i = int(np.flatnonzero(values < VACUUM_KPA)[0])
-                problems.append(f"{name} line {i + 2}: {column} {values[i]:g} is below absolute vacuum "
-                                f"({VACUUM_KPA:g} kPa gauge); log gauge pressures in kPa")
+                problems.append(
+                    f"{name} line {i + 2}: {column} {values[i]:g} is below absolute vacuum "
+                    f"({VACUUM_KPA:g} kPa gauge); log gauge pressures in kPa"
+                )
     if problems:
         return None, problems
     return PressureLog(str(path), t, p, m), []
@@ -148,14 +156,18 @@ def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, l
     if problems:
         return None, problems
     if not np.array_equal(frame, np.arange(len(frame))):
-        return None, [f"frame-times file {name}: frames must be 0, 1, 2, ... in order, one row each"]
+        return None, [
+            f"frame-times file {name}: frames must be 0, 1, 2, ... in order, one row each"
+        ]
     if (np.diff(t) <= 0).any():
         i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
         return None, [f"frame-times file {name} line {i + 2}: time_s does not increase"]
     return t, []
 
 
-def turning_points(pressure_kpa: np.ndarray, deadband_kpa: float = TREND_DEADBAND_KPA) -> np.ndarray:
+def turning_points(
+    pressure_kpa: np.ndarray, deadband_kpa: float = TREND_DEADBAND_KPA
+) -> np.ndarray:
     """Indices of the confirmed extremes of a pressure series (the last sample of each extreme).
 
     Examples
@@ -212,18 +224,24 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
     t = np.asarray(time_s, float)
     lo, hi = log.span_s
     inside = np.isfinite(t) & (t >= lo) & (t <= hi)
-    out = pd.DataFrame({"pressure_kpa": np.where(inside, np.interp(t, log.time_s, log.pressure_kpa), np.nan)})
+    out = pd.DataFrame(
+        {"pressure_kpa": np.where(inside, np.interp(t, log.time_s, log.pressure_kpa), np.nan)}
+    )
     if log.measured_kpa is not None:
-        out["measured_pressure_kpa"] = np.where(inside, np.interp(t, log.time_s, log.measured_kpa), np.nan)
+        out["measured_pressure_kpa"] = np.where(
+            inside, np.interp(t, log.time_s, log.measured_kpa), np.nan
+        )
     tp = turning_points(log.pressure_kpa)
     # direction of each log interval: up until the first turning point, then alternating
     edges = log.time_s[tp]
     n_turns = np.searchsorted(edges, t, side="left")  # a frame at a peak's own time is still rising
-    out["direction"] = np.where(n_turns % 2 == 0, "up", "down")
+    out["direction"] = np.where(n_turns % 2 == 0, *DIRECTIONS)
     steps = step_times(log)
     k = np.searchsorted(steps, t, side="right")
     out["step"] = k.astype(int)
-    out["since_step_s"] = np.where(k > 0, t - steps[np.maximum(k - 1, 0)] if steps.size else np.nan, np.nan)
+    out["since_step_s"] = np.where(
+        k > 0, t - steps[np.maximum(k - 1, 0)] if steps.size else np.nan, np.nan
+    )
     out["in_log"] = inside
     return out
 
@@ -233,7 +251,12 @@ def span_text(span: tuple[float, float]) -> str:
     return f"{span[0]:.2f}-{span[1]:.2f} s"
 
 
-def covers(log_span: tuple[float, float], video_span: tuple[float, float], slack_s: float = 0.0) -> bool:
+def covers(
+    log_span: tuple[float, float], video_span: tuple[float, float], slack_s: float = 0.0
+) -> bool:
     """Whether the log's span holds the video's (within ``slack_s`` at each end)."""
-    return log_span[0] <= video_span[0] + slack_s and video_span[1] - slack_s <= log_span[1] and not math.isnan(
-        video_span[0])
+    return (
+        log_span[0] <= video_span[0] + slack_s
+        and video_span[1] - slack_s <= log_span[1]
+        and not math.isnan(video_span[0])
+    )

@@ -22,11 +22,11 @@ import numpy as np
 from pipeline.measure.core import (
     DEFAULT_METHOD,
     AngleResult,
-    _reduce,
     decode_for_work,
     decodes_grey,
     failed,
     measure_decoded,
+    reduce_image,
     reduction_for,
 )
 from pipeline.measure.settings import MeasureSettings
@@ -37,8 +37,18 @@ from pipeline.video.reader import Frame, VideoInfo, read_frames
 CHUNK_FRAMES = 64
 #: columns a chunk returns, each a list with one value per frame
 CHUNK_COLUMNS: tuple[str, ...] = (
-    "frame", "pts_s", "psi_deg", "kappa_per_mm", "length_mm", "length_px", "method", "residual_px", "status",
-    "reason", "seconds", "degree",
+    "frame",
+    "pts_s",
+    "psi_deg",
+    "kappa_per_mm",
+    "length_mm",
+    "length_px",
+    "method",
+    "residual_px",
+    "status",
+    "reason",
+    "seconds",
+    "degree",
 )
 
 
@@ -60,7 +70,9 @@ class FrameChunk:
     title: str = ""
 
 
-def measure_frame(frame: Frame, settings: MeasureSettings, method: str, packets: bool) -> tuple[AngleResult, np.ndarray | None, int]:
+def measure_frame(
+    frame: Frame, settings: MeasureSettings, method: str, packets: bool
+) -> tuple[AngleResult, np.ndarray | None, int]:
     """Measure one frame read by :func:`~pipeline.video.reader.read_frames`.
 
     Returns the result, the work image (for an overlay) and its reduction factor.
@@ -71,19 +83,32 @@ def measure_frame(frame: Frame, settings: MeasureSettings, method: str, packets:
     if packets:
         img, f = decode_for_work(frame.data, grey=grey)
         if img is None:
-            return failed(method, f"frame {frame.index}: its JPEG packet cannot be decoded (the video is truncated or corrupt here)"), None, 1
+            return (
+                failed(
+                    method,
+                    f"frame {frame.index}: its JPEG packet cannot be decoded (the video is "
+                    "truncated or corrupt here)",
+                ),
+                None,
+                1,
+            )
         return measure_decoded(frame.data, img, f, settings, method=method), img, f
     full = cv2.cvtColor(frame.data, cv2.COLOR_BGR2GRAY) if grey else frame.data
     f = reduction_for(full.shape[1])
-    img = _reduce(full, f)
+    img = reduce_image(full, f)
     return measure_decoded(None, img, f, settings, method=method, full=full), img, f
 
 
 def run_chunk(chunk: FrameChunk) -> dict[str, list[Any]]:
-    """Measure every frame of a chunk; return :data:`CHUNK_COLUMNS` as lists (one entry per frame)."""
+    """Measure every frame of a chunk; return :data:`CHUNK_COLUMNS` as lists (one entry per
+    frame)."""
     out: dict[str, list[Any]] = {c: [] for c in CHUNK_COLUMNS}
     overlays = dict(chunk.overlays)
-    frames = read_frames(chunk.info, chunk.first, chunk.count) if chunk.settings is not None else iter(())
+    frames = (
+        read_frames(chunk.info, chunk.first, chunk.count)
+        if chunk.settings is not None
+        else iter(())
+    )
     for k in range(chunk.first, chunk.first + chunk.count):
         t0 = time.perf_counter()
         img, f = None, 1
@@ -95,7 +120,9 @@ def run_chunk(chunk: FrameChunk) -> dict[str, list[Any]]:
             try:
                 res, img, f = measure_frame(frame, chunk.settings, chunk.method, chunk.info.packets)
             except Exception as exc:  # noqa: BLE001 - one bad frame never stops the video
-                res = failed(chunk.method, f"internal error on this frame: {type(exc).__name__}: {exc}")
+                res = failed(
+                    chunk.method, f"internal error on this frame: {type(exc).__name__}: {exc}"
+                )
         seconds = time.perf_counter() - t0
         if k in overlays:
             write_overlay(overlays[k], img, f, res, f"{chunk.title} frame {k}")

@@ -2,8 +2,10 @@
 
 Examples
 --------
->>> is_video_dataset({"source": "synthetic_video"}), is_video_dataset({"source": "rig", "record": "photos"})
-(True, False)
+>>> is_video_dataset({"source": "synthetic_video"})
+True
+>>> is_video_dataset({"source": "rig", "record": "photos"})
+False
 >>> names_pattern(["a.b", "c"]), names_pattern([])
 ('a\\\\.b|c', '(?!)')
 """
@@ -19,7 +21,8 @@ from pipeline.photoset import is_video_manifest, read_manifest
 
 
 def is_video_dataset(ds: Mapping[str, Any]) -> bool:
-    """Whether a config dataset's photo set lists videos (rendered, recorded, or a folder's manifest)."""
+    """Whether a config dataset's photo set lists videos (rendered, recorded, or a folder's
+    manifest)."""
     source = ds["source"]
     if source == "synthetic_video":
         return True
@@ -40,6 +43,9 @@ def names_pattern(names: Iterable[str]) -> str:
 
 def profile_options(ds: Mapping[str, Any]) -> str:
     """The pressure-profile options shared by ``synth-video`` and ``acquire --record video``."""
-    return (f"--profile {ds['profile']} --max-kpa {ds['max_kpa']} --rate-kpa-s {ds['rate_kpa_s']}"
-            f" --step-kpa {ds['step_kpa']} --hold-s {ds['hold_s']} --cycles {ds['cycles']} --fps {ds['fps']}"
-            f" --rest-s {ds['rest_s']}")
+    return (
+        f"--profile {ds['profile']} --max-kpa {ds['max_kpa']} --rate-kpa-s {ds['rate_kpa_s']}"
+        f" --step-kpa {ds['step_kpa']} --hold-s {ds['hold_s']} --cycles {ds['cycles']} --fps "
+        f"{ds['fps']}"
+        f" --rest-s {ds['rest_s']}"
+    )

@@ -1,4 +1,5 @@
-"""Write a video with OpenCV's ``VideoWriter`` (FFmpeg back-end): the codecs that work, or a clear refusal.
+"""Write a video with OpenCV's ``VideoWriter`` (FFmpeg back-end): the codecs that work, or a clear
+refusal.
 
 MJPEG in AVI works in every OpenCV build with FFmpeg (and is what most USB lab cameras record);
 MPEG-4 Part 2 too.  H.264 needs an encoder (libx264, OpenH264) that the pip wheels of OpenCV do
@@ -14,7 +15,11 @@ import cv2
 from pipeline.errors import UserInputError
 
 #: codec name -> (four-character code, file suffix)
-CODECS: dict[str, tuple[str, str]] = {"mjpg": ("MJPG", ".avi"), "mp4v": ("mp4v", ".avi"), "h264": ("avc1", ".mp4")}
+CODECS: dict[str, tuple[str, str]] = {
+    "mjpg": ("MJPG", ".avi"),
+    "mp4v": ("mp4v", ".avi"),
+    "h264": ("avc1", ".mp4"),
+}
 
 
 def open_writer(path: Path, codec: str, fps: float, size: tuple[int, int]) -> cv2.VideoWriter:
@@ -28,10 +33,15 @@ def open_writer(path: Path, codec: str, fps: float, size: tuple[int, int]) -> cv
     if codec not in CODECS:
         raise UserInputError(f"codec {codec!r} is unknown; use one of {sorted(CODECS)}")
     fourcc, _ = CODECS[codec]
-    writer = cv2.VideoWriter(str(path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*fourcc), float(fps), size)
+    writer = cv2.VideoWriter(
+        str(path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*fourcc), float(fps), size
+    )
     if not writer.isOpened():
         writer.release()
         Path(path).unlink(missing_ok=True)
-        raise UserInputError(f"this OpenCV build cannot encode {codec} (FourCC {fourcc}); use codec mjpg (what USB lab "
-                             "cameras record) or mp4v")
+        raise UserInputError(
+            f"this OpenCV build cannot encode {codec} (FourCC {fourcc}); use codec mjpg (what USB "
+            "lab "
+            "cameras record) or mp4v"
+        )
     return writer

@@ -1,5 +1,6 @@
 # ruff: noqa: UP031, RUF046, PLR0124  (MicroPython: %-formatting, explicit int(), NaN test)
-"""Pure logic of the Pico firmware: line protocol, DAC and ADC arithmetic, limits, e-stop, load cell.
+"""Pure logic of the Pico firmware: line protocol, DAC and ADC arithmetic, limits, e-stop, load
+cell.
 
 This file runs unchanged on the Pico (MicroPython) and on the host (CPython: tests and the
 emulator).  It therefore imports nothing, uses no dataclasses and no f-strings, and talks to the
@@ -113,12 +114,15 @@ def kpa_to_code(kpa: float, cfg: Config) -> int:
 
 
 def code_to_kpa(code: int, cfg: Config) -> float:
-    """Nominal regulator pressure (kPa) commanded by DAC ``code`` (inverse of :func:`kpa_to_code`)."""
+    """Nominal regulator pressure (kPa) commanded by DAC ``code`` (inverse of
+    :func:`kpa_to_code`)."""
     v_reg = cfg.vref_v * code / 4096.0 * cfg.amp_gain
     return v_reg / cfg.reg_input_fs_v * cfg.full_scale_kpa
 
 
-def mcp4921_frame(code: int, buffered: bool = False, gain_1x: bool = True, active: bool = True) -> bytes:
+def mcp4921_frame(
+    code: int, buffered: bool = False, gain_1x: bool = True, active: bool = True
+) -> bytes:
     """The two SPI bytes (MSB first) that set the MCP4921 to ``code``.
 
     Bit 15 = 0 (write DAC A), bit 14 BUF, bit 13 GA (1 = gain 1x), bit 12 SHDN (1 = output on),
@@ -133,7 +137,9 @@ def mcp4921_frame(code: int, buffered: bool = False, gain_1x: bool = True, activ
 def monitor_kpa(u16: int, cfg: Config) -> float:
     """Pressure (kPa) from the regulator monitor voltage read as ``ADC.read_u16()`` (0..65535)."""
     v_mon = u16 / 65535.0 * cfg.adc_vref_v / cfg.monitor_divider
-    return (v_mon - cfg.monitor_zero_v) / (cfg.monitor_fs_v - cfg.monitor_zero_v) * cfg.full_scale_kpa
+    return (
+        (v_mon - cfg.monitor_zero_v) / (cfg.monitor_fs_v - cfg.monitor_zero_v) * cfg.full_scale_kpa
+    )
 
 
 def kpa_to_monitor_u16(kpa: float, cfg: Config) -> int:
@@ -141,7 +147,9 @@ def kpa_to_monitor_u16(kpa: float, cfg: Config) -> int:
 
     The RP2040 ADC has 12 bits; MicroPython scales them to 16 as ``(raw << 4) | (raw >> 8)``.
     """
-    v_adc = (cfg.monitor_zero_v + kpa / cfg.full_scale_kpa * (cfg.monitor_fs_v - cfg.monitor_zero_v)) * cfg.monitor_divider
+    v_adc = (
+        cfg.monitor_zero_v + kpa / cfg.full_scale_kpa * (cfg.monitor_fs_v - cfg.monitor_zero_v)
+    ) * cfg.monitor_divider
     raw = int(round(v_adc / cfg.adc_vref_v * 4095.0))
     raw = min(max(raw, 0), 4095)
     return (raw << 4) | (raw >> 8)
@@ -322,7 +330,11 @@ class Controller:
             code = self._apply(kpa)
             return "OK SET %.3f %d" % (kpa, code)
         if cmd == "GET" and n == 0:
-            return "OK GET %.3f %.3f %d" % (self.setpoint_kpa, self.measured_kpa(), 1 if self.estop else 0)
+            return "OK GET %.3f %.3f %d" % (
+                self.setpoint_kpa,
+                self.measured_kpa(),
+                1 if self.estop else 0,
+            )
         if cmd == "VENT" and n == 0:
             self.vent()
             return "OK VENT"
@@ -332,7 +344,9 @@ class Controller:
             counts = self.hw.read_load_counts()
             if counts is None:
                 return "ERR HW"
-            return "OK LOAD %.5f" % counts_to_newtons(counts, self.tare_counts, self.counts_per_newton)
+            return "OK LOAD %.5f" % counts_to_newtons(
+                counts, self.tare_counts, self.counts_per_newton
+            )
         if cmd == "LOADRAW" and n == 0:
             counts = self.hw.read_load_counts()
             return "ERR HW" if counts is None else "OK LOADRAW %d" % counts

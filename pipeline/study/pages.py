@@ -11,10 +11,10 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.bench import charts
 from pipeline.fileio import read_table
+from pipeline.study import charts
 
-#: the tables a bench directory holds (written by ``python -m pipeline bench``)
+#: the tables a bench directory holds (written by ``python -m pipeline bench study``)
 TABLES: tuple[str, ...] = (
     "speed_accuracy.csv", "stability.csv", "breakdown.csv", "repeatability.csv", "model_choice.csv",
     "model_cost.csv",
@@ -23,7 +23,11 @@ TABLES: tuple[str, ...] = (
 
 def _read(bench_dir: Path, name: str) -> pd.DataFrame | None:
     path = Path(bench_dir) / name
-    return read_table(path, f"the bench's {name} (rerun 'python -m pipeline bench')") if path.is_file() else None
+    return (
+        read_table(path, f"the bench's {name} (rerun 'python -m pipeline bench study')")
+        if path.is_file()
+        else None
+    )
 
 
 def figures(bench_dir: Path) -> list[Figure]:
@@ -33,7 +37,7 @@ def figures(bench_dir: Path) -> list[Figure]:
     Parameters
     ----------
     bench_dir : Path
-        Output directory of ``python -m pipeline bench``.
+        Output directory of ``python -m pipeline bench study``.
 
     Returns
     -------
@@ -48,11 +52,18 @@ def figures(bench_dir: Path) -> list[Figure]:
     stab = _read(bench_dir, "stability.csv")
     if stab is not None and not stab.empty:
         out.append(charts.stability_figure(stab))
-    bd, choice, rep = (_read(bench_dir, n) for n in ("breakdown.csv", "model_choice.csv", "repeatability.csv"))
+    bd, choice, rep = (
+        _read(bench_dir, n) for n in ("breakdown.csv", "model_choice.csv", "repeatability.csv")
+    )
     if any(t is not None for t in (bd, choice, rep)):
         empty = pd.DataFrame()
-        out.append(charts.tables_figure(bd if bd is not None else empty, choice if choice is not None else empty,
-                                        rep if rep is not None else empty))
+        out.append(
+            charts.tables_figure(
+                bd if bd is not None else empty,
+                choice if choice is not None else empty,
+                rep if rep is not None else empty,
+            )
+        )
     cost = _read(bench_dir, "model_cost.csv")
     if cost is not None:
         out.append(charts.model_cost_figure(cost))

@@ -8,12 +8,13 @@ missing (:func:`fmt`).
 
 Examples
 --------
->>> from pipeline.report.style import report_style, text_page
+>>> from pipeline.layout.style import report_style, text_page
 >>> with report_style():
 ...     fig = text_page()
 ...     flow = Flow(fig)
 ...     flow.heading("Results")
-...     flow.table(Table((Column("material", "left"), Column("RMS (deg)")), (("DS20", fmt(47.04, 1)),)))
+...     columns = (Column("material", "left"), Column("RMS (deg)"))
+...     flow.table(Table(columns, (("DS20", fmt(47.04, 1)),)))
 >>> [t.get_text() for t in fig.texts]
 ['Results', 'material', 'RMS (deg)', 'DS20', '47.0']
 """
@@ -27,15 +28,15 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from matplotlib import ft2font
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties, findfont, get_font
-from matplotlib import ft2font
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.transforms import Affine2D, Transform
 
-from pipeline.report.style import FOOTER_PT, MARGIN_PT, MIN_FONT_PT, Color
+from pipeline.layout.style import FOOTER_PT, MARGIN_PT, MIN_FONT_PT, Color
 
 #: what a missing value reads as, everywhere in the report
 NA = "n/a"
@@ -67,8 +68,11 @@ def fmt(value: object, digits: int = 0, unit: str = "") -> str:
 
 
 #: unhinted glyph outlines, as in the PDF (``LoadFlags`` from matplotlib 3.10 on)
-_NO_HINTING = ft2font.LoadFlags.NO_HINTING if hasattr(ft2font, "LoadFlags") else ft2font.LOAD_NO_HINTING
-#: size (pt) at which widths are measured; advance widths of unhinted outlines scale linearly with size
+_NO_HINTING = (
+    ft2font.LoadFlags.NO_HINTING if hasattr(ft2font, "LoadFlags") else ft2font.LOAD_NO_HINTING
+)
+#: size (pt) at which widths are measured; advance widths of unhinted outlines scale linearly with
+#: size
 _REFERENCE_PT = 10.0
 
 
@@ -80,12 +84,16 @@ def _reference_width(text: str, weight: str, family: str) -> float:
     return font.get_width_height()[0] / 64.0
 
 
-def text_width_pt(text: str, size: float, weight: str = "normal", family: str = "DejaVu Sans") -> float:
+def text_width_pt(
+    text: str, size: float, weight: str = "normal", family: str = "DejaVu Sans"
+) -> float:
     """Width of one line of text at ``size`` pt, from the font's (unhinted) metrics."""
     return _reference_width(text, weight, family) * size / _REFERENCE_PT if text else 0.0
 
 
-def wrap(text: str, width_pt: float, size: float, weight: str = "normal", family: str = "DejaVu Sans") -> list[str]:
+def wrap(
+    text: str, width_pt: float, size: float, weight: str = "normal", family: str = "DejaVu Sans"
+) -> list[str]:
     """Greedy word wrap of ``text`` to lines no wider than ``width_pt``.
 
     A word wider than the line is broken after a ``/`` (file paths), else kept whole.
@@ -193,8 +201,10 @@ class Flow:
         self.y = top_pt
         self.width = self.page_w - 2 * left_pt if width_pt is None else width_pt
         self.bottom = self.page_h - bottom_pt
-        self.transform: Transform = (Affine2D().scale(1 / 72.0, -1 / 72.0).translate(0.0, fig.get_figheight())
-                                     + fig.dpi_scale_trans)
+        self.transform: Transform = (
+            Affine2D().scale(1 / 72.0, -1 / 72.0).translate(0.0, fig.get_figheight())
+            + fig.dpi_scale_trans
+        )
 
     @property
     def remaining_pt(self) -> float:
@@ -205,15 +215,37 @@ class Flow:
         """Leave ``pt`` of vertical space."""
         self.y += pt
 
-    def _line(self, x: float, text: str, size: float, *, weight: str = "normal", color: object = "black",
-              family: str = "DejaVu Sans", ha: str = "left", style: str = "normal") -> None:
-        self.fig.text(x, self.y, text, transform=self.transform, fontsize=size, fontweight=weight, color=color,
-                      family=family, ha=ha, va="top", fontstyle=style)
+    def _line(
+        self,
+        x: float,
+        text: str,
+        size: float,
+        *,
+        weight: str = "normal",
+        color: object = "black",
+        family: str = "DejaVu Sans",
+        ha: str = "left",
+        style: str = "normal",
+    ) -> None:
+        self.fig.text(
+            x,
+            self.y,
+            text,
+            transform=self.transform,
+            fontsize=size,
+            fontweight=weight,
+            color=color,
+            family=family,
+            ha=ha,
+            va="top",
+            fontstyle=style,
+        )
 
     def text(self, text: str, *, size: float = 8.5, weight: str = "normal", color: object = "black",
              indent_pt: float = 0.0, family: str = "DejaVu Sans", style: str = "normal",
              hanging_pt: float = 0.0) -> None:
-        """A paragraph wrapped to the flow's width (``hanging_pt``: indent of the following lines)."""
+        """A paragraph wrapped to the flow's width (``hanging_pt``: indent of the following
+        lines)."""
         size = max(size, MIN_FONT_PT)
         first = True
         for line in wrap(text, self.width - indent_pt - hanging_pt, size, weight, family):
@@ -286,13 +318,25 @@ class Flow:
         for r, row in enumerate(cells):
             height = max(len(c) for c in row) * line_h
             if r % 2 == 1 and len(cells) > 3:
-                self.fig.patches.append(Rectangle((self.x - 2.0, self.y - 1.2), total + 4.0, height + 0.4,
-                                                  transform=self.transform, facecolor="#f1f1f1", edgecolor="none",
-                                                  zorder=-1))
+                self.fig.patches.append(
+                    Rectangle(
+                        (self.x - 2.0, self.y - 1.2),
+                        total + 4.0,
+                        height + 0.4,
+                        transform=self.transform,
+                        facecolor="#f1f1f1",
+                        edgecolor="none",
+                        zorder=-1,
+                    )
+                )
             top = self.y
             for c in range(n):
                 self.y = top
-                color = table.row_colors[r] if c == 0 and r < len(table.row_colors) and table.row_colors[r] else "black"
+                color = (
+                    table.row_colors[r]
+                    if c == 0 and r < len(table.row_colors) and table.row_colors[r]
+                    else "black"
+                )
                 for line in row[c]:
                     self._cell(edges[c], widths[c], table.columns[c].align, line, size,
                                weight="bold" if color != "black" else "normal", color=color,
@@ -306,16 +350,33 @@ class Flow:
         for note in table.notes:
             self.text(note, size=note_size, color="0.25")
 
-    def _cell(self, x0: float, width: float, align: str, text: str, size: float, *, weight: str = "normal",
-              color: object = "black", family: str = "DejaVu Sans") -> None:
+    def _cell(
+        self,
+        x0: float,
+        width: float,
+        align: str,
+        text: str,
+        size: float,
+        *,
+        weight: str = "normal",
+        color: object = "black",
+        family: str = "DejaVu Sans",
+    ) -> None:
         if not text:
             return
         x = {"left": x0, "right": x0 + width, "center": x0 + width / 2}[align]
         self._line(x, text, size, weight=weight, ha=align, color=color, family=family)
 
     def _rule(self, x0: float, x1: float, linewidth: float) -> None:
-        self.fig.add_artist(Line2D([x0, x1], [self.y, self.y], transform=self.transform, color="black",
-                                   linewidth=linewidth))
+        self.fig.add_artist(
+            Line2D(
+                [x0, x1],
+                [self.y, self.y],
+                transform=self.transform,
+                color="black",
+                linewidth=linewidth,
+            )
+        )
 
 
 def table_height_pt(table: Table, width_pt: float) -> float:
@@ -337,14 +398,19 @@ def rows_that_fit(table: Table, width_pt: float, height_pt: float) -> int:
     lo, hi = 1, len(table.rows)
     while lo < hi:
         mid = (lo + hi + 1) // 2
-        if table_height_pt(dataclasses.replace(table, rows=table.rows[:mid]), width_pt) <= height_pt:
+        if (
+            table_height_pt(dataclasses.replace(table, rows=table.rows[:mid]), width_pt)
+            <= height_pt
+        ):
             lo = mid
         else:
             hi = mid - 1
     return lo
 
 
-def _layout(table: Table, width_pt: float) -> tuple[float, list[float], list[list[list[str]]], list[list[str]]]:
+def _layout(
+    table: Table, width_pt: float
+) -> tuple[float, list[float], list[list[list[str]]], list[list[str]]]:
     """Font size, column widths and the wrapped lines of every cell, fitted to ``width_pt``.
 
     The font shrinks (not below :data:`MIN_FONT_PT`) until the table fits; if it still does not,

@@ -1,4 +1,4 @@
-"""Accuracy benchmark of the eccentricity measurement: ``python -m pipeline.force.bench``.
+"""Accuracy benchmark of the eccentricity measurement: ``python -m pipeline bench force``.
 
 Prints (and with ``--out`` writes as CSV) the error ``e_measured - e_true`` of
 
@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from pipeline.fileio import write_table
 from pipeline.force.ellipse import ellipse_points, fit_ellipse
 
 TARGET = 0.02
@@ -47,24 +48,44 @@ def point_sweep(*, seeds: int = 3, noise_px: float = 0.5, a_px: float = 280.0) -
         for fraction in (1.0, 0.75, 0.58, 0.45, 0.4, 0.35):
             for gap in (0.0, 45.0, 90.0):
                 for seed in range(seeds):
-                    pts = arc_points(e, fraction, gap, a_px=a_px, noise_px=noise_px,
-                                     rng=np.random.default_rng([seed, int(100 * e), int(100 * fraction), int(gap)]))
+                    pts = arc_points(
+                        e,
+                        fraction,
+                        gap,
+                        a_px=a_px,
+                        noise_px=noise_px,
+                        rng=np.random.default_rng(
+                            [seed, int(100 * e), int(100 * fraction), int(gap)]
+                        ),
+                    )
                     for mode in ("never", "auto", "always"):
                         t0 = time.perf_counter()
                         fit = fit_ellipse(pts, refine=mode)  # type: ignore[arg-type]
-                        rows.append({"e_true": e, "arc_fraction": fraction, "gap_deg": gap, "seed": seed,
-                                     "refine": mode, "error": fit.eccentricity - e, "e_sd": fit.eccentricity_sd,
-                                     "status": fit.status, "ms": 1000 * (time.perf_counter() - t0)})
+                        rows.append(
+                            {
+                                "e_true": e,
+                                "arc_fraction": fraction,
+                                "gap_deg": gap,
+                                "seed": seed,
+                                "refine": mode,
+                                "error": fit.eccentricity - e,
+                                "e_sd": fit.eccentricity_sd,
+                                "status": fit.status,
+                                "ms": 1000 * (time.perf_counter() - t0),
+                            }
+                        )
     return pd.DataFrame(rows)
 
 
-def image_sweep(*, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int = 2) -> pd.DataFrame:
+def image_sweep(
+    *, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int = 2
+) -> pd.DataFrame:
     """Whole-pipeline errors on rendered photos."""
     import cv2
 
     from pipeline.force.blocked import measure_blocked_image
-    from pipeline.measure.settings import resolve_settings
     from pipeline.force.synth_blocked import blocked_arc_mm
+    from pipeline.measure.settings import resolve_settings
     from pipeline.synth import render_curve, scene_from
 
     rows = []
@@ -77,16 +98,37 @@ def image_sweep(*, scenes: Sequence[str] = ("clean", "lab", "hard"), seeds: int 
                         shape = blocked_arc_mm(e, 270.0, arc_fraction=fraction, gap_deg=gap)
                         key = [seed, int(100 * e), int(100 * fraction), int(gap)]
                         rot = float(np.random.default_rng(key).uniform(-180.0, 180.0))
-                        img = render_curve(shape.points_mm, scene, seed=np.random.SeedSequence(key), rotation_deg=rot)
-                        photo = cv2.imdecode(np.frombuffer(img.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+                        img = render_curve(
+                            shape.points_mm,
+                            scene,
+                            seed=np.random.SeedSequence(key),
+                            rotation_deg=rot,
+                        )
+                        photo = cv2.imdecode(
+                            np.frombuffer(img.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR
+                        )
                         t0 = time.perf_counter()
-                        settings = resolve_settings(l0_mm=270.0, mm_per_px=scene.mm_per_px, line_color=scene.line_color,
-                                                    fixed_end=list(img.fixed_end_px))
+                        settings = resolve_settings(
+                            l0_mm=270.0,
+                            mm_per_px=scene.mm_per_px,
+                            line_color=scene.line_color,
+                            fixed_end=list(img.fixed_end_px),
+                        )
                         r = measure_blocked_image(photo, settings)
-                        rows.append({"scene": scene_name, "e_true": e, "arc_fraction": fraction, "gap_deg": gap,
-                                     "seed": seed, "error": r.eccentricity - e, "status": r.status,
-                                     "reason": r.reason, "in_frame": img.line_in_frame,
-                                     "ms": 1000 * (time.perf_counter() - t0)})
+                        rows.append(
+                            {
+                                "scene": scene_name,
+                                "e_true": e,
+                                "arc_fraction": fraction,
+                                "gap_deg": gap,
+                                "seed": seed,
+                                "error": r.eccentricity - e,
+                                "status": r.status,
+                                "reason": r.reason,
+                                "in_frame": img.line_in_frame,
+                                "ms": 1000 * (time.perf_counter() - t0),
+                            }
+                        )
     return pd.DataFrame(rows)
 
 
@@ -111,15 +153,28 @@ def _summary(df: pd.DataFrame, by: list[str]) -> pd.DataFrame:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print the tables."""
-    parser = argparse.ArgumentParser(prog="python -m pipeline.force.bench", description=__doc__.split("\n")[0])
-    parser.add_argument("--seeds", type=int, default=3, help="noise seeds per point-sweep case (default 3)")
-    parser.add_argument("--noise-px", type=float, default=0.5, help="point noise sd in px (default 0.5)")
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline bench force", description=__doc__.split("\n")[0]
+    )
+    parser.add_argument(
+        "--seeds", type=int, default=3, help="noise seeds per point-sweep case (default 3)"
+    )
+    parser.add_argument(
+        "--noise-px", type=float, default=0.5, help="point noise sd in px (default 0.5)"
+    )
     parser.add_argument("--no-images", action="store_true", help="skip the rendered-photo sweep")
-    parser.add_argument("--out", default=None, help="write the raw rows to this CSV prefix (_points.csv, _images.csv)")
+    parser.add_argument(
+        "--out",
+        default=None,
+        help="write the raw rows to this CSV prefix (_points.csv, _images.csv)",
+    )
     args = parser.parse_args(argv)
     pd.set_option("display.width", 200)
     pts = point_sweep(seeds=args.seeds, noise_px=args.noise_px)
-    print(f"== ellipse fit on noisy points (noise {args.noise_px} px, semi-major 280 px), by refinement and arc fraction")
+    print(
+        f"== ellipse fit on noisy points (noise {args.noise_px} px, semi-major 280 px), by "
+        "refinement and arc fraction"
+    )
     print(_summary(pts, ["refine", "arc_fraction"]).to_string())
     print("\n== auto refinement, by opening position (gap 0 deg = at a major-axis end)")
     print(_summary(pts[pts["refine"] == "auto"], ["gap_deg"]).to_string())
@@ -127,7 +182,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     sel = pts[(pts["refine"] == "auto") & (pts["arc_fraction"] >= 0.4)]
     print(_summary(sel, ["e_true"]).to_string())
     if args.out:
-        pts.to_csv(f"{args.out}_points.csv", index=False)
+        write_table(pts, f"{args.out}_points.csv", float_format=None)
     if not args.no_images:
         imgs = image_sweep(seeds=max(1, args.seeds - 1))
         print("\n== rendered photos (render -> extract -> fit), by scene and arc fraction")
@@ -135,12 +190,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("\n== rendered photos, by scene and true e")
         print(_summary(imgs, ["scene", "e_true"]).to_string())
         bad = imgs[(imgs["status"] == "ok") & (imgs["error"].abs() > TARGET)]
-        print(f"\nok photos outside the {TARGET} target: {len(bad)} of {int((imgs['status'] == 'ok').sum())}")
+        print(
+            f"\nok photos outside the {TARGET} target: {len(bad)} of "
+            f"{int((imgs['status'] == 'ok').sum())}"
+        )
         flagged = imgs[imgs["status"] != "ok"]["reason"].value_counts().head(8)
         if len(flagged):
             print("most common flag/fail reasons:\n" + flagged.to_string())
         if args.out:
-            imgs.to_csv(f"{args.out}_images.csv", index=False)
+            write_table(imgs, f"{args.out}_images.csv", float_format=None)
     return 0
 
 

@@ -1,7 +1,7 @@
 """Tables of the speed/accuracy and stability study, from the per-image results of :mod:`run`.
 
 Every function here is pure: a DataFrame in, a DataFrame out.  The input is the long table
-written by :func:`pipeline.bench.run.run_grid` (one row per image and method) with at least the
+written by :func:`pipeline.study.run.run_grid` (one row per image and method) with at least the
 columns ``case_id, kind, condition, value, nominal, psi_true_deg, bulge, seed, method, psi_deg,
 abs_error_deg, status, degree, seconds, decode_seconds``.  ``seconds`` is the time per image
 as ``python -m pipeline measure`` spends it (file read + JPEG decode + measurement, one core);
@@ -46,7 +46,9 @@ NOMINAL_PSI_MAX_DEG = 300.0
 # small functions with known answers (unit-tested on crafted data)
 
 
-def pareto_front(time_s: Sequence[float] | np.ndarray, error_deg: Sequence[float] | np.ndarray) -> np.ndarray:
+def pareto_front(
+    time_s: Sequence[float] | np.ndarray, error_deg: Sequence[float] | np.ndarray
+) -> np.ndarray:
     """Mark the points no other point beats on both time and error (both: smaller is better).
 
     A point is dominated when another point is no worse on both axes and strictly better on
@@ -163,7 +165,9 @@ def with_nominal(results: pd.DataFrame) -> pd.DataFrame:
     They are the rows of the ``psi`` sweep with ``|psi| <= NOMINAL_PSI_MAX_DEG`` (all other
     knobs at their nominal values), relabelled; the original rows are kept.
     """
-    sel = results[(results["condition"] == "psi") & (results["psi_true_deg"].abs() <= NOMINAL_PSI_MAX_DEG)]
+    sel = results[
+        (results["condition"] == "psi") & (results["psi_true_deg"].abs() <= NOMINAL_PSI_MAX_DEG)
+    ]
     return pd.concat([results, sel.assign(condition=NOMINAL)], ignore_index=True)
 
 
@@ -193,7 +197,9 @@ def speed_accuracy(results: pd.DataFrame) -> pd.DataFrame:
     table["pareto"] = False
     for idx in table.groupby("condition", sort=False).groups.values():
         sub = table.loc[idx]
-        table.loc[idx, "pareto"] = pareto_front(sub["median_ms_per_image"], sub["p95_abs_error_deg"])
+        table.loc[idx, "pareto"] = pareto_front(
+            sub["median_ms_per_image"], sub["p95_abs_error_deg"]
+        )
     first = table["condition"].eq(NOMINAL)
     return pd.concat([table[first], table[~first]], ignore_index=True)
 
@@ -210,7 +216,9 @@ def stability(results: pd.DataFrame) -> pd.DataFrame:
     """
     sweeps = results[results["kind"] == "sweep"]
     table = (
-        sweeps.groupby(["condition", "value", "nominal", "method"], sort=False)[list(sweeps.columns)]
+        sweeps.groupby(["condition", "value", "nominal", "method"], sort=False)[
+            list(sweeps.columns)
+        ]
         .apply(_error_stats)
         .reset_index()
     )
@@ -222,8 +230,8 @@ def stability(results: pd.DataFrame) -> pd.DataFrame:
         table.assign(_k=key)
         .sort_values(["_k", "value"], kind="stable")
         .drop(columns="_k")[
-            ["condition", "value", "nominal", "method"] + [c for c in table.columns if c not in
-                                                           ("condition", "value", "nominal", "method")]
+            ["condition", "value", "nominal", "method"]
+            + [c for c in table.columns if c not in ("condition", "value", "nominal", "method")]
         ]
         .reset_index(drop=True)
     )
@@ -248,13 +256,21 @@ def breakdown(stab: pd.DataFrame, *, threshold_deg: float = BREAKDOWN_P95_DEG) -
     for (cond, method), g in stab.groupby(["condition", "method"], sort=False):
         nominal = float(g["nominal"].iloc[0])
         value, reason = breakdown_point(
-            g["value"], g["p95_abs_error_deg"], g["failure_rate"], nominal, threshold_deg=threshold_deg
+            g["value"],
+            g["p95_abs_error_deg"],
+            g["failure_rate"],
+            nominal,
+            threshold_deg=threshold_deg,
         )
         bad = (g["failure_rate"] > 0) | ~(g["p95_abs_error_deg"] <= threshold_deg)
         if np.isfinite(value):
             dist = np.abs(g["value"] - nominal)
             closer = g[dist < abs(value - nominal)]
-            last_good = closer.loc[(closer["value"] - nominal).abs().idxmax(), "value"] if len(closer) else np.nan
+            last_good = (
+                closer.loc[(closer["value"] - nominal).abs().idxmax(), "value"]
+                if len(closer)
+                else np.nan
+            )
             # the last good value on the same side as the breakdown
             same_side = closer[np.sign(closer["value"] - nominal) == np.sign(value - nominal)]
             if len(same_side):
@@ -303,7 +319,9 @@ def repeatability(results: pd.DataFrame) -> pd.DataFrame:
                 "bias_deg": float(x.mean() - psi) if x.size else np.nan,
                 "sd_deg": float(x.std(ddof=1)) if x.size > 1 else np.nan,
                 "range_deg": float(np.ptp(x)) if x.size else np.nan,
-                "robust_sd_deg": float(1.4826 * np.median(np.abs(x - np.median(x)))) if x.size else np.nan,
+                "robust_sd_deg": float(1.4826 * np.median(np.abs(x - np.median(x))))
+                if x.size
+                else np.nan,
                 "n_ok": int(x_ok.size),
                 "sd_ok_deg": float(x_ok.std(ddof=1)) if x_ok.size > 1 else np.nan,
             }
@@ -338,11 +356,26 @@ def model_choice(results: pd.DataFrame, *, methods: Sequence[str] = ("turning", 
         Columns ``method, condition, value, bulge, truth_constant_curvature, n,
         degree_counts, share_richer, consistent``; empty when no method exposes a degree.
     """
-    columns = ["method", "condition", "value", "bulge", "truth_constant_curvature", "n", "degree_counts",
-               "share_richer", "consistent"]
-    sel = results[results["method"].isin(list(methods)) & (results["kind"] == "sweep") & results["degree"].notna()]
+    columns = [
+        "method",
+        "condition",
+        "value",
+        "bulge",
+        "truth_constant_curvature",
+        "n",
+        "degree_counts",
+        "share_richer",
+        "consistent",
+    ]
+    sel = results[
+        results["method"].isin(list(methods))
+        & (results["kind"] == "sweep")
+        & results["degree"].notna()
+    ]
     rows = []
-    for (method, cond, value, bulge), g in sel.groupby(["method", "condition", "value", "bulge"], sort=False):
+    for (method, cond, value, bulge), g in sel.groupby(
+        ["method", "condition", "value", "bulge"], sort=False
+    ):
         deg = g["degree"].astype(int)
         richer = deg > richer_than
         constant = bool(bulge == 0)
@@ -354,7 +387,9 @@ def model_choice(results: pd.DataFrame, *, methods: Sequence[str] = ("turning", 
                 "bulge": float(bulge),
                 "truth_constant_curvature": constant,
                 "n": len(g),
-                "degree_counts": ";".join(f"{d}:{c}" for d, c in sorted(deg.value_counts().items())),
+                "degree_counts": ";".join(
+                    f"{d}:{c}" for d, c in sorted(deg.value_counts().items())
+                ),
                 "share_richer": float(richer.mean()),
                 "consistent": float((~richer).mean() if constant else richer.mean()),
             }
@@ -380,18 +415,22 @@ def model_choice_summary(choice: pd.DataFrame) -> pd.DataFrame:
             sub = g[mask]
             n = int(sub["n"].sum())
             row[f"n_{key}"] = n
-            row[f"richer_on_{key}"] = float((sub["share_richer"] * sub["n"]).sum() / n) if n else float("nan")
+            row[f"richer_on_{key}"] = (
+                float((sub["share_richer"] * sub["n"]).sum() / n) if n else float("nan")
+            )
         rows.append(row)
-    return pd.DataFrame(rows, columns=["method", "n_constant", "richer_on_constant", "n_bulged", "richer_on_bulged"])
+    return pd.DataFrame(
+        rows, columns=["method", "n_constant", "richer_on_constant", "n_bulged", "richer_on_bulged"]
+    )
 
 
 def model_cost(**kwargs: object) -> pd.DataFrame:
-    """Model quadrature grid size against error and time, from ``pipeline.model.bench``.
+    """Model quadrature grid size against error and time (:mod:`pipeline.study.model_cost`).
 
     Parameters
     ----------
     **kwargs
-        Passed to :func:`pipeline.model.bench.benchmark_model` (grid sizes, repeats, ...).
+        Passed to :func:`pipeline.study.model_cost.benchmark_model` (grid sizes, repeats, ...).
 
     Returns
     -------
@@ -399,7 +438,7 @@ def model_cost(**kwargs: object) -> pd.DataFrame:
         Columns ``grid_n, seconds, max_rel_error`` first, then whatever else the model
         benchmark reports (node counts, forward/inverse split, inverse error in deg).
     """
-    from pipeline.model.bench import benchmark_model
+    from pipeline.study.model_cost import benchmark_model
 
     table = benchmark_model(**kwargs)  # type: ignore[arg-type]
     first = ["grid_n", "seconds", "max_rel_error"]

@@ -1,7 +1,7 @@
 """The scenes of the study: sweeps of one condition at a time, the others nominal.
 
 A :class:`Grid` is a list of :class:`Sweep` (one per condition) plus a repeatability block;
-:func:`cases` expands it into the :class:`Case` list that :mod:`pipeline.bench.run` renders and
+:func:`cases` expands it into the :class:`Case` list that :mod:`pipeline.study.run` renders and
 measures.  Two grids are defined in :data:`GRIDS`:
 
 ``default``
@@ -171,8 +171,19 @@ def cases(grid: Grid, *, base_seed: int = 1) -> list[Case]:
             seed: int | None, overrides: tuple[tuple[str, object], ...]) -> None:
         cid = len(out)
         out.append(
-            Case(cid, kind, sweep_name, float(value), float(nominal), float(psi), float(bulge),
-                 base_seed * 100003 + cid if seed is None else seed, overrides, grid.preset, grid.l0_mm)
+            Case(
+                cid,
+                kind,
+                sweep_name,
+                float(value),
+                float(nominal),
+                float(psi),
+                float(bulge),
+                base_seed * 100003 + cid if seed is None else seed,
+                overrides,
+                grid.preset,
+                grid.l0_mm,
+            )
         )
 
     for sweep in grid.sweeps:
@@ -205,8 +216,30 @@ def get_grid(name: str) -> Grid:
 # ---------------------------------------------------------------------------------------------
 # the two grids
 
-_PSI_DEFAULT = (-360, -330, -270, -190, -180, -170, -90, -30, -3, -1, 0, 1, 3, 30, 90, 170, 180, 190,
-                210, 270, 330, 360)
+_PSI_DEFAULT = (
+    -360,
+    -330,
+    -270,
+    -190,
+    -180,
+    -170,
+    -90,
+    -30,
+    -3,
+    -1,
+    0,
+    1,
+    3,
+    30,
+    90,
+    170,
+    180,
+    190,
+    210,
+    270,
+    330,
+    360,
+)
 _PSI_FULL = tuple(sorted(
     set(range(-360, 361, 30))
     | {-3, -2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2, 3, 5, 10}  # radius unbounded at 0
@@ -224,27 +257,109 @@ def _sweeps(fine: bool) -> tuple[Sweep, ...]:
         return Sweep(name, label, knob, values, float(nominal), psis, **kw)  # type: ignore[arg-type]
 
     sweeps = [
-        Sweep("psi", "true bending angle psi (deg)", "psi_deg",
-              tuple(float(v) for v in (_PSI_FULL if fine else _PSI_DEFAULT)), 0.0, (), 3 if fine else 2),
-        sw("noise", "sensor noise sigma (grey levels)", "noise_sigma",
-           (0, 2.5, 8, 20), (0, 1, 2.5, 5, 8, 12, 20, 30, 45), 2.5),
-        sw("blur", "optical blur sigma (px)", "blur_sigma_px", (0, 0.8, 2, 4), (0, 0.4, 0.8, 1.5, 2, 3, 4, 6, 8), 0.8),
-        sw("jpeg", "JPEG quality (1-100)", "jpeg_quality", (20, 50, 90, 95), (5, 10, 20, 35, 50, 60, 75, 90, 95, 100), 90),
-        sw("contrast", "line contrast (ink opacity, 0-1)", "line_contrast",
-           (0.25, 0.5, 0.95, 1.0), (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 0.95, 1.0), 0.95),
-        sw("resolution", "line length (px)", "line_length_px",
-           (120, 300, 650), (50, 80, 120, 200, 300, 450, 650, 975, 1300), 650),
-        sw("width", "line width (px)", "line_width_px", (1.5, 6, 14), (1, 1.5, 2, 3, 4, 6, 9, 14, 20), 6),
-        sw("occlusion", "occluded fraction of the line (0-0.5)", "occluded_fraction",
-           (0, 0.05, 0.15, 0.3), (0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5), 0),
-        sw("clutter", "grey distractor marks (count)", "distractor_marks", (0, 5, 20), (0, 5, 10, 20, 40), 5),
-        sw("tilt", "camera tilt (deg)", "tilt_deg", (0, 1, 5, 12), (0, 1, 2, 3, 5, 8, 12, 16, 20), 1),
-        sw("bulge", "non-constant curvature (bulge, 0 = arc)", "bulge",
-           (0, 0.2, 0.5), (0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9), 0),
+        Sweep(
+            "psi",
+            "true bending angle psi (deg)",
+            "psi_deg",
+            tuple(float(v) for v in (_PSI_FULL if fine else _PSI_DEFAULT)),
+            0.0,
+            (),
+            3 if fine else 2,
+        ),
+        sw(
+            "noise",
+            "sensor noise sigma (grey levels)",
+            "noise_sigma",
+            (0, 2.5, 8, 20),
+            (0, 1, 2.5, 5, 8, 12, 20, 30, 45),
+            2.5,
+        ),
+        sw(
+            "blur",
+            "optical blur sigma (px)",
+            "blur_sigma_px",
+            (0, 0.8, 2, 4),
+            (0, 0.4, 0.8, 1.5, 2, 3, 4, 6, 8),
+            0.8,
+        ),
+        sw(
+            "jpeg",
+            "JPEG quality (1-100)",
+            "jpeg_quality",
+            (20, 50, 90, 95),
+            (5, 10, 20, 35, 50, 60, 75, 90, 95, 100),
+            90,
+        ),
+        sw(
+            "contrast",
+            "line contrast (ink opacity, 0-1)",
+            "line_contrast",
+            (0.25, 0.5, 0.95, 1.0),
+            (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 0.95, 1.0),
+            0.95,
+        ),
+        sw(
+            "resolution",
+            "line length (px)",
+            "line_length_px",
+            (120, 300, 650),
+            (50, 80, 120, 200, 300, 450, 650, 975, 1300),
+            650,
+        ),
+        sw(
+            "width",
+            "line width (px)",
+            "line_width_px",
+            (1.5, 6, 14),
+            (1, 1.5, 2, 3, 4, 6, 9, 14, 20),
+            6,
+        ),
+        sw(
+            "occlusion",
+            "occluded fraction of the line (0-0.5)",
+            "occluded_fraction",
+            (0, 0.05, 0.15, 0.3),
+            (0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5),
+            0,
+        ),
+        sw(
+            "clutter",
+            "grey distractor marks (count)",
+            "distractor_marks",
+            (0, 5, 20),
+            (0, 5, 10, 20, 40),
+            5,
+        ),
+        sw(
+            "tilt",
+            "camera tilt (deg)",
+            "tilt_deg",
+            (0, 1, 5, 12),
+            (0, 1, 2, 3, 5, 8, 12, 16, 20),
+            1,
+        ),
+        sw(
+            "bulge",
+            "non-constant curvature (bulge, 0 = arc)",
+            "bulge",
+            (0, 0.2, 0.5),
+            (0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9),
+            0,
+        ),
     ]
     if fine:
-        sweeps.insert(-2, sw("clutter_ink", "distractor marks in the line's own ink (count)", "distractor_marks",
-                             (), (0, 1, 2, 5, 10, 20), 0, fixed=(("distractor_color", "line"),)))
+        sweeps.insert(
+            -2,
+            sw(
+                "clutter_ink",
+                "distractor marks in the line's own ink (count)",
+                "distractor_marks",
+                (),
+                (0, 1, 2, 5, 10, 20),
+                0,
+                fixed=(("distractor_color", "line"),),
+            ),
+        )
     return tuple(sweeps)
 
 

@@ -1,6 +1,6 @@
 """Benchmark of the angle measurement: accuracy per method and speed, printed as tables.
 
-``python -m pipeline.measure.bench [--n N] [--seed S]``
+``python -m pipeline bench measure [--n N] [--seed S]``
 
 Accuracy, on synthetic photos with exact ground truth (:mod:`pipeline.synth`):
 
@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Sequence
 from functools import partial
 from pathlib import Path
 
@@ -45,9 +46,9 @@ import pandas as pd
 
 from pipeline.measure.colors import BLACK
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work, measure_decoded, measure_file
-from pipeline.measure.settings import resolve_settings
 from pipeline.measure.estimators import METHODS, algebraic_circle, hyper
-from pipeline.measure.extract import _candidates, _choose, line_mask
+from pipeline.measure.extract import line_component, line_mask
+from pipeline.measure.settings import resolve_settings
 from pipeline.synth import render_actuator, scene_from
 
 L0_MM = 180.0
@@ -73,8 +74,14 @@ def _cases(kind: str, n: int, rng: np.random.Generator) -> list[tuple[float, flo
     if kind == "nominal":
         return [(float(rng.uniform(-300, 300)), 0.0, float(rng.uniform(0, 3))) for _ in range(n)]
     if kind == "near_straight":
-        return [(float(rng.uniform(-3, 3)), 0.0, float(rng.uniform(0, 3))) for _ in range(max(n // 2, 4))]
-    return [(float(rng.uniform(-250, 100)), float(rng.uniform(0.2, 0.6)), 1.0) for _ in range(max(n // 2, 4))]
+        return [
+            (float(rng.uniform(-3, 3)), 0.0, float(rng.uniform(0, 3)))
+            for _ in range(max(n // 2, 4))
+        ]
+    return [
+        (float(rng.uniform(-250, 100)), float(rng.uniform(0.2, 0.6)), 1.0)
+        for _ in range(max(n // 2, 4))
+    ]
 
 
 def accuracy(n: int, seed: int) -> pd.DataFrame:
@@ -90,14 +97,26 @@ def accuracy(n: int, seed: int) -> pd.DataFrame:
                 pts = _profile_curve(psi, "bump" if i % 2 else "tip")
                 r = render_curve(pts, scene, seed=seed * 1000 + i + 100 * len(kind))
             else:
-                r = render_actuator(psi, L0_MM, scene, seed=seed * 1000 + i + 100 * len(kind), bulge=bulge)
+                r = render_actuator(
+                    psi, L0_MM, scene, seed=seed * 1000 + i + 100 * len(kind), bulge=bulge
+                )
             data = np.frombuffer(r.jpeg_bytes, np.uint8)
             img, f = decode_for_work(data, grey=True)  # as measure_file / the workers do
             for method in METHODS:
-                settings = resolve_settings(l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px))
+                settings = resolve_settings(
+                    l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px)
+                )
                 res = measure_decoded(data, img, f, settings, method=method)
-                rows.append({"kind": kind, "method": method, "psi_true": psi, "psi_deg": res.psi_deg,
-                             "error": res.psi_deg - psi, "status": res.status})
+                rows.append(
+                    {
+                        "kind": kind,
+                        "method": method,
+                        "psi_true": psi,
+                        "psi_deg": res.psi_deg,
+                        "error": res.psi_deg - psi,
+                        "status": res.status,
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -119,12 +138,13 @@ def _skeleton_psi(path: Path, mm_per_px: float, fixed_end: tuple[float, float]) 
     img = cv2.imread(str(path))
     mask, _ = line_mask(img, BLACK)
     skel = skeletonize(mask.astype(bool))  # the whole frame, as a straightforward pipeline does
-    cands = _candidates(mask, fixed_end)
-    best, _ = _choose(cands, 0.03 * float(np.hypot(*img.shape[:2])))
-    h, w = best.sub.shape
-    ys, xs = np.nonzero(skel[best.y0 : best.y0 + h, best.x0 : best.x0 + w] & (best.sub > 0))
+    x0, y0, sub = line_component(mask, fixed_end, 0.03 * float(np.hypot(*img.shape[:2])))
+    h, w = sub.shape
+    ys, xs = np.nonzero(skel[y0 : y0 + h, x0 : x0 + w] & (sub > 0))
     pts = np.c_[xs, -ys].astype(float)
-    return float(abs(np.rad2deg(hyper(pts, np.random.default_rng(0)).kappa_per_px / mm_per_px * L0_MM)))
+    return float(
+        abs(np.rad2deg(hyper(pts, np.random.default_rng(0)).kappa_per_px / mm_per_px * L0_MM))
+    )
 
 
 def _median_time(fn, repeats: int = 3) -> float:
@@ -146,7 +166,8 @@ EQUAL_ACCURACY_TOL_DEG = 0.01
 
 
 def _bare_circle_px(data: np.ndarray) -> float:
-    """The least a measurement could do: radius (decoded px) of a Hyper circle through the biggest dark blob.
+    """The least a measurement could do: radius (decoded px) of a Hyper circle through the biggest
+    dark blob.
 
     Decode at 1/4 size in grey, Otsu threshold, largest connected component, algebraic fit of
     its pixels: no colour, no clamp cut, no ordering or sign, no quality checks, and often the
@@ -163,7 +184,8 @@ def _bare_circle_px(data: np.ndarray) -> float:
 
 def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] = SPEED_SIZES,
           repeats: int = 3) -> pd.DataFrame:
-    """Per image: seconds of imread, ours, the skeleton baseline and the decode floor; errors at two tilts.
+    """Per image: seconds of imread, ours, the skeleton baseline and the decode floor; errors at two
+    tilts.
 
     Each image (psi uniform in -300..300, one seed) is rendered twice with the ``lab`` scene:
     with ``tilt_deg=0`` (the estimators' own accuracy) and with the preset's camera tilt (1 deg;
@@ -208,7 +230,9 @@ def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] =
                 r = render_actuator(psi, L0_MM, scene, seed=seed * 500 + i)
                 path = workdir / f"s{width}_{i}_tilt{tilt:g}.jpg"
                 path.write_bytes(r.jpeg_bytes)
-                settings = resolve_settings(l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px))
+                settings = resolve_settings(
+                    l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px)
+                )
                 res, _ = measure_file(path, settings)
                 skel = _skeleton_psi(path, scene.mm_per_px, r.fixed_end_px)
                 if not timing:
@@ -222,11 +246,21 @@ def speed(n: int, seed: int, workdir: Path, sizes: tuple[tuple[int, int], ...] =
                             partial(cv2.imdecode, data, cv2.IMREAD_REDUCED_GRAYSCALE_8), repeats),
                         "bare_s": _median_time(partial(_bare_circle_px, data), repeats),
                     }
-                rows.append({"size": f"{width}x{height}", "image": i, "tilt_deg": tilt, "psi_true": psi,
-                             "ours_psi": res.psi_deg, "ours_status": res.status, "skeleton_psi": skel,
-                             "ours_abs_err": abs(res.psi_deg - psi),
-                             "ours_absmag_err": abs(abs(res.psi_deg) - abs(psi)),
-                             "skeleton_absmag_err": abs(skel - abs(psi)), **timing})
+                rows.append(
+                    {
+                        "size": f"{width}x{height}",
+                        "image": i,
+                        "tilt_deg": tilt,
+                        "psi_true": psi,
+                        "ours_psi": res.psi_deg,
+                        "ours_status": res.status,
+                        "skeleton_psi": skel,
+                        "ours_abs_err": abs(res.psi_deg - psi),
+                        "ours_absmag_err": abs(abs(res.psi_deg) - abs(psi)),
+                        "skeleton_absmag_err": abs(skel - abs(psi)),
+                        **timing,
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -264,8 +298,11 @@ def speed_table(sp: pd.DataFrame) -> pd.DataFrame:
     return tab
 
 
-def _bootstrap_median_ci(d: np.ndarray, rng: np.random.Generator, resamples: int) -> tuple[float, float]:
-    """Percentile 95 % bootstrap interval of the median of ``d`` (no interpolation, so inf is kept)."""
+def _bootstrap_median_ci(
+    d: np.ndarray, rng: np.random.Generator, resamples: int
+) -> tuple[float, float]:
+    """Percentile 95 % bootstrap interval of the median of ``d`` (no interpolation, so inf is
+    kept)."""
     idx = rng.integers(0, d.size, size=(resamples, d.size))
     lo, hi = np.percentile(np.median(d[idx], axis=1), [2.5, 97.5], method="inverted_cdf")
     return float(lo), float(hi)
@@ -303,11 +340,20 @@ def paired_accuracy(sp: pd.DataFrame, seed: int, resamples: int = 2000) -> pd.Da
         skel = g["skeleton_absmag_err"].fillna(np.inf).to_numpy(float)
         d = np.where(ours == skel, 0.0, ours - skel)  # inf - inf would be NaN: both failed = a tie
         lo, hi = _bootstrap_median_ci(d, rng, resamples)
-        out.append({"size": size, "tilt_deg": tilt, "n": len(g),
-                    "ours_med_err": float(g["ours_abs_err"].fillna(np.inf).median()),
-                    "ours_|psi|_med_err": float(np.median(ours)), "skel_|psi|_med_err": float(np.median(skel)),
-                    "med_diff": float(np.median(d)), "ci_lo": lo, "ci_hi": hi,
-                    "ours_as_good": float(np.mean(d <= 0))})
+        out.append(
+            {
+                "size": size,
+                "tilt_deg": tilt,
+                "n": len(g),
+                "ours_med_err": float(g["ours_abs_err"].fillna(np.inf).median()),
+                "ours_|psi|_med_err": float(np.median(ours)),
+                "skel_|psi|_med_err": float(np.median(skel)),
+                "med_diff": float(np.median(d)),
+                "ci_lo": lo,
+                "ci_hi": hi,
+                "ours_as_good": float(np.mean(d <= 0)),
+            }
+        )
     return pd.DataFrame(out)
 
 
@@ -344,19 +390,31 @@ def print_speed(sp: pd.DataFrame, seed: int) -> None:
     fmt = "{:.3f}".format
     tab = speed_table(sp)
     print("\n== speed per image (ms, median over images; median of 3 runs each; 1 OpenCV thread)")
-    print("   decode_floor = cv2.imdecode(bytes, IMREAD_REDUCED_GRAYSCALE_8); max_speedup = skeleton / decode_floor")
-    print("   bare = decode at 1/4 + Otsu + largest component + Hyper fit, no checks (timed, never scored)")
+    print(
+        "   decode_floor = cv2.imdecode(bytes, IMREAD_REDUCED_GRAYSCALE_8); max_speedup = skeleton "
+        "/ decode_floor"
+    )
+    print(
+        "   bare = decode at 1/4 + Otsu + largest component + Hyper fit, no checks (timed, never "
+        "scored)"
+    )
     print(tab.to_string(float_format=fmt))
     paired = paired_accuracy(sp, seed)
     print("\n== accuracy on the same images (deg; errors on |psi|, the baseline has no sign; "
           "diff = |err_ours| - |err_skel|, 95 % bootstrap CI of its median)")
     print(paired.to_string(index=False, float_format=fmt))
-    print(f"\n   rule: 'met' = skeleton/ours >= {TARGET_SPEEDUP:g} and, at tilt 0, the CI upper bound of "
-          f"the median diff <= {EQUAL_ACCURACY_TOL_DEG:g} deg")
+    print(
+        f"\n   rule: 'met' = skeleton/ours >= {TARGET_SPEEDUP:g} and, at tilt 0, the CI upper "
+        "bound of "
+        f"the median diff <= {EQUAL_ACCURACY_TOL_DEG:g} deg"
+    )
     for size, v in verdicts(tab, paired).items():
-        print(f"   {size}: {TARGET_SPEEDUP:g}x at equal or better accuracy: {v} "
-              f"(skeleton/ours {tab.loc[size, 'skeleton/ours']:.1f}x, at most {tab.loc[size, 'max_speedup']:.1f}x "
-              "for any method that decodes the file)")
+        print(
+            f"   {size}: {TARGET_SPEEDUP:g}x at equal or better accuracy: {v} "
+            f"(skeleton/ours {tab.loc[size, 'skeleton/ours']:.1f}x, at most "
+            f"{tab.loc[size, 'max_speedup']:.1f}x "
+            "for any method that decodes the file)"
+        )
 
 
 def _scaling_set(folder: Path, renders: list, scene, copies: int) -> None:
@@ -371,9 +429,19 @@ def _scaling_set(folder: Path, renders: list, scene, copies: int) -> None:
             name = f"p{i:03d}.jpg" if trial == 0 else f"p{i:03d}_t{trial}.jpg"
             if trial:
                 (folder / name).hardlink_to(folder / f"p{i:03d}.jpg")
-            rows.append({"image": name, "pressure_kpa": float(i), "direction": "up", "material": "DS20",
-                         "actuator": "A1", "trial": str(trial + 1), "step": i,
-                         "fixed_end_x": r.fixed_end_px[0], "fixed_end_y": r.fixed_end_px[1]})
+            rows.append(
+                {
+                    "image": name,
+                    "pressure_kpa": float(i),
+                    "direction": "up",
+                    "material": "DS20",
+                    "actuator": "A1",
+                    "trial": str(trial + 1),
+                    "step": i,
+                    "fixed_end_x": r.fixed_end_px[0],
+                    "fixed_end_y": r.fixed_end_px[1],
+                }
+            )
     write_manifest(folder, pd.DataFrame(rows))
     write_settings(folder, {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px})
 
@@ -402,11 +470,24 @@ def scaling(n: int, seed: int, workdir: Path, copies: int = COPIES) -> dict[str,
     return out
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print its tables."""
-    ap = argparse.ArgumentParser(prog="python -m pipeline.measure.bench", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--n", type=int, default=60, help="nominal images for accuracy (half as many near-straight and bulged)")
-    ap.add_argument("--n-speed", type=int, default=40, help="images per resolution for the speed and paired accuracy tables (40: the paired CI at 4000x3000 is then about +-0.007 deg; 16 leaves it too wide to decide)")
+    ap = argparse.ArgumentParser(
+        prog="python -m pipeline bench measure", description=__doc__.split("\n\n")[0]
+    )
+    ap.add_argument(
+        "--n",
+        type=int,
+        default=60,
+        help="nominal images for accuracy (half as many near-straight and bulged)",
+    )
+    ap.add_argument(
+        "--n-speed",
+        type=int,
+        default=40,
+        help="images per resolution for the speed and paired accuracy tables (40: the paired CI at "
+             "4000x3000 is then about +-0.007 deg; 16 leaves it too wide to decide)",
+    )
     ap.add_argument("--n-set", type=int, default=32, help="photos in the --jobs scaling set")
     ap.add_argument("--seed", type=int, default=1, help="seed of the synthetic cases")
     args = ap.parse_args(argv)

@@ -57,7 +57,12 @@ RC: dict[str, object] = {
 }
 
 #: material -> colour (the paper's four silicones; others get the colours below in name order)
-MATERIAL_COLORS: dict[str, str] = {"DS20": "#1f77b4", "DS30": "#ff7f0e", "SS40": "#2ca02c", "SS50": "#d62728"}
+MATERIAL_COLORS: dict[str, str] = {
+    "DS20": "#1f77b4",
+    "DS30": "#ff7f0e",
+    "SS40": "#2ca02c",
+    "SS50": "#d62728",
+}
 _OTHER_COLORS = ("#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
 
 Color = tuple[float, float, float]
@@ -75,7 +80,9 @@ def footer_fraction(size_in: tuple[float, float]) -> float:
     return FOOTER_PT / (72.0 * size_in[1])
 
 
-def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, top_pt: float = 0.0) -> Figure:
+def page(
+    landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, top_pt: float = 0.0
+) -> Figure:
     """A new A4 page; constrained layout places its axes above the footer band.
 
     Parameters
@@ -86,7 +93,7 @@ def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, to
         Name of the page (``Figure.get_label()``), e.g. ``"summary"``; tests find pages by it.
     bottom_pt, top_pt : float
         Extra bands (pt) kept free of axes at the bottom (above the footer) and at the top, for
-        text or tables placed with :class:`pipeline.report.typeset.Flow`.
+        text or tables placed with :class:`pipeline.layout.typeset.Flow`.
 
     Returns
     -------
@@ -96,7 +103,9 @@ def page(landscape: bool = False, *, label: str = "", bottom_pt: float = 0.0, to
     height_pt = 72.0 * size[1]
     bottom = (FOOTER_PT + bottom_pt) / height_pt
     top = top_pt / height_pt
-    fig = Figure(figsize=size, layout=ConstrainedLayoutEngine(rect=(0.0, bottom, 1.0, 1.0 - bottom - top)))
+    fig = Figure(
+        figsize=size, layout=ConstrainedLayoutEngine(rect=(0.0, bottom, 1.0, 1.0 - bottom - top))
+    )
     fig.set_label(label)
     return fig
 

@@ -1,6 +1,6 @@
-"""Speed and accuracy of the model against the quadrature size (prints figures; not a timed test).
+"""Time and error of the model against its quadrature grid size: the study's ``model_cost.csv``.
 
-``python -m pipeline model bench`` or ``python -m pipeline.model.bench``.
+``python -m pipeline bench model`` prints the table (:mod:`pipeline.bench.model`).
 """
 
 from __future__ import annotations
@@ -82,13 +82,13 @@ def benchmark_model(
     """
     table = load_materials()
     mats: list[Material] = [table[m] for m in materials]
-    psi = np.linspace(210.0, -360.0, n_angles)
+    psi = {m.name: np.linspace(m.psi0_deg, -360.0, n_angles) for m in mats}
     ref_kw = {**options, **grid_options(reference_n)}
     ref_p = {}
     pressures = {}
     ref_psi = {}
     for m in mats:
-        ref_p[m.name], _ = pressure_core(m, np.radians(psi), make_options(**ref_kw))
+        ref_p[m.name], _ = pressure_core(m, np.radians(psi[m.name]), make_options(**ref_kw))
         top = float(np.nanmax(ref_p[m.name])) if np.isfinite(ref_p[m.name]).any() else 0.0
         pressures[m.name] = np.linspace(0.0, top, n_pressures)
         ref_psi[m.name] = psi_deg(m, pressures[m.name], **ref_kw)
@@ -98,7 +98,7 @@ def benchmark_model(
 
         def forward(kw: dict[str, Any] = kw) -> None:
             for m in mats:
-                pressure_core(m, np.radians(psi), make_options(**kw))
+                pressure_core(m, np.radians(psi[m.name]), make_options(**kw))
 
         def inverse(kw: dict[str, Any] = kw) -> None:
             for m in mats:
@@ -108,7 +108,7 @@ def benchmark_model(
         t_inv, c_inv = _best_time(inverse, repeats)
         rel, dpsi = 0.0, 0.0
         for m in mats:
-            p, _ = pressure_core(m, np.radians(psi), make_options(**kw))
+            p, _ = pressure_core(m, np.radians(psi[m.name]), make_options(**kw))
             ok = np.isfinite(p) & np.isfinite(ref_p[m.name]) & (np.abs(ref_p[m.name]) > 1e-9)
             if ok.any():
                 rel = max(rel, float(np.max(np.abs(p[ok] / ref_p[m.name][ok] - 1.0))))
@@ -131,32 +131,3 @@ def benchmark_model(
             }
         )
     return pd.DataFrame(rows)
-
-
-def format_benchmark(df: pd.DataFrame) -> str:
-    """Human-readable table of :func:`benchmark_model` (times in ms)."""
-    out = df.copy()
-    for col in ("forward_seconds", "inverse_seconds", "seconds", "cpu_seconds"):
-        out[col.replace("seconds", "ms")] = (out.pop(col) * 1e3).round(3)
-    return out.to_string(index=False, float_format=lambda v: f"{v:.3g}")
-
-
-def main() -> int:
-    """Print the benchmark (4 materials x 400 angles forward + 400 pressures inverse)."""
-    df = benchmark_model()
-    print(
-        "model benchmark: 4 materials x 400 angles (forward) + 400 pressures (loading inverse), "
-        "one process"
-    )
-    print(format_benchmark(df))
-    default = df[df.grid_n == 4]
-    if len(default):
-        print(
-            f"default grid (grid_n=4): {1e3 * float(default.seconds.iloc[0]):.2f} ms wall, "
-            f"{1e3 * float(default.cpu_seconds.iloc[0]):.2f} ms CPU in total (target < 10 ms)"
-        )
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,7 +1,7 @@
 """Rendering benchmark: the default synthetic campaign, images per second; or one photo per scene.
 
-``python -m pipeline.synth.bench [--quick] [--jobs N] [--scene lab] [--out DIR]``
-``python -m pipeline.synth.bench --photos [--repeats R]``
+``python -m pipeline bench synth [--quick] [--jobs N] [--scene lab] [--out DIR]``
+``python -m pipeline bench synth --photos [--repeats R]``
 
 The default campaign is 4 materials x 3 actuators x 6 trials of full ramps (10 kPa steps up to
 260 kPa or psi = -psi0 and back) at 1280x960 JPEG; the target is under 2 minutes on 2 cores.
@@ -22,6 +22,7 @@ import os
 import shutil
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 MATERIALS = ("DS20", "DS30", "SS40", "SS50")
@@ -42,7 +43,7 @@ def photo_times(preset: str, width: int, height: int, repeats: int = 5) -> dict[
     from pipeline.synth.camera import make_camera
     from pipeline.synth.centreline import actuator_centreline_mm
     from pipeline.synth.presets import scene_from
-    from pipeline.synth.scene import _compose, world_extent_mm
+    from pipeline.synth.scene import compose_photo, world_extent_mm
 
     cv2.setNumThreads(1)
     scene = scene_from(preset, width=width, height=height)
@@ -54,7 +55,14 @@ def photo_times(preset: str, width: int, height: int, repeats: int = 5) -> dict[
         w0, c0 = time.perf_counter(), time.process_time()
         backdrop = make_backdrop(scene, camera, seed=child_seed(1, k), keepout_mm=curves)
         w1, c1 = time.perf_counter(), time.process_time()
-        r = _compose(curves[k % len(curves)], scene, camera, backdrop, scene.body_width_mm, np.random.default_rng(k))
+        r = compose_photo(
+            curves[k % len(curves)],
+            scene,
+            camera,
+            backdrop,
+            scene.body_width_mm,
+            np.random.default_rng(k),
+        )
         w2 = time.perf_counter()
         _ = r.jpeg_bytes
         w3, c3 = time.perf_counter(), time.process_time()
@@ -68,31 +76,62 @@ def photos_report(repeats: int) -> None:
     """Print :func:`photo_times` for every preset and size, with ratios to ``lab``."""
     from pipeline.synth.presets import SCENE_PRESETS
 
-    print(f"synth photo bench: one core, median of {repeats}, seconds (wall clock; cpu = this process's CPU time); "
-          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus")
+    print(
+        f"synth photo bench: one core, median of {repeats}, seconds (wall clock; cpu = this "
+        "process's CPU time); "
+        f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cpus"
+    )
     for width, height in PHOTO_SIZES:
-        print(f"  {width}x{height}  {'scene':17s} {'backdrop':>8s} {'photo':>7s} {'jpeg':>6s} {'per photo':>9s} "
-              f"{'/ lab':>6s} {'cpu':>6s} {'alone':>7s} {'cpu':>6s}")
+        print(
+            f"  {width}x{height}  {'scene':17s} {'backdrop':>8s} {'photo':>7s} {'jpeg':>6s} "
+            f"{'per photo':>9s} "
+            f"{'/ lab':>6s} {'cpu':>6s} {'alone':>7s} {'cpu':>6s}"
+        )
         base = photo_times("lab", width, height, repeats)
         for preset in ["lab", *(p for p in SCENE_PRESETS if p != "lab")]:
             t = base if preset == "lab" else photo_times(preset, width, height, repeats)
-            print(f"  {'':{len(str(width)) + len(str(height)) + 1}s}  {preset:17s} {t['backdrop']:8.3f} {t['photo']:7.3f} "
-                  f"{t['jpeg']:6.3f} {t['per_photo']:9.3f} {t['per_photo'] / base['per_photo']:6.2f} "
-                  f"{t['per_photo_cpu']:6.3f} {t['single']:7.3f} {t['single_cpu']:6.3f}")
-    print("  per photo = photo + jpeg (a ramp reuses its backdrop); alone = one photo with its own backdrop; "
-          "target: a 1280x960 body photo < 0.2 s")
+            print(
+                f"  {'':{len(str(width)) + len(str(height)) + 1}s}  {preset:17s} "
+                f"{t['backdrop']:8.3f} {t['photo']:7.3f} "
+                f"{t['jpeg']:6.3f} {t['per_photo']:9.3f} {t['per_photo'] / base['per_photo']:6.2f} "
+                f"{t['per_photo_cpu']:6.3f} {t['single']:7.3f} {t['single_cpu']:6.3f}"
+            )
+    print(
+        "  per photo = photo + jpeg (a ramp reuses its backdrop); alone = one photo with its own "
+        "backdrop; "
+        "target: a 1280x960 body photo < 0.2 s"
+    )
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark and print images/s per material and in total."""
     from pipeline.synth.photoset_writer import render_photoset
 
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="1 actuator x 1 trial per material instead of 3 x 6")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes (default: all cores)")
+    p = argparse.ArgumentParser(
+        prog="python -m pipeline bench synth",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "--quick", action="store_true", help="1 actuator x 1 trial per material instead of 3 x 6"
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="worker processes (default: all cores)",
+    )
     p.add_argument("--scene", default="lab", help="scene preset (default lab)")
-    p.add_argument("--out", default=None, help="keep the photo sets in this folder (default: a temporary one, deleted)")
-    p.add_argument("--photos", action="store_true", help="time one photo per preset and size instead of the campaign")
+    p.add_argument(
+        "--out",
+        default=None,
+        help="keep the photo sets in this folder (default: a temporary one, deleted)",
+    )
+    p.add_argument(
+        "--photos",
+        action="store_true",
+        help="time one photo per preset and size instead of the campaign",
+    )
     p.add_argument("--repeats", type=int, default=5, help="runs per figure of --photos (default 5)")
     args = p.parse_args(argv)
     if args.photos:
@@ -101,19 +140,32 @@ def main(argv: list[str] | None = None) -> int:
     actuators, trials = (1, 1) if args.quick else (3, 6)
     root = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="synth_bench_"))
     total_n, total_t, total_bytes = 0, 0.0, 0
-    print(f"synth bench: {len(MATERIALS)} materials x {actuators} x {trials} ramps, scene {args.scene}, "
-          f"1280x960 JPEG, jobs {args.jobs}, cpus {os.cpu_count()}")
+    print(
+        f"synth bench: {len(MATERIALS)} materials x {actuators} x {trials} ramps, scene "
+        f"{args.scene}, "
+        f"1280x960 JPEG, jobs {args.jobs}, cpus {os.cpu_count()}"
+    )
     try:
         for material in MATERIALS:
             out = root / material
             t0 = time.perf_counter()
-            truth = render_photoset(out, material, actuators=actuators, trials=trials, seed=1, scene=args.scene,
-                                    jobs=args.jobs)
+            truth = render_photoset(
+                out,
+                material,
+                actuators=actuators,
+                trials=trials,
+                seed=1,
+                scene=args.scene,
+                jobs=args.jobs,
+            )
             dt = time.perf_counter() - t0
             size = sum(f.stat().st_size for f in out.glob("*.jpg"))
             total_n, total_t, total_bytes = total_n + len(truth), total_t + dt, total_bytes + size
-            print(f"  {material}: {len(truth):5d} images in {dt:6.1f} s = {len(truth) / dt:6.1f} images/s, "
-                  f"{size / len(truth) / 1024:.0f} KiB/image")
+            print(
+                f"  {material}: {len(truth):5d} images in {dt:6.1f} s = {len(truth) / dt:6.1f} "
+                "images/s, "
+                f"{size / len(truth) / 1024:.0f} KiB/image"
+            )
         print(f"  total: {total_n} images in {total_t:.1f} s = {total_n / total_t:.1f} images/s "
               f"({total_bytes / 2**20:.0f} MiB); target for the full campaign: < 120 s")
     finally:

@@ -1,6 +1,6 @@
 """Render every scene of a grid and measure it with every angle method the way the pipeline does.
 
-For each :class:`~pipeline.bench.grids.Case` one worker renders the photo with
+For each :class:`~pipeline.study.grids.Case` one worker renders the photo with
 :func:`pipeline.synth.render_actuator`, writes its JPEG bytes (the scene's quality) to a file and
 measures that file once per method of :data:`pipeline.measure.METHODS` through
 :func:`pipeline.measure.worker.run_task` -- the very function
@@ -25,14 +25,13 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from pipeline.bench.grids import Case
+from pipeline.study.grids import Case
 
 #: columns of the per-image results table, in order
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -103,12 +102,26 @@ def measure_case(case: Case, methods: Sequence[str], workdir: str | Path) -> lis
             row = run_task(Task(str(path), settings, method))
             err = row["psi_deg"] - case.psi_deg
             out[method] = {
-                "case_id": case.case_id, "kind": case.kind, "condition": case.condition, "value": case.value,
-                "nominal": case.nominal, "psi_true_deg": case.psi_deg, "bulge": case.bulge, "seed": case.seed,
-                "width_px": scene.width, "line_length_px": case.l0_mm / scene.mm_per_px, "method": method,
-                "psi_deg": row["psi_deg"], "error_deg": err, "abs_error_deg": abs(err), "status": row["status"],
-                "reason": row["reason"], "degree": np.nan if row["degree"] is None else float(row["degree"]),
-                "residual_px": row["residual_px"], "seconds": row["seconds"], "decode_seconds": decode_s,
+                "case_id": case.case_id,
+                "kind": case.kind,
+                "condition": case.condition,
+                "value": case.value,
+                "nominal": case.nominal,
+                "psi_true_deg": case.psi_deg,
+                "bulge": case.bulge,
+                "seed": case.seed,
+                "width_px": scene.width,
+                "line_length_px": case.l0_mm / scene.mm_per_px,
+                "method": method,
+                "psi_deg": row["psi_deg"],
+                "error_deg": err,
+                "abs_error_deg": abs(err),
+                "status": row["status"],
+                "reason": row["reason"],
+                "degree": np.nan if row["degree"] is None else float(row["degree"]),
+                "residual_px": row["residual_px"],
+                "seconds": row["seconds"],
+                "decode_seconds": decode_s,
                 "render_seconds": render_s,
             }
     finally:
@@ -133,7 +146,7 @@ def run_grid(
     Parameters
     ----------
     cases : sequence of Case
-        From :func:`pipeline.bench.grids.cases`.
+        From :func:`pipeline.study.grids.cases`.
     methods : sequence of str, optional
         Methods to compare (default: every key of :data:`pipeline.measure.METHODS`).
     jobs : int
@@ -171,8 +184,3 @@ def run_grid(
                 if progress:
                     progress(min((i + 1) * size, len(cases)), len(cases))
     return pd.DataFrame(rows, columns=list(RESULT_COLUMNS))
-
-
-def cases_table(cases: Sequence[Case]) -> pd.DataFrame:
-    """The cases as a table (what was rendered), for the record."""
-    return pd.DataFrame([{**asdict(c), "overrides": ";".join(f"{k}={v}" for k, v in c.overrides)} for c in cases])

@@ -1,0 +1,38 @@
+"""``photoset check`` of any photo set: the format's problems and, for a video set, its videos'.
+
+:mod:`pipeline.photoset` checks the format (``photoset.yaml``, the manifest rows, the settings,
+the images and calibrations); :mod:`pipeline.video.clips` checks the videos and pressure logs of a
+video set.  :func:`check_photoset` loads the set once and asks both.
+"""
+
+from __future__ import annotations
+
+import os
+
+from pipeline.photoset import Problem, file_problems, load_checked
+from pipeline.video.clips import clip_problems
+
+
+def check_photoset(
+    folder: str | os.PathLike[str],
+    *,
+    decode_images: bool = True,
+    require_images: bool = True,
+    warnings: bool = False,
+) -> list[Problem]:
+    """Every problem of a photo set (of images or videos), each naming the file, line and fix.
+
+    Parameters are those of :func:`pipeline.photoset.validate_photoset`; for a video set
+    ``decode_images`` reads every frame and ``require_images`` reports missing videos and logs.
+
+    Returns
+    -------
+    list of Problem
+        Empty when the set is valid (and, with ``warnings``, nothing is doubtful).
+    """
+    ps, problems = load_checked(folder)
+    if ps is not None:
+        if ps.is_video:
+            problems += clip_problems(ps, decode=decode_images, require_files=require_images)
+        problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
+    return [p for p in problems if warnings or not p.warning]
