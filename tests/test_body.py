@@ -204,3 +204,17 @@ def test_a_tube_longer_than_the_body_is_never_an_ok_psi():
     cv2.line(img, (int(min(x0, x3)), y_mid), (0, y_mid), (90, 140, 200), 12, cv2.LINE_AA)
     res = measure_image(img, settings_for(fe))
     assert res.status != "ok" or res.psi_deg == pytest.approx(120.0, abs=5.0), res.reason
+
+
+def test_realscenes_bench_prints_its_tables_at_the_size_asked(capsys):
+    from pipeline.bench.realscenes import main
+
+    args = ["--n", "1", "--size", "640x360", "--no-fixed-direction", "--dev-set", "/nonexistent"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "median time per 640x360 photo" in out
+    assert "fixed_direction_deg given" not in out
+    for scene in ("green_fibre", "grey_dots", "grey_dots_clear", "dark_translucent", "lab_body"):
+        assert scene in out
+    with pytest.raises(SystemExit):
+        main(["--size", "wide"])
