@@ -45,3 +45,22 @@ def test_a_folder_without_tables_gives_no_page_and_a_strip_needs_overlays(measur
     assert write_strip(measured, tmp_path / "no-overlays", tmp_path) is None
     write_continuous(measured.assign(psi_deg=np.nan, status="failed"), tmp_path / "all_failed")
     assert len(figures(tmp_path / "all_failed")) == 1  # every frame failed: the page still says so
+
+
+def test_video_pages_have_no_overlaps_no_small_fonts_nothing_on_the_footer(measured, tmp_path):
+    from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
+    from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
+
+    write_continuous(measured, tmp_path / "continuous" / "steps")
+    with report_style():
+        figs = figures(tmp_path / "continuous" / "steps")
+        assert figs
+        for fig in figs:
+            texts = drawn_texts(fig)
+            assert len(texts) > 5
+            assert overlapping_texts(texts) == []
+            assert [(t.text, t.size_pt) for t in texts if t.size_pt < MIN_FONT_PT] == []
+            on_footer = [
+                t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5
+            ]
+            assert on_footer == []

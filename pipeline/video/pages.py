@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from pipeline.layout.style import A4_PORTRAIT_IN, footer_fraction, text_page
+from pipeline.layout.style import A4_PORTRAIT_IN, MIN_FONT_PT, footer_fraction, text_page
 
 #: step rows shown in the table (the rest are counted)
 MAX_TABLE_ROWS = 12
@@ -147,7 +147,9 @@ def figures(folder: Path) -> list[Figure]:
     ax_p.grid(False)
     lines = ax_t.get_legend_handles_labels()
     more = ax_p.get_legend_handles_labels()
-    ax_t.legend(lines[0] + more[0], lines[1] + more[1], loc="upper right", fontsize=6.5, ncol=2)
+    ax_t.legend(
+        lines[0] + more[0], lines[1] + more[1], loc="upper right", fontsize=MIN_FONT_PT, ncol=2
+    )
     ax_t.set_title("Every frame measured (medians of short time bins)", fontsize=9)
 
     ax_l = fig.add_subplot(grid[1, 0])
@@ -169,7 +171,7 @@ def figures(folder: Path) -> list[Figure]:
     ax_l.set_ylabel("psi (deg)")
     ax_l.set_title("Hysteresis loops (binned by pressure)", fontsize=9)
     if len(loops):
-        ax_l.legend(fontsize=6, loc="best")
+        ax_l.legend(fontsize=MIN_FONT_PT, loc="best")
 
     ax_s = fig.add_subplot(grid[1, 1])
     if len(settling):
@@ -184,7 +186,7 @@ def figures(folder: Path) -> list[Figure]:
         ax_s.axhline(1.0, color="0.5", lw=0.6)
         ax_s.plot([], [], color="C0", label="steps up")
         ax_s.plot([], [], color="C1", label="steps down")
-        ax_s.legend(fontsize=6.5, loc="lower right")
+        ax_s.legend(fontsize=MIN_FONT_PT, loc="lower right")
         ax_s.set_title("Settling after each step", fontsize=9)
     else:
         ax_s.text(
@@ -251,7 +253,7 @@ def figures(folder: Path) -> list[Figure]:
             cellLoc="center",
         )
         table.auto_set_font_size(False)
-        table.set_fontsize(6.5)
+        table.set_fontsize(MIN_FONT_PT)
         table.scale(1.0, 1.15)
         more_rows = len(steps) - len(shown)
         ax_tab.set_title(
