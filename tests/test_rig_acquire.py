@@ -21,7 +21,9 @@ import pandas as pd
 import pytest
 
 from pipeline.photoset import load_photoset, validate_photoset
-from pipeline.rig.acquire import EXIT_CODES
+from pipeline.rig.acquire import EXIT_CODES, failure_status
+from pipeline.rig.cameras import CameraError
+from pipeline.rig.driver import EStopError, LimitError, PortLostError, RigError
 from pipeline.rig.emulator import Emulator, Faults, PlantParams
 
 REPO = Path(__file__).resolve().parents[1]
@@ -463,3 +465,21 @@ def test_rig_benchmark_times_a_real_live_measurement():
     costs = synthetic_costs(2)
     assert costs["live_psi_measured"] == 2
     assert costs["live_psi_measure_median_ms"] > 0
+
+
+@pytest.mark.parametrize(
+    ("exc", "status"),
+    [
+        (KeyboardInterrupt(), "interrupted"),
+        (EStopError("EVT ESTOP"), "estop"),
+        (PortLostError("port gone"), "port_lost"),
+        (CameraError("no frame"), "camera"),
+        (LimitError("over max", sent=True), "limit"),
+        (RigError("other rig trouble"), "error"),
+        (ValueError("bug"), "error"),
+    ],
+)
+def test_every_failure_of_a_run_has_its_status_and_exit_code(exc, status):
+    got, message = failure_status(exc)
+    assert got == status and message
+    assert got in EXIT_CODES

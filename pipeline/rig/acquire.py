@@ -37,7 +37,7 @@ from pipeline.measure.settings import MeasureSettings, SettingsError, resolve_se
 from pipeline.photoset import MANIFEST, append_manifest_rows, write_manifest, write_settings
 from pipeline.rig import session
 from pipeline.rig.cameras import Camera, CameraError, Shot
-from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
+from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError
 
 if TYPE_CHECKING:
     from typing_extensions import Self
@@ -114,6 +114,29 @@ class SessionResult:
     @property
     def exit_code(self) -> int:
         return EXIT_CODES[self.status]
+
+
+def failure_status(exc: BaseException) -> tuple[str, str]:
+    """How a run that raised ``exc`` ended: its :class:`SessionResult` status and message.
+
+    Examples
+    --------
+    >>> failure_status(KeyboardInterrupt())
+    ('interrupted', 'interrupted (Ctrl-C / SIGTERM)')
+    >>> failure_status(ValueError("bad"))
+    ('error', 'ValueError: bad')
+    """
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted", "interrupted (Ctrl-C / SIGTERM)"
+    if isinstance(exc, EStopError):
+        return "estop", str(exc)
+    if isinstance(exc, PortLostError):
+        return "port_lost", str(exc)
+    if isinstance(exc, CameraError):
+        return "camera", f"camera failed: {exc}"
+    if isinstance(exc, LimitError):
+        return "limit", str(exc)
+    return "error", f"{type(exc).__name__}: {exc}"
 
 
 class _Interrupts:
@@ -369,19 +392,10 @@ def run_session(
             driver.vent()
             if watchdog:
                 driver.set_watchdog(0.0)
-    except KeyboardInterrupt:
-        result.status, result.message = "interrupted", "interrupted (Ctrl-C / SIGTERM)"
-    except EStopError as exc:
-        result.status, result.message = "estop", str(exc)
-    except PortLostError as exc:
-        result.status, result.message = "port_lost", str(exc)
-    except CameraError as exc:
-        result.status, result.message = "camera", f"camera failed: {exc}"
-    except LimitError as exc:
-        result.status, result.message = "limit", str(exc)
-    except (RigError, Exception) as exc:  # noqa: BLE001 - any failure must still vent and report
-        result.status, result.message = "error", f"{type(exc).__name__}: {exc}"
-        traceback.print_exc(file=stream)
+    except (KeyboardInterrupt, Exception) as exc:  # noqa: BLE001 - any failure must still vent and report
+        result.status, result.message = failure_status(exc)
+        if result.status == "error":
+            traceback.print_exc(file=stream)
     finally:
         bar.close()
         if result.status != "done":

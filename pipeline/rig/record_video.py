@@ -32,9 +32,9 @@ from pipeline.errors import UserInputError
 from pipeline.fileio import write_table
 from pipeline.photoset import MANIFEST, append_manifest_rows, is_video_manifest, write_settings
 from pipeline.rig import session
-from pipeline.rig.acquire import SessionResult, _Interrupts
+from pipeline.rig.acquire import SessionResult, _Interrupts, failure_status
 from pipeline.rig.cameras import CameraError
-from pipeline.rig.driver import EStopError, LimitError, PicoDriver, PortLostError, RigError
+from pipeline.rig.driver import PicoDriver
 from pipeline.rig.video_cameras import VideoRecorder
 from pipeline.video.profile import PressureProfile
 
@@ -271,19 +271,10 @@ def run_video_session(driver: PicoDriver, recorder: VideoRecorder, cfg: VideoSes
             driver.vent()
             if cfg.watchdog_s > 0:
                 driver.set_watchdog(0.0)
-    except KeyboardInterrupt:
-        result.status, result.message = "interrupted", "interrupted (Ctrl-C / SIGTERM)"
-    except EStopError as exc:
-        result.status, result.message = "estop", str(exc)
-    except PortLostError as exc:
-        result.status, result.message = "port_lost", str(exc)
-    except CameraError as exc:
-        result.status, result.message = "camera", f"camera failed: {exc}"
-    except LimitError as exc:
-        result.status, result.message = "limit", str(exc)
-    except (RigError, Exception) as exc:  # noqa: BLE001 - any failure must still vent and report
-        result.status, result.message = "error", f"{type(exc).__name__}: {exc}"
-        traceback.print_exc(file=stream)
+    except (KeyboardInterrupt, Exception) as exc:  # noqa: BLE001 - any failure must still vent and report
+        result.status, result.message = failure_status(exc)
+        if result.status == "error":
+            traceback.print_exc(file=stream)
     finally:
         if result.status != "done":
             result.vented = driver.safe_vent()
