@@ -130,7 +130,28 @@ def test_a_selection_covering_the_photo_fails():
 def test_a_body_leaving_the_photo_is_flagged():
     img, fe, _ = body_photo(20.0, shift=(420.0, 0.0))
     res = measure_image(img, settings_for(fe))
-    assert res.status == "flagged" and "border" in res.reason
+    assert res.status == "flagged" and "border at its free end" in res.reason
+
+
+@pytest.mark.parametrize(("scene", "i"), [("dark_translucent", 9), ("lab", 9), ("green_fibre", 9)])
+def test_a_side_along_the_image_border_is_measured_from_the_other_edge(scene, i):
+    # 720p frames with the clamp at the top edge: the body's upper side runs out of the photo
+    # near the clamp.  Taking the middle of what is seen there tilted the base tangent (11 deg
+    # off for the translucent body); half the body's width in from the seen edge is right, and
+    # since the free end is inside the photo, it is a note, not a flag.
+    from pipeline.synth import render_actuator, scene_from
+
+    psi = float(np.linspace(215.0, -220.0, 12)[i])
+    overrides = {"line_contrast": 0.0, "body_translucency": 0.0} if scene == "lab" else {}
+    r = render_actuator(
+        psi, 270.0, scene_from(scene, width=1280, height=720, **overrides), seed=30 + i,
+        bulge=0.4 if i % 2 else 0.0,
+    )
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert "a side runs along the image border" in res.reason
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=2.5)
 
 
 def test_roi_restricts_the_search():

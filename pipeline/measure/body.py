@@ -80,6 +80,10 @@ class BodyExtraction:
     free_end_width_ratio : float
         The body's width near its free end over its median width: well below 1 when one side of
         the tip was not selected (a faint, translucent side), which shifts the tip's direction.
+    side_on_border : bool
+        A side of the body (not its free end) runs along the image border: the centre line
+        there lies half the body's width from the other edge.  (At the free end the border is
+        ``line.touches_border``: the tip may be outside the photo.)
     """
 
     line: LineExtraction
@@ -91,6 +95,7 @@ class BodyExtraction:
     end_short_px: float = 0.0
     ridge_tip_deg: float = 0.0
     free_end_width_ratio: float = 1.0
+    side_on_border: bool = False
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -521,6 +526,11 @@ def _soft_body(comp: np.ndarray, strength: np.ndarray) -> np.ndarray:
     return soft
 
 
+#: an edge this close to the image border (px) is the border's, not the body's
+BORDER_PX = 1.0
+#: the free end, for "the tip may be outside the photo": the last this many half-widths of the
+#: centre line (at least a tenth of it) and the length carried on beyond it
+TIP_BORDER_HALF_WIDTHS = 4.0
 #: the ridge's last this many half-widths are a tip's corners or its cap, not its course
 RIDGE_TIP_HALF_WIDTHS = 2.0
 #: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
@@ -592,7 +602,7 @@ def _march(
             t = cur - prev
             t = t / max(float(np.hypot(*t)), 1e-9)
             ahead = cur + MARCH_STEP_PX * t
-            mid, wid = _midpoints(soft, np.array([cur, ahead]), reach=3.0 * half + 4.0)
+            mid, wid, _ = _midpoints(soft, np.array([cur, ahead]), reach=3.0 * half + 4.0)
             if not np.isfinite(wid[1]) or not END_WIDTH_LOW * med <= wid[1] <= END_WIDTH_HIGH * med:
                 break
             step = mid[1]
@@ -675,8 +685,41 @@ def _extensions(
     return out[0], out[1]
 
 
-def _midpoints(soft: np.ndarray, points: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Move each point to the middle of the two edges along its normal; return points and widths."""
+def _on_border(comp: np.ndarray, points: np.ndarray, half: float) -> bool:
+    """Whether the body ``comp`` reaches the image border within about a width of ``points``."""
+    h, w = comp.shape
+    near = np.zeros_like(comp)
+    cv2.polylines(
+        near,
+        [np.round(points * 16).astype(np.int32)],
+        False,
+        1,
+        max(3, int(2 * half)) * 2 + 1,
+        cv2.LINE_8,
+        4,
+    )
+    ys, xs = np.nonzero(near & comp)
+    return bool(len(xs)) and bool(
+        xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1
+    )
+
+
+def _midpoints(
+    soft: np.ndarray,
+    points: np.ndarray,
+    reach: float,
+    expected_width: float | np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Move each point to the middle of the two edges along its normal; return points, widths
+    and where one side is the image border.
+
+    An "edge" on the image border is not the body's: the body goes on outside the photo.  Where
+    one side ends there, the point is put half ``expected_width`` (the body's width nearby) in
+    from the other, real edge, and that width is returned (NaN where what is seen is wider than
+    the body: the profile runs along something else); without ``expected_width`` the width there
+    is NaN (unknown).  A body whose side runs along the border (a clamp at the photo's
+    edge) is so not pulled off its middle by the border.
+    """
     n = _normals(points)
     k = int(np.ceil(reach * 2))
     off = np.arange(-k, k + 1, dtype=np.float32) / 2.0
@@ -704,7 +747,31 @@ def _midpoints(soft: np.ndarray, points: np.ndarray, reach: float) -> tuple[np.n
     good = np.isfinite(left) & np.isfinite(right) & inside[:, c]
     mid = np.where(good, 0.5 * (left + right), 0.0)
     width = np.where(good, right - left, np.nan)
-    return points + mid[:, None] * n, width
+    h, w = soft.shape[:2]
+    cut = []
+    for off_side in (left, right):
+        e = points + np.nan_to_num(off_side)[:, None] * n
+        cut.append(
+            good
+            & (
+                (e[:, 0] < BORDER_PX)
+                | (e[:, 1] < BORDER_PX)
+                | (e[:, 0] > w - 1 - BORDER_PX)
+                | (e[:, 1] > h - 1 - BORDER_PX)
+            )
+        )
+    one = cut[0] ^ cut[1]
+    width[cut[0] | cut[1]] = np.nan
+    if expected_width is not None:
+        exp = np.broadcast_to(np.asarray(expected_width, dtype=float), (len(points),))
+        # what is seen of the body there is no wider than the body (else the profile runs along
+        # something else: a clamp face, the tip)
+        fix = one & np.isfinite(exp) & (right - left <= END_WIDTH_HIGH * exp)
+        # half the expected width in from the side that is a real edge
+        mid = np.where(fix & cut[0], right - 0.5 * exp, mid)
+        mid = np.where(fix & cut[1], left + 0.5 * exp, mid)
+        width = np.where(fix, exp, width)
+    return points + mid[:, None] * n, width, one
 
 
 def extract_body(
@@ -788,10 +855,20 @@ def extract_body(
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
     widths = np.full(len(pts), np.nan)
     capped = False  # the free end was cut where the width changed (a tip cap, a blob)
+    window = int(round(LOCAL_WIDTH_HALF_WIDTHS * half))  # noqa: RUF046 (numpy scalar)
+    reach = 3.0 * half + 4.0
     for _ in range(2):
-        moved, wid = _midpoints(soft, pts, reach=3.0 * half + 4.0)
+        moved, wid, cut = _midpoints(soft, pts, reach=reach)
+        if cut.any():
+            # a side is the image border there: along the middle of what is seen (its normals
+            # follow the body, those of a ridge hugging the border need not), each point half
+            # the body's width in from the side that is a real edge
+            pts = _smooth(np.where(cut[:, None], moved, pts), max(1.0, SMOOTH_HALF_WIDTHS * half))
+            moved, wid, _ = _midpoints(
+                soft, pts, reach=reach, expected_width=local_widths(wid, window)
+            )
         med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
-        ref = local_widths(wid, int(round(LOCAL_WIDTH_HALF_WIDTHS * half)))  # noqa: RUF046 (numpy scalar)
+        ref = local_widths(wid, window)
         bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * ref) | (wid < END_WIDTH_LOW * ref)
         moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
         span = _good_span(~bad, max(3, int(round(half))))  # noqa: RUF046 (numpy scalar)
@@ -815,21 +892,17 @@ def extract_body(
     if len(along_ridge) > len(pts) and len(pts) >= 8:
         ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
     trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
-    # the body proper (not the tube or a plate joined to it at the clamp) may not reach the border
-    near = np.zeros_like(comp)
-    cv2.polylines(
-        near,
-        [np.round(pts * 16).astype(np.int32)],
-        False,
-        1,
-        max(3, int(2 * half)) * 2 + 1,
-        cv2.LINE_8,
-        4,
-    )
-    ys, xs = np.nonzero(near & comp)
-    touches = bool(len(xs)) and bool(
-        xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1
-    )
+    # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
+    # free end the tip may be outside the photo; along a side the middle was taken from the
+    # other edge (see _midpoints)
+    s_pts = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
+    tip = pts[s_pts >= s_pts[-1] - max(TIP_BORDER_HALF_WIDTHS * half, 0.1 * s_pts[-1])]
+    if len(pts) >= 2:
+        t = pts[-1] - pts[-2]
+        t = t / max(float(np.hypot(*t)), 1e-9)
+        tip = np.vstack([tip, pts[-1] + t * (trimmed[1] + half)])
+    touches_tip = _on_border(comp, tip, half)
+    side_on_border = not touches_tip and _on_border(comp, pts, half)
     contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
     holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1] if hier is not None else []
     loop = bool(holes) and max(cv2.contourArea(c) for c in holes) > 4.0 * half * half
@@ -837,7 +910,7 @@ def extract_body(
     line = LineExtraction(
         centreline_px=pts * scale + (scale - 1) / 2,
         width_px=float(2.0 * half * scale),
-        touches_border=touches,
+        touches_border=touches_tip,
         n_candidates=1 + rivals,
         contrast=float(min(contrast * 10.0, 441.0)),
         ends_gap_px=ends_gap * scale,
@@ -853,5 +926,5 @@ def extract_body(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
-        free_end_width_ratio=end_med[1] / max(body_width, 1e-6),
+        free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
     )

@@ -378,6 +378,7 @@ def measure_body(
         end_short_px=body.end_short_px,
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
+        side_on_border=body.side_on_border,
     )
     used = "tangents" if method == "auto" or base is not None else method
     return _measured(psi, est, line, quality, settings, used)

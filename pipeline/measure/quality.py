@@ -181,21 +181,28 @@ def assess_body(
     end_short_px: float = 0.0,
     ridge_tip_deg: float = 0.0,
     free_end_width_ratio: float = 1.0,
+    side_on_border: bool = False,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
-    Flagged when the body leaves the photo; several bodies compete; the fixed end is not
-    reached or guessed; the outline is uneven (the segmentation leaked into the backdrop, or
-    lost part of the body); the free end's direction depends on how much of the end is fitted
-    (a hooked or ragged tip); the body closes on itself; or it is much shorter than ``l0``
-    (partly hidden).  Notes (status stays ``ok``) say how psi was taken.
+    Flagged when the free end reaches the image border (a side along it is a note); several
+    bodies compete; the fixed end is not reached or guessed; the outline is uneven (the
+    segmentation leaked into the backdrop, or lost part of the body); the free end's direction
+    depends on how much of the end is fitted (a hooked or ragged tip); the body closes on
+    itself; or it is much shorter than ``l0`` (partly hidden).  Notes (status stays ``ok``) say
+    how psi was taken.
     """
     import numpy as np
 
     flags: list[str] = []
     notes: list[str] = []
     if line.touches_border:
-        flags.append("body touches the image border")
+        flags.append("body touches the image border at its free end: the tip may be outside")
+    elif side_on_border:
+        notes.append(
+            "a side runs along the image border: the centre line there is half the body's width "
+            "from the other edge"
+        )
     if line.n_candidates > 1:
         flags.append(f"{line.n_candidates} candidate bodies")
     if not line.fixed_end_found:
