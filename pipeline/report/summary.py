@@ -200,7 +200,7 @@ def quality_table(
             )
         total = sum(counts, np.zeros(4, dtype=int))
         body.append(("all", "", "", "", *(str(int(v)) for v in total), ""))
-        columns = (
+        columns: tuple[Column, ...] = (
             Column("Dataset", "left"),
             Column("Data", "left"),
             Column("Material", "left"),
