@@ -264,7 +264,7 @@ def hysteresis_width(hyst_material: pd.DataFrame) -> tuple[float, float]:
 def bootstrap_k_p(
     material: str,
     rows: pd.DataFrame,
-    fit_k_p: FitKp,
+    fit_k_p: Callable[[str, np.ndarray, np.ndarray], tuple[float, Any]],
     *,
     n_boot: int = 200,
     seed: int = 0,
@@ -532,6 +532,7 @@ def comparison_groups(
         mfile = fm.materials_file if fm else ""
         l0s: list[float] = []
         if have_l0:
+            assert angles is not None  # have_l0 says so
             sel = angles[
                 (angles["dataset"].astype(str) == dataset)
                 & (angles["material"].astype(str) == material)
@@ -696,20 +697,22 @@ def compare(
             if run_fit is not None and usable
             else None
         )
-        kwargs = {
-            "psi0_deg": float(run_psi0.get(material, PSI0_DEG)),
-            "n_boot": n_boot,
-            "seed": seed,
-        }
+        material_psi0_deg = float(run_psi0.get(material, PSI0_DEG))
         note = group.note
         try:
-            rec = compare_material(material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, **kwargs)
+            rec = compare_material(
+                material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, psi0_deg=material_psi0_deg,
+                n_boot=n_boot, seed=seed,
+            )
         except UserInputError as exc:
             warnings.warn(
                 f"{group.curve}: model unavailable ({exc}); model columns left empty", stacklevel=2
             )
             note = f"model unavailable: {exc}"
-            rec = compare_material(material, hm, rows, model_psi=None, fit_k_p=None, **kwargs)
+            rec = compare_material(
+                material, hm, rows, model_psi=None, fit_k_p=None, psi0_deg=material_psi0_deg,
+                n_boot=n_boot, seed=seed,
+            )
         if note and group.note:
             warnings.warn(f"{group.curve}: {note}", stacklevel=2)
         data = [sources.get(d, "unknown") for d in group.datasets]

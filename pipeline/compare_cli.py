@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -158,7 +159,7 @@ def data_source(folder: str) -> str:
     return "synthetic" if (Path(folder) / TRUTH).is_file() else "measured"
 
 
-def model_fit_text(options: dict[str, object]) -> str:
+def model_fit_text(options: dict[str, Any]) -> str:
     """What in the model is fitted to the paper's numbers, for rms.csv's ``model_fit``."""
     from pipeline.model import make_options
 

@@ -415,7 +415,8 @@ def _video_row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
         for key in ("material", "actuator", "trial"):
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
-        key3 = tuple(str(df[k].iloc[i]) for k in ("material", "actuator", "trial"))
+        material, actuator, trial = (str(df[k].iloc[i]) for k in ("material", "actuator", "trial"))
+        key3 = (material, actuator, trial)
         if key3 in ramps:
             out.append(
                 Problem(

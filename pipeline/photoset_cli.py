@@ -172,12 +172,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from pipeline.measure.calibration import MAX_RMS_PX, write_store
+    from pipeline.measure.calibration import MAX_RMS_PX, Calibration, write_store
 
     limit = MAX_RMS_PX if args.max_error_px is None else args.max_error_px
     # a folder-wide calibration that fails refuses the set, naming the file
     ps = photoset.load_photoset(args.folder)
-    used: dict[object, tuple[object, list[int]]] = {}
+    used: dict[tuple[tuple[str, ...], float, tuple[int, int]], tuple[Calibration, list[int]]] = {}
     for line, row in zip(ps.manifest["manifest_line"], ps.rows):
         if row is not None and row.calibration is not None:
             used.setdefault(row.calibration.key, (row.calibration, []))[1].append(int(line))
@@ -195,14 +195,15 @@ def _calibrate(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
         return 1
-    path = write_store(args.folder, [c for c, _ in used.values()])  # type: ignore[misc]
+    path = write_store(args.folder, [c for c, _ in used.values()])
     for cal, lines in used.values():
-        plane = cal.plane  # type: ignore[attr-defined]
-        boards = ", ".join(Path(b).name for b in cal.boards)  # type: ignore[attr-defined]
+        plane = cal.plane
+        assert plane is not None  # a row's calibration is resolved (computed or read) on loading
+        boards = ", ".join(Path(b).name for b in cal.boards)
         f = plane.camera_matrix[0]
         print(
             f"{boards}: {cal.board_size}, {cal.square_mm:g} mm squares; {plane.views} photo(s), "
-            f"{plane.corners} corners; "  # type: ignore[attr-defined]
+            f"{plane.corners} corners; "
             f"{len(lines)} row(s)"
         )
         print(

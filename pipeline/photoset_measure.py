@@ -64,11 +64,12 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
         image = str(image)
         overlay = None if overlays_dir is None else str(overlays_dir / f"{Path(image).stem}.jpg")
         title = f"{image}  {pressure:g} kPa {direction}"
-        cal = None if ps.rows[i] is None else ps.rows[i].calibration
+        row = ps.rows[i]
+        cal = None if row is None else row.calibration
         if cal is not None and cal.plane is not None:
             title += f"  calibrated ({cal.plane.rms_px:.2f} px)"
         tasks.append(
-            Task(str(ps.image_path(image)), ps.rows[i], method, overlay, title, ps.row_reason(i))
+            Task(str(ps.image_path(image)), row, method, overlay, title, ps.row_reason(i))
         )
     return tasks
 

@@ -185,7 +185,7 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
     cal = settings.calibration
     if cal is None or cal.plane is None:
         return None
-    base = img if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+    base = np.asarray(img if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), np.uint8)
     try:
         check_size(cal.plane, base.shape, scale)
     except CalibrationMismatch as exc:
@@ -203,7 +203,7 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
         return panel
     panel = rectify(base, cal.plane, scale)
     k = size[0] / panel.shape[1]
-    panel = cv2.resize(panel, size, interpolation=cv2.INTER_AREA)
+    panel = np.asarray(cv2.resize(panel, size, interpolation=cv2.INTER_AREA), np.uint8)
     if len(res.centreline_px):
         q = cal.plane.to_plane(res.centreline_px) / scale * k
         colour = _STATUS_BGR.get(res.status, (255, 255, 255))

@@ -66,6 +66,7 @@ def _timed(data: np.ndarray, settings: MeasureSettings, repeats: int) -> tuple[A
     for _ in range(repeats):
         t0 = time.perf_counter()
         img, f = decode_for_work(data, grey=decodes_grey(settings))
+        assert img is not None  # a photo the bench rendered
         res = measure_decoded(data, img, f, settings)
         times.append(time.perf_counter() - t0)
     assert res is not None

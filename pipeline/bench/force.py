@@ -60,7 +60,7 @@ def point_sweep(*, seeds: int = 3, noise_px: float = 0.5, a_px: float = 280.0) -
                     )
                     for mode in ("never", "auto", "always"):
                         t0 = time.perf_counter()
-                        fit = fit_ellipse(pts, refine=mode)  # type: ignore[arg-type]
+                        fit = fit_ellipse(pts, refine=mode)
                         rows.append(
                             {
                                 "e_true": e,

@@ -102,6 +102,7 @@ def accuracy(n: int, seed: int) -> pd.DataFrame:
                 )
             data = np.frombuffer(r.jpeg_bytes, np.uint8)
             img, f = decode_for_work(data, grey=True)  # as measure_file / the workers do
+            assert img is not None  # the photo just rendered
             for method in METHODS:
                 settings = resolve_settings(
                     l0_mm=L0_MM, mm_per_px=scene.mm_per_px, fixed_end=list(r.fixed_end_px)
@@ -136,6 +137,7 @@ def _skeleton_psi(path: Path, mm_per_px: float, fixed_end: tuple[float, float]) 
     from skimage.morphology import skeletonize
 
     img = cv2.imread(str(path))
+    assert img is not None  # a photo the bench wrote
     mask, _ = line_mask(img, BLACK)
     skel = skeletonize(mask.astype(bool))  # the whole frame, as a straightforward pipeline does
     x0, y0, sub = line_component(mask, fixed_end, 0.03 * float(np.hypot(*img.shape[:2])))
@@ -174,6 +176,7 @@ def _bare_circle_px(data: np.ndarray) -> float:
     wrong blob.  Timed only, as a floor for the cost of any real measurement; never scored.
     """
     grey = cv2.imdecode(data, cv2.IMREAD_REDUCED_GRAYSCALE_4)
+    assert grey is not None  # a photo the bench rendered
     _, mask = cv2.threshold(grey, 0, 255, cv2.THRESH_BINARY_INV | cv2.THRESH_OTSU)
     _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     k = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))

@@ -22,6 +22,7 @@ import argparse
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -76,13 +77,14 @@ def body_cases(
     for name, overrides in BODY_SCENES.items():
         if scenes is not None and name not in scenes:
             continue
-        scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)  # type: ignore[arg-type]
+        scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
             r = render_actuator(
                 float(psi), 270.0, scene, seed=seed + i, bulge=0.4 if i % 2 else 0.0
             )
             img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
-            extra = {}
+            assert img is not None  # the photo just rendered
+            extra: dict[str, Any] = {}
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
             settings = resolve_settings(

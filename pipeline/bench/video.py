@@ -175,6 +175,7 @@ def breakdown(folder: Path, sample_every: int = 30) -> dict[str, float]:
             continue
         t1 = time.process_time()
         img, f = decode_for_work(frame.data, grey=grey)
+        assert img is not None  # a frame of the clip the bench rendered
         t2 = time.process_time()
         measure_decoded(frame.data, img, f, settings)
         measure_cpu += time.process_time() - t2

@@ -255,18 +255,16 @@ def measure_blocked_image(
     pts = line.centreline_px
     length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) if len(pts) > 1 else 0.0
     mm_per_px = settings.mm_per_px
-    scale_ok = mm_per_px is not None
     expected = settings.l0_mm / mm_per_px if mm_per_px else None
+    scale = float(mm_per_px) if mm_per_px is not None else float("nan")
     fit = fit_ellipse(pts, refine=refine, **fit_options)
     if not fit:
-        return EccentricityResult(
-            fit, length, float(mm_per_px) if scale_ok else float("nan"), "failed", fit.reason, pts
-        )
+        return EccentricityResult(fit, length, scale, "failed", fit.reason, pts)
     reasons = line_flags(line, length, expected) + ([fit.reason] if fit.reason else [])
     return EccentricityResult(
         fit=fit,
         length_px=length,
-        mm_per_px=float(mm_per_px) if scale_ok else float("nan"),
+        mm_per_px=scale,
         status="flagged" if reasons else "ok",
         reason="; ".join(reasons),
         centreline_px=pts,
@@ -290,7 +288,7 @@ class _Task:
     path: str
     settings: MeasureSettings | None
     reason: str
-    refine: str
+    refine: Refine
     fit_options: dict[str, Any]
 
 
@@ -304,7 +302,7 @@ def _measure_row(task: _Task) -> dict[str, Any]:
     else:
         result = measure_blocked_image(
             _read_image(p), task.settings, refine=task.refine, **task.fit_options
-        )  # type: ignore[arg-type]
+        )
     row = result.row()
     row["seconds"] = round(time.perf_counter() - t0, 4)
     return row

@@ -10,11 +10,15 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Iterator, Sequence
+from typing import TYPE_CHECKING
 
 import matplotlib as mpl
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType  # for the type checker only
 
 MM_PER_IN = 25.4
 #: A4 portrait and landscape, inches (210 x 297 mm)
@@ -33,7 +37,7 @@ PSI_LABEL = "Bending angle ψ (deg)"
 P_LABEL = "Input pressure P (kPa)"
 
 #: fonts shipped with matplotlib, so every machine renders (and embeds) the same glyphs
-RC: dict[str, object] = {
+RC: dict[RcKeyType, object] = {
     "font.family": "DejaVu Sans",
     "font.size": 8.5,
     "axes.titlesize": 9.5,

@@ -69,7 +69,9 @@ def fmt(value: object, digits: int = 0, unit: str = "") -> str:
 
 #: unhinted glyph outlines, as in the PDF (``LoadFlags`` from matplotlib 3.10 on)
 _NO_HINTING = (
-    ft2font.LoadFlags.NO_HINTING if hasattr(ft2font, "LoadFlags") else ft2font.LOAD_NO_HINTING
+    ft2font.LoadFlags.NO_HINTING
+    if hasattr(ft2font, "LoadFlags")
+    else ft2font.LOAD_NO_HINTING  # type: ignore[attr-defined]  # matplotlib < 3.10; stubs: 3.10+
 )
 #: size (pt) at which widths are measured; advance widths of unhinted outlines scale linearly with
 #: size
@@ -425,13 +427,13 @@ def _layout(
     while True:
         headers = [c.header.split("\n") for c in table.columns]
         fonts = [c.family for c in table.columns]
-        cells = [[wrap(str(v), wraps[c], size, "bold", fonts[c]) if wraps[c] else str(v).split("\n")
-                  for c, v in enumerate(row)] for row in table.rows]
+        cells = [[wrap(str(v), wp, size, "bold", font) if wp else str(v).split("\n")
+                  for v, wp, font in zip(row, wraps, fonts)] for row in table.rows]
         widths = []
         for c in range(n):
             w = max(text_width_pt(h, size, "bold") for h in headers[c])
-            for row in cells:
-                w = max([w] + [text_width_pt(line, size, "bold", fonts[c]) for line in row[c]])
+            for wrapped in cells:
+                w = max([w] + [text_width_pt(line, size, "bold", fonts[c]) for line in wrapped[c]])
             widths.append(w)
         col = 0
         for label, span in table.groups:  # a spanning header widens the columns under it if needed
@@ -451,6 +453,7 @@ def _layout(
             return size, widths, cells, headers
         widest = max(left, key=lambda c: widths[c])
         target = widths[widest] - (total - width_pt)
-        if target < 40.0 or (wraps[widest] is not None and wraps[widest] <= target):
+        wrap_now = wraps[widest]
+        if target < 40.0 or (wrap_now is not None and wrap_now <= target):
             return size, widths, cells, headers
         wraps[widest] = target

@@ -298,7 +298,7 @@ def body_mask(
     h, w = image_bgr.shape[:2]
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     allowed = np.ones((h, w), np.uint8) if region is None else region
-    strength = np.zeros((h, w), np.float32)
+    strength: np.ndarray = np.zeros((h, w), np.float32)
     contrast = float("inf")
     mask = allowed.copy()
     if settings.color is not None:

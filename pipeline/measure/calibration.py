@@ -147,7 +147,7 @@ class PlaneCalibration:
         und = cv2.undistortPoints(
             p, self.k, np.asarray(self.dist_coeffs), P=self.k, criteria=_UNDISTORT_CRITERIA
         )
-        return cv2.perspectiveTransform(und, self.h).reshape(-1, 2)
+        return np.asarray(cv2.perspectiveTransform(und, self.h), np.float64).reshape(-1, 2)
 
     def to_image(self, points_plane: ArrayLike) -> NDArray[np.float64]:
         """Plane px -> image px (the inverse of :meth:`to_plane`)."""
@@ -156,7 +156,7 @@ class PlaneCalibration:
         k = self.k
         rays = np.column_stack([(und - k[:2, 2]) / [k[0, 0], k[1, 1]], np.ones(len(und))])
         px, _ = cv2.projectPoints(rays, np.zeros(3), np.zeros(3), k, np.asarray(self.dist_coeffs))
-        return px.reshape(-1, 2)
+        return np.asarray(px, np.float64).reshape(-1, 2)
 
     def to_mm(self, points_px: ArrayLike) -> NDArray[np.float64]:
         """Image px -> plane mm (the plane px times ``mm_per_px``)."""
@@ -311,9 +311,10 @@ def calibrate_views(
     dist = np.asarray(dist, float).ravel()[:5]
     plane = np.asarray(corners_px[0], np.float64).reshape(-1, 1, 2)
     und = cv2.undistortPoints(plane, k, dist, P=k, criteria=_UNDISTORT_CRITERIA).reshape(-1, 2)
-    h_mm, _ = cv2.findHomography(und, board, 0)
-    if h_mm is None:  # pragma: no cover - 4+ non-collinear corners always give one
+    homography, _ = cv2.findHomography(und, board, 0)
+    if homography is None:  # pragma: no cover - 4+ non-collinear corners always give one
         raise CalibrationError("the board corners do not define a plane")
+    h_mm = np.asarray(homography, np.float64)
     residual = cv2.perspectiveTransform(und.reshape(-1, 1, 2), h_mm).reshape(-1, 2) - board
     h_plane, s = _plane_frame(h_mm, und.mean(axis=0))
     return PlaneCalibration(
@@ -354,9 +355,10 @@ def calibrate_files(
     for path in boards:
         name = Path(path).name
         data = np.fromfile(str(path), np.uint8)
-        grey = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
-        if grey is None:
+        decoded = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
+        if decoded is None:
             raise CalibrationError(f"calibration board photo {name!r} cannot be decoded")
+        grey = np.asarray(decoded, np.uint8)
         this = (grey.shape[1], grey.shape[0])
         if size is not None and this != size:
             raise CalibrationError(
@@ -514,7 +516,8 @@ def rectify(
     src = plane.to_image(np.column_stack([xs.ravel(), ys.ravel()]) * scale) / scale
     mx = src[:, 0].reshape(hh, ww).astype(np.float32)
     my = src[:, 1].reshape(hh, ww).astype(np.float32)
-    return cv2.remap(image, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    out = cv2.remap(image, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    return np.asarray(out, np.uint8)
 
 
 def describe_problem(cal: Calibration, exc: Exception) -> tuple[str, str]:

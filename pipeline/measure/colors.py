@@ -209,7 +209,8 @@ def parse_color(value: Any) -> ColorSpec:
         )
     if not parts:
         raise ColorError("colour is empty; give a name such as 'black' or an HSV range")
-    texts, ranges = [], []
+    texts: list[str] = []
+    ranges: list[HsvRange] = []
     for part in parts:
         text, rng = _parse_part(part)
         texts.append(text)
@@ -236,7 +237,7 @@ def color_mask(image_bgr: np.ndarray, spec: ColorSpec) -> np.ndarray:
     hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)
     out = np.zeros(image_bgr.shape[:2], np.uint8)
     for lo, hi in spec.ranges:
-        out |= cv2.inRange(hsv, lo, hi)
+        out |= np.asarray(cv2.inRange(hsv, lo, hi), np.uint8)
     return (out > 0).astype(np.uint8)
 
 

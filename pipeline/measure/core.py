@@ -596,6 +596,7 @@ def measure_decoded(
         res.status == "failed" or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX
     ):
         factor //= 2
+        finer: np.ndarray | None
         if full is not None:
             finer = reduce_image(full, factor)
         else:

@@ -80,18 +80,15 @@ def contact_sheet(
     """Tile overlay images (in the given order) into one sheet; unreadable tiles stay grey."""
     if not paths:
         raise ValueError("no overlays for a contact sheet")
-    tiles = []
-    for p in paths:
-        img = cv2.imread(str(p))
-        tiles.append(img)
+    images = [cv2.imread(str(p)) for p in paths]
     h_ref = next(
-        (t.shape[0] * tile_width_px // t.shape[1] for t in tiles if t is not None),
+        (t.shape[0] * tile_width_px // t.shape[1] for t in images if t is not None),
         tile_width_px * 3 // 4,
     )
     grey = np.full((h_ref, tile_width_px, 3), 128, np.uint8)
-    tiles = [
+    tiles: list[np.ndarray] = [
         grey if t is None else cv2.resize(t, (tile_width_px, h_ref), interpolation=cv2.INTER_AREA)
-        for t in tiles
+        for t in images
     ]
     rows = int(np.ceil(len(tiles) / columns))
     tiles += [np.zeros_like(grey)] * (rows * columns - len(tiles))

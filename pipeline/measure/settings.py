@@ -195,7 +195,7 @@ def is_missing(value: Any) -> bool:
 def _number(
     raw: Mapping[str, Any], key: str, problems: list[SettingProblem], fix: str
 ) -> float | None:
-    value = raw.get(key)
+    value: Any = raw.get(key)  # anything a user wrote; float() refuses what is no number
     if is_missing(value):
         return None
     try:
@@ -492,7 +492,7 @@ def settings_problems(
         except ColorError as exc:
             problems.append(SettingProblem("line_color", str(exc), "fix line_color"))
     fixed_end = _fixed_end(raw, problems)
-    direction = raw.get("fixed_direction_deg")
+    direction: Any = raw.get("fixed_direction_deg")
     fixed_direction: float | None = None
     if not is_missing(direction):
         try:

@@ -7,6 +7,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -38,8 +39,9 @@ _OPTION_HELP = {
 }
 
 
-def add_reading_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add one ``--<option>`` flag per model reading, plus ``--l0-mm`` and ``--eq12-scale``.
+def add_reading_arguments(parser: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
+    """Add one ``--<option>`` flag per model reading, plus ``--l0-mm`` and ``--eq12-scale``
+    (to a parser or to an argument group of one).
 
     Shared by ``model`` and ``compare``; :func:`reading_options` collects what was given.
     """
@@ -67,7 +69,7 @@ def add_reading_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def reading_options(args: argparse.Namespace) -> dict[str, object]:
+def reading_options(args: argparse.Namespace) -> dict[str, Any]:
     """The model options given on the command line (readings, l0, eq12_scale, k_P, unloading)."""
     keys = [*CHOICES, "l0_mm", "k_p", "eq12_scale", "unload_from_kpa"]
     return {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
@@ -233,7 +235,7 @@ def _anchor_lines(df: pd.DataFrame) -> list[str]:
 
 def format_calibration(
     table: dict[str, Material],
-    options: dict[str, object],
+    options: dict[str, Any],
     *,
     search: bool = False,
     search_keys: tuple[str, ...] | None = None,

@@ -53,6 +53,7 @@ def strain_energy_mpa(
 ) -> FloatArray:
     """Ogden strain-energy density W of Eq. 8 (MPa), lambda_3 = 1/(lambda_1 lambda_2)."""
     lam3 = 1.0 / (lam1 * lam2)
-    return sum(
-        mu / a * (lam1**a + lam2**a + lam3**a - 3.0) for mu, a in zip(mu_mpa, alpha, strict=True)
-    )
+    out = np.zeros(np.broadcast_shapes(np.shape(lam1), np.shape(lam2)))
+    for mu, a in zip(mu_mpa, alpha, strict=True):
+        out = out + mu / a * (lam1**a + lam2**a + lam3**a - 3.0)
+    return out

@@ -130,7 +130,7 @@ def contents(figures: list[Figure]) -> list[tuple[str, int]]:
     out: list[tuple[str, int]] = []
     seen: set[str] = set()
     for number, fig in enumerate(figures, start=2):
-        kind = fig.get_label().split(" ")[0]
+        kind = str(fig.get_label()).split(" ")[0]
         if kind in CONTENTS and kind not in seen:
             seen.add(kind)
             out.append((CONTENTS[kind], number))

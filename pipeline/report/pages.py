@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pandas as pd
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
@@ -123,7 +124,7 @@ def plot_hysteresis(
         ax.legend(loc="best", frameon=False)
 
 
-def legend_proxies() -> tuple[list[object], list[str]]:
+def legend_proxies() -> tuple[list[Artist], list[str]]:
     """Neutral legend entries for the hysteresis plots of every material."""
     dark, light = (0.3, 0.3, 0.3), lighter((0.3, 0.3, 0.3))
     return (
@@ -358,7 +359,7 @@ def material_page(data: ReportData, material: str) -> Figure:
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)
     fig.suptitle(f"{material}: bending angle versus pressure", color=color, fontweight="bold")
-    top, bottom = fig.subfigures(2, 1, height_ratios=[1.45, 1.0])
+    top, bottom = fig.subfigures(2, 1, squeeze=False, height_ratios=[1.45, 1.0])[:, 0]
     plot_hysteresis(
         top.subplots(),
         data,

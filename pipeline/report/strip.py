@@ -147,7 +147,7 @@ def strip_image(
     >>> img.shape, spans
     ((60, 170, 3), [(0, 80), (90, 170)])
     """
-    tiles = []
+    tiles: list[np.ndarray] = []
     for photo in photos:
         if photo.image is None:
             tiles.append(np.full((height_px, height_px * 4 // 3, 3), 225, np.uint8))

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
@@ -200,7 +201,7 @@ def quality_table(
             )
         total = sum(counts, np.zeros(4, dtype=int))
         body.append(("all", "", "", "", *(str(int(v)) for v in total), ""))
-        columns = (
+        columns: tuple[Column, ...] = (
             Column("Dataset", "left"),
             Column("Data", "left"),
             Column("Material", "left"),
@@ -325,7 +326,7 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     return fig
 
 
-def overview_axes(ax, data: ReportData) -> None:  # type: ignore[no-untyped-def]
+def overview_axes(ax: Axes, data: ReportData) -> None:
     """Mean psi against P of every material: rising pressure solid, falling dashed."""
     colors = material_colors(data.materials)
     for m in data.materials:

@@ -348,15 +348,10 @@ def run_session(
         print(f"acquire: {result.message}", file=stream)
         return result
     plans = trial_plans(cfg)
-    total = sum(
-        len(seq)
-        - (
-            session.first_missing(seq, rec)
-            if session.first_missing(seq, rec) is not None
-            else len(seq)
-        )
-        for _, seq, rec in plans
-    )
+    total = 0  # steps still to record
+    for _, seq, rec in plans:
+        first = session.first_missing(seq, rec)
+        total += 0 if first is None else len(seq) - first
     result.steps_skipped = sum(len(rec) for _, _, rec in plans)
     bar = tqdm(
         total=total,
@@ -405,6 +400,12 @@ def run_session(
     return result
 
 
+def _fewer_steps(bar: tqdm, n: int) -> None:
+    """Take ``n`` steps off the progress bar's total (an up leg cut short at -psi0)."""
+    assert bar.total is not None  # the bar is made with the steps still to record
+    bar.total -= n
+
+
 def _run_trial(
     driver: PicoDriver,
     camera: Camera,
@@ -434,7 +435,7 @@ def _run_trial(
                 and _recorded_image_stops(cfg, plan, stop_up, settings)
             ):
                 seq = session.trial_sequence(trial, up, plan.step)
-                bar.total -= len(session.trial_sequence(trial, up)) - len(seq)
+                _fewer_steps(bar, len(session.trial_sequence(trial, up)) - len(seq))
                 start = session.first_missing(seq, recorded)
                 if start is None:
                     return
@@ -467,7 +468,7 @@ def _run_trial(
             and stop_up(image_bytes, settings)
         ):
             new_seq = session.trial_sequence(trial, up, plan.step)
-            bar.total -= len(seq) - len(new_seq)
+            _fewer_steps(bar, len(seq) - len(new_seq))
             bar.refresh()
             seq = new_seq
         i += 1
@@ -587,7 +588,10 @@ def psi0_stop_criterion(
     measurements never stop the ramp.
     """
     if measure_image is None:
-        from pipeline.measure import measure_image
+        from pipeline.measure import measure_image as default_measure
+
+        measure_image = default_measure
+    measure = measure_image  # never None: the name the closure below calls
 
     def stop(image_bytes: bytes, settings: MeasureSettings) -> bool:
         import cv2
@@ -596,7 +600,7 @@ def psi0_stop_criterion(
         if image is None:
             return False
         try:
-            r = measure_image(image, settings)
+            r = measure(image, settings)
         except Exception as exc:  # noqa: BLE001 - a failed live measurement must never stop the rig
             log.warning(
                 "live psi measurement failed (%s: %s); the ramp continues to --max-kpa",

@@ -50,6 +50,8 @@ if sys.platform != "win32":
     import termios
 
     _PORT_ERRORS = (*_PORT_ERRORS, termios.error)
+#: opening a port: the port errors, and pyserial's ValueError for a malformed port or URL
+_OPEN_ERRORS: tuple[type[BaseException], ...] = (*_PORT_ERRORS, ValueError)
 
 #: garbage lines tolerated while waiting for one reply
 MAX_GARBAGE_PER_REPLY = 20
@@ -194,7 +196,7 @@ class PicoDriver:
             link = serial.serial_for_url(
                 port, baudrate=BAUDRATE, timeout=0.05, write_timeout=timeout_s
             )
-        except (*_PORT_ERRORS, ValueError) as exc:
+        except _OPEN_ERRORS as exc:
             raise PortLostError(
                 f"cannot open serial port {port!r}: {exc}; check the cable and the --port name"
             ) from exc

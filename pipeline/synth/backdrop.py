@@ -267,7 +267,7 @@ def _draw_tube_and_clamp(
         cast = _clamp_mask(scene, camera, px, width).astype(np.float32) / 255.0
         img *= (1.0 - scene.shadow * shadow_of(cast, style, scene.mm_per_px))[..., None]
     if px is not None:
-        mask = np.zeros(img.shape[:2], np.uint8)
+        mask: NDArray[np.uint8] = np.zeros(img.shape[:2], np.uint8)
         cv2.polylines(
             mask, [np.round(px * s).astype(np.int32)], False, 255, width, cv2.LINE_AA, SHIFT
         )
@@ -275,7 +275,7 @@ def _draw_tube_and_clamp(
         cv2.polylines(
             edge, [np.round(px * s).astype(np.int32)], False, 255, width + 2, cv2.LINE_AA, SHIFT
         )
-        edge = cv2.subtract(edge, cv2.erode(mask, np.ones((3, 3), np.uint8)))
+        edge = np.asarray(cv2.subtract(edge, cv2.erode(mask, np.ones((3, 3), np.uint8))), np.uint8)
         bx, by, bw_, bh = cv2.boundingRect(cv2.bitwise_or(mask, edge))  # only where the tube is
         if bw_ > 0:
             win, m, e = (
@@ -337,11 +337,11 @@ def _draw_tube_and_clamp(
             )
     else:
         # a black anodised plate, lit unevenly, a bevel along its front edge and a clamp bar
-        mask = np.zeros(img.shape[:2], np.uint8)
+        h, w = img.shape[:2]
+        mask = np.zeros((h, w), np.uint8)
         cv2.fillPoly(
             mask, [np.round(camera.to_px(outline_mm) * s).astype(np.int32)], 255, cv2.LINE_AA, SHIFT
         )
-        h, w = mask.shape
         ang = rng.uniform(0, 2 * np.pi)
         bx, by, bw_, bh = cv2.boundingRect(mask)
         if bw_ > 0:
@@ -350,7 +350,7 @@ def _draw_tube_and_clamp(
             sheen = 8.0 + 8.0 * ((xx / w) * np.cos(ang) + (yy / h) * np.sin(ang))
             win = img[by:by + bh, bx:bx + bw_]
             win *= 1 - a
-            win += (np.float32([29, 29, 32])[None, None, :] + sheen[..., None]) * a
+            win += (np.array([29, 29, 32], np.float32)[None, None, :] + sheen[..., None]) * a
         bevel = camera.to_px([[0.0, outline_mm[1, 1]], [0.0, outline_mm[2, 1]]])
         cv2.polylines(img, [np.round(bevel * s).astype(np.int32)], False, (68, 69, 73),
                       max(1, round(0.8 / scene.mm_per_px)), cv2.LINE_AA, SHIFT)

@@ -102,7 +102,9 @@ def _mask(
         cv2.resize(big, (shape[1], shape[0]), interpolation=cv2.INTER_AREA).astype(np.float32)
         / 255.0
     )
-    return cv2.GaussianBlur(alpha, (0, 0), blur_px) if blur_px > 0 else alpha
+    if blur_px > 0:
+        return np.asarray(cv2.GaussianBlur(alpha, (0, 0), blur_px), np.float32)
+    return alpha
 
 
 def render_board(

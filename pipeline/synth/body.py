@@ -442,9 +442,11 @@ def shadow_of(
     sh, sw = small.shape
     fx, fy = sw / w, sh / h
     d = SHADOW_OFFSET_MM / mm_per_px
-    m = np.float32([[1, 0, style.shadow_dir[0] * d * fx], [0, 1, style.shadow_dir[1] * d * fy]])
+    m = np.array(
+        [[1, 0, style.shadow_dir[0] * d * fx], [0, 1, style.shadow_dir[1] * d * fy]], np.float32
+    )
     moved = cv2.warpAffine(small, m, (sw, sh), flags=cv2.INTER_LINEAR)
     out = cv2.GaussianBlur(moved, (0, 0), sigma * fx)
     if f > 1.0:
         out = cv2.resize(out, (w, h), interpolation=cv2.INTER_LINEAR)
-    return out
+    return np.asarray(out, np.float32)

@@ -23,6 +23,7 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import cv2
 import numpy as np
@@ -126,15 +127,14 @@ def undistort(
         return p.reshape(-1, 2)
     k = np.array([[focal_px, 0, centre_px[0]], [0, focal_px, centre_px[1]], [0, 0, 1.0]])
     crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
-    return cv2.undistortPoints(p, k, np.array([k1, 0, 0, 0, 0.0]), P=k, criteria=crit).reshape(
-        -1, 2
-    )
+    und = cv2.undistortPoints(p, k, np.array([k1, 0, 0, 0, 0.0]), P=k, criteria=crit)
+    return np.asarray(und, np.float64).reshape(-1, 2)
 
 
-def apply_homography(h: NDArray[np.float64], points_px: ArrayLike) -> NDArray[np.float64]:
+def apply_homography(h: NDArray[np.floating[Any]], points_px: ArrayLike) -> NDArray[np.float64]:
     """Apply a 3x3 homography to image points."""
     p = np.asarray(points_px, dtype=np.float64).reshape(-1, 1, 2)
-    return cv2.perspectiveTransform(p, h).reshape(-1, 2)
+    return np.asarray(cv2.perspectiveTransform(p, h), np.float64).reshape(-1, 2)
 
 
 def tilt_homography(scene: SceneParams) -> NDArray[np.float64]:

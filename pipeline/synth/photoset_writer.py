@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
@@ -186,7 +187,7 @@ def choose_layout(
     """
     jit = 2.5 * scene.rotation_jitter_deg
     pts = np.vstack([_rotate(e, d) for e in extents_mm for d in ({-jit, 0.0, jit})])
-    best = None
+    best: tuple[float, float, NDArray[np.float64]] | None = None
     for rot in np.arange(0.0, 360.0, 15.0):
         cam = Camera(scene.width, scene.height, scene.mm_per_px, float(rot), (0.0, 0.0), np.eye(3))
         px = cam.flat_px(pts)
@@ -197,6 +198,7 @@ def choose_layout(
         )
         if best is None or need < best[0] - 1e-9:
             best = (need, float(rot), (px.max(axis=0) + px.min(axis=0)) / 2)
+    assert best is not None  # the loop tries 24 directions
     _, rot, centre = best
     origin = np.array([scene.width / 2, scene.height / 2]) - centre
     for _ in range(3):  # centre the shapes as seen through the tilted camera
@@ -440,7 +442,8 @@ def render_photoset(
         if sc.target == "body":
             # the fixed end of the body's centre line, at the clamp face (base mounting angle)
             base = camera_for(sc, rotation_deg=base_rot, origin_px=fixed_flat)
-            fixed_end_px = tuple(float(v) for v in base.to_px([[0.0, sc.body_width_mm / 2]])[0])
+            end_x, end_y = base.to_px([[0.0, sc.body_width_mm / 2]])[0]
+            fixed_end_px = (float(end_x), float(end_y))
             settings["target"] = "body"
         else:
             settings["line_color"] = sc.line_color

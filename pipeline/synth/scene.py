@@ -376,8 +376,8 @@ def compose_photo(
         )
         a_glare = _glare(centre_px, scene, rng, shape, off)
         if blur > 0:
-            a_body = cv2.GaussianBlur(a_body, (0, 0), blur)
-            a_ink = cv2.GaussianBlur(a_ink, (0, 0), blur)
+            a_body = np.asarray(cv2.GaussianBlur(a_body, (0, 0), blur), np.float32)
+            a_ink = np.asarray(cv2.GaussianBlur(a_ink, (0, 0), blur), np.float32)
         out = image[y0:y1, x0:x1]
         for colour, alpha in (
             (scene.body_bgr, a_body),
@@ -433,7 +433,7 @@ def _result(
     return RenderedImage(
         image=image,
         centreline_px=curve,
-        fixed_end_px=tuple(float(v) for v in curve[0]),
+        fixed_end_px=(float(curve[0, 0]), float(curve[0, 1])),
         psi_image_deg=turning_angle_deg(curve, y_down=True),
         line_in_frame=in_frame,
         jpeg_quality=scene.jpeg_quality,
@@ -545,8 +545,8 @@ def _compose_body(
         if scene.shadow > 0:
             out *= (1.0 - scene.shadow * shadow_of(alpha, style, mpp))[..., None]
         if blur > 0:
-            prem = cv2.GaussianBlur(prem, (0, 0), blur)
-            alpha = cv2.GaussianBlur(alpha, (0, 0), blur)
+            prem = np.asarray(cv2.GaussianBlur(prem, (0, 0), blur), np.float32)
+            alpha = np.asarray(cv2.GaussianBlur(alpha, (0, 0), blur), np.float32)
         out = out * (1.0 - alpha[..., None]) + prem
         a_glare = _glare(layer_px, scene, rng, shape, off)
         if a_glare is not None:

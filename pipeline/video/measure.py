@@ -65,11 +65,8 @@ def _tasks(
         reasons = [r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r]
         reason = "; ".join(reasons)
         n = clip.n_frames
-        picks = (
-            np.unique(np.round(np.linspace(0, n - 1, min(OVERLAYS_PER_VIDEO, n))).astype(int))
-            if n
-            else []
-        )
+        # evenly spread frames (none of an empty clip)
+        picks = np.unique(np.round(np.linspace(0, n - 1, min(OVERLAYS_PER_VIDEO, n))).astype(int))
         overlays = (
             {int(k): str(overlays_dir / frame_overlay_name(clip.video, int(k))) for k in picks}
             if overlays_dir

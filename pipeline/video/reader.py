@@ -16,7 +16,7 @@ Examples
 --------
 >>> import tempfile, os, cv2, numpy as np
 >>> path = os.path.join(tempfile.mkdtemp(), "clip.avi")
->>> w = cv2.VideoWriter(path, cv2.VideoWriter_fourcc(*"MJPG"), 10, (64, 48))
+>>> w = cv2.VideoWriter(path, cv2.VideoWriter.fourcc(*"MJPG"), 10, (64, 48))
 >>> for i in range(5):
 ...     _ = w.write(np.full((48, 64, 3), 40 * i, np.uint8))
 >>> w.release()

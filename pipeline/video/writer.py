@@ -34,7 +34,7 @@ def open_writer(path: Path, codec: str, fps: float, size: tuple[int, int]) -> cv
         raise UserInputError(f"codec {codec!r} is unknown; use one of {sorted(CODECS)}")
     fourcc, _ = CODECS[codec]
     writer = cv2.VideoWriter(
-        str(path), cv2.CAP_FFMPEG, cv2.VideoWriter_fourcc(*fourcc), float(fps), size
+        str(path), cv2.CAP_FFMPEG, cv2.VideoWriter.fourcc(*fourcc), float(fps), size
     )
     if not writer.isOpened():
         writer.release()
