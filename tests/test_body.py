@@ -182,6 +182,20 @@ def test_a_body_thinning_towards_its_tip_is_measured_to_its_end(psi):
     assert res.psi_deg == pytest.approx(psi, abs=3.0)
 
 
+def test_the_centre_line_stops_at_a_rigid_cap_wider_than_the_body():
+    # the translucent ribbed body on black with a white cap 15-20 % wider than its last rib: the
+    # centre line marched on into the cap read psi 5 deg high (the tangent window carried the
+    # body's curvature on through the cap, which does not bend)
+    from pipeline.synth import render_actuator, scene_from
+
+    r = render_actuator(215.0, 270.0, scene_from("dark_translucent", width=2000, height=1500),
+                        seed=30)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=3.5)
+
+
 def test_a_free_end_with_one_side_lost_is_flagged():
     img, fe, _ = body_photo(-120.0, width=46.0, lost_side_from=0.8, seed=4)
     res = measure_image(img, settings_for(fe))

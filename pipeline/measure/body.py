@@ -533,6 +533,11 @@ BORDER_PX = 1.0
 TIP_BORDER_HALF_WIDTHS = 4.0
 #: the ridge's last this many half-widths are a tip's corners or its cap, not its course
 RIDGE_TIP_HALF_WIDTHS = 2.0
+#: the march goes on while the body's width stays within these fractions of its width near that
+#: end: a cap 15-20 % wider than the body is not the body (marching into it turned the tip by
+#: 5-7 deg at |psi| ~ 220 on rendered capped bodies); a blurred, rounded tip is (1.1 stopped short
+#: of a faint translucent tip)
+MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH = 0.8, 1.15
 #: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
@@ -583,7 +588,7 @@ def _march(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
     edges": each new point is the middle of the profile across the body ahead, kept while the
-    body's width there is within [END_WIDTH_LOW, END_WIDTH_HIGH] of its median near that end
+    body's width there is within [MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH] of its median near that end
     (``end_med``: start, end).
 
     The ridge path stops about a half-width short of each end (there the medial axis forks into
@@ -603,7 +608,9 @@ def _march(
             t = t / max(float(np.hypot(*t)), 1e-9)
             ahead = cur + MARCH_STEP_PX * t
             mid, wid, _ = _midpoints(soft, np.array([cur, ahead]), reach=3.0 * half + 4.0)
-            if not np.isfinite(wid[1]) or not END_WIDTH_LOW * med <= wid[1] <= END_WIDTH_HIGH * med:
+            if not (
+                np.isfinite(wid[1]) and MARCH_WIDTH_LOW * med <= wid[1] <= MARCH_WIDTH_HIGH * med
+            ):
                 break
             step = mid[1]
             d = step - prev  # the course over the last few points, not one step's jitter
