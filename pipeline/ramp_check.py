@@ -9,8 +9,8 @@ neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in i
 
 - a photo more than :data:`SLACK_DEG` outside that range is ``flagged``, with the reason
   ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
-  The worst photo goes first and the leg is checked again without it, so one wrong photo
-  never drags its neighbours down;
+  The worst photo goes first (one already flagged on its own before one that is not) and the
+  leg is checked again without it, so one wrong photo never drags its neighbours down;
 - a photo whose measured line length is far from the ramp's median is ``flagged`` (a partial
   line);
 - a photo ``flagged`` only for a cosmetic reason (line partly hidden, touching the border) whose
@@ -128,13 +128,20 @@ def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np
     re-trust."""
     keep = list(range(len(leg)))
     psi_all = leg["psi_deg"].to_numpy(float)
+    doubtful = (leg["status"] != "ok").to_numpy()  # flagged on its own, before the ramp
     while len(keep) >= 3:
         psi = psi_all[keep]
-        worst, i, lo, hi = max(
+        breaking = [
             (_outside(psi[i], *_allowed(psi, i)), i, *_allowed(psi, i)) for i in range(len(keep))
-        )
-        if worst <= SLACK_DEG:
+        ]
+        breaking = [b for b in breaking if b[0] > SLACK_DEG]
+        if not breaking:
             break
+        # a photo already doubtful on its own is blamed before one that is not (two photos that
+        # disagree break each other's range alike); then the worst
+        _, i, lo, hi = max(
+            [b for b in breaking if doubtful[keep[b[1]]]] or breaking
+        )
         k = position[leg.index[keep[i]]]
         status[k] = "flagged"
         reason[k] = _join(

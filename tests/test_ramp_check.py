@@ -106,3 +106,14 @@ def test_short_legs_and_separate_ramps():
     b = _ramp(_ds20_like(), actuator="A2")
     out = check_ramps(pd.concat([a, b], ignore_index=True))
     assert (out["status"] == "ok").all()
+
+
+def test_of_two_photos_that_break_each_others_range_the_doubtful_one_is_blamed():
+    # the dev set's c_20C / c_30C: a partly walked ring (-120, flagged on its own) beside a right
+    # photo (-186); each lies 66 deg outside the range the other allows
+    psi = [-120.0, -186.0, -68.0, -12.0, -8.0]
+    df = _ramp(psi)
+    df.loc[0, ["status", "reason"]] = ["flagged", "body closes on itself"]
+    out = check_ramps(df)
+    assert out["reason"].iloc[0].startswith("breaks its ramp")
+    assert out["status"].iloc[1] == "ok" and "breaks" not in out["reason"].iloc[1]
