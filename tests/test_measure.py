@@ -409,3 +409,44 @@ def test_default_init_path_reads_like_the_configured_path() -> None:
     diff = np.abs(np.array(auto) - np.array(configured))
     # was 2.4 deg low on average, two sign flips 'ok'
     assert np.median(diff) <= 0.3 and diff.max() < 1.5
+
+
+def _phone_jpeg(path, stored_hw=(300, 400), orientation=6, metadata_kb=120):
+    """A JPEG as a phone writes a portrait photo: stored landscape with an EXIF orientation, and
+    more metadata (ICC profile, maker notes) before the frame header than 64 KB."""
+    from PIL import Image
+
+    img = Image.fromarray(np.zeros((*stored_hw, 3), np.uint8))
+    exif = img.getexif()
+    exif[0x0112] = orientation
+    img.save(path, exif=exif.tobytes(), quality=90)
+    raw = path.read_bytes()
+    app2 = b"\xff\xe2" + (60002).to_bytes(2, "big") + bytes(60000)
+    path.write_bytes(raw[:2] + app2 * (metadata_kb // 60) + raw[2:])
+    return path
+
+
+@pytest.mark.parametrize(
+    ("orientation", "size"), [(1, (400, 300)), (6, (300, 400)), (8, (300, 400))]
+)
+def test_jpeg_size_is_the_size_opencv_decodes_a_phone_photo_at(tmp_path, orientation, size):
+    path = _phone_jpeg(tmp_path / "p.jpg", orientation=orientation)
+    data = np.fromfile(str(path), np.uint8)
+    decoded = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    assert jpeg_size(data) == size == (decoded.shape[1], decoded.shape[0])
+    img, f = decode_for_work(data)
+    assert img is not None and (img.shape[1] * f, img.shape[0] * f) == size
+
+
+def test_photoset_check_takes_a_phone_photo_as_it_is_seen(tmp_path):
+    # the fixed end read off an image viewer of the portrait photo (y = 380 of 400) is inside it
+    from pipeline.photoset_check import check_photoset
+
+    _phone_jpeg(tmp_path / "a.jpg")
+    write_manifest(
+        tmp_path,
+        pd.DataFrame({"image": ["a.jpg"], "pressure_kpa": [0.0], "direction": ["up"],
+                      "material": ["SS50"], "actuator": ["A1"], "trial": ["1"]}),
+    )
+    write_settings(tmp_path, {"l0_mm": 210, "fixed_end": [250, 380], "roi": [10, 300, 290, 390]})
+    assert [str(p) for p in check_photoset(tmp_path)] == []

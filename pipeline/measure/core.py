@@ -16,6 +16,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Literal
 
 import cv2
 import numpy as np
@@ -450,7 +451,13 @@ _REDUCED_GREY = {
 
 
 def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
-    """(width, height) from a JPEG's frame header without decoding; None if not a JPEG.
+    """(width, height) of a JPEG as OpenCV decodes it, from its headers; None if not a JPEG.
+
+    The frame header gives the stored size; an EXIF orientation that turns the picture by 90 deg
+    (5-8: how a phone stores a portrait photo) swaps it, since OpenCV decodes the photo turned
+    upright (so the pixel coordinates a user reads off an image viewer are that size's).  The
+    headers are walked to the frame header however long the metadata before it (EXIF with a
+    thumbnail, ICC profiles and maker notes often pass 64 KB).
 
     Examples
     --------
@@ -459,9 +466,14 @@ def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
     >>> jpeg_size(buf.tobytes())
     (40, 30)
     """
-    b = bytes(data[:65536]) if isinstance(data, np.ndarray) else data[:65536]
-    if b[:2] != b"\xff\xd8":
+    b = (
+        np.ascontiguousarray(data, dtype=np.uint8).reshape(-1).data
+        if isinstance(data, np.ndarray)
+        else memoryview(data)
+    )
+    if bytes(b[:2]) != b"\xff\xd8":
         return None
+    orientation = 1
     i = 2
     while i + 9 < len(b):
         if b[i] != 0xFF:
@@ -471,12 +483,31 @@ def jpeg_size(data: bytes | np.ndarray) -> tuple[int, int] | None:
             i += 1
             continue
         seg = int.from_bytes(b[i + 2 : i + 4], "big")
+        if marker == 0xE1 and bytes(b[i + 4 : i + 10]) == b"Exif\x00\x00":
+            orientation = _exif_orientation(bytes(b[i + 10 : i + 2 + seg]))
         if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):
             h = int.from_bytes(b[i + 5 : i + 7], "big")
             w = int.from_bytes(b[i + 7 : i + 9], "big")
-            return w, h
+            return (h, w) if orientation in (5, 6, 7, 8) else (w, h)
         i += 2 + seg
     return None
+
+
+def _exif_orientation(tiff: bytes) -> int:
+    """The EXIF orientation tag (0x0112) of IFD0 in a TIFF block; 1 (upright) if absent."""
+    if tiff[:2] not in (b"II", b"MM") or len(tiff) < 8:
+        return 1
+    order: Literal["little", "big"] = "little" if tiff[:2] == b"II" else "big"
+    ifd = int.from_bytes(tiff[4:8], order)
+    if ifd + 2 > len(tiff):
+        return 1
+    for k in range(int.from_bytes(tiff[ifd : ifd + 2], order)):
+        e = ifd + 2 + 12 * k
+        if e + 12 > len(tiff):
+            break
+        if int.from_bytes(tiff[e : e + 2], order) == 0x0112:
+            return int.from_bytes(tiff[e + 8 : e + 10], order)
+    return 1
 
 
 def decode_for_work(
