@@ -196,6 +196,19 @@ def test_the_centre_line_stops_at_a_rigid_cap_wider_than_the_body():
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=3.5)
 
 
+def test_a_wobbly_centre_line_is_flagged_not_an_ok_psi():
+    # the translucent body with dots on grey at 720p: its faint side makes the centre line wobble
+    # near both ends, and the end tangents read -32.8 deg for -22.3 (it was ok); a smooth fit of
+    # the whole centre line's turning disagrees, and says so
+    from pipeline.synth import render_actuator, scene_from
+
+    psi = float(np.linspace(215.0, -220.0, 12)[6])
+    r = render_actuator(psi, 270.0, scene_from("grey_dots_clear", width=1280, height=720), seed=36)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert res.status == "flagged" and "smooth fit of the whole centre line" in res.reason
+
+
 def test_a_free_end_with_one_side_lost_is_flagged():
     img, fe, _ = body_photo(-120.0, width=46.0, lost_side_from=0.8, seed=4)
     res = measure_image(img, settings_for(fe))

@@ -29,6 +29,7 @@ from pipeline.measure.estimators import (
     auto_choice,
     hyper,
     tangents,
+    turning,
     turning_quick,
 )
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
@@ -353,6 +354,8 @@ def measure_body(
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
+        # the same turning from a smooth fit of the whole centre line: the check of a wobbly line
+        smooth = turning(pts, rng, ends_px=ends)
         est = (
             tip
             if method in ("auto", "tangents") or base is not None
@@ -380,6 +383,7 @@ def measure_body(
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
+        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth.turning_rad - free.turning_rad))),
     )
     used = "tangents" if method == "auto" or base is not None else method
     return _measured(psi, est, line, quality, settings, used)

@@ -155,6 +155,10 @@ def assess(
 
 #: body: the free end's tangent may move this much (deg) when its fit window doubles
 TIP_UNSTABLE_DEG = 8.0
+#: body: psi from the end tangents and from a smooth fit of the whole centre line's tangent angle
+#: (:func:`~pipeline.measure.estimators.turning`) may differ this much (deg); more: a wobbly
+#: centre line (on rendered translucent bodies it caught the ok rows 8-10 deg off)
+SMOOTH_DISAGREE_DEG = 8.0
 #: body: width along the centre line (90th / 10th percentile) above this -> uneven outline
 WIDTH_RATIO = 2.2
 #: body: the free end's direction may change this much (deg) when the centre line is carried on
@@ -182,6 +186,7 @@ def assess_body(
     ridge_tip_deg: float = 0.0,
     free_end_width_ratio: float = 1.0,
     side_on_border: bool = False,
+    smooth_mismatch_deg: float = 0.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -221,6 +226,12 @@ def assess_body(
     if abs(psi_check_deg - psi_deg) > TIP_UNSTABLE_DEG:
         flags.append(
             f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)"
+        )
+    if abs(smooth_mismatch_deg) > SMOOTH_DISAGREE_DEG:
+        flags.append(
+            f"the end tangents and a smooth fit of the whole centre line disagree by "
+            f"{abs(smooth_mismatch_deg):.0f} deg: the centre line wobbles (a faint or translucent "
+            "side?); check with photoset preview"
         )
     if line.branched_fraction > 0.05:
         flags.append("body closes on itself")
