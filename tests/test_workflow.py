@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import pypdfium2 as pdfium
 import pytest
 import yaml
 
@@ -47,6 +48,30 @@ def _tiny_config() -> dict:
         "compare": {"bootstrap": 20},
         "bench": {"in_report": False},
     }
+
+
+#: a small synthetic video dataset, run with the two photo sets: SS40 through pressure steps
+#: 0-40-80-40-0 kPa held 2.5 s each (320x240, 10 fps, 135 frames)
+VIDEO_DATASET = {
+    "name": "vid",
+    "source": "synthetic_video",
+    "material": "SS40",
+    "profile": "steps",
+    "max_kpa": 80,
+    "step_kpa": 40,
+    "hold_s": 2.5,
+    "fps": 10,
+    "rest_s": 0.5,
+    "scene": "lab",
+    "scene_set": {"width": 320, "height": 240, "tilt_deg": 0},
+}
+
+
+def _finished_config() -> dict:
+    """The config of the finished run: the two photo sets and the video dataset."""
+    cfg = _tiny_config()
+    cfg["datasets"].append(dict(VIDEO_DATASET))
+    return cfg
 
 
 def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedProcess:
@@ -89,7 +114,7 @@ ON_THE_FINISHED_RUN = pytest.mark.xdist_group("finished_run")
 @pytest.fixture(scope="module")
 def finished_run(tmp_path_factory, request):
     repo = Path(request.config.rootpath)
-    workdir = _workdir(tmp_path_factory.mktemp("wf"), repo, _tiny_config())
+    workdir = _workdir(tmp_path_factory.mktemp("wf"), repo, _finished_config())
     out = _snakemake(workdir, repo, "--cores", "2")
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-5000:]
     return repo, workdir
@@ -107,9 +132,10 @@ def test_outputs_exist_and_hold_real_numbers(finished_run):
         assert {"material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n"} <= set(
             hyst.columns
         )
-    # both sets carry ground truth: the run is measured against it
+    # every set carries ground truth: the run is measured against it (the video's in its own test)
     accuracy = run_accuracy(res).set_index("dataset")
-    assert set(accuracy.index) == {"sample", "tiny"}
+    assert set(accuracy.index) == {"sample", "tiny", "vid"}
+    accuracy = accuracy.loc[["sample", "tiny"]]
     assert (accuracy["n_ok"] >= accuracy["n"] - 1).all()
     assert (accuracy["median_deg"] < 1.0).all() and (accuracy["n_ok_over_5deg"] == 0).all()
     rms = pd.read_csv(res / "rms.csv")
@@ -131,7 +157,7 @@ def test_rerun_does_nothing(finished_run):
 @ON_THE_FINISHED_RUN
 def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config()
+    cfg = _finished_config()
     cfg["datasets"].append(
         {
             "name": "new",
@@ -161,7 +187,7 @@ def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
 @ON_THE_FINISHED_RUN
 def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config()
+    cfg = _finished_config()
     cfg["model"] = {"readings": {"l0_factor": "metres", "jacobian": "deformed"}}
     (workdir / "config3.yaml").write_text(yaml.safe_dump(cfg))
     out = _snakemake(
@@ -169,11 +195,13 @@ def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     )
     assert out.returncode == 0, out.stderr[-3000:]
     jobs = _planned_jobs(out.stdout)
-    assert jobs.get("model_curve") == 2 and jobs.get("compare") == 1  # DS20 (sample) and SS50
-    assert "measure" not in jobs and "synth_photoset" not in jobs  # photos and angles stay
+    # DS20 (sample), SS50 (tiny) and SS40 (vid)
+    assert jobs.get("model_curve") == 3 and jobs.get("compare") == 1
+    # photos, videos and angles stay
+    assert not {"measure", "synth_photoset", "synth_video", "continuous"} & set(jobs)
     commands = [line for line in out.stdout.splitlines() if "python -m pipeline model curve" in line
                 or "python -m pipeline compare" in line]
-    assert len(commands) == 3
+    assert len(commands) == 4
     assert all("--jacobian deformed --l0-factor metres" in c for c in commands)
 
 
@@ -395,3 +423,23 @@ def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, rep
     angles = pd.read_csv(tmp_path / "results" / "datasets" / "rigA1" / "angles.csv")
     assert (angles["status"] == "ok").all()
     assert angles["psi_deg"].iloc[0] > angles["psi_deg"].iloc[2]  # pressure uncurls it
+
+
+@ON_THE_FINISHED_RUN
+def test_a_video_dataset_runs_from_render_to_its_report_page(finished_run):
+    """The video dataset of the finished run: rendered, measured frame by frame, aggregated as a
+    continuous recording and given its report page (that a re-run does nothing, the video's jobs
+    included, is ``test_rerun_does_nothing``)."""
+    _repo, workdir = finished_run
+    res = workdir / "results"
+    angles = pd.read_csv(res / "datasets" / "vid" / "angles.csv")
+    assert len(angles) == 135 and {"frame", "time_s"} <= set(angles.columns)
+    accuracy = run_accuracy(res).set_index("dataset")
+    assert accuracy.loc["vid", "n_ok"] >= 130 and accuracy.loc["vid", "median_deg"] < 0.1
+    steps = pd.read_csv(res / "continuous" / "vid" / "steps.csv")
+    assert list(steps["to_kpa"]) == [40, 80, 40, 0] and steps["rise_time_s"].notna().all()
+    assert (res / "continuous" / "vid" / "strip.jpg").is_file()
+    doc = pdfium.PdfDocument(str(res / "report.pdf"))
+    text = [doc[i].get_textpage().get_text_range() for i in range(len(doc))]
+    doc.close()
+    assert sum("Video dataset vid" in t for t in text) == 1
