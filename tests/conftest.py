@@ -56,3 +56,12 @@ def measured(video_set):
     from pipeline.photoset_measure import measure_photoset
 
     return measure_photoset(video_set, jobs=2)
+
+
+@pytest.fixture(scope="session")
+def soft_ss50() -> str:
+    """A materials file holding SS50 at half the packaged modulus (mu 0.34 MPa), l0 240 mm."""
+    return (
+        "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
+        "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n"
+    )
