@@ -11,6 +11,19 @@ import pytest
 REPO = Path(__file__).resolve().parent.parent
 
 
+#: session fixtures whose tests run on one xdist worker (pyproject: --dist loadgroup), so that each
+#: is built once per run, not once on every worker
+ONE_WORKER_FIXTURES = {"video_set": "video_set", "measured": "video_set"}
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        used = getattr(item, "fixturenames", ())
+        for group in sorted({g for name, g in ONE_WORKER_FIXTURES.items() if name in used}):
+            item.add_marker(pytest.mark.xdist_group(group))
+
+
 @pytest.fixture
 def repo() -> Path:
     """The repository root (Snakefile, config.yaml, sample_images/)."""
