@@ -11,6 +11,19 @@ import pytest
 REPO = Path(__file__).resolve().parent.parent
 
 
+#: session fixtures whose tests run on one xdist worker (pyproject: --dist loadgroup), so that each
+#: is built once per run, not once on every worker
+ONE_WORKER_FIXTURES = {"video_set": "video_set", "measured": "video_set"}
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        used = getattr(item, "fixturenames", ())
+        for group in sorted({g for name, g in ONE_WORKER_FIXTURES.items() if name in used}):
+            item.add_marker(pytest.mark.xdist_group(group))
+
+
 @pytest.fixture
 def repo() -> Path:
     """The repository root (Snakefile, config.yaml, sample_images/)."""
@@ -56,3 +69,12 @@ def measured(video_set):
     from pipeline.photoset_measure import measure_photoset
 
     return measure_photoset(video_set, jobs=2)
+
+
+@pytest.fixture(scope="session")
+def soft_ss50() -> str:
+    """A materials file holding SS50 at half the packaged modulus (mu 0.34 MPa), l0 240 mm."""
+    return (
+        "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
+        "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n"
+    )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
 import pandas as pd
@@ -511,20 +510,14 @@ def test_a_dataset_with_its_own_materials_file_is_compared_against_that_files_mo
     ]
 
 
-SOFT_SS50 = (
-    "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
-    "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n"
-)
-
-
-def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys):
+def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys, soft_ss50):
     """compare --dataset-materials: the real model of the dataset's file (half SS50's modulus, l0
     240 mm)."""
     from pipeline import model
     from pipeline.cli import main
 
     own = tmp_path / "soft.yaml"
-    own.write_text(SOFT_SS50)
+    own.write_text(soft_ss50)
     soft = model.load_materials(own)["SS50"]
     folders = []
     for name in ("std", "soft"):
@@ -592,219 +585,3 @@ def test_cli_compares_a_dataset_against_its_own_materials_file(tmp_path, capsys)
     std_curve = c[c["curve"] == out.loc["std", "curve"]]
     assert not np.allclose(std_curve["pressure_kpa"], own_curve["pressure_kpa"], equal_nan=True)
     assert main([*args, "--dataset-materials", str(own)]) == 2  # one file per dataset, or '-'
-
-
-@pytest.mark.slow
-def test_workflow_models_each_dataset_at_its_own_l0(tmp_path, repo):
-    """End to end (real snakemake, tiny config in a temporary folder): SS50 photo sets, one of
-    an actuator with l0 = 220 mm; its model curve and its RMS use 220 mm, the other's the default,
-    and the report says which l0 each curve used and that synthetic RMS is a self-check.  A third
-    set, the photos of 'short', names its own materials file (SS50 at half the modulus): its
-    model curve and RMS are that file's, the report names the file and its sha256."""
-    import subprocess
-    import sys
-
-    import pypdfium2 as pdfium
-    import yaml
-
-    from pipeline import model
-    from pipeline.cli import main
-
-    short = tmp_path / "short"  # a folder photo set of a shorter actuator (rendered by synth)
-    assert (
-        main(
-            [
-                "synth",
-                str(short),
-                "--material",
-                "SS50",
-                "--actuators",
-                "1",
-                "--trials",
-                "1",
-                "--step-kpa",
-                "80",
-                "--max-kpa",
-                "240",
-                "--scene",
-                "clean",
-                "--set",
-                "width=400",
-                "--set",
-                "height=300",
-                "--l0-mm",
-                "220",
-                "--seed",
-                "3",
-            ]
-        )
-        == 0
-    )
-    (tmp_path / "soft.yaml").write_text(
-        SOFT_SS50
-    )  # SS50 at mu 0.34 MPa; l0 240 mm, but the photos say 220
-    config = {
-        "datasets": [
-            {
-                "name": "std",
-                "source": "synthetic",
-                "material": "SS50",
-                "actuators": 1,
-                "trials": 1,
-                "step_kpa": 80,
-                "max_kpa": 240,
-                "scene": "clean",
-                "scene_set": {"width": 400, "height": 300},
-            },
-            {"name": "short", "source": "folder", "path": str(short)},
-            {"name": "soft", "source": "folder", "path": str(short), "materials_file": "soft.yaml"},
-        ],
-        "compare": {"bootstrap": 5},
-        "bench": {"in_report": False},
-    }
-    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "snakemake",
-            "-s",
-            str(repo / "Snakefile"),
-            "--directory",
-            str(tmp_path),
-            "--cores",
-            "2",
-        ],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-5000:]
-    res = tmp_path / "results"
-    angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
-    assert (angles["l0_mm"] == 220.0).all()  # measure carries each photo's l0
-    default = model.load_materials()["SS50"].l0_mm
-    assert default != 220.0
-    rms = pd.read_csv(res / "rms.csv").set_index("datasets")
-    assert rms.loc["short", "curve"] == "SS50, l0 220 mm" and rms.loc["short", "l0_mm"] == 220.0
-    assert rms.loc["short", "l0_source"] == "photo set"
-    assert rms.loc["std", "l0_mm"] == default == 255.0
-    assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
-    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at
-    # their 220 mm
-    soft = model.load_materials(tmp_path / "soft.yaml")["SS50"]
-    assert soft.mu_mpa == (0.34,) and model.load_materials()["SS50"].mu_mpa == (0.68,)
-    assert (
-        rms.loc["soft", "curve"]
-        == "SS50, l0 220 mm, materials soft.yaml"
-        != rms.loc["short", "curve"]
-    )
-    assert (
-        rms.loc["soft", "materials_file"] == "soft.yaml"
-        and rms.loc["soft", "l0_source"] == "photo set"
-    )
-    assert rms.loc["soft", "l0_mm"] == 220.0  # the photo set's l0 wins over the file's 240 mm
-    assert (
-        rms.loc[["std", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)"
-    ).all()
-    h_short = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
-    h_soft = pd.read_csv(res / "datasets" / "soft" / "hysteresis.csv")
-    pd.testing.assert_frame_equal(
-        h_short, h_soft
-    )  # same photos: any difference below is the model's
-    p_s, psi_s = h_soft["pressure_kpa"].to_numpy(float), h_soft["psi_mean_deg"].to_numpy(float)
-    at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s, l0_mm=220.0))[0]
-    assert rms.loc["soft", "rms_deg"] == pytest.approx(at_soft, rel=1e-4)
-    assert (
-        rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0
-    )  # drawn from the paper's SS50, not the soft one
-    # two datasets naming SS50 with different materials files: two model curves, neither overwritten
-    own_curve = pd.read_csv(res / "datasets" / "soft" / "model" / "SS50.csv")
-    run_curve = pd.read_csv(res / "model" / "SS50.csv")
-    np.testing.assert_allclose(
-        own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9
-    )
-    np.testing.assert_allclose(
-        run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9
-    )
-    assert not np.allclose(own_curve["pressure_kpa"], run_curve["pressure_kpa"], equal_nan=True)
-    soft_compared = pd.read_csv(res / "compare_curves.csv").query(
-        "curve == 'SS50, l0 220 mm, materials soft.yaml'"
-    )
-    np.testing.assert_allclose(
-        soft_compared["pressure_kpa"],
-        model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
-        rtol=1e-5,
-    )
-    # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
-    hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
-    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
-    at_220 = rms_deg(psi, model.psi_deg("SS50", p, l0_mm=220.0))[0]
-    at_default = rms_deg(psi, model.psi_deg("SS50", p))[0]
-    assert rms.loc["short", "rms_deg"] == pytest.approx(at_220, rel=1e-4)
-    assert abs(at_220 - at_default) > 1e-3
-    curves = pd.read_csv(res / "compare_curves.csv")
-    c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
-    assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
-    np.testing.assert_allclose(
-        c220["pressure_kpa"],
-        model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
-        rtol=1e-5,
-        atol=1e-9,
-    )
-    doc = pdfium.PdfDocument(str(res / "report.pdf"))
-    pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
-    doc.close()
-    comparison = next(t for t in pages if "Model versus measurements, beside" in t)
-    assert (
-        "photos rendered from this package's model, so the RMS is a self-check, not a validation"
-        in comparison
-    )
-    assert (
-        "Materials file of the model curves: packaged (pipeline/model/materials.yaml) "
-        "(std, short); soft.yaml (soft)" in comparison
-    )
-    provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
-    assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
-    assert "220 (photo set) soft.yaml" in provenance
-    import hashlib
-
-    inputs = next(t for t in pages if "Input files" in t)
-    assert hashlib.sha256((tmp_path / "soft.yaml").read_bytes()).hexdigest() in inputs.replace(
-        " ", ""
-    )
-    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report),
-    # nothing else
-    with (tmp_path / "soft.yaml").open("a") as fh:
-        fh.write("# k_P re-measured\n")
-    dry = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "snakemake",
-            "-s",
-            str(repo / "Snakefile"),
-            "--directory",
-            str(tmp_path),
-            "--cores",
-            "2",
-            "-n",
-        ],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert dry.returncode == 0, dry.stderr[-3000:]
-    table = dry.stdout.split("Job stats:")[-1]
-    jobs = {
-        m[1]: int(m[2])
-        for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE)
-        if m[1] != "total"
-    }
-    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[
-        -2000:
-    ]
-    assert f"SS50, l0 {default:g} mm" in provenance
-    material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
-    assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material
-    assert "model, l0 220 mm, materials soft.yaml" in material

@@ -10,9 +10,6 @@ synthetic, dates from the inputs, n/a for missing values, identical bytes for id
 from __future__ import annotations
 
 import dataclasses
-import fcntl
-import os
-import pickle
 import subprocess
 import sys
 from pathlib import Path
@@ -325,21 +322,6 @@ def write_force(folder: Path) -> Path:
     return folder
 
 
-def shared(tmp_path_factory: pytest.TempPathFactory, name: str, make):  # type: ignore[no-untyped-def]
-    """``make(folder)`` computed once per test run, however many xdist workers ask (lock, then
-    pickle)."""
-    if not os.environ.get("PYTEST_XDIST_WORKER"):
-        return make(tmp_path_factory.mktemp(name))
-    root = tmp_path_factory.getbasetemp().parent  # one folder per run, shared by its workers
-    with open(root / f"{name}.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        done = root / f"{name}.pickle"
-        if not done.is_file():
-            (root / name).mkdir()
-            done.write_bytes(pickle.dumps(make(root / name)))
-        return pickle.loads(done.read_bytes())
-
-
 def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
     """Inputs shaped like the default run (4 materials, a second DS20 set, bench and force folders)
     and the report built from them."""
@@ -375,23 +357,24 @@ def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
     return inputs, pdf, rms
 
 
+#: tests of the default report go to one xdist worker (pyproject: --dist loadgroup), which builds
+#: it (and draws its pages) once
+ON_THE_DEFAULT_REPORT = pytest.mark.xdist_group("default_report")
+
+
 @pytest.fixture(scope="module")
 def default(tmp_path_factory):
     """(inputs, report.pdf, rms.csv) of a report shaped like the default run's."""
-    return shared(tmp_path_factory, "report-default", make_default)
+    return make_default(tmp_path_factory.mktemp("report-default"))
 
 
 @pytest.fixture(scope="module")
-def pages(default, tmp_path_factory):
+def pages(default):
     """(label, texts drawn) of every page of the default report, each page drawn once (not
     saved)."""
-
-    def make(_folder: Path) -> list:
-        with report_style():
-            made, _ = report_figures(load_report_data(default[0]))
-            return [(f.get_label(), drawn_texts(f)) for f in made]
-
-    return shared(tmp_path_factory, "report-pages", make)
+    with report_style():
+        made, _ = report_figures(load_report_data(default[0]))
+        return [(f.get_label(), drawn_texts(f)) for f in made]
 
 
 def pdf_text(pdf: Path, page: int) -> str:
@@ -402,6 +385,7 @@ def pdf_text(pdf: Path, page: int) -> str:
         doc.close()
 
 
+@ON_THE_DEFAULT_REPORT
 def test_every_page_is_a4(default):
     _inputs, pdf, _rms = default
     doc = pdfium.PdfDocument(str(pdf))
@@ -417,6 +401,7 @@ def test_every_page_is_a4(default):
     assert "Provenance" in pdf_text(pdf, 15)
 
 
+@ON_THE_DEFAULT_REPORT
 def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
     labels = [label for label, _ in pages]
     assert labels[:15] == [
@@ -464,6 +449,7 @@ def test_the_overlap_check_sees_overlaps_and_only_drawn_texts():
     assert all(t.box.x1 <= 72 * fig.get_figwidth() + 1 for t in texts)
 
 
+@ON_THE_DEFAULT_REPORT
 def test_page_one_figures_read_back_match_rms_csv(default):
     _inputs, pdf, rms = default
     text = pdf_text(pdf, 0)
@@ -501,6 +487,7 @@ def test_page_one_figures_read_back_match_rms_csv(default):
     assert "SS50: the mean curve never reaches ψ = 0 up to 250 kPa" in " ".join(text.split())
 
 
+@ON_THE_DEFAULT_REPORT
 def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     inputs, pdf, _rms = default
     text = " ".join(pdf_text(pdf, 0).split())
@@ -558,12 +545,14 @@ def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
     assert dataset_dates(rows.drop(columns="timestamp"), tmp_path) == (None, None, "")
 
 
+@ON_THE_DEFAULT_REPORT
 def test_missing_values_read_na_on_the_comparison_page(pages):
     comparison = dict(pages)["comparison"]
     # SS50: table cells and the two bars of P at psi = 0
     assert sum(t.text == NA for t in comparison) >= 2 + 2
 
 
+@ON_THE_DEFAULT_REPORT
 def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default):
     from pipeline.report.strip import build_strip, crop_banner
 
@@ -579,6 +568,7 @@ def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default
     assert "actuator DS20/A1, trial 1" in text
 
 
+@ON_THE_DEFAULT_REPORT
 def test_bench_pages_say_where_each_method_breaks(pages):
     stability = " ".join(t.text for t in dict(pages)["stability"])
     assert (
@@ -602,6 +592,7 @@ def test_bench_pages_say_where_each_method_breaks(pages):
     assert labels.count("0.17°") == 5 and labels.count("0.22°") == 1
 
 
+@ON_THE_DEFAULT_REPORT
 def test_identical_inputs_identical_bytes_across_processes(default, tmp_path):
     inputs, pdf, rms = default
     d = inputs.datasets
@@ -725,6 +716,7 @@ def test_bad_inputs_exit_2(tmp_path):
     )
 
 
+@ON_THE_DEFAULT_REPORT
 def test_each_material_has_one_colour_on_every_page(default):
     from matplotlib.colors import to_rgb
 

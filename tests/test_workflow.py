@@ -16,11 +16,14 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
+import pypdfium2 as pdfium
 import pytest
 import yaml
 
 from pipeline.bench.campaign import run_accuracy
+from pipeline.compare import rms_deg
 
 pytestmark = pytest.mark.slow
 
@@ -47,6 +50,51 @@ def _tiny_config() -> dict:
         "compare": {"bootstrap": 20},
         "bench": {"in_report": False},
     }
+
+
+#: a small synthetic video dataset, run with the two photo sets: SS40 through pressure steps
+#: 0-40-80-40-0 kPa held 2.5 s each (320x240, 10 fps, 135 frames)
+VIDEO_DATASET = {
+    "name": "vid",
+    "source": "synthetic_video",
+    "material": "SS40",
+    "profile": "steps",
+    "max_kpa": 80,
+    "step_kpa": 40,
+    "hold_s": 2.5,
+    "fps": 10,
+    "rest_s": 0.5,
+    "scene": "lab",
+    "scene_set": {"width": 320, "height": 240, "tilt_deg": 0},
+}
+
+
+#: the photo set of a shorter SS50 actuator (l0 220 mm), rendered by synth into the work folder
+SHORT = "short"
+#: the materials file of 'soft' (the photos of 'short' against SS50 at half the modulus)
+SOFT_YAML = "soft.yaml"
+
+
+def _finished_config() -> dict:
+    """The config of the finished run: the two photo sets, the video dataset, and the photos of a
+    shorter actuator twice, against the packaged model ('short') and against its own materials
+    file ('soft')."""
+    cfg = _tiny_config()
+    cfg["datasets"] += [
+        dict(VIDEO_DATASET),
+        {"name": "short", "source": "folder", "path": SHORT},
+        {"name": "soft", "source": "folder", "path": SHORT, "materials_file": SOFT_YAML},
+    ]
+    return cfg
+
+
+def _render_short(folder: Path) -> None:
+    """A folder photo set of an SS50 actuator of l0 = 220 mm (the packaged SS50 has 255 mm)."""
+    from pipeline.cli import main
+
+    args = ["--material", "SS50", "--actuators", "1", "--trials", "1", "--step-kpa", "80"]
+    args += ["--max-kpa", "240", "--scene", "clean", "--set", "width=400", "--set", "height=300"]
+    assert main(["synth", str(folder), *args, "--l0-mm", "220", "--seed", "3"]) == 0
 
 
 def _snakemake(workdir: Path, repo: Path, *args: str) -> subprocess.CompletedProcess:
@@ -87,9 +135,11 @@ ON_THE_FINISHED_RUN = pytest.mark.xdist_group("finished_run")
 
 
 @pytest.fixture(scope="module")
-def finished_run(tmp_path_factory, request):
+def finished_run(tmp_path_factory, request, soft_ss50):
     repo = Path(request.config.rootpath)
-    workdir = _workdir(tmp_path_factory.mktemp("wf"), repo, _tiny_config())
+    workdir = _workdir(tmp_path_factory.mktemp("wf"), repo, _finished_config())
+    _render_short(workdir / SHORT)
+    (workdir / SOFT_YAML).write_text(soft_ss50)  # SS50 at mu 0.34 MPa; l0 240 mm, photos say 220
     out = _snakemake(workdir, repo, "--cores", "2")
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-5000:]
     return repo, workdir
@@ -107,9 +157,10 @@ def test_outputs_exist_and_hold_real_numbers(finished_run):
         assert {"material", "direction", "pressure_kpa", "psi_mean_deg", "psi_sd_deg", "n"} <= set(
             hyst.columns
         )
-    # both sets carry ground truth: the run is measured against it
+    # every set carries ground truth: the run is measured against it (the video's in its own test)
     accuracy = run_accuracy(res).set_index("dataset")
-    assert set(accuracy.index) == {"sample", "tiny"}
+    assert set(accuracy.index) == {"sample", "tiny", "vid", "short", "soft"}
+    accuracy = accuracy.drop(index="vid")
     assert (accuracy["n_ok"] >= accuracy["n"] - 1).all()
     assert (accuracy["median_deg"] < 1.0).all() and (accuracy["n_ok_over_5deg"] == 0).all()
     rms = pd.read_csv(res / "rms.csv")
@@ -131,7 +182,7 @@ def test_rerun_does_nothing(finished_run):
 @ON_THE_FINISHED_RUN
 def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config()
+    cfg = _finished_config()
     cfg["datasets"].append(
         {
             "name": "new",
@@ -161,7 +212,7 @@ def test_adding_a_dataset_reruns_only_its_jobs_and_the_summary(finished_run):
 @ON_THE_FINISHED_RUN
 def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     repo, workdir = finished_run
-    cfg = _tiny_config()
+    cfg = _finished_config()
     cfg["model"] = {"readings": {"l0_factor": "metres", "jacobian": "deformed"}}
     (workdir / "config3.yaml").write_text(yaml.safe_dump(cfg))
     out = _snakemake(
@@ -169,11 +220,14 @@ def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     )
     assert out.returncode == 0, out.stderr[-3000:]
     jobs = _planned_jobs(out.stdout)
-    assert jobs.get("model_curve") == 2 and jobs.get("compare") == 1  # DS20 (sample) and SS50
-    assert "measure" not in jobs and "synth_photoset" not in jobs  # photos and angles stay
+    # DS20 (sample), SS50 (tiny and short), SS40 (vid), and soft's SS50 of its own file
+    assert jobs.get("model_curve") == 3 and jobs.get("model_curve_dataset") == 1
+    assert jobs.get("compare") == 1
+    # photos, videos and angles stay
+    assert not {"measure", "synth_photoset", "synth_video", "continuous"} & set(jobs)
     commands = [line for line in out.stdout.splitlines() if "python -m pipeline model curve" in line
                 or "python -m pipeline compare" in line]
-    assert len(commands) == 3
+    assert len(commands) == 5
     assert all("--jacobian deformed --l0-factor metres" in c for c in commands)
 
 
@@ -395,3 +449,144 @@ def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, rep
     angles = pd.read_csv(tmp_path / "results" / "datasets" / "rigA1" / "angles.csv")
     assert (angles["status"] == "ok").all()
     assert angles["psi_deg"].iloc[0] > angles["psi_deg"].iloc[2]  # pressure uncurls it
+
+
+@ON_THE_FINISHED_RUN
+def test_a_video_dataset_runs_from_render_to_its_report_page(finished_run):
+    """The video dataset of the finished run: rendered, measured frame by frame, aggregated as a
+    continuous recording and given its report page (that a re-run does nothing, the video's jobs
+    included, is ``test_rerun_does_nothing``)."""
+    _repo, workdir = finished_run
+    res = workdir / "results"
+    angles = pd.read_csv(res / "datasets" / "vid" / "angles.csv")
+    assert len(angles) == 135 and {"frame", "time_s"} <= set(angles.columns)
+    accuracy = run_accuracy(res).set_index("dataset")
+    assert accuracy.loc["vid", "n_ok"] >= 130 and accuracy.loc["vid", "median_deg"] < 0.1
+    steps = pd.read_csv(res / "continuous" / "vid" / "steps.csv")
+    assert list(steps["to_kpa"]) == [40, 80, 40, 0] and steps["rise_time_s"].notna().all()
+    assert (res / "continuous" / "vid" / "strip.jpg").is_file()
+    doc = pdfium.PdfDocument(str(res / "report.pdf"))
+    text = [doc[i].get_textpage().get_text_range() for i in range(len(doc))]
+    doc.close()
+    assert sum("Video dataset vid" in t for t in text) == 1
+
+
+@ON_THE_FINISHED_RUN
+def test_workflow_models_each_dataset_at_its_own_l0(finished_run, tmp_path):
+    """SS50 photo sets of the finished run, 'short' of an actuator with l0 = 220 mm: its model
+    curve and its RMS use 220 mm, tiny's the default, and the report says which l0 each curve used
+    and that synthetic RMS is a self-check.  'soft', the photos of 'short', names its own
+    materials file (SS50 at half the modulus): its model curve and RMS are that file's, the report
+    names the file and its sha256."""
+    import hashlib
+
+    from pipeline import model
+
+    repo, workdir = finished_run
+    res = workdir / "results"
+    angles = pd.read_csv(res / "datasets" / "short" / "angles.csv")
+    assert (angles["l0_mm"] == 220.0).all()  # measure carries each photo's l0
+    default = model.load_materials()["SS50"].l0_mm
+    assert default != 220.0
+    rms = pd.read_csv(res / "rms.csv").set_index("datasets")
+    assert rms.loc["short", "curve"] == "SS50, l0 220 mm" and rms.loc["short", "l0_mm"] == 220.0
+    assert rms.loc["short", "l0_source"] == "photo set"
+    assert rms.loc["tiny", "l0_mm"] == default == 255.0
+    assert (rms["rms_kind"] == "self-check").all() and (rms["data_source"] == "synthetic").all()
+    # 'soft': the photos of 'short', compared against its own file's SS50 (mu 0.34 MPa, not 0.68) at
+    # their 220 mm
+    soft = model.load_materials(workdir / SOFT_YAML)["SS50"]
+    assert soft.mu_mpa == (0.34,) and model.load_materials()["SS50"].mu_mpa == (0.68,)
+    assert (
+        rms.loc["soft", "curve"]
+        == "SS50, l0 220 mm, materials soft.yaml"
+        != rms.loc["short", "curve"]
+    )
+    assert (
+        rms.loc["soft", "materials_file"] == "soft.yaml"
+        and rms.loc["soft", "l0_source"] == "photo set"
+    )
+    assert rms.loc["soft", "l0_mm"] == 220.0  # the photo set's l0 wins over the file's 240 mm
+    assert (
+        rms.loc[["tiny", "short"], "materials_file"] == "packaged (pipeline/model/materials.yaml)"
+    ).all()
+    h_short = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
+    h_soft = pd.read_csv(res / "datasets" / "soft" / "hysteresis.csv")
+    pd.testing.assert_frame_equal(
+        h_short, h_soft
+    )  # same photos: any difference below is the model's
+    p_s, psi_s = h_soft["pressure_kpa"].to_numpy(float), h_soft["psi_mean_deg"].to_numpy(float)
+    at_soft = rms_deg(psi_s, model.psi_deg(soft, p_s, l0_mm=220.0))[0]
+    assert rms.loc["soft", "rms_deg"] == pytest.approx(at_soft, rel=1e-4)
+    assert (
+        rms.loc["soft", "rms_deg"] > rms.loc["short", "rms_deg"] + 5.0
+    )  # drawn from the paper's SS50, not the soft one
+    # two datasets naming SS50 with different materials files: two model curves, neither overwritten
+    own_curve = pd.read_csv(res / "datasets" / "soft" / "model" / "SS50.csv")
+    run_curve = pd.read_csv(res / "model" / "SS50.csv")
+    np.testing.assert_allclose(
+        own_curve["pressure_kpa"], model.model_curve(soft)["pressure_kpa"], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        run_curve["pressure_kpa"], model.model_curve("SS50")["pressure_kpa"], rtol=1e-9
+    )
+    assert not np.allclose(own_curve["pressure_kpa"], run_curve["pressure_kpa"], equal_nan=True)
+    soft_compared = pd.read_csv(res / "compare_curves.csv").query(
+        "curve == 'SS50, l0 220 mm, materials soft.yaml'"
+    )
+    np.testing.assert_allclose(
+        soft_compared["pressure_kpa"],
+        model.model_curve(soft, l0_mm=220.0)["pressure_kpa"],
+        rtol=1e-5,
+    )
+    # the RMS of 'short' is against the model at 220 mm: recompute it from its hysteresis.csv
+    hyst = pd.read_csv(res / "datasets" / "short" / "hysteresis.csv")
+    p, psi = hyst["pressure_kpa"].to_numpy(float), hyst["psi_mean_deg"].to_numpy(float)
+    at_220 = rms_deg(psi, model.psi_deg("SS50", p, l0_mm=220.0))[0]
+    at_default = rms_deg(psi, model.psi_deg("SS50", p))[0]
+    assert rms.loc["short", "rms_deg"] == pytest.approx(at_220, rel=1e-4)
+    assert abs(at_220 - at_default) > 1e-3
+    curves = pd.read_csv(res / "compare_curves.csv")
+    c220 = curves[curves["curve"] == "SS50, l0 220 mm"]
+    assert len(c220) == 400 and (c220["l0_mm"] == 220.0).all()
+    np.testing.assert_allclose(
+        c220["pressure_kpa"],
+        model.model_curve("SS50", l0_mm=220.0)["pressure_kpa"],
+        rtol=1e-5,
+        atol=1e-9,
+    )
+    doc = pdfium.PdfDocument(str(res / "report.pdf"))
+    pages = [" ".join(doc[i].get_textpage().get_text_range().split()) for i in range(len(doc))]
+    doc.close()
+    comparison = next(t for t in pages if "Model versus measurements, beside" in t)
+    assert (
+        "photos rendered from this package's model, so the RMS is a self-check, not a validation"
+        in comparison
+    )
+    assert (
+        "Materials file of the model curves: packaged (pipeline/model/materials.yaml) "
+        "(sample, vid, tiny, short); soft.yaml (soft)" in comparison
+    )
+    provenance = next(t for t in pages if "Model versus measurements: which model curve" in t)
+    assert "SS50, l0 220 mm" in provenance and "220 (photo set)" in provenance
+    assert "220 (photo set) soft.yaml" in provenance
+    assert f"SS50, l0 {default:g} mm" in provenance
+    inputs = next(t for t in pages if "Input files" in t)
+    assert hashlib.sha256((workdir / SOFT_YAML).read_bytes()).hexdigest() in inputs.replace(
+        " ", ""
+    )
+    material = next(t for t in pages if "SS50: bending angle versus pressure" in t)
+    assert "model, l0 220 mm" in material and f"model, l0 {default:g} mm" in material
+    assert "model, l0 220 mm, materials soft.yaml" in material
+    # an edited materials file re-runs what it feeds (its model curve, the comparison, the report),
+    # nothing else (in a copy: the finished run stays as it is for the other tests)
+    work = tmp_path / "wf"
+    shutil.copytree(workdir, work)  # photos, results and Snakemake's records, times kept
+    with (work / SOFT_YAML).open("a") as fh:
+        fh.write("# k_P re-measured\n")
+    dry = _snakemake(work, repo, "--cores", "2", "-n")
+    assert dry.returncode == 0, dry.stderr[-3000:]
+    jobs = _planned_jobs(dry.stdout)
+    assert jobs == {"all": 1, "compare": 1, "model_curve_dataset": 1, "report": 1}, dry.stdout[
+        -2000:
+    ]

@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
-from scipy import optimize, stats
 
 from pipeline.errors import UserInputError
 from pipeline.model.anchors import (
@@ -113,6 +112,8 @@ def fit_k_p(
     k0 = k0 if k0 > 0 and math.isfinite(k0) else mat.k_p
     logs = math.log(k0) + np.linspace(-1.5, 1.5, 31)  # coarse scan guards against local minima
     best = logs[int(np.argmin([sse(v) for v in logs]))]
+    from scipy import optimize, stats  # here: scipy.stats costs a second at every import
+
     res = optimize.minimize_scalar(
         sse, bounds=(best - 0.1, best + 0.1), method="bounded", options={"xatol": 1e-10}
     )
@@ -327,6 +328,8 @@ def fit_l0(
     if not math.isfinite(values[i]):
         return math.nan
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    from scipy import optimize
+
     res = optimize.minimize_scalar(
         lambda v: _model_worst(table, opts, v), bounds=(a, b), method="bounded",
         options={"xatol": 1e-2},
