@@ -22,6 +22,12 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         used = getattr(item, "fixturenames", ())
         for group in sorted({g for name, g in ONE_WORKER_FIXTURES.items() if name in used}):
             item.add_marker(pytest.mark.xdist_group(group))
+    # the long ones first (the shared workflow run alone is over a minute on one worker): handed
+    # out last, they left one worker busy while the other had nothing left to do
+    items.sort(
+        key=lambda it: 0 if it.get_closest_marker("slow") or it.get_closest_marker("xdist_group")
+        else 1
+    )
 
 
 @pytest.fixture
