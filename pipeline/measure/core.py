@@ -354,8 +354,6 @@ def measure_body(
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
-        # the same turning from a smooth fit of the whole centre line: the check of a wobbly line
-        smooth = turning(pts, rng, ends_px=ends)
         est = (
             tip
             if method in ("auto", "tangents") or base is not None
@@ -364,6 +362,11 @@ def measure_body(
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
+    # the same turning from a smooth fit of the whole centre line: the check of a wobbly line
+    try:
+        smooth_turning = turning(pts, np.random.default_rng(SEED), ends_px=ends).turning_rad
+    except (ValueError, np.linalg.LinAlgError):
+        smooth_turning = free.turning_rad  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
     quality = assess_body(
@@ -383,7 +386,7 @@ def measure_body(
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
-        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth.turning_rad - free.turning_rad))),
+        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
     )
     used = "tangents" if method == "auto" or base is not None else method
     return _measured(psi, est, line, quality, settings, used)
