@@ -651,7 +651,6 @@ def _extensions(
     pts: np.ndarray,
     half: float,
     fixed_xy: tuple[float, float] | None,
-    capped: bool,
 ) -> tuple[float, float]:
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
@@ -861,7 +860,6 @@ def extract_body(
     soft = _soft_body(comp, strength)
     pts = _smooth(_resample(path, 1.0), max(1.0, 0.5 * half))
     widths = np.full(len(pts), np.nan)
-    capped = False  # the free end was cut where the width changed (a tip cap, a blob)
     window = int(round(LOCAL_WIDTH_HALF_WIDTHS * half))  # noqa: RUF046 (numpy scalar)
     reach = 3.0 * half + 4.0
     for _ in range(2):
@@ -898,7 +896,7 @@ def extract_body(
     ridge_tip_deg = 0.0
     if len(along_ridge) > len(pts) and len(pts) >= 8:
         ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
-    trimmed = _extensions(comp, pts, half, fe if reached else None, capped)
+    trimmed = _extensions(comp, pts, half, fe if reached else None)
     # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
     # free end the tip may be outside the photo; along a side the middle was taken from the
     # other edge (see _midpoints)
