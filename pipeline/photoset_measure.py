@@ -128,13 +128,36 @@ def measure_photoset(
         out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
     else:
         out = _measure_photos(ps, method, jobs, odir)
+    drawn = out[["status", "reason"]].copy()
     if ramp_check:
         out = check_ramps(out)
     if "calibration_px" in out.columns:
         out = flag_doubtful_calibration(out)
     if odir is not None:
+        if not ps.is_video:
+            note_changed_statuses(out, drawn, odir)
         write_contact_sheets(out, odir)
     return out
+
+
+def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_dir: Path) -> None:
+    """Write the final status on the overlay of each photo whose status or reason the set's
+    checks changed after it was drawn (``drawn``: the per-photo ``status`` and ``reason``)."""
+    from pipeline.measure.overlay import note_final_status
+
+    changed = (angles["status"] != drawn["status"]) | (angles["reason"] != drawn["reason"])
+    for image, status, reason in zip(
+        angles.loc[changed, "image"], angles.loc[changed, "status"], angles.loc[changed, "reason"]
+    ):
+        path = overlays_dir / f"{Path(str(image)).stem}.jpg"
+        img = cv2.imread(str(path))
+        if img is None:
+            continue
+        ok, buf = cv2.imencode(
+            ".jpg", note_final_status(img, str(status), str(reason)), [cv2.IMWRITE_JPEG_QUALITY, 85]
+        )
+        if ok:
+            atomic_write_bytes(path, buf.tobytes())
 
 
 def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> pd.DataFrame:

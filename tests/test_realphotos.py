@@ -39,3 +39,24 @@ def test_every_doubtful_real_photo_says_why(measured):
     assert len(doubtful) and doubtful["reason"].str.len().min() > 10
     # words, not reprs
     assert not doubtful["reason"].str.contains(r"\(\(\(|array\(|np\.", regex=True).any()
+
+
+def test_an_overlay_shows_the_status_the_ramp_check_gave(tmp_path):
+    # c_30C is ok on its own and flagged by the ramp check (line length): its overlay, drawn
+    # green before the check, says so along its bottom; d_50C, ok throughout, is left as drawn
+    import cv2
+    import numpy as np
+
+    from pipeline.photoset_measure import measure_photoset
+
+    angles = measure_photoset(DEV_SET, overlays_dir=tmp_path)
+    assert angles.set_index("image").loc["c_30C.png", "status"] == "flagged"
+
+    def orange_at_bottom(name):
+        band = cv2.imread(str(tmp_path / name))[-32:].astype(int)
+        b, g, r = band[..., 0], band[..., 1], band[..., 2]
+        return bool(((r > 180) & (g > 100) & (g < 200) & (b < 90)).sum() > 30)
+
+    assert orange_at_bottom("c_30C.jpg")
+    assert not orange_at_bottom("d_50C.jpg")
+    assert np.isfinite(angles["psi_deg"]).all()

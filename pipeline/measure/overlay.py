@@ -74,6 +74,30 @@ def draw_overlay(
     return out
 
 
+def note_final_status(overlay_bgr: np.ndarray, status: str, reason: str) -> np.ndarray:
+    """The overlay with the photo's final status written along its bottom.
+
+    For a status that the checks over the whole set (the ramp check, the calibration check)
+    changed after the photo was drawn, so that its overlay never shows ``ok`` for a row the
+    table flags, nor the other way round.
+    """
+    out = overlay_bgr.copy()
+    band = out[-32:, :]
+    band[:] = (band * 0.35).astype(np.uint8)
+    text = f"then {status}" + (f": {reason}" if reason else "")
+    cv2.putText(
+        out,
+        text[:90],
+        (8, out.shape[0] - 11),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.55,
+        _COLOURS.get(status, (255, 255, 255)),
+        1,
+        cv2.LINE_AA,
+    )
+    return out
+
+
 def contact_sheet(
     paths: Sequence[Path], *, columns: int = 6, tile_width_px: int = 320
 ) -> np.ndarray:
