@@ -87,6 +87,7 @@ _TEXT_COLUMNS = (
     "line_color",
     "positive_turn",
     "target",
+    "free_end",
     "background",
     "roi",
     "exclude",

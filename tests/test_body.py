@@ -95,6 +95,16 @@ def test_body_psi_is_the_total_turning(psi):
     assert res.psi_deg == pytest.approx(psi, abs=2.5)
 
 
+@pytest.mark.parametrize("psi", [240.0, 120.0, 30.0, -200.0])
+@pytest.mark.parametrize("width", [46.0, 24.0])
+def test_a_free_strip_that_bends_to_its_cut_end(psi, width):
+    # no clamp, no sealed end: the strip's centre line turns through psi right to its end face
+    img, fe, _ = body_photo(psi, width=width, clamp=False, seed=5)
+    res = measure_image(img, settings_for(fe, free_end="bends"))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=2.0)
+
+
 @pytest.mark.parametrize("psi", [150.0, -120.0])
 def test_textured_body_and_excluded_clamp(psi):
     img, fe, clamp = body_photo(psi, texture=True, seed=3)

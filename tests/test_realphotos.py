@@ -3,7 +3,7 @@
 The committed photo set is measured as a lab runs it (``measure`` on the folder, one
 photoset.yaml, a fixed end per row because the strips are free) and scored against labels.csv.
 What must hold: no row is ``ok`` outside its tolerance (a wrong number is flagged or failed, with a
-reason in words), and at least as many rows are within tolerance as today (5 of 10; the issue's
+reason in words), and at least as many rows are within tolerance as today (6 of 10; the issue's
 target of 9 is not reached: see ``python -m pipeline bench realscenes``).
 """
 
@@ -31,7 +31,28 @@ def test_no_wrong_ok_on_real_photos(measured):
 
 def test_real_photos_within_tolerance(measured):
     within = (measured["error_deg"].abs() <= measured["tolerance_deg"]).sum()
-    assert within >= 5, measured[["image", "psi_deg", "psi_signed_net_deg", "status", "reason"]]
+    assert within >= 6, measured[["image", "psi_deg", "psi_signed_net_deg", "status", "reason"]]
+
+
+def test_a_cut_strip_is_measured_to_its_end(tmp_path):
+    # the strips have no sealed end (photoset.yaml: free_end: bends): d_60C's red layer ends
+    # ragged, its centre line stops short of the end face, and without carrying the end's
+    # turning on to the last pixel the near-closed U reads 11 deg low (outside its 10 deg)
+    import shutil
+
+    import pandas as pd
+
+    from pipeline.photoset import read_settings, write_settings
+
+    folder = tmp_path / "strips"
+    shutil.copytree(DEV_SET, folder)
+    label = pd.read_csv(folder / "labels.csv").set_index("image").loc["images/d_60C.png"]
+    errors = {}
+    for free_end in ("bends", "capped"):
+        write_settings(folder, {**read_settings(folder), "free_end": free_end})
+        table = dev_set(folder).set_index("image")
+        errors[free_end] = abs(table.loc["d_60C.png", "error_deg"])
+    assert errors["bends"] <= label["tolerance_deg"] < errors["capped"], errors
 
 
 def test_every_doubtful_real_photo_says_why(measured):

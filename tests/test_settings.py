@@ -101,7 +101,9 @@ def test_resolved_settings_are_typed():
         fixed_direction_deg="90",
         target="body",
         line_color="white",
+        free_end=" Bends",
     )
+    assert s.free_end == "bends" and resolve_settings(l0_mm=1).free_end == "capped"
     assert s.l0_mm == 210.0 and s.fixed_end_px == (3.0, 4.5) and s.fixed_direction_deg == 90.0
     assert len(s.roi) == 4 and len(s.exclude) == 1 and s.color == parse_color("white")
     assert resolve_settings(l0_mm=1, target="body").color is None  # a body needs no colour
@@ -119,6 +121,7 @@ def test_resolved_settings_are_typed():
         ({"l0_mm": 1, "fixed_direction_deg": "left"}, "fixed_direction_deg"),
         ({"l0_mm": 1, "fixed_end": "near"}, "fixed_end"),
         ({"l0_mm": 1, "positive_turn": "left"}, "positive_turn"),
+        ({"l0_mm": 1, "free_end": "open"}, "free_end"),
         ({"l0_mm": 1, "background": "nope.jpg"}, "background"),
     ],
 )

@@ -542,6 +542,9 @@ MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH = 0.8, 1.15
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
 MARCH_STEP_PX = 2.0
+#: a free end that bends (``free_end: bends``) is carried on to the last body pixel within this
+#: many half-widths of the centre line's course (the middle of its end face, not a corner)
+FREE_TIP_ACROSS = 0.3
 
 
 def _uncovered(ridge: np.ndarray, end: np.ndarray) -> float:
@@ -651,14 +654,18 @@ def _extensions(
     pts: np.ndarray,
     half: float,
     fixed_xy: tuple[float, float] | None,
+    free_end_bends: bool = False,
 ) -> tuple[float, float]:
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
     The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel:
-    the body bends right from the clamp.  The free end: 0.  Past the centre line's last point lies
-    the actuator's sealed end (a cap), which does not bend, so the tip's direction is the centre
-    line's own at its end; carrying the curvature on over the cap read |psi| 5 % high on rendered
-    capped bodies.
+    the body bends right from the clamp.  The free end (``free_end: capped``): 0.  Past the centre
+    line's last point lies the actuator's sealed end (a cap), which does not bend, so the tip's
+    direction is the centre line's own at its end; carrying the curvature on over the cap read
+    |psi| 5 % high on rendered capped bodies.  With ``free_end_bends`` (``free_end: bends``: a
+    free strip, cut, with no sealed end) the free end is carried on to the body's last pixel like
+    an unclamped fixed end: the centre line stops about a half-width short of the end face, and
+    the strip bends through that part too.
     """
     ys, xs = np.nonzero(comp)
     q = np.c_[xs, ys].astype(float)
@@ -671,13 +678,15 @@ def _extensions(
         if end == 0 and fixed_xy is not None:
             out.append(max(0.0, float((np.asarray(fixed_xy) - p) @ t)))
             continue
-        if end == -1:
+        if end == -1 and not free_end_bends:
             out.append(0.0)
             continue
         d = q - p
         along, across = d @ t, np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
         # this end's tip, not what lies beyond a gap
-        sel = (across <= half) & (along > 0) & (along <= 2.5 * half + 2.0)
+        sel = (across <= (FREE_TIP_ACROSS * half if end == -1 else half)) & (along > 0) & (
+            along <= 2.5 * half + 2.0
+        )
         if sel.any():  # the tip's pixels run on from the end without a gap
             a = np.sort(along[sel])
             gap = np.nonzero(np.diff(np.r_[0.0, a]) > 2.0)[0]
@@ -896,7 +905,9 @@ def extract_body(
     ridge_tip_deg = 0.0
     if len(along_ridge) > len(pts) and len(pts) >= 8:
         ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
-    trimmed = _extensions(comp, pts, half, fe if reached else None)
+    trimmed = _extensions(
+        comp, pts, half, fe if reached else None, free_end_bends=settings.free_end == "bends"
+    )
     # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
     # free end the tip may be outside the photo; along a side the middle was taken from the
     # other edge (see _midpoints)

@@ -31,6 +31,10 @@ Keys
 ``fixed_direction_deg``
     Direction in which the actuator leaves the clamp, on screen, degrees counter-clockwise from
     +x: psi is then the free end's tangent against this direction.
+``free_end``
+    ``capped`` (the default: an actuator's sealed end, which does not bend; psi is the direction
+    where the body's centre line stops) or ``bends`` (a free strip cut at its end, with no sealed
+    end: the end's turning is carried on to the body's last pixel).  ``target: body`` only.
 ``method``
     The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
     run's method (``--method``, config ``measure.method``) applies.
@@ -74,10 +78,11 @@ Polygon = tuple[tuple[float, float], ...]
 
 TARGETS: tuple[str, ...] = ("line", "body")
 POSITIVE_TURNS: tuple[str, ...] = ("ccw", "cw")
+FREE_ENDS: tuple[str, ...] = ("capped", "bends")
 #: every settings key, as it may appear in photoset.yaml (fixed_end as fixed_end_x/_y in rows)
 KEYS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
-    "exclude", "fixed_direction_deg", "method", "calibration",
+    "exclude", "fixed_direction_deg", "free_end", "method", "calibration",
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
@@ -92,6 +97,7 @@ OVERRIDE_COLUMNS: tuple[str, ...] = (
     "roi",
     "exclude",
     "fixed_direction_deg",
+    "free_end",
     "method",
     "calibration",
 )
@@ -143,6 +149,9 @@ class MeasureSettings:
         Regions to ignore (px).
     fixed_direction_deg : float or None
         Known direction (deg, ccw from +x on screen) in which the actuator leaves the clamp.
+    free_end : {"capped", "bends"}
+        The body's free end is a sealed end that does not bend, or a cut end that bends with the
+        rest (``target: body``).
     method : str or None
         Estimator for these photos; None: the run's.
     calibration : Calibration or None
@@ -160,6 +169,7 @@ class MeasureSettings:
     roi: Polygon | None = None
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None
+    free_end: str = "capped"
     method: str | None = None
     calibration: Calibration | None = None
 
@@ -509,6 +519,18 @@ def settings_problems(
                 )
             )
             fixed_direction = None
+    free_end = raw.get("free_end")
+    free_end = "capped" if is_missing(free_end) else str(free_end).strip().lower()
+    if free_end not in FREE_ENDS:
+        problems.append(
+            SettingProblem(
+                "free_end",
+                f"free_end = {raw.get('free_end')!r}",
+                "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that "
+                "bends right to its cut end)",
+            )
+        )
+        free_end = "capped"
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
@@ -588,6 +610,7 @@ def settings_problems(
         roi=roi,
         exclude=tuple(exclude),
         fixed_direction_deg=fixed_direction,
+        free_end=free_end,
         method=method,
         calibration=calibration,
     ), []
