@@ -120,7 +120,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     preview.add_argument("folder", metavar="DIR", help="photo-set folder")
     preview.add_argument(
-        "--out", help="JPEG to write (default: <DIR name>_preview.jpg in the current folder)"
+        "--out",
+        help="sheet to write, .jpg or .png (default: <DIR name>_preview.jpg in the current folder)",
     )
     preview.add_argument(
         "--all", action="store_true", help="every photo, not only the first and last of each ramp"

@@ -29,6 +29,9 @@ from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 
 TILE_WIDTH_PX = 480
+#: size of the words on a tile (OpenCV simplex font scale) and how many lines a reason may take
+TEXT_SCALE = 0.48
+REASON_LINES = 6
 _STATUS_BGR = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
 
 
@@ -145,18 +148,17 @@ def preview_tile(
     text = [
         title,
         f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",
-        res.reason[:80],
-        res.reason[80:160],
+        *wrap_text(res.reason, 2 * tint.shape[1] - 16, TEXT_SCALE, REASON_LINES),
     ]
-    box = tint[: 12 + 20 * len(text)]
-    box[:] = (box * 0.35).astype(np.uint8)
+    # the words in a band above the photo and its mask: the whole reason, none of the photo hidden
+    band = np.full((12 + 20 * len(text), 2 * tint.shape[1], 3), 30, np.uint8)
     for i, t in enumerate(text):
         cv2.putText(
-            tint,
+            band,
             t,
             (8, 20 + 20 * i),
             cv2.FONT_HERSHEY_SIMPLEX,
-            0.48,
+            TEXT_SCALE,
             colour if i else (255, 255, 255),
             1,
             cv2.LINE_AA,
@@ -173,7 +175,42 @@ def preview_tile(
         cv2.LINE_AA,
     )
     rectified = rectified_panel(img, float(f), settings, res, (small.shape[1], small.shape[0]))
-    return np.hstack([tint, right] + ([] if rectified is None else [rectified]))
+    panels = np.hstack([tint, right] + ([] if rectified is None else [rectified]))
+    band = cv2.copyMakeBorder(
+        band, 0, 0, 0, panels.shape[1] - band.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30)
+    )
+    return np.vstack([band, panels])
+
+
+def wrap_text(text: str, width_px: int, scale: float, max_lines: int) -> list[str]:
+    """``text`` broken at spaces into lines no wider than ``width_px`` in OpenCV's simplex font.
+
+    At most ``max_lines`` lines; what does not fit ends the last one with an ellipsis.
+
+    Examples
+    --------
+    >>> wrap_text("a b c", 1000, 0.48, 3)
+    ['a b c']
+    >>> lines = wrap_text("the centre line stops short " * 20, 300, 0.48, 3)
+    >>> len(lines), lines[-1].endswith("...")
+    (3, True)
+    """
+
+    def fits(line: str) -> bool:
+        return cv2.getTextSize(line, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] <= width_px
+
+    lines: list[str] = []
+    for word in text.split():
+        if lines and fits(f"{lines[-1]} {word}"):
+            lines[-1] = f"{lines[-1]} {word}"
+        else:
+            lines.append(word)
+    if len(lines) > max_lines:
+        last = lines[max_lines - 1]
+        while last and not fits(last + " ..."):
+            last = last.rsplit(" ", 1)[0] if " " in last else last[:-1]
+        lines = [*lines[: max_lines - 1], last + " ..."]
+    return lines
 
 
 def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, res: AngleResult,
@@ -249,7 +286,18 @@ def write_preview(
     method: str = "auto",
     every: bool = False,
 ) -> tuple[Path, int]:
-    """Write the preview contact sheet of a photo set (JPEG); return its path and the tile count."""
+    """Write the preview contact sheet of a photo set; return its path and the tile count.
+
+    The sheet is a JPEG, or a PNG when ``out`` ends in ``.png``; another ending is refused before
+    anything is measured.
+    """
+    path = Path(out)
+    encoding = {".jpg": ".jpg", ".jpeg": ".jpg", ".png": ".png"}.get(path.suffix.lower())
+    if encoding is None:
+        raise UserInputError(
+            f"--out {out}: the preview is written as a JPEG or a PNG (fix: end the name in .jpg "
+            "or .png)"
+        )
     ps = load_photoset(folder)
     if ps.is_video:
         raise UserInputError(
@@ -294,8 +342,8 @@ def write_preview(
             for i in range(0, len(tiles), 2)
         ]
     )
-    _ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 88])
-    path = Path(out)
+    params = [cv2.IMWRITE_JPEG_QUALITY, 88] if encoding == ".jpg" else []
+    _ok, buf = cv2.imencode(encoding, sheet, params)
     atomic_write_bytes(path, buf.tobytes())
     return path, len(tiles)
 

@@ -60,6 +60,10 @@ def test_every_doubtful_real_photo_says_why(measured):
     assert len(doubtful) and doubtful["reason"].str.len().min() > 10
     # words, not reprs
     assert not doubtful["reason"].str.contains(r"\(\(\(|array\(|np\.", regex=True).any()
+    # a runaway fit's figure is not quoted (c_20C's smooth fit ran to thousands of degrees)
+    quoted = doubtful["reason"].str.extractall(r"disagree by (\d+) deg")[0].astype(int)
+    assert (quoted <= 360).all(), quoted
+    assert doubtful["reason"].str.contains("disagree by more than a full turn").any()
 
 
 def test_an_overlay_shows_the_status_the_ramp_check_gave(tmp_path):
@@ -81,3 +85,24 @@ def test_an_overlay_shows_the_status_the_ramp_check_gave(tmp_path):
     assert orange_at_bottom("c_30C.jpg")
     assert not orange_at_bottom("d_50C.jpg")
     assert np.isfinite(angles["psi_deg"]).all()
+
+
+@pytest.mark.parametrize(("name", "magic"), [("sheet.png", b"\x89PNG"), ("sheet.JPG", b"\xff\xd8")])
+def test_the_preview_of_the_dev_set_is_written_as_its_name_says(tmp_path, name, magic):
+    import cv2
+
+    from pipeline.preview import write_preview
+
+    path, tiles = write_preview(DEV_SET, tmp_path / name)
+    assert tiles == 4  # first and last photo of each strip's temperature series
+    assert path.read_bytes()[:4].startswith(magic)
+    assert cv2.imread(str(path)) is not None
+
+
+def test_a_preview_name_that_is_no_image_format_is_refused(tmp_path):
+    from pipeline.errors import UserInputError
+    from pipeline.preview import write_preview
+
+    with pytest.raises(UserInputError, match=r"\.jpg or \.png"):
+        write_preview(DEV_SET, tmp_path / "sheet.gif")
+    assert not (tmp_path / "sheet.gif").exists()

@@ -229,9 +229,14 @@ def assess_body(
         )
     if abs(smooth_mismatch_deg) > SMOOTH_DISAGREE_DEG:
         flags.append(
-            f"the end tangents and a smooth fit of the whole centre line disagree by "
-            f"{abs(smooth_mismatch_deg):.0f} deg: the centre line wobbles (a faint or translucent "
-            "side?); check with photoset preview"
+            "the end tangents and a smooth fit of the whole centre line disagree by "
+            + (
+                f"{abs(smooth_mismatch_deg):.0f} deg"
+                if abs(smooth_mismatch_deg) <= 360.0
+                else "more than a full turn"  # the fit ran away: its figure would mean nothing
+            )
+            + ": the centre line wobbles (a faint or translucent side?); check with photoset "
+            "preview"
         )
     if line.branched_fraction > 0.05:
         flags.append("body closes on itself")
