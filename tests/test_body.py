@@ -226,6 +226,22 @@ def test_a_free_end_with_one_side_lost_is_flagged():
     assert "free end" in res.reason, res.reason
 
 
+def test_a_hook_where_the_body_meets_the_clamp_is_flagged_not_an_ok_psi():
+    # silicone with dots on grey, saved again at JPEG quality 40: the selection runs into the
+    # plate's edge at the clamp and the centre line's first pixels hook towards it; a fit over
+    # the usual end window smooths the hook into the base tangent (it was ok at 16 deg off), a
+    # fit over half that window turns 13 deg
+    from pipeline.synth import render_actuator, scene_from
+
+    psi = float(np.linspace(215.0, -220.0, 12)[6])
+    r = render_actuator(psi, 270.0, scene_from("grey_dots", width=1280, height=960), seed=36)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 40])
+    res = measure_image(cv2.imdecode(buf, cv2.IMREAD_COLOR), settings_for(r.fixed_end_px))
+    assert abs(res.psi_deg - r.psi_image_deg) > 10.0  # still wrong: the check is what changed
+    assert res.status == "flagged" and "the fixed end's direction turns" in res.reason
+
+
 def test_translucent_body_on_grey_without_a_background_photo():
     # the rendered analogue of silicone with dots on a grey backdrop, no empty-scene photo: the
     # faint side of the body fades towards the tip; measured to its end, not cut where it thins

@@ -25,8 +25,10 @@ from numpy.typing import NDArray
 from pipeline.measure.calibration import CalibrationMismatch, check_size
 from pipeline.measure.estimators import (
     METHODS,
+    TANGENT_WINDOW_FRACTION,
     CurveEstimate,
     auto_choice,
+    end_tangents,
     hyper,
     tangents,
     turning,
@@ -369,6 +371,15 @@ def measure_body(
         smooth_turning = free.turning_rad  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
+    # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
+    start, end, _ = end_tangents(pts, ends_px=ends)
+    start_short, end_short, _ = end_tangents(
+        pts, ends_px=ends, window_fraction=0.5 * TANGENT_WINDOW_FRACTION
+    )
+    short_shift = (
+        0.0 if base is not None else float(np.rad2deg(start_short - start)),
+        float(np.rad2deg(end_short - end)),
+    )
     quality = assess_body(
         line,
         psi_deg=psi,
@@ -387,6 +398,7 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
+        short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method
     return _measured(psi, est, line, quality, settings, used)

@@ -155,6 +155,11 @@ def assess(
 
 #: body: the free end's tangent may move this much (deg) when its fit window doubles
 TIP_UNSTABLE_DEG = 8.0
+#: body: either end's tangent may move this much (deg) when its fit window halves.  On 480
+#: rendered analogue photos (5 scenes; clean at 1280x960 with two seeds and at 1280x720; with
+#: JPEG quality 40, noise, uneven light, blur or underexposure) 10 deg flagged 3 ``ok`` rows off
+#: by more than 5 deg (2 of the 3 off by more than 10) and 1 right one; 8 deg flagged 6 right ones
+END_HOOK_DEG = 10.0
 #: body: psi from the end tangents and from a smooth fit of the whole centre line's tangent angle
 #: (:func:`~pipeline.measure.estimators.turning`) may differ this much (deg); more: a wobbly
 #: centre line (on rendered translucent bodies it caught the ok rows 8-10 deg off)
@@ -187,13 +192,16 @@ def assess_body(
     free_end_width_ratio: float = 1.0,
     side_on_border: bool = False,
     smooth_mismatch_deg: float = 0.0,
+    short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
     Flagged when the free end reaches the image border (a side along it is a note); several
     bodies compete; the fixed end is not reached or guessed; the outline is uneven (the
     segmentation leaked into the backdrop, or lost part of the body); the free end's direction
-    depends on how much of the end is fitted (a hooked or ragged tip); the body closes on
+    depends on how much of the end is fitted (a hooked or ragged tip), or either end's direction
+    on fitting half as much of it (``short_end_shift_deg``: a hook in the last few pixels, where
+    the body meets the clamp or the tip, that a longer fit smooths over); the body closes on
     itself; or it is much shorter than ``l0`` (partly hidden).  Notes (status stays ``ok``) say
     how psi was taken.
     """
@@ -227,6 +235,14 @@ def assess_body(
         flags.append(
             f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)"
         )
+    for end, shift in zip(("fixed", "free"), short_end_shift_deg, strict=True):
+        if abs(shift) > END_HOOK_DEG:
+            flags.append(
+                f"the {end} end's direction turns {abs(shift):.0f} deg when fitted over half as "
+                "much of it: a hook where the body meets the "
+                + ("clamp" if end == "fixed" else "tip")
+                + "?; check with photoset preview"
+            )
     if abs(smooth_mismatch_deg) > SMOOTH_DISAGREE_DEG:
         flags.append(
             "the end tangents and a smooth fit of the whole centre line disagree by "
