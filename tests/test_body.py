@@ -242,6 +242,38 @@ def test_a_hook_where_the_body_meets_the_clamp_is_flagged_not_an_ok_psi():
     assert res.status == "flagged" and "the fixed end's direction turns" in res.reason
 
 
+def _paint_gap(img, psi, gap_px, at=0.6, length=600.0, width=46.0, backdrop=(190, 196, 200)):
+    """Paint a band of backdrop ``gap_px`` long across the body of :func:`body_photo` (defaults)
+    at fraction ``at`` of its length: a stretch of the body that the selection cannot see."""
+    k = np.deg2rad(psi) / length
+    s = np.linspace(0.0, length, 3000)
+    mid = np.c_[np.sin(k * s) / k, (1 - np.cos(k * s)) / k] + np.c_[
+        -np.sin(k * s), np.cos(k * s)
+    ] * (width / 2)
+    off = np.array([W / 2 - mid[:, 0].mean(), H / 2 + mid[:, 1].mean()])
+    i = int(at * (len(s) - 1))
+    c = np.array([mid[i, 0], -mid[i, 1]]) + off
+    t = np.array([np.cos(k * s[i]), -np.sin(k * s[i])])
+    n = np.array([-t[1], t[0]])
+    g, w = gap_px / 2, width
+    band = np.array([c - t * g - n * w, c + t * g - n * w, c + t * g + n * w, c - t * g + n * w])
+    cv2.fillPoly(img, [np.round(band).astype(np.int32)], backdrop)
+    return img
+
+
+@pytest.mark.parametrize("psi", [150.0, -120.0, 200.0])
+@pytest.mark.parametrize("gap", [20, 40])
+def test_a_stretch_the_selection_misses_is_bridged_along_the_body(psi, gap):
+    # a faint stretch (dim light on a translucent body, a shadow) splits the selection: the piece
+    # at the clamp stopped at the gap (50-69 deg off, flagged); the piece ahead of its free end,
+    # on its course, is joined and the centre line walked on to the tip
+    img, fe, _ = body_photo(psi, seed=3)
+    res = measure_image(_paint_gap(img, psi, gap), settings_for(fe))
+    assert res.psi_deg == pytest.approx(psi, abs=2.5)
+    assert res.status == "flagged" and "body partly hidden" in res.reason, res.reason
+    assert "candidate bodies" not in res.reason
+
+
 def test_an_underexposed_photo_is_measured_like_a_well_exposed_one():
     # the translucent body on grey at 0.45x exposure: its faint differences from the backdrop fell
     # below the least colour difference a body must show, and 11 of 12 photos were lost

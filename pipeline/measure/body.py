@@ -819,6 +819,81 @@ def _midpoints(
     return points + mid[:, None] * n, width, one
 
 
+#: a gap in the selection along the body's course is bridged when the selection goes on within
+#: this many half-widths beyond the free end of the part found ...
+BRIDGE_HALF_WIDTHS = 6.0
+#: ... in a piece at least this many half-widths squared in area (a stretch of body, not a speck)
+BRIDGE_MIN_AREA_HALF2 = 8.0
+#: at most this many gaps are bridged
+MAX_BRIDGES = 3
+
+
+def _bridge_gaps(
+    mask: np.ndarray,
+    comp: np.ndarray,
+    fixed_xy: tuple[float, float] | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[float]]:
+    """Join pieces of the selection that carry the body on past a gap at its free end.
+
+    A faint stretch (a translucent body where the light is dim, a highlight, a shadow) splits the
+    selection; the piece at the fixed end then stops short and the rest is a rival.  While
+    another piece of at least :data:`BRIDGE_MIN_AREA_HALF2` half-widths squared lies ahead of the
+    free end of the ridge path, on its course, within :data:`BRIDGE_HALF_WIDTHS` half-widths,
+    the gap is filled with a band of the body's width and the ridge is walked again.
+
+    Returns
+    -------
+    comp : ndarray
+        The body, with the pieces and bridges joined.
+    dt : ndarray
+        Its distance transform.
+    path : ndarray
+        Its ridge path (x, y) from the fixed end.
+    gaps_px : list of float
+        Length of each gap bridged (work px).
+    """
+    gaps: list[float] = []
+    while True:
+        dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+        path, _ = _ridge_path(comp, dt, fixed_xy)
+        if len(gaps) >= MAX_BRIDGES or len(path) < 8:
+            return comp, dt, path, gaps
+        xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
+        half = max(float(np.median(dt[yi, xi])), 1.0)
+        seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+        back = path[int(np.searchsorted(seg, seg[-1] - max(3.0 * half, 4.0)))]
+        t = path[-1] - back
+        if float(np.hypot(*t)) < 1e-6:
+            return comp, dt, path, gaps
+        t = t / float(np.hypot(*t))
+        others = (mask > 0) & (comp == 0)
+        _, labels, stats, _ = cv2.connectedComponentsWithStats(
+            others.astype(np.uint8), connectivity=8
+        )
+        ys, xs = np.nonzero(others)
+        d = np.c_[xs, ys].astype(float) - path[-1]
+        along = d @ t
+        across = np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
+        ahead = (along > 0) & (along <= BRIDGE_HALF_WIDTHS * half) & (across <= half + 0.5 * along)
+        big = stats[:, cv2.CC_STAT_AREA] >= BRIDGE_MIN_AREA_HALF2 * half * half
+        ahead &= big[labels[ys, xs]]
+        if not ahead.any():
+            return comp, dt, path, gaps
+        k = int(np.flatnonzero(ahead)[np.argmin(np.hypot(along[ahead], across[ahead]))])
+        piece = (labels == labels[ys[k], xs[k]]).astype(np.uint8)
+        # the bridge ends in the middle of the piece's near end, not on its nearest corner
+        near = np.hypot(d[:, 0], d[:, 1])
+        inner = cv2.distanceTransform(piece, cv2.DIST_L2, 5)[ys, xs]
+        sel = (piece[ys, xs] > 0) & (near <= near[k] + 2.0 * half)
+        k = int(np.flatnonzero(sel)[np.argmax(inner[sel])])
+        q = (int(xs[k]), int(ys[k]))
+        p = (int(np.round(path[-1][0])), int(np.round(path[-1][1])))
+        comp = comp.copy()
+        comp[piece > 0] = 1
+        cv2.line(comp, p, q, 1, max(1, round(2.0 * half)), cv2.LINE_8)
+        gaps.append(float(np.hypot(q[0] - p[0], q[1] - p[1])))
+
+
 def extract_body(
     image_bgr: np.ndarray,
     settings: MeasureSettings,
@@ -882,8 +957,11 @@ def extract_body(
             f"no body found: nothing {what} survives the clean-up; check line_color / background / "
             "roi (python -m pipeline photoset preview)"
         ) from None
-    dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
-    path, guessed = _ridge_path(comp, dt, fe if reached else None)
+    comp, dt, path, gaps = _bridge_gaps(mask, comp, fe if reached else None)
+    guessed = not reached or fe is None
+    if gaps:  # the pieces joined are no longer rivals
+        _, _, stats, _ = cv2.connectedComponentsWithStats(mask & (1 - comp), connectivity=8)
+        rivals = int((stats[1:, cv2.CC_STAT_AREA] >= 0.25 * comp.sum()).sum())
     # the body's half-width along its own ridge (not over the whole component: a tube or a clamp
     # joined to it would pull a component-wide figure far off)
     xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
@@ -964,7 +1042,7 @@ def extract_body(
         fixed_end_auto=guessed,
         clamp_removed=not guessed,
         trimmed_px=(trimmed[0] * scale, trimmed[1] * scale),
-        gap_bridged=False,
+        gap_bridged=bool(gaps),
         fixed_end_found=reached,
     )
     gap = float(np.hypot(*(pts[0] - np.asarray(fe)))) if fe is not None and reached else 0.0

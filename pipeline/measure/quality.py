@@ -258,6 +258,11 @@ def assess_body(
         flags.append("body closes on itself")
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
+    if line.gap_bridged:
+        flags.append(
+            "body partly hidden: the selection has a gap along the body's course, bridged "
+            "(photoset preview shows it)"
+        )
     if continues:
         flags.append(
             "the selection goes on past a gap beyond the free end: part of the body may be missed "
