@@ -164,6 +164,23 @@ def test_a_side_along_the_image_border_is_measured_from_the_other_edge(scene, i)
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=2.5)
 
 
+def test_a_body_cut_off_by_an_exclude_polygon_is_flagged_not_an_ok_psi():
+    # an exclude box drawn over the clamp plate that also covers the curled-back tip: the rest of
+    # the body was measured as if it ended there, ok at 33 deg off
+    from pipeline.synth import render_actuator, scene_from
+
+    r = render_actuator(215.0, 270.0, scene_from("dark_translucent", width=1280, height=960),
+                        seed=30)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    box = [0.0, 0.0, float(r.fixed_end_px[0]) - 3.0, float(H)]
+    res = measure_image(img, settings_for(r.fixed_end_px, exclude=[box]))
+    assert abs(res.psi_deg - r.psi_image_deg) > 20.0  # the tip is not seen: psi cannot be right
+    assert res.status == "flagged" and "edge of roi / exclude" in res.reason, res.reason
+    # without the box, nothing is said of it
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert "edge of roi / exclude" not in res.reason
+
+
 def test_roi_restricts_the_search():
     img, fe, _ = body_photo(60.0)
     # a second thing of the body's colour

@@ -84,6 +84,9 @@ class BodyExtraction:
         A side of the body (not its free end) runs along the image border: the centre line
         there lies half the body's width from the other edge.  (At the free end the border is
         ``line.touches_border``: the tip may be outside the photo.)
+    tip_at_region_edge : bool
+        The free end reaches the edge of the ``roi`` or of an ``exclude`` polygon: the body may
+        go on where it is not looked at.
     """
 
     line: LineExtraction
@@ -96,6 +99,7 @@ class BodyExtraction:
     ridge_tip_deg: float = 0.0
     free_end_width_ratio: float = 1.0
     side_on_border: bool = False
+    tip_at_region_edge: bool = False
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -730,8 +734,12 @@ def _extensions(
     return out[0], out[1]
 
 
-def _on_border(comp: np.ndarray, points: np.ndarray, half: float) -> bool:
-    """Whether the body ``comp`` reaches the image border within about a width of ``points``."""
+def _on_border(
+    comp: np.ndarray, points: np.ndarray, half: float, region: np.ndarray | None = None
+) -> bool:
+    """Whether the body ``comp`` reaches the image border within about a width of ``points``;
+    with ``region`` (the allowed pixels, 1), whether it reaches that region's edge there instead:
+    an ``roi`` or ``exclude`` polygon that cuts the body off."""
     h, w = comp.shape
     near = np.zeros_like(comp)
     cv2.polylines(
@@ -743,6 +751,9 @@ def _on_border(comp: np.ndarray, points: np.ndarray, half: float) -> bool:
         cv2.LINE_8,
         4,
     )
+    if region is not None:
+        outside = cv2.dilate((region == 0).astype(np.uint8), np.ones((3, 3), np.uint8))
+        return bool((near & comp & outside).any())
     ys, xs = np.nonzero(near & comp)
     return bool(len(xs)) and bool(
         xs.min() <= 0 or ys.min() <= 0 or xs.max() >= w - 1 or ys.max() >= h - 1
@@ -1026,6 +1037,7 @@ def extract_body(
         t = t / max(float(np.hypot(*t)), 1e-9)
         tip = np.vstack([tip, pts[-1] + t * (trimmed[1] + half)])
     touches_tip = _on_border(comp, tip, half)
+    tip_at_region_edge = region is not None and _on_border(comp, tip, half, region)
     side_on_border = not touches_tip and _on_border(comp, pts, half)
     contours, hier = cv2.findContours(comp, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
     holes = [c for c, hh in zip(contours, hier[0]) if hh[3] != -1] if hier is not None else []
@@ -1051,4 +1063,5 @@ def extract_body(
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
+        tip_at_region_edge=tip_at_region_edge,
     )

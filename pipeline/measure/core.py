@@ -397,6 +397,7 @@ def measure_body(
         ridge_tip_deg=body.ridge_tip_deg,
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
+        tip_at_region_edge=body.tip_at_region_edge,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
     )

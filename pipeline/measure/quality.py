@@ -191,6 +191,7 @@ def assess_body(
     ridge_tip_deg: float = 0.0,
     free_end_width_ratio: float = 1.0,
     side_on_border: bool = False,
+    tip_at_region_edge: bool = False,
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
 ) -> Quality:
@@ -215,6 +216,11 @@ def assess_body(
         notes.append(
             "a side runs along the image border: the centre line there is half the body's width "
             "from the other edge"
+        )
+    if tip_at_region_edge:
+        flags.append(
+            "the body's free end reaches the edge of roi / exclude: the tip may be cut off there "
+            "(photoset preview shows the outlines)"
         )
     if line.n_candidates > 1:
         flags.append(f"{line.n_candidates} candidate bodies")
