@@ -39,6 +39,41 @@ BODY_SCENES: dict[str, dict[str, object]] = {
     "lab_body": {"line_contrast": 0.0, "body_translucency": 0.0, "body_bgr": (90, 140, 200)},
 }
 _PRESET = {"lab_body": "lab"}
+#: what a real camera may do to a photo (``--camera``): the analogues are rendered clean, then
+#: saved again at JPEG quality 40, given sensor noise (sigma 8 grey levels), lit unevenly (0.6x at
+#: the left edge to 1.3x at the right), defocused (Gaussian blur sigma 2.5 px) or underexposed
+#: (0.45x)
+CAMERAS: tuple[str, ...] = ("clean", "jpeg40", "noise", "uneven", "blur", "dark")
+
+
+def through_camera(image: np.ndarray, camera: str, seed: int) -> np.ndarray:
+    """``image`` (BGR uint8) as a real camera of kind ``camera`` (one of :data:`CAMERAS`) may
+    give it; seeded, so the same photo comes out every run.
+
+    Examples
+    --------
+    >>> img = np.full((4, 6, 3), 100, np.uint8)
+    >>> int(through_camera(img, "dark", 0).max()), int(through_camera(img, "uneven", 0)[0, -1, 0])
+    (45, 130)
+    >>> bool((through_camera(img, "noise", 1) == through_camera(img, "noise", 1)).all())
+    True
+    """
+    if camera == "clean":
+        return image
+    if camera == "jpeg40":
+        _ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 40])
+        return np.asarray(cv2.imdecode(buf, cv2.IMREAD_COLOR), np.uint8)
+    if camera == "noise":
+        noise = np.random.default_rng(seed).normal(0.0, 8.0, image.shape)
+        return np.clip(image + noise, 0, 255).astype(np.uint8)
+    if camera == "uneven":
+        gain = np.linspace(0.6, 1.3, image.shape[1])[None, :, None]
+        return np.clip(image * gain, 0, 255).astype(np.uint8)
+    if camera == "blur":
+        return cv2.GaussianBlur(image, (0, 0), 2.5)
+    if camera == "dark":
+        return np.clip(image * 0.45, 0, 255).astype(np.uint8)
+    raise ValueError(f"camera {camera!r}: use one of {', '.join(CAMERAS)}")
 
 
 def body_cases(
@@ -49,6 +84,7 @@ def body_cases(
     height: int = 960,
     fixed_direction: bool = False,
     scenes: tuple[str, ...] | None = None,
+    camera: str = "clean",
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -64,6 +100,8 @@ def body_cases(
         Also give ``fixed_direction_deg`` (the clamp's direction, known to the renderer).
     scenes : tuple of str, optional
         Only these of :data:`BODY_SCENES` (default: all).
+    camera : str
+        What the camera does to each rendered photo (:func:`through_camera`).
 
     Returns
     -------
@@ -84,6 +122,7 @@ def body_cases(
             )
             img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
             assert img is not None  # the photo just rendered
+            img = through_camera(img, camera, seed=i)
             extra: dict[str, Any] = {}
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
@@ -163,6 +202,13 @@ def main(argv: Sequence[str] | None = None) -> int:
              "judged on include 4000x3000 photos and 1280x720 video frames)",
     )
     parser.add_argument(
+        "--camera",
+        choices=CAMERAS,
+        default="clean",
+        help="what a real camera does to the rendered analogues: saved at JPEG quality 40, sensor "
+             "noise, uneven light, defocus, underexposure (default clean)",
+    )
+    parser.add_argument(
         "--no-fixed-direction",
         action="store_true",
         help="only the first analogue table (fixed end given), not the one with "
@@ -201,10 +247,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
     for fixed in (False,) if args.no_fixed_direction else (False, True):
-        df = body_cases(args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed)
+        df = body_cases(
+            args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
+            camera=args.camera,
+        )
         print(
             "\n== synthetic analogues, body mode, fixed end "
-            f"given{', fixed_direction_deg given' if fixed else ''} "
+            f"given{', fixed_direction_deg given' if fixed else ''}"
+            f"{'' if args.camera == 'clean' else ', camera ' + args.camera} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())

@@ -28,6 +28,7 @@ from pipeline.measure.estimators import (
     TANGENT_WINDOW_FRACTION,
     CurveEstimate,
     auto_choice,
+    end_curvature,
     end_tangents,
     hyper,
     tangents,
@@ -398,6 +399,10 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
+        missed_tip_deg=float(
+            np.rad2deg(abs(end_curvature(line.centreline_px)))
+            * max(0.0, body.end_short_px - 0.5 * line.width_px)
+        ),
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
     )

@@ -543,6 +543,27 @@ def end_tangents(
     return a, b, float(np.hypot(ra, rb) / np.sqrt(2.0))
 
 
+def end_curvature(points: np.ndarray, window_fraction: float = TANGENT_WINDOW_FRACTION) -> float:
+    """Curvature (rad per px, signed as the turning of ``points``) over the last
+    ``window_fraction`` of the line: the slope of its tangent angle against arc length there.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, np.pi, 400)
+    >>> pts = np.c_[np.cos(t), np.sin(t)] * 50.0  # ccw, radius 50
+    >>> round(end_curvature(pts) * 50.0, 3)
+    1.0
+    """
+    s = arc_length(points)
+    tail = points[s >= s[-1] * (1.0 - window_fraction)]
+    if len(tail) < 4:
+        return 0.0
+    d = np.diff(tail, axis=0)
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    along = np.cumsum(np.hypot(d[:, 0], d[:, 1]))
+    return float(np.polyfit(along, theta, 1)[0])
+
+
 def tangents(
     points: np.ndarray,
     rng: np.random.Generator,

@@ -192,6 +192,7 @@ def assess_body(
     free_end_width_ratio: float = 1.0,
     side_on_border: bool = False,
     tip_at_region_edge: bool = False,
+    missed_tip_deg: float = 0.0,
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
 ) -> Quality:
@@ -202,7 +203,9 @@ def assess_body(
     segmentation leaked into the backdrop, or lost part of the body); the free end's direction
     depends on how much of the end is fitted (a hooked or ragged tip), or either end's direction
     on fitting half as much of it (``short_end_shift_deg``: a hook in the last few pixels, where
-    the body meets the clamp or the tip, that a longer fit smooths over); the body closes on
+    the body meets the clamp or the tip, that a longer fit smooths over); the centre line stops
+    short of a tip that still turns (``missed_tip_deg``: the free end's curvature times the part
+    of the body beyond the centre line's end, less half a width for a cap); the body closes on
     itself; or it is much shorter than ``l0`` (partly hidden).  Notes (status stays ``ok``) say
     how psi was taken.
     """
@@ -291,6 +294,12 @@ def assess_body(
         flags.append(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven "
             "outline there): check with photoset preview"
+        )
+    elif missed_tip_deg > TIP_UNSTABLE_DEG:
+        flags.append(
+            f"the centre line stops {end_short_px:.0f} px short of the body's free end where the "
+            f"body still turns: about {missed_tip_deg:.0f} deg of its turning may be missing "
+            "(photoset preview shows it)"
         )
     if start_gap_px > 2.0 * line.width_px + 4.0:
         flags.append(
