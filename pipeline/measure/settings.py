@@ -218,6 +218,34 @@ def _number(
     return number
 
 
+def _choice(
+    raw: Mapping[str, Any],
+    key: str,
+    choices: tuple[str, ...],
+    problems: list[SettingProblem],
+    fix: str,
+) -> str:
+    """``raw[key]`` as one of ``choices`` (case and spaces ignored; missing: the first), or the
+    first with a problem added.
+
+    Examples
+    --------
+    >>> problems = []
+    >>> _choice({"target": " Body"}, "target", TARGETS, problems, "fix"), problems
+    ('body', [])
+    >>> _choice({"target": "tip"}, "target", TARGETS, problems, "use line or body")
+    'line'
+    >>> problems[0].message
+    "target = 'tip'"
+    """
+    value = raw.get(key)
+    choice = choices[0] if is_missing(value) else str(value).strip().lower()
+    if choice not in choices:
+        problems.append(SettingProblem(key, f"{key} = {value!r}", fix))
+        return choices[0]
+    return choice
+
+
 def _points(value: Any, key: str) -> Polygon:
     """A polygon from ``[[x, y], ...]`` or a box ``[x0, y0, x1, y1]`` (strings parsed as YAML)."""
     if isinstance(value, str):
@@ -473,28 +501,11 @@ def settings_problems(
         problems,
         "set mm_per_px to the image scale in mm per pixel, or leave it out",
     )
-    target = raw.get("target")
-    target = "line" if is_missing(target) else str(target).strip().lower()
-    if target not in TARGETS:
-        problems.append(
-            SettingProblem(
-                "target",
-                f"target = {raw.get('target')!r}",
-                "use 'line' (a drawn line) or 'body' (the actuator's outline)",
-            )
-        )
-        target = "line"
-    turn = raw.get("positive_turn")
-    turn = "ccw" if is_missing(turn) else str(turn).strip().lower()
-    if turn not in POSITIVE_TURNS:
-        problems.append(
-            SettingProblem(
-                "positive_turn",
-                f"positive_turn = {raw.get('positive_turn')!r}",
-                "use 'ccw' or 'cw'",
-            )
-        )
-        turn = "ccw"
+    target = _choice(
+        raw, "target", TARGETS, problems,
+        "use 'line' (a drawn line) or 'body' (the actuator's outline)",
+    )
+    turn = _choice(raw, "positive_turn", POSITIVE_TURNS, problems, "use 'ccw' or 'cw'")
     color: ColorSpec | None = BLACK if target == "line" else None
     if not is_missing(raw.get("line_color")):
         try:
@@ -519,18 +530,11 @@ def settings_problems(
                 )
             )
             fixed_direction = None
-    free_end = raw.get("free_end")
-    free_end = "capped" if is_missing(free_end) else str(free_end).strip().lower()
-    if free_end not in FREE_ENDS:
-        problems.append(
-            SettingProblem(
-                "free_end",
-                f"free_end = {raw.get('free_end')!r}",
-                "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that "
-                "bends right to its cut end)",
-            )
-        )
-        free_end = "capped"
+    free_end = _choice(
+        raw, "free_end", FREE_ENDS, problems,
+        "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that bends right "
+        "to its cut end)",
+    )
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
