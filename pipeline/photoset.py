@@ -592,13 +592,21 @@ def file_problems(
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
     problems += _calibration_problems(ps)
-    if any(r is not None and r.mm_per_px is None and r.calibration is None for r in ps.rows):
+    unscaled = [
+        r for r in ps.rows if r is not None and r.mm_per_px is None and r.calibration is None
+    ]
+    if unscaled:
+        # a line's psi is its curvature times l0 with a scale, its measured turning without; a
+        # body's psi is its tip angle either way, and the scale only checks its length
         problems.append(
             Problem(
                 str(folder / SETTINGS),
                 None,
                 "no mm_per_px: psi will be the turning of the measured line, so a line cut short "
-                "by the clamp or the border reads low",
+                "by the clamp or the border reads low"
+                if any(r.target == "line" for r in unscaled)
+                else "no mm_per_px: a body is not checked against l0_mm, so one partly hidden or "
+                "cut short is not flagged for its length",
                 "measure the image scale (mm per pixel) and set mm_per_px",
                 warning=True,
             )

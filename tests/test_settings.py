@@ -157,6 +157,23 @@ def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
     assert len(loaded.rows) == 8 and calls == {"yaml": 1, "csv": 1}
 
 
+@pytest.mark.parametrize(("target", "says"), [("line", "line cut short"), ("body", "l0_mm")])
+def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, target, says):
+    # a line's psi rests on its measured length without a scale; a body's tip angle does not, and
+    # only its length check is lost
+    from pipeline import photoset_init
+
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0, "target": target},
+    )
+    (warning,) = [
+        p for p in ps.validate_photoset(photo_folder, warnings=True) if "mm_per_px" in p.message
+    ]
+    assert warning.warning and says in warning.message
+
+
 def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folder):
     from pipeline import photoset_init
 
