@@ -27,7 +27,8 @@ from pipeline.ramp_check import check_ramps
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
 #: :class:`~pipeline.measure.AngleResult`;
-#: empty on failed rows; ``l0_mm``: the length psi was computed with; ``calibration_px`` /
+#: empty on failed rows; ``width_px``: the line's or body's width, edge to edge; ``l0_mm``: the
+#: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
     "image",
@@ -35,6 +36,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "kappa_per_mm",
     "length_mm",
     "length_px",
+    "width_px",
     "method",
     "residual_px",
     "status",

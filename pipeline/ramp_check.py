@@ -12,7 +12,8 @@ neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in i
   The worst photo goes first (one already flagged on its own before one that is not) and the
   leg is checked again without it, so one wrong photo never drags its neighbours down;
 - a photo whose measured line length is far from the ramp's median is ``flagged`` (a partial
-  line);
+  line); a body's centre line, half the body's width beside the layer that does not stretch, is
+  first brought to that layer's length (:func:`layer_lengths`);
 - a photo ``flagged`` only for a cosmetic reason (line partly hidden, touching the border) whose
   psi lies between its ``ok`` neighbours (within :data:`AGREE_DEG`) is ``ok`` again, the reason
   saying why.
@@ -101,7 +102,7 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
         measured = ramp[ramp["status"] != "failed"]
         if "length_px" in measured.columns and len(measured) >= 3:
-            lengths = measured["length_px"].to_numpy(float)
+            lengths = layer_lengths(measured)
             med = float(np.nanmedian(lengths)) if np.isfinite(lengths).any() else np.nan
             for ix, length in zip(measured.index, lengths):
                 if (
@@ -121,6 +122,48 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
             _check_leg(leg, position, status, reason)
     out["status"], out["reason"] = status, reason
     return out
+
+
+def layer_lengths(measured: pd.DataFrame) -> np.ndarray:
+    """The measured lengths of a ramp's photos as lengths of the line that does not stretch.
+
+    A drawn line lies on the inextensible layer: its length is the same in every photo.  A body's
+    centre line lies half the body's width (``width_px``) beside that layer, so it is shorter by
+    ``width / 2 * psi`` (psi in rad) when the body bends towards its own side and longer when it
+    bends the other way: over a ramp from +210 to -225 deg a body a tenth of its length wide
+    changes its centre line's length by 40 %, which is no partial line.  Which side the layer is
+    on is the actuator's, the same on every photo of the ramp; it is taken as the one (or no
+    correction, a line) that makes the lengths most alike.
+
+    Examples
+    --------
+    >>> psi = np.array([210.0, 90.0, -60.0, -220.0])
+    >>> body = pd.DataFrame({"psi_deg": psi, "width_px": 60.0,
+    ...                      "length_px": 900.0 - 30.0 * np.deg2rad(psi)})
+    >>> np.round(layer_lengths(body), 1).tolist()
+    [900.0, 900.0, 900.0, 900.0]
+    >>> np.round(layer_lengths(body.assign(length_px=900.0)), 1).tolist()  # a drawn line
+    [900.0, 900.0, 900.0, 900.0]
+    """
+    lengths = measured["length_px"].to_numpy(float)
+    if "width_px" not in measured.columns:
+        return lengths
+    shift = 0.5 * measured["width_px"].to_numpy(float) * np.deg2rad(
+        measured["psi_deg"].to_numpy(float)
+    )
+    if not np.isfinite(shift).any():
+        return lengths
+    best, spread = lengths, np.inf
+    for side in (0.0, 1.0, -1.0):
+        candidate = lengths + side * np.nan_to_num(shift)
+        finite = candidate[np.isfinite(candidate)]
+        if finite.size < 3:
+            return lengths
+        med = float(np.median(finite))
+        mad = float(np.median(np.abs(finite - med))) / max(abs(med), 1e-9)
+        if mad < spread - 1e-9:
+            best, spread = candidate, mad
+    return best
 
 
 def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np.ndarray) -> None:

@@ -76,6 +76,22 @@ def test_a_partial_line_is_flagged_by_its_length():
     assert out.loc[4, "status"] == "flagged" and "length 67%" in out.loc[4, "reason"]
 
 
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_a_body_whose_centre_line_shortens_as_it_bends_is_no_partial_line(side):
+    # a body 70 px wide: its centre line, 35 px beside the layer that does not stretch, is 27 %
+    # shorter curled at +215 deg than at -215 (a rendered grey_dots ramp: 5 of 19 photos were
+    # flagged "line length 78% of its ramp's median", every one within 3.6 deg)
+    psi = _ds20_like()
+    df = _ramp(psi, width_px=70.0, length_px=900.0 - side * 35.0 * np.deg2rad(psi))
+    out = check_ramps(df)
+    assert (out["status"] == "ok").all(), out[["psi_deg", "length_px", "reason"]]
+    # a partial body is still one
+    df.loc[4, "length_px"] *= 0.6
+    out = check_ramps(df)
+    assert out.loc[4, "status"] == "flagged" and "line length" in out.loc[4, "reason"]
+    assert (out.drop(index=4)["status"] == "ok").all()
+
+
 def test_a_cosmetic_flag_on_a_photo_that_follows_its_ramp_is_lifted():
     df = _ramp(_ds20_like())
     df.loc[5, ["status", "reason"]] = ["flagged", "line partly hidden: gap bridged"]

@@ -87,6 +87,7 @@ def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
         "kappa_per_mm": res.kappa_per_mm,
         "length_mm": res.length_mm,
         "length_px": res.length_px,
+        "width_px": res.line_width_px,
         "method": res.method,
         "residual_px": res.residual_px,
         "status": res.status,

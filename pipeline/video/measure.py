@@ -137,6 +137,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
             "kappa_per_mm",
             "length_mm",
             "length_px",
+            "width_px",
             "residual_px",
             "degree",
         ):

@@ -43,6 +43,7 @@ CHUNK_COLUMNS: tuple[str, ...] = (
     "kappa_per_mm",
     "length_mm",
     "length_px",
+    "width_px",
     "method",
     "residual_px",
     "status",
