@@ -105,6 +105,15 @@ def test_a_free_strip_that_bends_to_its_cut_end(psi, width):
     assert res.psi_deg == pytest.approx(psi, abs=2.0)
 
 
+@pytest.mark.parametrize("psi", [210.0, 120.0, -150.0, -225.0])
+def test_a_fixed_end_clicked_inside_the_clamp_adds_no_bend(psi):
+    # fixed_end 30 px inside the clamp block: the base's curvature was carried on over the clamp,
+    # which does not bend (5-10 deg off, ok)
+    img, fe, _ = body_photo(psi, seed=int(abs(psi)))
+    res = measure_image(img, settings_for((fe[0] - 30.0, fe[1])))
+    assert res.psi_deg == pytest.approx(psi, abs=4.0)
+
+
 @pytest.mark.parametrize("psi", [150.0, -120.0])
 def test_textured_body_and_excluded_clamp(psi):
     img, fe, clamp = body_photo(psi, texture=True, seed=3)

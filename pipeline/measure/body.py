@@ -576,6 +576,8 @@ MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH = 0.8, 1.15
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
 MARCH_STEP_PX = 2.0
+#: the selection is a clamp, not the body, where it is wider than this many of the body's widths
+CLAMP_WIDTH_RATIO = 1.3
 #: a free end that bends (``free_end: bends``) is carried on to the last body pixel within this
 #: many half-widths of the centre line's course (the middle of its end face, not a corner)
 FREE_TIP_ACROSS = 0.3
@@ -693,13 +695,19 @@ def _extensions(
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
     The fixed end: to the given fixed-end point (the clamp face), else to the body's last pixel:
-    the body bends right from the clamp.  The free end (``free_end: capped``): 0.  Past the centre
-    line's last point lies the actuator's sealed end (a cap), which does not bend, so the tip's
-    direction is the centre line's own at its end; carrying the curvature on over the cap read
-    |psi| 5 % high on rendered capped bodies.  With ``free_end_bends`` (``free_end: bends``: a
-    free strip, cut, with no sealed end) the free end is carried on to the body's last pixel like
-    an unclamped fixed end: the centre line stops about a half-width short of the end face, and
-    the strip bends through that part too.
+    the body bends right from the clamp.  Not into a clamp that is part of the selection, though
+    (:func:`_clamp_distance`): the clamp does not bend, and a fixed end clicked inside it (20-40
+    px at 1280x960) carried the base's curvature on over the clamp (5-14 deg off on rendered
+    analogues).  With ``free_end_bends`` (a free strip: the end walked from is a cut end too) the
+    given point is reached whatever lies there.
+
+    The free end (``free_end: capped``): 0.  Past the centre line's last point lies the actuator's
+    sealed end (a cap), which does not bend, so the tip's direction is the centre line's own at
+    its end; carrying the curvature on over the cap read |psi| 5 % high on rendered capped
+    bodies.  With ``free_end_bends`` (``free_end: bends``: a free strip, cut, with no sealed end)
+    the free end is carried on to the body's last pixel like an unclamped fixed end: the centre
+    line stops about a half-width short of the end face, and the strip bends through that part
+    too.
     """
     ys, xs = np.nonzero(comp)
     q = np.c_[xs, ys].astype(float)
@@ -710,7 +718,10 @@ def _extensions(
         t = pts[end] - pts[inner]
         t = t / max(float(np.hypot(*t)), 1e-9)  # outward tangent
         if end == 0 and fixed_xy is not None:
-            out.append(max(0.0, float((np.asarray(fixed_xy) - p) @ t)))
+            reach = max(0.0, float((np.asarray(fixed_xy) - p) @ t))
+            if not free_end_bends:
+                reach = min(reach, _clamp_distance(comp, p, t, half, reach))
+            out.append(reach)
             continue
         if end == -1 and not free_end_bends:
             out.append(0.0)
@@ -732,6 +743,38 @@ def _extensions(
         else:
             out.append(0.0)
     return out[0], out[1]
+
+
+def _clamp_distance(
+    comp: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
+) -> float:
+    """How far (px, up to ``reach``) from ``start`` along ``direction`` the selection stays no
+    wider than the body: where its distance transform first exceeds :data:`CLAMP_WIDTH_RATIO`
+    times the body's half-width, the ray has entered a wider block (a clamp plate or bracket that
+    the selection took in), whose face lies a little before (for a square face).  A faint,
+    unselected stretch of body does not stop it.
+
+    Examples
+    --------
+    >>> comp = np.zeros((40, 120), np.uint8); comp[15:25, 20:80] = 1; comp[0:40, 80:110] = 1
+    >>> round(_clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0))
+    30
+    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
+    20.0
+    """
+    if not np.isfinite(reach) or reach <= 0:
+        return reach
+    dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+    h, w = comp.shape
+    for a in np.arange(0.0, reach + 1.0, 1.0):
+        x, y = np.round(start + a * direction).astype(int)
+        if not (0 <= x < w and 0 <= y < h):
+            break
+        if dt[y, x] > CLAMP_WIDTH_RATIO * half:
+            # entering a block from a band of half-width ``half``, the distance to the nearest
+            # edge passes CLAMP_WIDTH_RATIO * half this far past the block's face
+            return max(0.0, float(a) - float(np.sqrt(CLAMP_WIDTH_RATIO**2 - 1.0)) * half)
+    return reach
 
 
 def _on_border(
