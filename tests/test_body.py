@@ -382,3 +382,20 @@ def test_realscenes_bench_prints_its_tables_at_the_size_asked(capsys):
         assert scene in out
     with pytest.raises(SystemExit):
         main(["--size", "wide"])
+    with pytest.raises(SystemExit):
+        main(["--fixed-end-offset", "left"])
+    assert main(args + ["--camera", "dark", "--fixed-end-offset=-20,0"]) == 0
+    out = capsys.readouterr().out
+    assert "camera dark, fixed end moved by (-20, 0) px" in out
+
+
+def test_a_fixed_end_moved_into_the_clamp_moves_the_bench_cases():
+    # the bench's --fixed-end-offset reaches the measurement (a user's click into the clamp)
+    from pipeline.bench.realscenes import body_cases
+
+    at_face = body_cases(1, scenes=("lab_body",), width=640, height=480)
+    moved = body_cases(1, scenes=("lab_body",), width=640, height=480,
+                       fixed_end_offset_px=(-200.0, 0.0))
+    assert at_face["status"].iloc[0] == "ok"
+    assert moved["status"].iloc[0] == "flagged"
+    assert "no body reaches fixed_end" in moved["reason"].iloc[0]

@@ -78,7 +78,7 @@ def test_a_partial_line_is_flagged_by_its_length():
 
 @pytest.mark.parametrize("side", [1.0, -1.0])
 def test_a_body_whose_centre_line_shortens_as_it_bends_is_no_partial_line(side):
-    # a body 70 px wide: its centre line, 35 px beside the layer that does not stretch, is 27 %
+    # a body 70 px wide: its centre line, 35 px beside the layer that does not stretch, is 26 %
     # shorter curled at +215 deg than at -215 (a rendered grey_dots ramp: 5 of 19 photos were
     # flagged "line length 78% of its ramp's median", every one within 3.6 deg)
     psi = _ds20_like()

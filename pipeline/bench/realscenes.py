@@ -85,6 +85,7 @@ def body_cases(
     fixed_direction: bool = False,
     scenes: tuple[str, ...] | None = None,
     camera: str = "clean",
+    fixed_end_offset_px: tuple[float, float] = (0.0, 0.0),
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -102,6 +103,9 @@ def body_cases(
         Only these of :data:`BODY_SCENES` (default: all).
     camera : str
         What the camera does to each rendered photo (:func:`through_camera`).
+    fixed_end_offset_px : (float, float)
+        Added to the true fixed end (px): a user's click beside the clamp face (negative x: into
+        the clamp of the scenes, whose bodies leave it towards +x).
 
     Returns
     -------
@@ -126,9 +130,8 @@ def body_cases(
             extra: dict[str, Any] = {}
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
-            settings = resolve_settings(
-                l0_mm=270.0, target="body", fixed_end=[float(v) for v in r.fixed_end_px], **extra
-            )
+            fixed_end = [float(v) + o for v, o in zip(r.fixed_end_px, fixed_end_offset_px)]
+            settings = resolve_settings(l0_mm=270.0, target="body", fixed_end=fixed_end, **extra)
             t0 = time.perf_counter()
             res = measure_image(img, settings)
             rows.append(
@@ -209,6 +212,13 @@ def main(argv: Sequence[str] | None = None) -> int:
              "noise, uneven light, defocus, underexposure (default clean)",
     )
     parser.add_argument(
+        "--fixed-end-offset",
+        default="0,0",
+        metavar="DX,DY",
+        help="move the given fixed end by this many px, as a user's imprecise click (e.g. -20,0: "
+             "20 px into the clamp; default 0,0)",
+    )
+    parser.add_argument(
         "--no-fixed-direction",
         action="store_true",
         help="only the first analogue table (fixed end given), not the one with "
@@ -219,6 +229,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         width, height = (int(v) for v in args.size.lower().split("x"))
     except ValueError:
         parser.error(f"--size must be WxH in pixels, e.g. 1280x720, got {args.size!r}")
+    try:
+        dx, dy = (float(v) for v in args.fixed_end_offset.split(","))
+    except ValueError:
+        parser.error(f"--fixed-end-offset must be DX,DY in pixels, got {args.fixed_end_offset!r}")
     pd.set_option("display.width", 200)
     pd.set_option("display.max_colwidth", 90)
     if (args.dev_set / "labels.csv").is_file():
@@ -249,12 +263,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     for fixed in (False,) if args.no_fixed_direction else (False, True):
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
-            camera=args.camera,
+            camera=args.camera, fixed_end_offset_px=(dx, dy),
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
             f"given{', fixed_direction_deg given' if fixed else ''}"
-            f"{'' if args.camera == 'clean' else ', camera ' + args.camera} "
+            f"{'' if args.camera == 'clean' else ', camera ' + args.camera}"
+            f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())

@@ -687,6 +687,7 @@ def _follow_ridge(ridge: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray
 
 def _extensions(
     comp: np.ndarray,
+    dt: np.ndarray,
     pts: np.ndarray,
     half: float,
     fixed_xy: tuple[float, float] | None,
@@ -720,7 +721,7 @@ def _extensions(
         if end == 0 and fixed_xy is not None:
             reach = max(0.0, float((np.asarray(fixed_xy) - p) @ t))
             if not free_end_bends:
-                reach = min(reach, _clamp_distance(comp, p, t, half, reach))
+                reach = min(reach, _clamp_distance(dt, p, t, half, reach))
             out.append(reach)
             continue
         if end == -1 and not free_end_bends:
@@ -746,10 +747,10 @@ def _extensions(
 
 
 def _clamp_distance(
-    comp: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
+    dt: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
 ) -> float:
     """How far (px, up to ``reach``) from ``start`` along ``direction`` the selection stays no
-    wider than the body: where its distance transform first exceeds :data:`CLAMP_WIDTH_RATIO`
+    wider than the body: where its distance transform ``dt`` first exceeds :data:`CLAMP_WIDTH_RATIO`
     times the body's half-width, the ray has entered a wider block (a clamp plate or bracket that
     the selection took in), whose face lies a little before (for a square face).  A faint,
     unselected stretch of body does not stop it.
@@ -757,15 +758,15 @@ def _clamp_distance(
     Examples
     --------
     >>> comp = np.zeros((40, 120), np.uint8); comp[15:25, 20:80] = 1; comp[0:40, 80:110] = 1
-    >>> round(_clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0))
+    >>> dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+    >>> round(_clamp_distance(dt, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0))
     30
-    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
+    >>> _clamp_distance(dt, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
     20.0
     """
     if not np.isfinite(reach) or reach <= 0:
         return reach
-    dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
-    h, w = comp.shape
+    h, w = dt.shape
     for a in np.arange(0.0, reach + 1.0, 1.0):
         x, y = np.round(start + a * direction).astype(int)
         if not (0 <= x < w and 0 <= y < h):
@@ -1068,7 +1069,7 @@ def extract_body(
     if len(along_ridge) > len(pts) and len(pts) >= 8:
         ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
     trimmed = _extensions(
-        comp, pts, half, fe if reached else None, free_end_bends=settings.free_end == "bends"
+        comp, dt, pts, half, fe if reached else None, free_end_bends=settings.free_end == "bends"
     )
     # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
     # free end the tip may be outside the photo; along a side the middle was taken from the

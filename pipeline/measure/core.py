@@ -399,9 +399,11 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
+        # the part of the body past the centre line's end, less what is not bend: half a width
+        # of cap, or the stretch already carried on to a cut end (free_end: bends)
         missed_tip_deg=float(
             np.rad2deg(abs(end_curvature(line.centreline_px)))
-            * max(0.0, body.end_short_px - 0.5 * line.width_px)
+            * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1]))
         ),
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
