@@ -206,6 +206,33 @@ def test_mpeg4_frames_are_read_decoded_and_measured_the_same_way(tmp_path):
     assert len(ok) >= len(m) - 1 and (ok["psi_deg"] - ok["psi_image_deg"]).abs().median() < 0.2
 
 
+def test_a_video_of_a_body_without_a_line_is_a_body_set_and_measured_as_one(tmp_path):
+    # a step response filmed at 720p, as the held-back green-backdrop frames are: the set says
+    # target: body (it said line_color: black, and every frame was flagged with a wrong angle)
+    folder = tmp_path / "body"
+    truth = render_video(
+        folder,
+        "DS20",
+        profile=PressureProfile("steps", max_kpa=80, step_kpa=40, hold_s=0.5),
+        fps=6,
+        rest_s=0.3,
+        scene="green_fibre",
+        scene_overrides={"width": 1280, "height": 720},
+        seed=2,
+    )
+    settings = photoset.load_photoset(folder).rows[0]
+    assert settings.target == "body" and Path(settings.background_path).is_file()
+    out = measure_photoset(folder, jobs=1)
+    m = out.merge(truth, on=["image", "frame"], suffixes=("", "_true"))
+    err = (m["psi_deg"] - m["psi_image_deg"]).abs()
+    ok = m["status"] == "ok"
+    assert ok.mean() >= 0.8 and err[ok].median() < 5.0
+    assert truth["psi_image_deg"].max() - truth["psi_image_deg"].min() > 150  # a real step
+    # within 5 deg below psi 180; above it the white cap's face bends the last pixels of the
+    # centre line (a known fault, 2-11 deg high at psi 210: see the closing note)
+    assert (err[ok & (m["psi_image_deg"].abs() < 180)] < 5.0).all()
+
+
 def test_h264_is_written_when_the_build_can_and_refused_by_name_when_not(tmp_path):
     profile = PressureProfile("ramp", max_kpa=20, rate_kpa_s=40)
     try:

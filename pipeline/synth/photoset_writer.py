@@ -78,6 +78,19 @@ def material_key(material: str) -> int:
     return zlib.crc32(material.encode()) & 0x7FFFFFFF
 
 
+def target_settings(sc: SceneParams) -> dict[str, Any]:
+    """What a photo set of scene ``sc`` measures: ``target: body`` for a body without a line,
+    else the drawn line's ``line_color``.
+
+    Examples
+    --------
+    >>> from pipeline.synth.presets import scene_from
+    >>> target_settings(scene_from("green_fibre")), target_settings(scene_from("lab"))
+    ({'target': 'body'}, {'line_color': 'black'})
+    """
+    return {"target": "body"} if sc.target == "body" else {"line_color": sc.line_color}
+
+
 def image_name(
     material: str, actuator: str, trial: str, step: int, direction: str, pressure_kpa: float
 ) -> str:
@@ -444,9 +457,7 @@ def render_photoset(
             base = camera_for(sc, rotation_deg=base_rot, origin_px=fixed_flat)
             end_x, end_y = base.to_px([[0.0, sc.body_width_mm / 2]])[0]
             fixed_end_px = (float(end_x), float(end_y))
-            settings["target"] = "body"
-        else:
-            settings["line_color"] = sc.line_color
+        settings.update(target_settings(sc))
         settings.update(
             {
                 "fixed_end": [round(fixed_end_px[0], 2), round(fixed_end_px[1], 2)],

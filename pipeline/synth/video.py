@@ -16,10 +16,12 @@ Frames are rendered by :func:`pipeline.synth.render_actuator` over one static sc
 with OpenCV's ``VideoWriter`` as MJPEG (what USB lab cameras record; FFmpeg's encoder, default
 quality, about 30 kB a 1280x720 frame) or MPEG-4 Part 2; H.264 when this OpenCV build can encode
 it (most pip wheels cannot: the request is then refused, naming the codecs that work).  The folder
-is a video photo set (:mod:`pipeline.video`): ``manifest.csv`` (one row), ``photoset.yaml``, the
-video, the pressure log (``time_s, pressure_kpa`` = setpoint, ``measured_kpa`` = the regulator's
-pressure plus monitor noise) and ``truth.csv`` (per frame: its time on the log clock, psi,
-psi as seen in the image, the true pressure).  The video starts ``clock_offset_s`` after the log.
+is a video photo set (:mod:`pipeline.video`): ``manifest.csv`` (one row), ``photoset.yaml``
+(``target: body`` for a scene of a body without a line, as a still photo set of that scene says),
+the video, ``background.jpg`` (the empty scene) for a scene that has one, the pressure log
+(``time_s, pressure_kpa`` = setpoint, ``measured_kpa`` = the regulator's pressure plus monitor
+noise) and ``truth.csv`` (per frame: its time on the log clock, psi, psi as seen in the image, the
+true pressure).  The video starts ``clock_offset_s`` after the log.
 
 Examples
 --------
@@ -46,7 +48,7 @@ import pandas as pd
 from scipy.signal import lfilter
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import write_table
+from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.photoset import TRUTH, write_manifest, write_settings
 from pipeline.synth.actuator import (
     ActuatorBehaviour,
@@ -60,14 +62,26 @@ from pipeline.synth.actuator import (
 from pipeline.synth.backdrop import make_backdrop
 from pipeline.synth.camera import make_camera
 from pipeline.synth.centreline import centreline_mm
-from pipeline.synth.photoset_writer import choose_layout, default_l0_mm, material_key
+from pipeline.synth.photoset_writer import (
+    BACKGROUND_IMAGE,
+    choose_layout,
+    default_l0_mm,
+    material_key,
+    target_settings,
+)
 from pipeline.synth.presets import SceneParams, scene_from
-from pipeline.synth.scene import child_seed, render_actuator, world_extent_mm
+from pipeline.synth.scene import (
+    child_seed,
+    encode_jpeg,
+    render_actuator,
+    render_background,
+    world_extent_mm,
+)
 from pipeline.video.profile import PressureProfile
 from pipeline.video.writer import CODECS, open_writer
 
 #: seed streams (after the material key)
-_ACTUATOR, _TRIAL, _TABLE, _FRAME, _LOG = 11, 12, 13, 14, 15
+_ACTUATOR, _TRIAL, _TABLE, _FRAME, _LOG, _BACKGROUND = 11, 12, 13, 14, 15, 16
 #: the rig counts as vented (the hysteresis peak restarts) below this pressure (kPa)
 VENTED_KPA = 1.0
 #: time step of the simulation (s)
@@ -340,16 +354,18 @@ def render_video(
             ]
         ),
     )
-    write_settings(
-        out,
-        {
-            "l0_mm": l0,
-            "mm_per_px": float(sc.mm_per_px),
-            "line_color": sc.line_color,
-            "fixed_end": [round(fixed_end[0], 2), round(fixed_end[1], 2)],
-            "positive_turn": "ccw",
-        },
-    )
+    settings: dict[str, Any] = {
+        "l0_mm": l0,
+        "mm_per_px": float(sc.mm_per_px),
+        **target_settings(sc),
+        "fixed_end": [round(fixed_end[0], 2), round(fixed_end[1], 2)],
+        "positive_turn": "ccw",
+    }
+    if sc.background_photo:  # the empty scene, filmed with the same camera and light
+        empty = render_background(backdrop, sc, seed=child_seed(seed, mk, _BACKGROUND))
+        atomic_write_bytes(out / BACKGROUND_IMAGE, encode_jpeg(empty, sc.jpeg_quality))
+        settings["background"] = BACKGROUND_IMAGE
+    write_settings(out, settings)
     truth = pd.DataFrame(
         {
             "image": name,
