@@ -611,6 +611,23 @@ def file_problems(
                 warning=True,
             )
         )
+    if any(
+        r is not None and r.target == "body" and r.free_end == "capped" and r.sealed_end_mm is None
+        for r in ps.rows
+    ):
+        # measured on rendered bodies (python -m pipeline bench realscenes --sealed-end-mm 8)
+        problems.append(
+            Problem(
+                str(folder / SETTINGS),
+                None,
+                "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
+                "runs on into a sealed end or cap; one longer than about 4 mm reads |psi| above "
+                "150 deg about 5 deg high",
+                "measure the actuator's end that does not bend (from where the chamber ends to the "
+                "tip, cap included) and set sealed_end_mm (with mm_per_px)",
+                warning=True,
+            )
+        )
     return problems
 
 

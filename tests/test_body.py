@@ -387,6 +387,9 @@ def test_realscenes_bench_prints_its_tables_at_the_size_asked(capsys):
     assert main(args + ["--camera", "dark", "--fixed-end-offset=-20,0"]) == 0
     out = capsys.readouterr().out
     assert "camera dark, fixed end moved by (-20, 0) px" in out
+    assert main(args + ["--sealed-end-mm", "8", "--give-sealed-end"]) == 0
+    out = capsys.readouterr().out
+    assert "sealed end 8 mm, sealed_end_mm given" in out and "median signed error" in out
 
 
 def test_a_fixed_end_moved_into_the_clamp_moves_the_bench_cases():
@@ -399,3 +402,41 @@ def test_a_fixed_end_moved_into_the_clamp_moves_the_bench_cases():
     assert at_face["status"].iloc[0] == "ok"
     assert moved["status"].iloc[0] == "flagged"
     assert "no body reaches fixed_end" in moved["reason"].iloc[0]
+
+
+def _long_sealed_end_cases(give: bool):
+    from pipeline.bench.realscenes import body_cases
+
+    return body_cases(
+        4, scenes=("grey_dots", "lab_body"), sealed_end_mm=12.0, give_sealed_end=give, seed=31
+    )
+
+
+def test_a_long_sealed_end_read_where_the_bending_stops_when_its_length_is_given():
+    # a 12 mm sealed end: the centre line runs on into it and its tangent carries the curvature on
+    # over a part that does not bend (|psi| > 150 read 5-14 deg high, ok); given sealed_end_mm,
+    # the tip is read where the bending stops
+    unknown, given = _long_sealed_end_cases(False), _long_sealed_end_cases(True)
+    big = unknown["psi_true_deg"].abs() > 150
+    over = unknown["error_deg"] * np.sign(unknown["psi_true_deg"])
+    assert over[big].median() > 4.0
+    assert (given["status"] == "ok").all(), given["reason"].tolist()
+    assert given["error_deg"].abs().max() < 5.5 and given["error_deg"].abs().median() < 2.0
+
+
+def test_the_sealed_end_is_turned_into_pixels_on_the_plane_of_a_calibration():
+    from pipeline.measure.core import _read_before_sealed_end
+    from pipeline.measure.extract import LineExtraction
+
+    t = np.linspace(0.0, 1.0, 50)
+    line = LineExtraction(centreline_px=np.c_[100.0 * t, 0.0 * t], width_px=10.0,
+                          touches_border=False, n_candidates=1, contrast=100.0, ends_gap_px=100.0,
+                          branched_fraction=0.0, fixed_end_auto=False, clamp_removed=True,
+                          trimmed_px=(0.0, 0.0))
+    # image: 0.5 mm/px, the face 10 px beyond the line's end, a 8 mm (16 px) sealed end
+    ends, sealed_px = _read_before_sealed_end(line, 10.0, (3.0, 0.0), 8.0, 0.5, line.centreline_px)
+    assert ends == (3.0, pytest.approx(-6.0)) and sealed_px == pytest.approx(16.0)
+    # on a plane twice as fine (0.25 mm per plane px): the same place, in plane px
+    ends, sealed_px = _read_before_sealed_end(line, 10.0, (6.0, 0.0), 8.0, 0.25,
+                                              2.0 * line.centreline_px)
+    assert ends == (6.0, pytest.approx(-12.0)) and sealed_px == pytest.approx(16.0)

@@ -174,6 +174,29 @@ def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, t
     assert warning.warning and says in warning.message
 
 
+@pytest.mark.parametrize(
+    ("extra", "warned"),
+    [
+        ({"target": "body"}, True),
+        ({"target": "body", "mm_per_px": 0.3, "sealed_end_mm": 6}, False),
+        ({"target": "body", "free_end": "bends"}, False),
+        ({"target": "line"}, False),
+    ],
+)
+def test_a_capped_body_set_without_its_sealed_end_is_warned(photo_folder, extra, warned):
+    from pipeline import photoset_init
+
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0, **extra},
+    )
+    said = [p for p in ps.validate_photoset(photo_folder, warnings=True)
+            if "sealed_end_mm" in p.message]
+    assert bool(said) == warned
+    assert all(p.warning and "reads |psi| above 150 deg" in p.message for p in said)
+
+
 def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folder):
     from pipeline import photoset_init
 
@@ -264,3 +287,26 @@ def test_each_kind_of_bad_row_fails_alone_and_the_rest_is_measured(small_set, tm
     assert "vacuum" in angles.loc[6, "reason"] and "twice" in angles.loc[9, "reason"]
     assert (angles.loc[[0, 5, 7, 8], "status"] == "ok").all()
     assert angles.loc[7, "pressure_kpa"] == -40.0
+
+
+@pytest.mark.parametrize(
+    ("raw", "message"),
+    [
+        ({"sealed_end_mm": -2, "mm_per_px": 0.3}, "must be a length >= 0"),
+        ({"sealed_end_mm": "abc", "mm_per_px": 0.3}, "must be a length >= 0"),
+        ({"sealed_end_mm": True, "mm_per_px": 0.3}, "must be a length >= 0"),
+        ({"sealed_end_mm": 8}, "needs the image scale"),
+        ({"sealed_end_mm": 8, "mm_per_px": 0.3, "free_end": "bends"}, "an end that bends"),
+    ],
+)
+def test_a_sealed_end_that_cannot_be_used_is_a_problem_naming_the_key(raw, message):
+    settings, problems = settings_problems({"l0_mm": 200, "target": "body", **raw})
+    assert settings is None
+    assert [p.key for p in problems] == ["sealed_end_mm"] and message in problems[0].message
+
+
+def test_a_sealed_end_is_a_length_in_mm_or_not_given():
+    assert resolve_settings(l0_mm=200, target="body").sealed_end_mm is None
+    s = resolve_settings(l0_mm=200, target="body", mm_per_px=0.3, sealed_end_mm="8.5")
+    assert s.sealed_end_mm == 8.5
+    assert resolve_settings(l0_mm=200, mm_per_px=0.3, sealed_end_mm=0).sealed_end_mm == 0.0

@@ -86,6 +86,8 @@ def body_cases(
     scenes: tuple[str, ...] | None = None,
     camera: str = "clean",
     fixed_end_offset_px: tuple[float, float] = (0.0, 0.0),
+    sealed_end_mm: float | None = None,
+    give_sealed_end: bool = False,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -106,6 +108,12 @@ def body_cases(
     fixed_end_offset_px : (float, float)
         Added to the true fixed end (px): a user's click beside the clamp face (negative x: into
         the clamp of the scenes, whose bodies leave it towards +x).
+    sealed_end_mm : float, optional
+        Length of the bodies' straight sealed end past the chamber (mm; default the scenes' own,
+        :data:`pipeline.synth.presets.SEALED_END_MM`): what the tip angle is read over.
+    give_sealed_end : bool
+        Also give ``sealed_end_mm`` (the scene's sealed end plus its tip cap, as the user who
+        built the actuator knows it) and ``mm_per_px`` (the scene's).
 
     Returns
     -------
@@ -119,6 +127,8 @@ def body_cases(
     for name, overrides in BODY_SCENES.items():
         if scenes is not None and name not in scenes:
             continue
+        if sealed_end_mm is not None:
+            overrides = {**overrides, "sealed_end_mm": sealed_end_mm}
         scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
             r = render_actuator(
@@ -130,6 +140,9 @@ def body_cases(
             extra: dict[str, Any] = {}
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
+            if give_sealed_end:
+                extra["sealed_end_mm"] = scene.sealed_end_mm + scene.tip_cap_mm
+                extra["mm_per_px"] = scene.mm_per_px
             fixed_end = [float(v) + o for v, o in zip(r.fixed_end_px, fixed_end_offset_px)]
             settings = resolve_settings(l0_mm=270.0, target="body", fixed_end=fixed_end, **extra)
             t0 = time.perf_counter()
@@ -219,6 +232,19 @@ def main(argv: Sequence[str] | None = None) -> int:
              "20 px into the clamp; default 0,0)",
     )
     parser.add_argument(
+        "--sealed-end-mm",
+        type=float,
+        default=None,
+        help="length of the bodies' straight sealed end past the chamber, mm (default 4): where "
+             "the tip angle breaks as it grows",
+    )
+    parser.add_argument(
+        "--give-sealed-end",
+        action="store_true",
+        help="the settings also give sealed_end_mm (the scene's sealed end and tip cap) and "
+             "mm_per_px, as a user who knows the actuator writes them",
+    )
+    parser.add_argument(
         "--no-fixed-direction",
         action="store_true",
         help="only the first analogue table (fixed end given), not the one with "
@@ -263,17 +289,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     for fixed in (False,) if args.no_fixed_direction else (False, True):
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
-            camera=args.camera, fixed_end_offset_px=(dx, dy),
+            camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
+            give_sealed_end=args.give_sealed_end,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
             f"given{', fixed_direction_deg given' if fixed else ''}"
             f"{'' if args.camera == 'clean' else ', camera ' + args.camera}"
-            f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'} "
+            f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'}"
+            f"{'' if args.sealed_end_mm is None else f', sealed end {args.sealed_end_mm:g} mm'}"
+            f"{', sealed_end_mm given' if args.give_sealed_end else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())
         print(f"   median time per {width}x{height} photo: {df['ms'].median():.0f} ms")
+        big = df[df["psi_true_deg"].abs() > 150]
+        print(
+            "   median signed error at |psi| > 150 deg: "
+            f"{big.loc[big['psi_true_deg'] > 0, 'error_deg'].median():+.1f} deg (psi > 0), "
+            f"{big.loc[big['psi_true_deg'] < 0, 'error_deg'].median():+.1f} deg (psi < 0)"
+        )
         wrong = df[(df["status"] == "ok") & (df["error_deg"].abs() > TOLERANCE_DEG)]
         if len(wrong):
             print("   ok but wrong:")

@@ -48,7 +48,12 @@ def photo_times(preset: str, width: int, height: int, repeats: int = 5) -> dict[
     cv2.setNumThreads(1)
     scene = scene_from(preset, width=width, height=height)
     curves = [actuator_centreline_mm(psi, 195.0, scene) for psi in (-150.0, 30.0, 180.0)]
-    extent = np.vstack([world_extent_mm(c, scene.body_width_mm, scene.tip_cap_mm) for c in curves])
+    extent = np.vstack(
+        [
+            world_extent_mm(c, scene.body_width_mm, scene.tip_cap_mm, scene.sealed_end_mm)
+            for c in curves
+        ]
+    )
     camera = make_camera(scene, rotation_deg=0.0, extent_mm=extent)
     rows = []
     for k in range(repeats):

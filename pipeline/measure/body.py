@@ -87,6 +87,10 @@ class BodyExtraction:
     tip_at_region_edge : bool
         The free end reaches the edge of the ``roi`` or of an ``exclude`` polygon: the body may
         go on where it is not looked at.
+    tip_face_px : float
+        How far the tip's face (the body's last pixel on the centre line's course, cap included)
+        lies beyond the centre line's free end (original px); computed only when
+        ``sealed_end_mm`` is given (0 otherwise).
     """
 
     line: LineExtraction
@@ -98,6 +102,7 @@ class BodyExtraction:
     end_short_px: float = 0.0
     ridge_tip_deg: float = 0.0
     free_end_width_ratio: float = 1.0
+    tip_face_px: float = 0.0
     side_on_border: bool = False
     tip_at_region_edge: bool = False
 
@@ -1108,4 +1113,9 @@ def extract_body(
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,
+        tip_face_px=(
+            0.0
+            if settings.sealed_end_mm is None
+            else _extensions(comp, dt, pts, half, None, free_end_bends=True)[1] * scale
+        ),
     )

@@ -350,6 +350,11 @@ def measure_body(
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
+    sealed_px = 0.0  # the known sealed end, image px
+    if settings.sealed_end_mm is not None:
+        ends, sealed_px = _read_before_sealed_end(
+            line, body.tip_face_px, ends, settings.sealed_end_mm, settings.mm_per_px, pts
+        )
     rng = np.random.default_rng(SEED)
     base = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
@@ -403,13 +408,61 @@ def measure_body(
         # of cap, or the stretch already carried on to a cut end (free_end: bends)
         missed_tip_deg=float(
             np.rad2deg(abs(end_curvature(line.centreline_px)))
-            * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1]))
+            * max(
+                0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px)
+            )
         ),
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method
     return _measured(psi, est, line, quality, settings, used)
+
+
+def _read_before_sealed_end(
+    line: LineExtraction,
+    tip_face_px: float,
+    ends: tuple[float, float],
+    sealed_end_mm: float,
+    mm_per_px: float | None,
+    points: NDArray[np.float64],
+) -> tuple[tuple[float, float], float]:
+    """The end lengths with the free end's moved to where the bending stops: ``sealed_end_mm``
+    back from the tip's face, which lies ``tip_face_px`` (image px) beyond the centre line's end.
+
+    The free end's tangent is then read there: inside the centre line when it runs on into the
+    sealed end (its last pixels carry the curvature on over a part that does not bend: 5-7 deg
+    high at |psi| > 150 deg for a 12 mm sealed end on rendered bodies), carried on when it
+    stops short of where the bending stops.
+
+    Parameters
+    ----------
+    line : LineExtraction
+        The body's centre line (image px).
+    tip_face_px : float
+        Distance from its free end to the tip's face (image px).
+    ends : (float, float)
+        End lengths as the estimators take them (image px, or plane px when calibrated).
+    sealed_end_mm : float
+        The known length of the end that does not bend (mm).
+    mm_per_px : float
+        Scale of ``points`` (mm per image px, or per plane px when calibrated).
+    points : ndarray (N, 2)
+        The centre line as the estimators take it (image or plane px).
+
+    Returns
+    -------
+    ends : (float, float)
+        The end lengths, the free end's negative when read inside the centre line.
+    sealed_px : float
+        The sealed end's length in image px.
+    """
+    assert mm_per_px is not None  # settings: sealed_end_mm needs a scale
+    image_len = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
+    work_len = float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
+    per_image_px = work_len / image_len if image_len > 0 else 1.0  # 1 without a calibration
+    sealed_px = sealed_end_mm / mm_per_px / per_image_px
+    return (ends[0], (tip_face_px - sealed_px) * per_image_px), sealed_px
 
 
 def measure_image(

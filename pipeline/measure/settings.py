@@ -35,6 +35,11 @@ Keys
     ``capped`` (the default: an actuator's sealed end, which does not bend; psi is the direction
     where the body's centre line stops) or ``bends`` (a free strip cut at its end, with no sealed
     end: the end's turning is carried on to the body's last pixel).  ``target: body`` only.
+``sealed_end_mm``
+    Length of the actuator's end that does not bend, from where its chamber ends to its tip
+    (sealed end and any cap, mm, >= 0): psi is then read that far back from the tip's face, not
+    where the centre line stops.  Needs ``mm_per_px`` or ``calibration``; ``target: body`` with
+    ``free_end: capped`` only.
 ``method``
     The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
     run's method (``--method``, config ``measure.method``) applies.
@@ -82,7 +87,7 @@ FREE_ENDS: tuple[str, ...] = ("capped", "bends")
 #: every settings key, as it may appear in photoset.yaml (fixed_end as fixed_end_x/_y in rows)
 KEYS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
-    "exclude", "fixed_direction_deg", "free_end", "method", "calibration",
+    "exclude", "fixed_direction_deg", "free_end", "sealed_end_mm", "method", "calibration",
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
@@ -98,6 +103,7 @@ OVERRIDE_COLUMNS: tuple[str, ...] = (
     "exclude",
     "fixed_direction_deg",
     "free_end",
+    "sealed_end_mm",
     "method",
     "calibration",
 )
@@ -152,6 +158,9 @@ class MeasureSettings:
     free_end : {"capped", "bends"}
         The body's free end is a sealed end that does not bend, or a cut end that bends with the
         rest (``target: body``).
+    sealed_end_mm : float or None
+        Length of the body's end that does not bend (mm); None: unknown, psi is read where the
+        centre line stops.
     method : str or None
         Estimator for these photos; None: the run's.
     calibration : Calibration or None
@@ -170,6 +179,7 @@ class MeasureSettings:
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None
     free_end: str = "capped"
+    sealed_end_mm: float | None = None
     method: str | None = None
     calibration: Calibration | None = None
 
@@ -461,6 +471,60 @@ def _calibration(
         return None
 
 
+def _sealed_end(
+    raw: Mapping[str, Any], problems: list[SettingProblem], free_end: str, mpp: float | None
+) -> float | None:
+    """``sealed_end_mm`` as a length >= 0 (mm), or None when not given; a problem when it is no
+    such length, when the body's end bends (``free_end: bends``) or when there is no scale to
+    turn it into pixels.
+
+    Examples
+    --------
+    >>> problems = []
+    >>> _sealed_end({"sealed_end_mm": "8"}, problems, "capped", 0.3), problems
+    (8.0, [])
+    >>> _sealed_end({"sealed_end_mm": 8}, problems, "capped", None)
+    >>> problems[0].fix
+    'give mm_per_px (or a calibration): the length is turned into pixels with it'
+    """
+    value: Any = raw.get("sealed_end_mm")
+    if is_missing(value):
+        return None
+    try:
+        length = float(value)
+    except (TypeError, ValueError):
+        length = float("nan")
+    fix = (
+        "give the length in mm from where the chamber ends to the tip (sealed end and cap), or "
+        "leave sealed_end_mm out"
+    )
+    if isinstance(value, bool) or not math.isfinite(length) or length < 0:
+        problems.append(
+            SettingProblem("sealed_end_mm", f"sealed_end_mm = {value!r} must be a length >= 0", fix)
+        )
+        return None
+    if free_end == "bends":
+        problems.append(
+            SettingProblem(
+                "sealed_end_mm",
+                "sealed_end_mm is given but free_end is 'bends' (an end that bends has no sealed "
+                "end)",
+                "leave sealed_end_mm out, or use free_end: capped",
+            )
+        )
+        return None
+    if mpp is None and is_missing(raw.get("calibration")):
+        problems.append(
+            SettingProblem(
+                "sealed_end_mm",
+                f"sealed_end_mm = {value!r} needs the image scale",
+                "give mm_per_px (or a calibration): the length is turned into pixels with it",
+            )
+        )
+        return None
+    return length
+
+
 def settings_problems(
     raw: Mapping[str, Any], *, folder: Any = None, calibrations: CalibrationCache | None = None
 ) -> tuple[MeasureSettings | None, list[SettingProblem]]:
@@ -535,6 +599,7 @@ def settings_problems(
         "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that bends right "
         "to its cut end)",
     )
+    sealed_end = _sealed_end(raw, problems, free_end, mpp)
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
@@ -615,6 +680,7 @@ def settings_problems(
         exclude=tuple(exclude),
         fixed_direction_deg=fixed_direction,
         free_end=free_end,
+        sealed_end_mm=sealed_end,
         method=method,
         calibration=calibration,
     ), []

@@ -37,8 +37,6 @@ from numpy.typing import NDArray
 
 from pipeline.synth.presets import SceneParams
 
-#: sealed end of silicone beyond the free end of the layer (mm)
-END_CAP_MM = 4.0
 #: width of a fibre strand (Gaussian sigma, mm) and of a refraction rim (mm)
 STRAND_SIGMA_MM = 0.16
 RIM_MM = 0.55

@@ -172,6 +172,7 @@ def _sample_extents(
             actuator_centreline_mm(float(r.psi_deg), l0_mm, scene, bulge=float(r.bulge), n=241),
             scene.body_width_mm,
             scene.tip_cap_mm,
+            scene.sealed_end_mm,
         )
         for r in rows.itertuples()
     ]

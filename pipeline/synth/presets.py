@@ -33,6 +33,8 @@ import numpy as np
 
 from pipeline.errors import UserInputError
 
+#: default length of a body's sealed end past its chamber (mm): straight, no turning
+SEALED_END_MM = 4.0
 #: marker colours (BGR ink) for the names understood by ``pipeline.photoset.line_color_ranges``
 LINE_INK_BGR: dict[str, tuple[int, int, int]] = {
     "black": (28, 26, 30),
@@ -168,6 +170,9 @@ class SceneParams:
     tip_cap_mm : float
         Length of a rigid end block at the free end (mm, 0 = none); it is a little wider than
         the body and coloured ``tip_cap_bgr``.
+    sealed_end_mm : float
+        Length of the body's sealed end past its chamber (mm): straight, as wide as the body, in
+        its colour; it adds no turning (``bench realscenes --sealed-end-mm`` varies it).
     tip_cap_bgr : tuple of int
         Colour of the tip cap (BGR).
     clamp_style : str
@@ -228,6 +233,7 @@ class SceneParams:
     dot_diameter_mm: float = 4.0
     dot_layout: str = "centre"
     tip_cap_mm: float = 0.0
+    sealed_end_mm: float = SEALED_END_MM
     tip_cap_bgr: tuple[int, int, int] = (40, 40, 44)
     clamp_style: str = "block"
     shadow: float = 0.0
@@ -278,6 +284,7 @@ def _problems(s: SceneParams) -> list[str]:
         "tilt_deg",
         "rotation_jitter_deg",
         "tip_cap_mm",
+        "sealed_end_mm",
     ):
         if not getattr(s, key) >= 0:
             out.append(f"{key} = {getattr(s, key)!r} must be >= 0")

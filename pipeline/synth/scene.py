@@ -47,7 +47,6 @@ from pipeline.synth.backdrop import (
 )
 from pipeline.synth.body import (
     CAP_OVERHANG,
-    END_CAP_MM,
     RIB_BULGE,
     BodyFrame,
     over,
@@ -59,7 +58,7 @@ from pipeline.synth.body import (
 )
 from pipeline.synth.camera import Camera, make_camera
 from pipeline.synth.centreline import DEFAULT_N, actuator_centreline_mm, turning_angle_deg
-from pipeline.synth.presets import LINE_INK_BGR, SceneParams
+from pipeline.synth.presets import LINE_INK_BGR, SEALED_END_MM, SceneParams
 
 #: supersampling factor of the marker-line mask
 LINE_SUPERSAMPLING = 4
@@ -197,7 +196,10 @@ def _roi(
 
 
 def world_extent_mm(
-    points_mm: NDArray[np.float64], body_width_mm: float, tip_mm: float = 0.0
+    points_mm: NDArray[np.float64],
+    body_width_mm: float,
+    tip_mm: float = 0.0,
+    sealed_mm: float = SEALED_END_MM,
 ) -> NDArray[np.float64]:
     """World points bounding the actuator (line, body, its end and tip cap, clamp block) for
     framing.
@@ -210,7 +212,7 @@ def world_extent_mm(
     if tip_mm > 0:
         t = points_mm[-1] - points_mm[-2]
         t = t / np.hypot(*t)
-        reach, over_mm = END_CAP_MM + tip_mm, CAP_OVERHANG * body_width_mm + 0.5
+        reach, over_mm = sealed_mm + tip_mm, CAP_OVERHANG * body_width_mm + 0.5
         parts.append(
             np.array(
                 [
@@ -310,7 +312,8 @@ def render_curve(
     body_w = scene.body_width_mm if body_width_mm is None else float(body_width_mm)
     if backdrop is None:
         camera = make_camera(scene, rotation_deg=rotation_deg, fixed_end_px=fixed_end_px,
-                             extent_mm=world_extent_mm(pts, body_w, scene.tip_cap_mm))
+                             extent_mm=world_extent_mm(pts, body_w, scene.tip_cap_mm,
+                                                       scene.sealed_end_mm))
         backdrop = make_backdrop(scene, camera, seed=child_seed(seed, 0), keepout_mm=[pts])
     camera = backdrop.camera
     rng = np.random.default_rng(child_seed(seed, 1))
@@ -337,7 +340,8 @@ def compose_photo(
     tang_end = pts_mm[-1] - pts_mm[-2]
     tang_end /= np.hypot(*tang_end)
     body_outer_mm = pts_mm[idx] + nrm_mm[idx] * body_w
-    cap = [pts_mm[-1] + tang_end * END_CAP_MM, body_outer_mm[-1] + tang_end * END_CAP_MM]
+    sealed = scene.sealed_end_mm
+    cap = [pts_mm[-1] + tang_end * sealed, body_outer_mm[-1] + tang_end * sealed]
     body_inner_px = camera.to_px(np.vstack([pts_mm[idx], cap[:1]]))
     body_outer_px = camera.to_px(np.vstack([body_outer_mm, cap[1:]]))
     line_c = centre_px[idx]
@@ -466,8 +470,8 @@ def _compose_body(
     idx = _decimate(camera.to_px(centre_mm))  # ~1 px apart on screen
     tang = pts_mm[-1] - pts_mm[-2]
     tang /= np.hypot(*tang)
-    m = max(2, int(np.ceil(END_CAP_MM / mpp)) + 1)
-    ext = np.linspace(0.0, END_CAP_MM, m)[1:]
+    m = max(2, int(np.ceil(scene.sealed_end_mm / mpp)) + 1)
+    ext = np.linspace(0.0, scene.sealed_end_mm, m)[1:]
     s_ax = np.concatenate([s_dense[idx], l0 + ext])
     c_ax = np.vstack([centre_mm[idx], centre_mm[-1] + ext[:, None] * tang])
     n_ax = np.vstack([nrm_mm[idx], np.repeat(nrm_mm[-1:], len(ext), axis=0)])
