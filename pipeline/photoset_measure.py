@@ -148,15 +148,21 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
     from pipeline.measure.overlay import note_final_status
 
     changed = (angles["status"] != drawn["status"]) | (angles["reason"] != drawn["reason"])
-    for image, status, reason in zip(
-        angles.loc[changed, "image"], angles.loc[changed, "status"], angles.loc[changed, "reason"]
+    for image, status, reason, drawn_reason in zip(
+        angles.loc[changed, "image"],
+        angles.loc[changed, "status"],
+        angles.loc[changed, "reason"],
+        drawn.loc[changed, "reason"],
+        strict=True,
     ):
         path = overlays_dir / f"{Path(str(image)).stem}.jpg"
         img = cv2.imread(str(path))
         if img is None:
             continue
         ok, buf = cv2.imencode(
-            ".jpg", note_final_status(img, str(status), str(reason)), [cv2.IMWRITE_JPEG_QUALITY, 85]
+            ".jpg",
+            note_final_status(img, str(status), str(reason), str(drawn_reason)),
+            [cv2.IMWRITE_JPEG_QUALITY, 85],
         )
         if ok:
             atomic_write_bytes(path, buf.tobytes())

@@ -25,6 +25,7 @@ from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
 from pipeline.measure.core import AngleResult, decode_for_work, measure_decoded
 from pipeline.measure.extract import line_mask, region_mask
+from pipeline.measure.overlay import wrap_text
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 
@@ -180,37 +181,6 @@ def preview_tile(
         band, 0, 0, 0, panels.shape[1] - band.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30)
     )
     return np.vstack([band, panels])
-
-
-def wrap_text(text: str, width_px: int, scale: float, max_lines: int) -> list[str]:
-    """``text`` broken at spaces into lines no wider than ``width_px`` in OpenCV's simplex font.
-
-    At most ``max_lines`` lines; what does not fit ends the last one with an ellipsis.
-
-    Examples
-    --------
-    >>> wrap_text("a b c", 1000, 0.48, 3)
-    ['a b c']
-    >>> lines = wrap_text("the centre line stops short " * 20, 300, 0.48, 3)
-    >>> len(lines), lines[-1].endswith("...")
-    (3, True)
-    """
-
-    def fits(line: str) -> bool:
-        return cv2.getTextSize(line, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] <= width_px
-
-    lines: list[str] = []
-    for word in text.split():
-        if lines and fits(f"{lines[-1]} {word}"):
-            lines[-1] = f"{lines[-1]} {word}"
-        else:
-            lines.append(word)
-    if len(lines) > max_lines:
-        last = lines[max_lines - 1]
-        while last and not fits(last + " ..."):
-            last = last.rsplit(" ", 1)[0] if " " in last else last[:-1]
-        lines = [*lines[: max_lines - 1], last + " ..."]
-    return lines
 
 
 def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, res: AngleResult,

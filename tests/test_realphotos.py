@@ -106,3 +106,33 @@ def test_a_preview_name_that_is_no_image_format_is_refused(tmp_path):
     with pytest.raises(UserInputError, match=r"\.jpg or \.png"):
         write_preview(DEV_SET, tmp_path / "sheet.gif")
     assert not (tmp_path / "sheet.gif").exists()
+
+
+def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
+    # the dev strips are 200 px wide: their overlays were 200 px with one 90-character reason
+    # line running off the photo; now enlarged, with the reason wrapped in a band of at most
+    # 30 % of the photo (the report's strip crops that band off)
+    import cv2
+
+    from pipeline.measure import measure_image
+    from pipeline.measure.overlay import (
+        LINE_PX,
+        draw_overlay,
+        final_status_text,
+        overlay_lines,
+    )
+    from pipeline.photoset import load_photoset
+
+    ps = load_photoset(DEV_SET)
+    img = cv2.imread(str(DEV_SET / "c_20C.png"))
+    res = measure_image(img, ps.rows[0])
+    assert res.status == "flagged" and len(res.reason) > 300
+    out = draw_overlay(img, res, title="c_20C.png")
+    assert out.shape[1] == 640
+    lines = overlay_lines(res, "c_20C.png", *out.shape[1::-1])
+    assert len(lines) >= 5 and lines[-1].endswith("...")
+    assert 10 + LINE_PX * len(lines) <= 0.3 * out.shape[0]
+    assert " ".join(lines[2:]).startswith(res.reason.split(";")[0])
+    assert final_status_text("flagged", "breaks its ramp; x", "x") == (
+        "then flagged: also breaks its ramp"
+    )

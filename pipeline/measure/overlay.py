@@ -5,6 +5,7 @@ Drawn with OpenCV only (no matplotlib), so parallel workers stay light.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -13,9 +14,25 @@ import numpy as np
 
 from pipeline.measure.core import AngleResult
 
-#: overlays are at most this wide (px)
-OVERLAY_WIDTH_PX = 640
+#: overlays are at most this wide (px); narrower photos are enlarged to it
+OVERLAY_WIDTH_PX, MIN_OVERLAY_WIDTH_PX = 640, 480
+#: text size and line height on overlays, and how many lines a reason may take
+TEXT_SCALE, LINE_PX, REASON_LINES = 0.5, 20, 5
 _COLOURS = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
+
+
+def overlay_lines(result: AngleResult, title: str, width_px: int, height_px: int) -> list[str]:
+    """The text of an overlay ``width_px`` x ``height_px``: the title, psi and the reason,
+    wrapped; the band they fill stays within its top 30 % (the report crops it off its photo
+    strip), what does not fit ends in an ellipsis."""
+    text = (
+        f"psi = {result.psi_deg:+.1f} deg ({result.method})"
+        if result.status != "failed"
+        else "failed"
+    )
+    lines = [title] if title else []
+    room = max(1, min(REASON_LINES, int(0.3 * height_px / LINE_PX) - len(lines) - 1))
+    return [*lines, text, *wrap_text(result.reason, width_px - 16, TEXT_SCALE, room)]
 
 
 def draw_overlay(
@@ -39,10 +56,14 @@ def draw_overlay(
     ndarray
         BGR image at most :data:`OVERLAY_WIDTH_PX` wide.
     """
-    f = min(1.0, OVERLAY_WIDTH_PX / image_bgr.shape[1])
+    # small photos are enlarged so that the text leaves most of them visible
+    w = image_bgr.shape[1]
+    f = OVERLAY_WIDTH_PX / w if w > OVERLAY_WIDTH_PX or w < MIN_OVERLAY_WIDTH_PX else 1.0
     out = (
-        cv2.resize(image_bgr, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
-        if f < 1
+        cv2.resize(
+            image_bgr, None, fx=f, fy=f, interpolation=cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
+        )
+        if f != 1
         else image_bgr.copy()
     )
     k = f / scale
@@ -51,51 +72,101 @@ def draw_overlay(
         pts = (result.centreline_px - (scale - 1) / 2) * k
         cv2.polylines(out, [np.round(pts * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
         cv2.circle(out, tuple(int(v) for v in np.round(pts[0])), 6, (255, 80, 0), 2, cv2.LINE_AA)
-    text = (
-        f"psi = {result.psi_deg:+.1f} deg ({result.method})"
-        if result.status != "failed"
-        else "failed"
-    )
-    lines = [t for t in (title, text, result.reason[:90]) if t]
-    if lines:
-        box = out[: 10 + 22 * len(lines), :]
-        box[:] = (box * 0.35).astype(np.uint8)
+    lines = overlay_lines(result, title, out.shape[1], out.shape[0])
+    box = out[: 10 + LINE_PX * len(lines), :]
+    box[:] = (box * 0.35).astype(np.uint8)
     for i, t in enumerate(lines):
         cv2.putText(
             out,
             t,
-            (8, 22 + 22 * i),
+            (8, 20 + LINE_PX * i),
             cv2.FONT_HERSHEY_SIMPLEX,
-            0.55,
-            colour if i else (255, 255, 255),
+            TEXT_SCALE,
+            colour if i or not title else (255, 255, 255),
             1,
             cv2.LINE_AA,
         )
     return out
 
 
-def note_final_status(overlay_bgr: np.ndarray, status: str, reason: str) -> np.ndarray:
+def final_status_text(status: str, reason: str, drawn_reason: str = "") -> str:
+    """What :func:`note_final_status` writes: the final status and the reason, less the part of
+    it the overlay already shows (``drawn_reason``).
+
+    Examples
+    --------
+    >>> final_status_text("flagged", "breaks its ramp: psi -188; tip hook", "tip hook")
+    'then flagged: also breaks its ramp: psi -188'
+    >>> final_status_text("flagged", "a; b; c", "b")
+    'then flagged: also a; c'
+    >>> final_status_text("ok", "", "line partly hidden")
+    'then ok'
+    """
+    if drawn_reason and drawn_reason in reason and drawn_reason != reason:
+        rest = re.sub(r"(;\s*)+", "; ", reason.replace(drawn_reason, "")).strip("; ")
+        reason = f"also {rest}"
+    return f"then {status}" + (f": {reason}" if reason else "")
+
+
+def note_final_status(
+    overlay_bgr: np.ndarray, status: str, reason: str, drawn_reason: str = ""
+) -> np.ndarray:
     """The overlay with the photo's final status written along its bottom.
 
     For a status that the checks over the whole set (the ramp check, the calibration check)
     changed after the photo was drawn, so that its overlay never shows ``ok`` for a row the
-    table flags, nor the other way round.
+    table flags, nor the other way round.  Of ``reason``, what the overlay already shows
+    (``drawn_reason``) is left out.
     """
     out = overlay_bgr.copy()
-    band = out[-32:, :]
+    text = final_status_text(status, reason, drawn_reason)
+    room = max(1, min(REASON_LINES, int(0.25 * out.shape[0] / LINE_PX)))
+    lines = wrap_text(text, out.shape[1] - 16, TEXT_SCALE, room)
+    band = out[out.shape[0] - 12 - LINE_PX * len(lines) :, :]
     band[:] = (band * 0.35).astype(np.uint8)
-    text = f"then {status}" + (f": {reason}" if reason else "")
-    cv2.putText(
-        out,
-        text[:90],
-        (8, out.shape[0] - 11),
-        cv2.FONT_HERSHEY_SIMPLEX,
-        0.55,
-        _COLOURS.get(status, (255, 255, 255)),
-        1,
-        cv2.LINE_AA,
-    )
+    for i, t in enumerate(lines):
+        cv2.putText(
+            out,
+            t,
+            (8, out.shape[0] - 12 - LINE_PX * (len(lines) - 1 - i)),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            TEXT_SCALE,
+            _COLOURS.get(status, (255, 255, 255)),
+            1,
+            cv2.LINE_AA,
+        )
     return out
+
+
+def wrap_text(text: str, width_px: int, scale: float, max_lines: int) -> list[str]:
+    """``text`` broken at spaces into lines no wider than ``width_px`` in OpenCV's simplex font.
+
+    At most ``max_lines`` lines; what does not fit ends the last one with an ellipsis.
+
+    Examples
+    --------
+    >>> wrap_text("a b c", 1000, 0.48, 3)
+    ['a b c']
+    >>> lines = wrap_text("the centre line stops short " * 20, 300, 0.48, 3)
+    >>> len(lines), lines[-1].endswith("...")
+    (3, True)
+    """
+
+    def fits(line: str) -> bool:
+        return cv2.getTextSize(line, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] <= width_px
+
+    lines: list[str] = []
+    for word in text.split():
+        if lines and fits(f"{lines[-1]} {word}"):
+            lines[-1] = f"{lines[-1]} {word}"
+        else:
+            lines.append(word)
+    if len(lines) > max_lines:
+        last = lines[max_lines - 1]
+        while last and not fits(last + " ..."):
+            last = last.rsplit(" ", 1)[0] if " " in last else last[:-1]
+        lines = [*lines[: max_lines - 1], last + " ..."]
+    return lines
 
 
 def contact_sheet(
