@@ -612,6 +612,20 @@ def file_problems(
             )
         )
     if any(
+        r is not None and r.target == "line" and (r.free_end != "capped" or r.sealed_end_mm)
+        for r in ps.rows
+    ):
+        problems.append(
+            Problem(
+                str(folder / SETTINGS),
+                None,
+                "free_end and sealed_end_mm are for a body (target: body); a drawn line is "
+                "measured between its own ends, so they are not used for its rows",
+                "leave them out, or set target: body to measure the actuator's outline",
+                warning=True,
+            )
+        )
+    if any(
         r is not None and r.target == "body" and r.free_end == "capped" and r.sealed_end_mm is None
         for r in ps.rows
     ):

@@ -197,6 +197,28 @@ def test_a_capped_body_set_without_its_sealed_end_is_warned(photo_folder, extra,
     assert all(p.warning and "reads |psi| above 150 deg" in p.message for p in said)
 
 
+@pytest.mark.parametrize(
+    ("extra", "warned"),
+    [
+        ({"free_end": "bends"}, True),
+        ({"sealed_end_mm": 5, "mm_per_px": 0.2}, True),
+        ({}, False),
+        ({"target": "body", "free_end": "bends"}, False),
+    ],
+)
+def test_body_keys_on_a_line_set_are_warned_as_unused(photo_folder, extra, warned):
+    from pipeline import photoset_init
+
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0, **extra},
+    )
+    said = [p for p in ps.validate_photoset(photo_folder, warnings=True)
+            if "are for a body" in p.message]
+    assert bool(said) == warned and all(p.warning for p in said)
+
+
 def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folder):
     from pipeline import photoset_init
 
