@@ -422,21 +422,3 @@ def test_a_long_sealed_end_read_where_the_bending_stops_when_its_length_is_given
     assert over[big].median() > 4.0
     assert (given["status"] == "ok").all(), given["reason"].tolist()
     assert given["error_deg"].abs().max() < 5.5 and given["error_deg"].abs().median() < 2.0
-
-
-def test_the_sealed_end_is_turned_into_pixels_on_the_plane_of_a_calibration():
-    from pipeline.measure.core import _read_before_sealed_end
-    from pipeline.measure.extract import LineExtraction
-
-    t = np.linspace(0.0, 1.0, 50)
-    line = LineExtraction(centreline_px=np.c_[100.0 * t, 0.0 * t], width_px=10.0,
-                          touches_border=False, n_candidates=1, contrast=100.0, ends_gap_px=100.0,
-                          branched_fraction=0.0, fixed_end_auto=False, clamp_removed=True,
-                          trimmed_px=(0.0, 0.0))
-    # image: 0.5 mm/px, the face 10 px beyond the line's end, a 8 mm (16 px) sealed end
-    ends, sealed_px = _read_before_sealed_end(line, 10.0, (3.0, 0.0), 8.0, 0.5, line.centreline_px)
-    assert ends == (3.0, pytest.approx(-6.0)) and sealed_px == pytest.approx(16.0)
-    # on a plane twice as fine (0.25 mm per plane px): the same place, in plane px
-    ends, sealed_px = _read_before_sealed_end(line, 10.0, (6.0, 0.0), 8.0, 0.25,
-                                              2.0 * line.centreline_px)
-    assert ends == (6.0, pytest.approx(-12.0)) and sealed_px == pytest.approx(16.0)

@@ -352,9 +352,10 @@ def measure_body(
         return failed(method, str(exc))
     sealed_px = 0.0  # the known sealed end, image px
     if settings.sealed_end_mm is not None:
-        ends, sealed_px = _read_before_sealed_end(
-            line, body.tip_face_px, ends, settings.sealed_end_mm, settings.mm_per_px, pts
-        )
+        assert settings.mm_per_px is not None  # settings: sealed_end_mm needs a scale
+        per_image_px = _work_per_image_px(line, pts)
+        sealed_px = settings.sealed_end_mm / settings.mm_per_px / per_image_px
+        ends = _read_before_sealed_end(body.tip_face_px, ends, sealed_px, per_image_px)
     rng = np.random.default_rng(SEED)
     base = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
@@ -419,50 +420,44 @@ def measure_body(
     return _measured(psi, est, line, quality, settings, used)
 
 
+def _work_per_image_px(line: LineExtraction, points: NDArray[np.float64]) -> float:
+    """Length units of ``points`` (the centre line as the estimators take it: image px, or plane
+    px when calibrated) per image px of ``line``.
+
+    Examples
+    --------
+    >>> from pipeline.measure.extract import LineExtraction
+    >>> line = LineExtraction(np.c_[np.arange(10.0), np.zeros(10)], 4.0, False, 1, 100.0, 9.0,
+    ...                       0.0, False, True, (0.0, 0.0))
+    >>> _work_per_image_px(line, 2.0 * line.centreline_px * [1, -1])
+    2.0
+    """
+    image_len = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
+    work_len = float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
+    return work_len / image_len if image_len > 0 else 1.0
+
+
 def _read_before_sealed_end(
-    line: LineExtraction,
-    tip_face_px: float,
-    ends: tuple[float, float],
-    sealed_end_mm: float,
-    mm_per_px: float | None,
-    points: NDArray[np.float64],
-) -> tuple[tuple[float, float], float]:
-    """The end lengths with the free end's moved to where the bending stops: ``sealed_end_mm``
-    back from the tip's face, which lies ``tip_face_px`` (image px) beyond the centre line's end.
+    tip_face_px: float, ends: tuple[float, float], sealed_px: float, per_image_px: float = 1.0
+) -> tuple[float, float]:
+    """The end lengths with the free end's moved to where the bending stops: ``sealed_px`` (image
+    px) back from the tip's face, which lies ``tip_face_px`` (image px) beyond the centre line's
+    end.
 
     The free end's tangent is then read there: inside the centre line when it runs on into the
     sealed end (its last pixels carry the curvature on over a part that does not bend: 5-7 deg
-    high at |psi| > 150 deg for a 12 mm sealed end on rendered bodies), carried on when it
-    stops short of where the bending stops.
+    high at |psi| > 150 deg for a 12 mm sealed end on rendered bodies), carried on when it stops
+    short of where the bending stops.  ``ends`` and the result are in the estimators' units,
+    ``per_image_px`` of them per image px.
 
-    Parameters
-    ----------
-    line : LineExtraction
-        The body's centre line (image px).
-    tip_face_px : float
-        Distance from its free end to the tip's face (image px).
-    ends : (float, float)
-        End lengths as the estimators take them (image px, or plane px when calibrated).
-    sealed_end_mm : float
-        The known length of the end that does not bend (mm).
-    mm_per_px : float
-        Scale of ``points`` (mm per image px, or per plane px when calibrated).
-    points : ndarray (N, 2)
-        The centre line as the estimators take it (image or plane px).
-
-    Returns
-    -------
-    ends : (float, float)
-        The end lengths, the free end's negative when read inside the centre line.
-    sealed_px : float
-        The sealed end's length in image px.
+    Examples
+    --------
+    >>> _read_before_sealed_end(10.0, (3.0, 0.0), 16.0)
+    (3.0, -6.0)
+    >>> _read_before_sealed_end(10.0, (6.0, 0.0), 16.0, per_image_px=2.0)
+    (6.0, -12.0)
     """
-    assert mm_per_px is not None  # settings: sealed_end_mm needs a scale
-    image_len = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
-    work_len = float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
-    per_image_px = work_len / image_len if image_len > 0 else 1.0  # 1 without a calibration
-    sealed_px = sealed_end_mm / mm_per_px / per_image_px
-    return (ends[0], (tip_face_px - sealed_px) * per_image_px), sealed_px
+    return ends[0], (tip_face_px - sealed_px) * per_image_px
 
 
 def measure_image(
