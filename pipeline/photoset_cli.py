@@ -65,6 +65,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="measure a drawn line (default) or the actuator's body",
     )
     init.add_argument(
+        "--sealed-end-mm",
+        type=float,
+        help="body: length of the actuator's end that does not bend, from where its chamber ends "
+             "to its tip (sealed end and cap), mm (needs --mm-per-px; recommended: without it a "
+             "long sealed end reads |psi| high)",
+    )
+    init.add_argument(
         "--line-color",
         default=None,
         help="colour of the line or body: a name (black, white, grey, red, orange, yellow, green, "
@@ -237,6 +244,8 @@ def _init(args: argparse.Namespace) -> int:
         settings["line_color"] = args.line_color or "black"
     if args.fixed_end:
         settings["fixed_end"] = list(_xy(args.fixed_end, "--fixed-end"))
+    if args.sealed_end_mm is not None:
+        settings["sealed_end_mm"] = args.sealed_end_mm
     df = photoset_init.init_photoset(
         args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite
     )

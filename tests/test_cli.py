@@ -67,6 +67,28 @@ def test_photoset_init_then_check(photo_folder):
     assert "OK (8 photos" in out.stdout
 
 
+def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
+    import yaml
+
+    args = ["photoset", "init", str(photo_folder), "--pattern",
+            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
+            "--target", "body", "--mm-per-px", "0.3", "--sealed-end-mm", "6"]
+    out = _run(*args)
+    assert out.returncode == 0, out.stderr
+    written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
+    assert written["sealed_end_mm"] == 6.0 and written["target"] == "body"
+    out = _run("photoset", "check", str(photo_folder))
+    assert out.returncode == 0 and "no sealed_end_mm" not in out.stdout
+    # without the scale it cannot be turned into pixels: check names the key and the fix
+    _run(*args, "--overwrite")
+    settings = photo_folder / "photoset.yaml"
+    written.pop("mm_per_px")
+    settings.write_text(yaml.safe_dump(written))
+    out = _run("photoset", "check", str(photo_folder))
+    assert out.returncode == 1 and "sealed_end_mm" in out.stdout + out.stderr
+    assert "give mm_per_px (or a calibration)" in out.stdout + out.stderr
+
+
 def test_bad_input_is_one_line_without_traceback(tmp_path):
     out = _run("photoset", "init", str(tmp_path / "nope"), "--pattern", "{pressure_kpa}.jpg")
     assert out.returncode == 2
