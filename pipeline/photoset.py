@@ -635,8 +635,8 @@ def file_problems(
                 str(folder / SETTINGS),
                 None,
                 "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
-                "runs on into a sealed end or cap; one longer than about 4 mm reads |psi| above "
-                "150 deg about 5 deg high",
+                "runs on into a sealed end or cap; on rendered bodies one of 8-12 mm read |psi| "
+                "above 150 deg 5-7 deg high",
                 "measure the actuator's end that does not bend (from where the chamber ends to the "
                 "tip, cap included) and set sealed_end_mm (with mm_per_px)",
                 warning=True,
