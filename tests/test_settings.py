@@ -318,6 +318,12 @@ def test_a_sealed_end_that_cannot_be_used_is_a_problem_naming_the_key(raw, messa
     assert [p.key for p in problems] == ["sealed_end_mm"] and message in problems[0].message
 
 
+def test_a_sealed_end_on_a_line_row_needs_no_scale():
+    # a line does not use it (check warns of that), so a missing scale is no problem there
+    settings, problems = settings_problems({"l0_mm": 200, "sealed_end_mm": 8})
+    assert problems == [] and settings is not None and settings.sealed_end_mm == 8.0
+
+
 def test_a_sealed_end_is_a_length_in_mm_or_not_given():
     assert resolve_settings(l0_mm=200, target="body").sealed_end_mm is None
     s = resolve_settings(l0_mm=200, target="body", mm_per_px=0.3, sealed_end_mm="8.5")

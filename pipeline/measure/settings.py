@@ -472,11 +472,15 @@ def _calibration(
 
 
 def _sealed_end(
-    raw: Mapping[str, Any], problems: list[SettingProblem], free_end: str, mpp: float | None
+    raw: Mapping[str, Any],
+    problems: list[SettingProblem],
+    free_end: str,
+    mpp: float | None,
+    target: str = "body",
 ) -> float | None:
     """``sealed_end_mm`` as a length >= 0 (mm), or None when not given; a problem when it is no
-    such length, when the body's end bends (``free_end: bends``) or when there is no scale to
-    turn it into pixels.
+    such length, when the body's end bends (``free_end: bends``) or when a body has no scale to
+    turn it into pixels (a line does not use it: ``photoset check`` warns of that instead).
 
     Examples
     --------
@@ -513,7 +517,7 @@ def _sealed_end(
             )
         )
         return None
-    if mpp is None and is_missing(raw.get("calibration")):
+    if mpp is None and is_missing(raw.get("calibration")) and target == "body":
         problems.append(
             SettingProblem(
                 "sealed_end_mm",
@@ -599,7 +603,7 @@ def settings_problems(
         "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that bends right "
         "to its cut end)",
     )
-    sealed_end = _sealed_end(raw, problems, free_end, mpp)
+    sealed_end = _sealed_end(raw, problems, free_end, mpp, target)
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
