@@ -167,7 +167,8 @@ SMOOTH_DISAGREE_DEG = 8.0
 #: body: width along the centre line (90th / 10th percentile) above this -> uneven outline
 WIDTH_RATIO = 2.2
 #: body: the free end's direction may change this much (deg) when the centre line is carried on
-#: along the selection's ridge over the part of the tip it did not reach
+#: along the selection's ridge over the part of the tip it did not reach; more is flagged, and
+#: psi is then the carried-on line's (:func:`pipeline.measure.core.carried_on_psi_deg`)
 RIDGE_TIP_DEG = 4.0
 #: body: a free end narrower than this fraction of the body's width has lost a side
 NARROW_FREE_END = 0.6
@@ -286,9 +287,8 @@ def assess_body(
     if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
         flags.append(
             f"the free end's direction is uncertain: the centre line stops {end_short_px:.0f} px "
-            "short of the body's "
-            "end, and carried on along the selection there its direction changes by "
-            f"{abs(ridge_tip_deg):.0f} deg (photoset preview shows it)"
+            "short of the body's end; psi is carried on along the selection there, which turns "
+            f"the end by {abs(ridge_tip_deg):.0f} deg (photoset preview shows it)"
         )
     elif end_short_px > 1.5 * line.width_px + 4.0:
         flags.append(
