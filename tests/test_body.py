@@ -428,3 +428,46 @@ def test_a_long_sealed_end_read_where_the_bending_stops_when_its_length_is_given
     assert (given["status"] == "ok").all(), given["reason"].tolist()
     assert given["error_deg"].abs().max() < 5.5 and given["error_deg"].abs().median() < 2.0
 
+
+def test_the_bodys_shadow_is_not_selected_with_a_background_photo(tmp_path):
+    # a rendered green_fibre ramp with its empty-scene photo: the shadow the body casts differs
+    # from the empty scene too, and was selected with the body, widening it on one side and round
+    # its tip (ok rows up to 15 deg off, the median 5.4); a shadow dims the backdrop and keeps its
+    # colour, so it is left out
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth.photoset_writer import render_photoset
+
+    truth = render_photoset(
+        tmp_path / "s", "DS20", actuators=1, trials=1, seed=2, scene="green_fibre", step_kpa=45,
+        max_kpa=180, scene_overrides={"width": 1280, "height": 960},
+    )
+    got = measure_photoset(tmp_path / "s", ramp_check=False).merge(
+        truth[["image", "psi_image_deg"]], on="image"
+    )
+    err = (got["psi_deg"] - got["psi_image_deg"]).abs()
+    assert (got["status"] == "ok").all(), got["reason"].tolist()
+    assert err.max() < 7.5 and err.median() < 3.5, err.round(1).tolist()
+
+
+def _band_photo(body_bgr, shadow_bgr=None):
+    """A 200-grey empty scene and the same with a horizontal body band (rows 40-59) and, below
+    it, a band of ``shadow_bgr`` (rows 60-74)."""
+    empty = np.full((120, 300, 3), 200, np.uint8)
+    photo = empty.copy()
+    photo[40:60, 30:270] = body_bgr
+    if shadow_bgr is not None:
+        photo[60:75, 30:270] = shadow_bgr
+    return photo, empty
+
+
+def test_a_shadow_beside_the_body_is_left_out_but_a_neutral_grey_body_is_kept():
+    from pipeline.measure.body import body_mask
+
+    settings = settings_for((30.0, 50.0))
+    photo, empty = _band_photo((60, 60, 200), shadow_bgr=(150, 150, 150))
+    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    assert mask[40:60, 40:260].all() and not mask[62:75, 40:260].any()
+    # a neutral grey body darker than a neutral backdrop looks like a shadow all over: kept
+    photo, empty = _band_photo((110, 110, 110))
+    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    assert mask[40:60, 40:260].all()
