@@ -19,6 +19,7 @@ how many rows are ``ok`` and right, and how many are ``ok`` and wrong (which mus
 from __future__ import annotations
 
 import argparse
+import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -88,6 +89,7 @@ def body_cases(
     fixed_end_offset_px: tuple[float, float] = (0.0, 0.0),
     sealed_end_mm: float | None = None,
     give_sealed_end: bool = False,
+    background: bool = False,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -114,6 +116,9 @@ def body_cases(
     give_sealed_end : bool
         Also give ``sealed_end_mm`` (the scene's sealed end plus its tip cap, as the user who
         built the actuator knows it) and ``mm_per_px`` (the scene's).
+    background : bool
+        Also give each photo its empty scene (``background``: same camera and light, its own
+        noise; passed through ``camera`` too).
 
     Returns
     -------
@@ -121,9 +126,10 @@ def body_cases(
     """
     from pipeline.measure import measure_image
     from pipeline.measure.settings import resolve_settings
-    from pipeline.synth import render_actuator, scene_from
+    from pipeline.synth import render_with_background, scene_from
 
     rows = []
+    empties = tempfile.TemporaryDirectory(prefix="realscenes_background_")
     for name, overrides in BODY_SCENES.items():
         if scenes is not None and name not in scenes:
             continue
@@ -131,13 +137,17 @@ def body_cases(
             overrides = {**overrides, "sealed_end_mm": sealed_end_mm}
         scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
-            r = render_actuator(
+            r, empty = render_with_background(
                 float(psi), 270.0, scene, seed=seed + i, bulge=0.4 if i % 2 else 0.0
             )
             img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
             assert img is not None  # the photo just rendered
             img = through_camera(img, camera, seed=i)
             extra: dict[str, Any] = {}
+            if background:
+                path = Path(empties.name) / f"{name}_{i}.png"
+                cv2.imwrite(str(path), through_camera(empty, camera, seed=1000 + i))
+                extra["background"] = str(path)
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
             if give_sealed_end:
@@ -158,6 +168,7 @@ def body_cases(
                     "ms": 1000 * (time.perf_counter() - t0),
                 }
             )
+    empties.cleanup()
     return pd.DataFrame(rows)
 
 
@@ -245,6 +256,11 @@ def main(argv: Sequence[str] | None = None) -> int:
              "mm_per_px, as a user who knows the actuator writes them",
     )
     parser.add_argument(
+        "--background",
+        action="store_true",
+        help="give each analogue its empty-scene photo (background:), as a user who took one",
+    )
+    parser.add_argument(
         "--no-fixed-direction",
         action="store_true",
         help="only the first analogue table (fixed end given), not the one with "
@@ -290,7 +306,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
-            give_sealed_end=args.give_sealed_end,
+            give_sealed_end=args.give_sealed_end, background=args.background,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
@@ -298,7 +314,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{'' if args.camera == 'clean' else ', camera ' + args.camera}"
             f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'}"
             f"{'' if args.sealed_end_mm is None else f', sealed end {args.sealed_end_mm:g} mm'}"
-            f"{', sealed_end_mm given' if args.give_sealed_end else ''} "
+            f"{', sealed_end_mm given' if args.give_sealed_end else ''}"
+            f"{', background photo given' if args.background else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())

@@ -12,7 +12,7 @@ actuator_centreline_mm, curvature_weights        non-constant-curvature shapes
 (``SceneParams.shape``) render_curve, render_actuator, RenderedImage     one photo with its exact
 centreline in pixels (the
                                                  line's, or for ``target: body`` the body's)
-render_background                                the empty scene (a ``background`` photo)
+render_background, render_with_background       the empty scene (a ``background`` photo)
 Backdrop, make_backdrop, make_camera             static scene reused across the photos of a ramp
 """
 
@@ -32,6 +32,7 @@ from pipeline.synth.scene import (
     render_actuator,
     render_background,
     render_curve,
+    render_with_background,
 )
 
 __all__ = [
@@ -50,6 +51,7 @@ __all__ = [
     "render_actuator",
     "render_background",
     "render_curve",
+    "render_with_background",
     "scene_from",
     "turning_angle_deg",
 ]

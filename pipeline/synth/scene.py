@@ -616,3 +616,33 @@ def render_actuator(
     pts = actuator_centreline_mm(psi_deg, l0_mm, scene, bulge=bulge, n=n)
     return render_curve(pts, scene, seed=seed, fixed_end_px=fixed_end_px, rotation_deg=rotation_deg,
                         backdrop=backdrop, body_width_mm=body_width_mm)
+
+
+def render_with_background(
+    psi_deg: float,
+    l0_mm: float,
+    scene: SceneParams,
+    *,
+    seed: int,
+    bulge: float = 0.0,
+) -> tuple[RenderedImage, NDArray[np.uint8]]:
+    """The photo :func:`render_actuator` renders (same arguments, same pixels) and its empty
+    scene (:func:`render_background`): the ``background`` photo a user would take.
+
+    Examples
+    --------
+    >>> from pipeline.synth.presets import scene_from
+    >>> sc = scene_from("green_fibre", width=320, height=240)
+    >>> photo, empty = render_with_background(90.0, 200.0, sc, seed=3)
+    >>> photo.jpeg_bytes == render_actuator(90.0, 200.0, sc, seed=3).jpeg_bytes, empty.shape
+    (True, (240, 320, 3))
+    """
+    pts = actuator_centreline_mm(psi_deg, l0_mm, scene, bulge=bulge)
+    camera = make_camera(
+        scene,
+        rotation_deg=0.0,
+        extent_mm=world_extent_mm(pts, scene.body_width_mm, scene.tip_cap_mm, scene.sealed_end_mm),
+    )
+    backdrop = make_backdrop(scene, camera, seed=child_seed(seed, 0), keepout_mm=[pts])
+    photo = render_curve(pts, scene, seed=seed, backdrop=backdrop)
+    return photo, render_background(backdrop, scene, seed=child_seed(seed, 2))
