@@ -90,6 +90,7 @@ def body_cases(
     sealed_end_mm: float | None = None,
     give_sealed_end: bool = False,
     background: bool = False,
+    background_exposure: float = 1.0,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -119,6 +120,8 @@ def body_cases(
     background : bool
         Also give each photo its empty scene (``background``: same camera and light, its own
         noise; passed through ``camera`` too).
+    background_exposure : float
+        The empty scene taken at this times the photos' exposure (a camera setting its own).
 
     Returns
     -------
@@ -146,7 +149,8 @@ def body_cases(
             extra: dict[str, Any] = {}
             if background:
                 path = Path(empties.name) / f"{name}_{i}.png"
-                cv2.imwrite(str(path), through_camera(empty, camera, seed=1000 + i))
+                exposed_empty = cv2.convertScaleAbs(empty, alpha=background_exposure)
+                cv2.imwrite(str(path), through_camera(exposed_empty, camera, seed=1000 + i))
                 extra["background"] = str(path)
             if fixed_direction and r.fixed_direction_deg is not None:
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
@@ -261,6 +265,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="give each analogue its empty-scene photo (background:), as a user who took one",
     )
     parser.add_argument(
+        "--background-exposure",
+        type=float,
+        default=1.0,
+        metavar="G",
+        help="with --background: the empty scene taken at G times the photos' exposure (a camera "
+             "that sets its own; default 1)",
+    )
+    parser.add_argument(
         "--no-fixed-direction",
         action="store_true",
         help="only the first analogue table (fixed end given), not the one with "
@@ -302,11 +314,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(s.to_string())
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
+    gain = args.background_exposure
     for fixed in (False,) if args.no_fixed_direction else (False, True):
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
             give_sealed_end=args.give_sealed_end, background=args.background,
+            background_exposure=gain,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
@@ -315,7 +329,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'}"
             f"{'' if args.sealed_end_mm is None else f', sealed end {args.sealed_end_mm:g} mm'}"
             f"{', sealed_end_mm given' if args.give_sealed_end else ''}"
-            f"{', background photo given' if args.background else ''} "
+            f"{', background photo given' if args.background else ''}"
+            f"{f' at {gain:g}x exposure' if gain != 1 else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())

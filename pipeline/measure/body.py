@@ -272,6 +272,38 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     return diff, sigma
 
 
+#: the exposure gains are measured on about this many pixels, neither near black nor saturated
+GAIN_PIXELS, GAIN_DARKEST, GAIN_BRIGHTEST = 20000, 12, 245
+
+
+def matched_exposure(background_bgr: np.ndarray, image_bgr: np.ndarray) -> np.ndarray:
+    """The empty-scene photo with each colour channel scaled to the photo's exposure.
+
+    A camera that sets its own exposure or white balance takes the empty scene a little darker
+    or lighter than the photos (the actuator is not in it); 10 % is enough to make the whole
+    backdrop differ from it.  The gain of each channel is the median ratio photo / empty scene
+    over the pixels of both that are neither near black nor saturated: most of them are
+    backdrop, which the actuator covers only in part.
+
+    Examples
+    --------
+    >>> bg = np.full((20, 20, 3), 100, np.uint8)
+    >>> photo = (bg * np.array([1.1, 1.0, 0.9])).astype(np.uint8)
+    >>> photo[0, 0] = 250
+    >>> matched_exposure(bg, photo)[1, 1].tolist()
+    [110, 100, 90]
+    """
+    step = max(1, int(np.sqrt(image_bgr.shape[0] * image_bgr.shape[1] / GAIN_PIXELS)))
+    a = image_bgr[::step, ::step].reshape(-1, 3).astype(np.float32)
+    b = background_bgr[::step, ::step].reshape(-1, 3).astype(np.float32)
+    usable = ((a > GAIN_DARKEST) & (a < GAIN_BRIGHTEST) & (b > GAIN_DARKEST)
+              & (b < GAIN_BRIGHTEST)).all(axis=1)
+    if usable.sum() < 100:
+        return background_bgr
+    gain = np.median(a[usable] / b[usable], axis=0)
+    return cv2.convertScaleAbs(background_bgr.astype(np.float32) * gain.astype(np.float32))
+
+
 #: a photo and its empty scene that differ by more than this noise (robust sigma of the colour
 #: distance, Lab with lightness weighted) are both smoothed (Gaussian, NOISY_BLUR_PX) first
 NOISY_SIGMA, NOISY_BLUR_PX = 2.0, 1.0
@@ -288,7 +320,7 @@ def background_difference(
     their background photos, 49 of 60 were ``ok`` and right and 10 ``ok`` but wrong unsmoothed
     (the translucent body's faint side lost in the noise), 55 and 5 smoothed.
     """
-    lab, ref = _lab(image_bgr), _lab(background_bgr)
+    lab, ref = _lab(image_bgr), _lab(matched_exposure(background_bgr, image_bgr))
     for smooth in (False, True):
         if smooth:
             lab = cv2.GaussianBlur(lab, (0, 0), NOISY_BLUR_PX)
