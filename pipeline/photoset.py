@@ -29,6 +29,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -764,6 +765,25 @@ def geometry_problems(
                     "give roi in pixels of this photo (x right, y down)",
                 )
             )
+    if s.background_path is not None:
+        from pipeline.measure.core import same_aspect
+
+        try:  # keyed by the file's time too: a replaced photo is read again
+            bsize = _background_size(s.background_path, os.stat(s.background_path).st_mtime_ns)
+        except OSError:
+            bsize = None  # a missing background is the settings' problem
+        if bsize is not None and not same_aspect(bsize, (w, h)):
+            out.append(
+                Problem(
+                    file,
+                    line,
+                    f"the photo is {w}x{h} px but background photo "
+                    f"{Path(s.background_path).name} is {bsize[0]}x{bsize[1]} px: it cannot be "
+                    "laid over the photo",
+                    "take the empty scene with the camera, resolution and orientation of the "
+                    "actuator photos",
+                )
+            )
     if s.fixed_end_px is not None and not (
         0 <= s.fixed_end_px[0] < w and 0 <= s.fixed_end_px[1] < h
     ):
@@ -776,6 +796,13 @@ def geometry_problems(
             )
         )
     return out
+
+
+@functools.lru_cache(maxsize=8)
+def _background_size(path: str, mtime_ns: int) -> tuple[int, int] | None:
+    """(width, height) of a background photo, read once per check (``mtime_ns``: the cache key
+    of its version)."""
+    return _image_size(Path(path))
 
 
 def _image_size(path: Path) -> tuple[int, int] | None:

@@ -227,6 +227,33 @@ def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folde
     assert f"line {len(m) + 1}: exclude" in text and "at least 3" in text
 
 
+
+def test_a_background_photo_of_another_shape_is_refused_and_its_rows_fail(photo_folder):
+    # an empty scene taken in portrait for landscape photos cannot be laid over them: check names
+    # the rows, and measure makes each a failed row with the reason, not a number
+    import cv2
+
+    from pipeline import photoset_init
+
+    cv2.imwrite(str(photo_folder / "empty.jpg"), np.full((32, 24, 3), 200, np.uint8))
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0, "target": "body", "background": "empty.jpg"},
+    )
+    problems = ps.validate_photoset(photo_folder)
+    text = "\n".join(map(str, problems))
+    assert len(problems) == 8, text
+    assert "line 2:" in text and "background photo empty.jpg is 24x32 px" in text
+    assert "the photo is 32x24 px" in text and "orientation" in text
+    got = measure_photoset(photo_folder, ramp_check=False)
+    assert (got["status"] == "failed").all()
+    assert got["reason"].str.contains("background photo empty.jpg is 24x32 px").all()
+    # the same shape, another resolution: laid over the photo (resized)
+    cv2.imwrite(str(photo_folder / "empty.jpg"), np.full((48, 64, 3), 200, np.uint8))
+    assert "background" not in "\n".join(map(str, ps.validate_photoset(photo_folder)))
+
+
 # ---------------------------------------------------------------------------------------------
 # one bad row is one failed row
 

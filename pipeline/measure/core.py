@@ -313,12 +313,35 @@ def plane_centreline(
 
 
 @functools.lru_cache(maxsize=4)
-def _background(path: str, shape: tuple[int, int]) -> np.ndarray | None:
-    """The empty-scene photo, resized to the work image (cached per worker: one decode)."""
+def _background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
+    """The empty-scene photo, resized to the work image (cached per worker: one decode), or why
+    it cannot be used."""
     img = cv2.imread(path, cv2.IMREAD_COLOR)
+    name = Path(path).name
     if img is None:
-        return None
+        return f"background photo {name} cannot be decoded"
+    bh, bw = img.shape[:2]
+    if not same_aspect((bw, bh), (shape[1], shape[0])):
+        return (
+            f"background photo {name} is {bw}x{bh} px, another shape than the photo: take the "
+            "empty scene with the camera, resolution and orientation of the photos"
+        )
     return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+
+
+def same_aspect(size_a: Sequence[int], size_b: Sequence[int], tolerance: float = 0.02) -> bool:
+    """Whether two images (width, height) have the same shape up to ``tolerance`` (relative; a
+    reduced work image loses up to a pixel of each side).
+
+    Examples
+    --------
+    >>> same_aspect((4000, 3000), (1000, 750)), same_aspect((1920, 1080), (1280, 960))
+    (True, False)
+    >>> same_aspect((3000, 4000), (4000, 3000))
+    False
+    """
+    ra, rb = size_a[0] / max(size_a[1], 1), size_b[0] / max(size_b[1], 1)
+    return abs(ra - rb) <= tolerance * rb
 
 
 def measure_body(
@@ -334,11 +357,10 @@ def measure_body(
 
     background = None
     if settings.background_path is not None and image_bgr is not None:
-        background = _background(settings.background_path, image_bgr.shape[:2])
-        if background is None:
-            return failed(
-                method, f"background photo {Path(settings.background_path).name} cannot be decoded"
-            )
+        loaded = _background(settings.background_path, image_bgr.shape[:2])
+        if isinstance(loaded, str):
+            return failed(method, loaded)
+        background = loaded
     try:
         body = extract_body(image_bgr, settings, scale=scale, background_bgr=background)
     except NoLineFound as exc:
