@@ -23,7 +23,7 @@ import pandas as pd
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
-from pipeline.measure.core import AngleResult, decode_for_work, measure_decoded
+from pipeline.measure.core import AngleResult, decode_for_work, load_background, measure_decoded
 from pipeline.measure.extract import line_mask, region_mask
 from pipeline.measure.overlay import wrap_text
 from pipeline.measure.settings import MeasureSettings
@@ -52,12 +52,12 @@ def selection(
 
 
 def _background(settings: MeasureSettings, shape: tuple[int, ...]) -> np.ndarray | None:
+    """The row's empty scene at the size of its photo (None without one, or one of another
+    shape: the row's measurement says why)."""
     if settings.background_path is None:
         return None
-    img = cv2.imread(settings.background_path, cv2.IMREAD_COLOR)
-    return (
-        None if img is None else cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
-    )
+    loaded = load_background(settings.background_path, (shape[0], shape[1]))
+    return None if isinstance(loaded, str) else loaded
 
 
 def _poly(points: tuple[tuple[float, float], ...], k: float) -> np.ndarray:

@@ -313,7 +313,7 @@ def plane_centreline(
 
 
 @functools.lru_cache(maxsize=4)
-def _background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
+def load_background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
     """The empty-scene photo, resized to the work image (cached per worker: one decode), or why
     it cannot be used."""
     img = cv2.imread(path, cv2.IMREAD_COLOR)
@@ -357,7 +357,7 @@ def measure_body(
 
     background = None
     if settings.background_path is not None and image_bgr is not None:
-        loaded = _background(settings.background_path, image_bgr.shape[:2])
+        loaded = load_background(settings.background_path, image_bgr.shape[:2])
         if isinstance(loaded, str):
             return failed(method, loaded)
         background = loaded
