@@ -72,6 +72,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "long sealed end reads |psi| high)",
     )
     init.add_argument(
+        "--background",
+        metavar="FILE",
+        help="body: a photo of the empty scene in the folder (same camera, light and framing, "
+             "no actuator; recommended for translucent bodies and busy scenes)",
+    )
+    init.add_argument(
         "--line-color",
         default=None,
         help="colour of the line or body: a name (black, white, grey, red, orange, yellow, green, "
@@ -246,6 +252,13 @@ def _init(args: argparse.Namespace) -> int:
         settings["fixed_end"] = list(_xy(args.fixed_end, "--fixed-end"))
     if args.sealed_end_mm is not None:
         settings["sealed_end_mm"] = args.sealed_end_mm
+    if args.background is not None:
+        if not (Path(args.folder) / args.background).is_file():
+            raise UserInputError(
+                f"--background {args.background}: no such file in {args.folder}; put the photo "
+                "of the empty scene in the photo-set folder and give its name"
+            )
+        settings["background"] = args.background
     df = photoset_init.init_photoset(
         args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite
     )

@@ -89,6 +89,25 @@ def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
     assert "give mm_per_px (or a calibration)" in out.stdout + out.stderr
 
 
+def test_photoset_init_names_the_empty_scene_photo_and_refuses_one_not_there(photo_folder):
+    import cv2
+    import numpy as np
+    import yaml
+
+    args = ["photoset", "init", str(photo_folder), "--pattern",
+            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
+            "--target", "body"]
+    out = _run(*args, "--background", "empty.jpg")
+    assert out.returncode == 2 and "--background empty.jpg: no such file" in out.stderr
+    assert "Traceback" not in out.stderr and not (photo_folder / "manifest.csv").exists()
+    cv2.imwrite(str(photo_folder / "empty.jpg"), np.full((24, 32, 3), 200, np.uint8))
+    out = _run(*args, "--background", "empty.jpg")
+    assert out.returncode == 0, out.stderr
+    assert yaml.safe_load((photo_folder / "photoset.yaml").read_text())["background"] == "empty.jpg"
+    # the empty scene is not a photo of the ramp (it does not match the pattern)
+    assert "empty.jpg" not in (photo_folder / "manifest.csv").read_text()
+
+
 def test_bad_input_is_one_line_without_traceback(tmp_path):
     out = _run("photoset", "init", str(tmp_path / "nope"), "--pattern", "{pressure_kpa}.jpg")
     assert out.returncode == 2
