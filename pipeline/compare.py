@@ -23,6 +23,10 @@ compared against a :class:`DatasetModel` built from that file (Ogden terms, k_P,
 and l0 unless its photos carry their own), pooled only with datasets of the same file, and
 ``materials_file`` names the file of every row.
 
+Measured and synthetic datasets never pool (``data_sources``): a lab's measured set of a
+material beside the synthetic ramps of the same material and l0 is a row of its own, its
+``curve`` ending in ``measured`` (the synthetic one's in ``synthetic``).
+
 What the RMS is (``rms_kind``): ``self-check`` when every dataset of the row is synthetic (its
 photos were rendered from this package's model, so the RMS checks the measurement chain, not the
 model), ``prediction`` when none is (no model parameter is fitted to these data: k_P is the
@@ -53,8 +57,9 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -468,6 +473,10 @@ class Group:
         Why the model columns are empty, or an empty string.
     materials_file : str
         The datasets' own materials file (:class:`DatasetModel`); empty: the run's model.
+    source_label : str
+        ``"measured"`` or ``"synthetic"`` when another group shares this one's material, l0 and
+        materials file but not its kind of data (measured photos never pool with rendered ones);
+        named in :attr:`curve`.
     """
 
     material: str
@@ -477,6 +486,7 @@ class Group:
     mixed: bool = False
     note: str = ""
     materials_file: str = ""
+    source_label: str = ""
 
     @property
     def curve(self) -> str:
@@ -488,7 +498,9 @@ class Group:
             base = f"{self.material}, {' + '.join(self.datasets)} (several l0)"
         else:
             base = self.material if self.l0_mm is None else f"{self.material}, l0 {self.l0_mm:g} mm"
-        return f"{base}, materials {self.materials_file}" if self.materials_file else base
+        if self.materials_file:
+            base = f"{base}, materials {self.materials_file}"
+        return f"{base}, {self.source_label}" if self.source_label else base
 
 
 def comparison_groups(
@@ -497,6 +509,7 @@ def comparison_groups(
     default_l0_mm: Mapping[str, float] | None = None,
     default_l0_source: str = "materials file",
     dataset_models: Mapping[str, DatasetModel] | None = None,
+    data_sources: Mapping[str, str] | None = None,
 ) -> list[Group]:
     """Split the (dataset, material) pairs of ``hyst`` into comparisons of one material and one l0.
 
@@ -514,6 +527,9 @@ def comparison_groups(
     dataset_models : mapping of str to DatasetModel, optional
         The own materials file of some datasets: their default l0 is that file's (source
         ``"dataset's materials file"``) and they pool only with datasets of the same file.
+    data_sources : mapping of str to str, optional
+        ``"synthetic"`` or ``"measured"`` per dataset: datasets pool only with datasets of the
+        same kind (a lab's measured DS20 set beside the synthetic DS20 ramps is its own row).
 
     Returns
     -------
@@ -524,6 +540,7 @@ def comparison_groups(
     """
     defaults = dict(default_l0_mm or {})
     own = dict(dataset_models or {})
+    kinds = dict(data_sources or {})
     pairs = hyst[["dataset", "material"]].astype(str).drop_duplicates()
     have_l0 = angles is not None and "l0_mm" in angles.columns
     found: dict[tuple[Any, ...], Group] = {}
@@ -565,7 +582,7 @@ def comparison_groups(
             l0, source = float(defaults[material]), default_l0_source
         else:
             l0, source = None, "model default"
-        key = (material, l0, mfile)
+        key = (material, l0, mfile, kinds.get(dataset, "unknown"))
         prev = found.get(key)
         if prev is None:
             found[key] = Group(material, l0, source, (dataset,), materials_file=mfile)
@@ -575,6 +592,11 @@ def comparison_groups(
             found[key] = Group(
                 material, l0, merged, prev.datasets + (dataset,), materials_file=mfile
             )
+    # the same curve for two kinds of data: each row names its kind
+    shared = Counter(k[:3] for k in found if k[1] != "several")
+    for k, g in found.items():
+        if k[1] != "several" and shared[k[:3]] > 1:
+            found[k] = replace(g, source_label=str(k[3]))
     file_l0 = {fm.materials_file: fm.l0_mm for fm in own.values()}
 
     def order(g: Group) -> tuple[str, int, str, int, float]:
@@ -674,7 +696,9 @@ def compare(
     own = dict(dataset_models or {})
     by_file = {fm.materials_file: fm for fm in own.values()}
     records = []
-    for group in comparison_groups(hyst, angles, dict(default_l0_mm or {}), default_l0_source, own):
+    for group in comparison_groups(
+        hyst, angles, dict(default_l0_mm or {}), default_l0_source, own, sources
+    ):
         material, l0 = group.material, group.l0_mm
         fm = by_file.get(group.materials_file)
         run_psi, run_fit, run_psi0 = (

@@ -338,6 +338,29 @@ def test_each_dataset_is_compared_at_its_own_l0():
     assert "unknown" in set(mixed["rms_kind"])  # c and d have no stated source
 
 
+def test_a_measured_set_never_pools_with_synthetic_ramps_of_the_same_material_and_l0():
+    # a lab adds its own DS20 photos (l0 255 mm) beside the default synthetic DS20 ramps of the
+    # same l0: it was one row "my_actuator + DS20", rms_kind mixed; its own RMS was not reported
+    angles = pd.concat(
+        [_angles("mine", "DS20", 255.0), _angles("DS20", "DS20", 255.0),
+         _angles("more", "DS20", 255.0)],
+        ignore_index=True,
+    )
+    out = compare(
+        _hyst_of(angles),
+        angles,
+        model_psi=lambda m, p, l0: 200.0 - 10.0 * np.asarray(p, float),
+        fit_k_p=None,
+        data_sources={"mine": "measured", "DS20": "synthetic", "more": "measured"},
+    )
+    rows = out.set_index("curve")
+    assert sorted(rows.index) == ["DS20, l0 255 mm, measured", "DS20, l0 255 mm, synthetic"]
+    assert rows.loc["DS20, l0 255 mm, measured", "datasets"] == "mine + more"
+    assert rows.loc["DS20, l0 255 mm, measured", "rms_kind"] == "prediction"
+    assert rows.loc["DS20, l0 255 mm, synthetic", "rms_kind"] == "self-check"
+    assert "mixed" not in set(out["rms_kind"])
+
+
 def test_a_dataset_mixing_l0_keeps_its_data_figures_and_says_why_no_model():
     one = pd.concat(
         [_angles("x", "DS20", 200.0), _angles("x", "DS20", 220.0).assign(actuator="B1")],
