@@ -513,6 +513,17 @@ def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     total = len(angles)
     assert f"all {total} {(angles['status'] == 'ok').sum()}" in text
     assert "synthetic: the photos were rendered from this model" in text
+    # 'sample' (real) and 'DS20' (synthetic) are both DS20: pooled in its plots, and said so
+    assert "DS20: real photos (sample) and synthetic ones (DS20) are plotted together" in text
+    assert "SS40: real photos" not in text
+    doc = pdfium.PdfDocument(str(pdf))
+    n_pages = len(doc)
+    doc.close()
+    pages_saying = [
+        k for k in range(1, n_pages)
+        if "real photos (sample) and synthetic" in " ".join(pdf_text(pdf, k).split())
+    ]
+    assert len(pages_saying) == 1  # the DS20 page
 
 
 def test_reasons_are_counted_once_per_photo_in_words():

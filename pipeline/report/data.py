@@ -321,6 +321,30 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
     )
 
 
+def mixed_sources_note(data: ReportData, material: str) -> str:
+    """A sentence when real and synthetic photo sets of ``material`` are plotted together (its
+    pages pool every dataset of a material in one mean curve), else ``""``.
+
+    ``compare`` keeps them apart (one rms.csv row each), so the tables do too; the plots do not.
+    """
+    kind = {d.name: d.source for d in data.datasets}
+    names = sorted(
+        data.angles.loc[data.angles["material"].astype(str) == material, "dataset"]
+        .astype(str)
+        .unique()
+    )
+    real = [n for n in names if kind.get(n) == "real"]
+    synthetic = [n for n in names if kind.get(n) == "synthetic"]
+    if not (real and synthetic):
+        return ""
+    return (
+        f"{material}: real photos ({', '.join(real)}) and synthetic ones ({', '.join(synthetic)}) "
+        "are plotted together in one mean curve; the tables compare each with the model on its "
+        f"own.  Remove the synthetic datasets of {material} from config.yaml to plot your photos "
+        "alone."
+    )
+
+
 def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
     """Source (synthetic, real or unknown) and photo dates of one dataset."""
     folder = dataset.photoset_dir

@@ -28,7 +28,7 @@ from pipeline.layout.style import (
     page,
 )
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
-from pipeline.report.data import ReportData, comparisons, rms_row
+from pipeline.report.data import ReportData, comparisons, mixed_sources_note, rms_row
 from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
 
@@ -354,7 +354,8 @@ def material_page(data: ReportData, material: str) -> Figure:
         title=f"{label}: this run beside the paper (rms.csv)",
         extra_notes=tuple(
             f"Also compared: {o} (all comparisons: the model-curve page)." for o in others
-        ),
+        )
+        + tuple(n for n in (mixed_sources_note(data, material),) if n),
     )
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)

@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 from pipeline.report.calibration import calibration_lines
-from pipeline.report.data import ReportData, comparisons, rms_row
+from pipeline.report.data import ReportData, comparisons, mixed_sources_note, rms_row
 from pipeline.report.reasons import top_reasons
 
 #: least height (pt) worth giving the overview plot on page 1
@@ -96,6 +96,7 @@ def results_table(data: ReportData) -> Table:
         "tests nothing."),
     ]
     notes += missing_notes(data)
+    notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
         notes.append(
             "synthetic: the photos were rendered from this model, so their RMS against the model "
