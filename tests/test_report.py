@@ -513,17 +513,38 @@ def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     total = len(angles)
     assert f"all {total} {(angles['status'] == 'ok').sum()}" in text
     assert "synthetic: the photos were rendered from this model" in text
-    # 'sample' (real) and 'DS20' (synthetic) are both DS20: pooled in its plots, and said so
-    assert "DS20: real photos (sample) and synthetic ones (DS20) are plotted together" in text
-    assert "SS40: real photos" not in text
+    # 'sample' (real) and 'DS20' (synthetic) are both DS20: its plots show the real one, and say so
+    assert (
+        "DS20: the plots show the real photos (sample) only; the synthetic ones (DS20) are left"
+        in text
+    )
+    assert "SS40: the plots show" not in text
     doc = pdfium.PdfDocument(str(pdf))
     n_pages = len(doc)
     doc.close()
     pages_saying = [
         k for k in range(1, n_pages)
-        if "real photos (sample) and synthetic" in " ".join(pdf_text(pdf, k).split())
+        if "real photos (sample) only" in " ".join(pdf_text(pdf, k).split())
     ]
     assert len(pages_saying) == 1  # the DS20 page
+
+
+@ON_THE_DEFAULT_REPORT
+def test_a_materials_plots_show_its_real_photos_not_the_synthetic_ones_beside_them(default):
+    # the default inputs hold DS20 twice: 'sample' (real: no truth.csv) and 'DS20' (synthetic).
+    # Pooled, the DS20 curves mixed rendered photos into a lab's own; now they are the real ones
+    from pipeline.aggregate import aggregate_hysteresis
+
+    inputs, _pdf, _rms = default
+    data = load_report_data(inputs)
+    sample = data.angles[data.angles["dataset"] == "sample"]
+    ds20 = data.hysteresis[data.hysteresis["material"] == "DS20"].reset_index(drop=True)
+    expected = aggregate_hysteresis(sample)
+    pd.testing.assert_frame_equal(ds20[expected.columns], expected, check_dtype=False)
+    ds20_actuators = set(data.per_actuator.loc[data.per_actuator["material"] == "DS20", "actuator"])
+    assert ds20_actuators and all(str(a).startswith("sample/") for a in ds20_actuators)
+    # the other materials are as aggregate wrote them
+    assert not data.hysteresis[data.hysteresis["material"] == "SS40"].empty
 
 
 def test_reasons_are_counted_once_per_photo_in_words():

@@ -14,6 +14,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 from PIL import Image
@@ -244,7 +245,25 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
             "hysteresis recomputed from the angles (setpoint levels, ok rows only): no "
             "--hysteresis given"
         )
-    per_actuator = aggregate_per_actuator(angles)
+    infos = tuple(dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets)
+    plotted = angles
+    pooled = mixed_materials(angles, infos)
+    if pooled:  # real beside synthetic photos of one material: its plots show the real ones
+        options = aggregate_options(inputs.config)
+        left_out = [
+            str(d) in pooled.get(str(m), ((), ()))[1]
+            for m, d in zip(angles["material"], angles["dataset"], strict=True)
+        ]
+        plotted = angles[~pd.Series(left_out, index=angles.index)]
+        again = plotted[plotted["material"].astype(str).isin(pooled)]
+        hysteresis = pd.concat(
+            [
+                hysteresis[~hysteresis["material"].astype(str).isin(pooled)],
+                aggregate_hysteresis(again, **options),
+            ],
+            ignore_index=True,
+        )
+    per_actuator = aggregate_per_actuator(plotted)
     rms = (
         pd.concat(
             [_read_csv(p, "rms.csv written by 'compare'", ("material",)) for p in inputs.rms],
@@ -283,9 +302,7 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         model_curves=curves,
         files=input_files(inputs),
         notes=notes,
-        datasets=tuple(
-            dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets
-        ),
+        datasets=infos,
     )
 
 
@@ -321,28 +338,63 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
     )
 
 
-def mixed_sources_note(data: ReportData, material: str) -> str:
-    """A sentence when real and synthetic photo sets of ``material`` are plotted together (its
-    pages pool every dataset of a material in one mean curve), else ``""``.
+def mixed_materials(
+    angles: pd.DataFrame, infos: Sequence[DatasetInfo]
+) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+    """The materials with both real and synthetic photo sets: material -> (real, synthetic)
+    dataset names.
 
-    ``compare`` keeps them apart (one rms.csv row each), so the tables do too; the plots do not.
+    Examples
+    --------
+    >>> a = pd.DataFrame({"material": ["DS20", "DS20", "SS40"],
+    ...                   "dataset": ["mine", "DS20", "SS40"]})
+    >>> infos = [DatasetInfo("mine", "real", None, None, ""),
+    ...          DatasetInfo("DS20", "synthetic", None, None, ""),
+    ...          DatasetInfo("SS40", "synthetic", None, None, "")]
+    >>> mixed_materials(a, infos)
+    {'DS20': (('mine',), ('DS20',))}
     """
-    kind = {d.name: d.source for d in data.datasets}
-    names = sorted(
-        data.angles.loc[data.angles["material"].astype(str) == material, "dataset"]
-        .astype(str)
-        .unique()
-    )
-    real = [n for n in names if kind.get(n) == "real"]
-    synthetic = [n for n in names if kind.get(n) == "synthetic"]
-    if not (real and synthetic):
+    kind = {d.name: d.source for d in infos}
+    out = {}
+    for material, names in angles.groupby(angles["material"].astype(str))["dataset"]:
+        names = sorted(names.astype(str).unique())
+        real = tuple(n for n in names if kind.get(n) == "real")
+        synthetic = tuple(n for n in names if kind.get(n) == "synthetic")
+        if real and synthetic:
+            out[str(material)] = (real, synthetic)
+    return out
+
+
+def mixed_sources_note(data: ReportData, material: str) -> str:
+    """A sentence when ``material`` has real and synthetic photo sets: its plots show the real
+    ones (the tables, from ``compare``, keep each on its own row), else ``""``."""
+    pooled = mixed_materials(data.angles, data.datasets).get(material)
+    if pooled is None:
         return ""
+    real, synthetic = pooled
     return (
-        f"{material}: real photos ({', '.join(real)}) and synthetic ones ({', '.join(synthetic)}) "
-        "are plotted together in one mean curve; the tables compare each with the model on its "
-        f"own.  Remove the synthetic datasets of {material} from config.yaml to plot your photos "
-        "alone."
+        f"{material}: the plots show the real photos ({', '.join(real)}) only; the synthetic "
+        f"ones ({', '.join(synthetic)}) are left out of them.  The tables compare each with the "
+        "model on its own."
     )
+
+
+def aggregate_options(config_path: Path | None) -> dict[str, Any]:
+    """``bin_kpa`` and ``include_flagged`` of the run's ``aggregate`` settings (the resolved
+    config), as ``aggregate`` used them; the defaults without a config."""
+    import yaml
+
+    cfg: Any = {}
+    if config_path is not None:
+        try:
+            cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
+        except (OSError, yaml.YAMLError):
+            cfg = {}  # model_readings_note reports an unreadable config
+    agg = (cfg.get("aggregate") or {}) if isinstance(cfg, dict) else {}
+    return {
+        "bin_kpa": agg.get("bin_kpa"),
+        "include_flagged": bool(agg.get("include_flagged", False)),
+    }
 
 
 def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
