@@ -515,10 +515,11 @@ def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     assert "synthetic: the photos were rendered from this model" in text
     # 'sample' (real) and 'DS20' (synthetic) are both DS20: its plots show the real one, and say so
     assert (
-        "DS20: the plots show the real photos (sample) only; the synthetic ones (DS20) are left"
+        "DS20: the plots and the photo strip show the real photos (sample) only; the synthetic "
+        "ones (DS20) are left"
         in text
     )
-    assert "SS40: the plots show" not in text
+    assert "SS40: the plots and" not in text
     doc = pdfium.PdfDocument(str(pdf))
     n_pages = len(doc)
     doc.close()
@@ -590,14 +591,16 @@ def test_strip_names_the_pooled_actuator_and_drops_the_overlay_text_band(default
 
     data = load_report_data(default[0])
     strip = build_strip(data, "DS20")
-    assert strip.actuator_label == "DS20/A1" and strip.dataset == "DS20"
+    # DS20 has a real set ('sample') beside the synthetic one: the strip shows the real photos
+    assert strip.actuator_label == "sample/A1" and strip.dataset == "sample"
     assert {p.source for p in strip.photos} == {"overlay", "raw"}
     overlay = cv2.imread(
-        str(default[0].datasets[1].overlays_dir / (Path(strip.images[0]).stem + ".jpg"))
+        str(default[0].datasets[0].overlays_dir / (Path(strip.images[0]).stem + ".jpg"))
     )
     assert crop_banner(overlay).shape[0] == overlay.shape[0] - 24
     text = " ".join(pdf_text(default[1], 2).split())
-    assert "actuator DS20/A1, trial 1" in text
+    assert "actuator sample/A1, trial 1" in text
+    assert build_strip(data, "SS40").actuator_label == "SS40/A1"
 
 
 @ON_THE_DEFAULT_REPORT

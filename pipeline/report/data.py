@@ -373,9 +373,9 @@ def mixed_sources_note(data: ReportData, material: str) -> str:
         return ""
     real, synthetic = pooled
     return (
-        f"{material}: the plots show the real photos ({', '.join(real)}) only; the synthetic "
-        f"ones ({', '.join(synthetic)}) are left out of them.  The tables compare each with the "
-        "model on its own."
+        f"{material}: the plots and the photo strip show the real photos ({', '.join(real)}) "
+        f"only; the synthetic ones ({', '.join(synthetic)}) are left out of them.  The tables "
+        "compare each with the model on its own."
     )
 
 

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
-from pipeline.report.data import Dataset, ReportData
+from pipeline.report.data import Dataset, ReportData, mixed_materials
 
 #: photos per strip
 STRIP_PHOTOS = 6
@@ -202,7 +202,14 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
     Strip or None
         ``None`` when the material has no angles rows.
     """
-    ramp = pick_ramp(data.angles, material)
+    # real beside synthetic photo sets of the material: a real one's ramp, as its plots show
+    pooled = mixed_materials(data.angles, data.datasets).get(material)
+    angles = (
+        data.angles
+        if pooled is None
+        else data.angles[data.angles["dataset"].astype(str).isin(pooled[0])]
+    )
+    ramp = pick_ramp(angles, material)
     if ramp.empty:
         return None
     first = ramp.iloc[0]
