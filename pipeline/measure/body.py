@@ -312,7 +312,8 @@ NOISY_SIGMA, NOISY_BLUR_PX = 2.0, 1.0
 def background_difference(
     image_bgr: np.ndarray, background_bgr: np.ndarray
 ) -> tuple[np.ndarray, float]:
-    """Colour distance of each pixel from the same pixel of the empty-scene photo, and its noise.
+    """Colour distance of each pixel from the same pixel of the empty-scene photo (matched to the
+    photo's exposure: :func:`matched_exposure`), and its noise.
 
     Both photos carry their own sensor noise, so their difference is noisier than either; where
     it is high (sigma over :data:`NOISY_SIGMA`: about 8 grey levels of noise per photo) both are
@@ -320,7 +321,7 @@ def background_difference(
     their background photos, 49 of 60 were ``ok`` and right and 10 ``ok`` but wrong unsmoothed
     (the translucent body's faint side lost in the noise), 55 and 5 smoothed.
     """
-    lab, ref = _lab(image_bgr), _lab(matched_exposure(background_bgr, image_bgr))
+    lab, ref = _lab(image_bgr), _lab(background_bgr)
     for smooth in (False, True):
         if smooth:
             lab = cv2.GaussianBlur(lab, (0, 0), NOISY_BLUR_PX)
@@ -425,6 +426,7 @@ def body_mask(
         mask &= color_mask(image_bgr, settings.color)
     if settings.color is None or background_bgr is not None:
         if background_bgr is not None:
+            background_bgr = matched_exposure(background_bgr, image_bgr)
             diff, sigma = background_difference(image_bgr, background_bgr)
         else:
             diff, sigma = backdrop_difference(exposed(image_bgr, allowed), allowed)
