@@ -259,6 +259,7 @@ def _init(args: argparse.Namespace) -> int:
                 "of the empty scene in the photo-set folder and give its name"
             )
         settings["background"] = args.background
+    kept = (Path(args.folder) / photoset.SETTINGS).is_file()  # never overwritten: the user's
     df = photoset_init.init_photoset(
         args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite
     )
@@ -267,7 +268,12 @@ def _init(args: argparse.Namespace) -> int:
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
         "down)"
     )
-    if args.l0_mm is None:
+    if kept:
+        print(
+            f"kept the existing {args.folder}/{photoset.SETTINGS} as it is (the setting options "
+            "were not written into it): edit it, or delete it and run init again"
+        )
+    elif args.l0_mm is None:
         print(
             f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline "
             f"photoset check {args.folder}'"

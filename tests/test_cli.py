@@ -106,6 +106,10 @@ def test_photoset_init_names_the_empty_scene_photo_and_refuses_one_not_there(pho
     assert yaml.safe_load((photo_folder / "photoset.yaml").read_text())["background"] == "empty.jpg"
     # the empty scene is not a photo of the ramp (it does not match the pattern)
     assert "empty.jpg" not in (photo_folder / "manifest.csv").read_text()
+    # a second init keeps the user's photoset.yaml and says its options were not written
+    out = _run(*args, "--background", "empty.jpg", "--sealed-end-mm", "5", "--overwrite")
+    assert out.returncode == 0 and "kept the existing" in out.stdout
+    assert "sealed_end_mm" not in (photo_folder / "photoset.yaml").read_text()
 
 
 def test_bad_input_is_one_line_without_traceback(tmp_path):
