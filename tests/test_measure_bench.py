@@ -31,7 +31,6 @@ PAIRED_COLUMNS = [
 
 @pytest.fixture(scope="module")
 def small_run(tmp_path_factory: pytest.TempPathFactory) -> pd.DataFrame:
-    pytest.importorskip("skimage")
     return bench.speed(
         2, seed=3, workdir=tmp_path_factory.mktemp("speed"), sizes=((640, 480),), repeats=1
     )
