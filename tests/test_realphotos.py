@@ -136,3 +136,14 @@ def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
     assert final_status_text("flagged", "breaks its ramp; x", "x") == (
         "then flagged: also breaks its ramp"
     )
+
+
+def test_the_realscenes_bench_scores_the_real_photos_alone_with_n_0(capsys):
+    # --n 0 (no rendered analogues) used to crash on scoring an empty table after the real photos
+    from pipeline.bench.realscenes import main
+
+    assert main(["--n", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "xia2023_strips" in out and "synthetic analogues" not in out
+    with pytest.raises(SystemExit):
+        main(["--n", "-1", "--dev-set", "none"])

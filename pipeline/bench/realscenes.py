@@ -223,7 +223,10 @@ def main(argv: Sequence[str] | None = None) -> int:
              "tests/data/xia2023_strips)",
     )
     parser.add_argument(
-        "--n", type=int, default=12, help="rendered photos per synthetic scene (default 12)"
+        "--n",
+        type=int,
+        default=12,
+        help="rendered photos per synthetic scene (default 12; 0: the real photos only)",
     )
     parser.add_argument("--seed", type=int, default=30)
     parser.add_argument(
@@ -314,8 +317,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(s.to_string())
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
+    if args.n < 0:
+        parser.error(f"--n {args.n}: give 0 or more rendered photos per scene")
     gain = args.background_exposure
-    for fixed in (False,) if args.no_fixed_direction else (False, True):
+    for fixed in () if args.n == 0 else (False,) if args.no_fixed_direction else (False, True):
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
