@@ -91,6 +91,7 @@ def body_cases(
     give_sealed_end: bool = False,
     background: bool = False,
     background_exposure: float = 1.0,
+    scene_set: dict[str, Any] | None = None,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -122,6 +123,9 @@ def body_cases(
         noise; passed through ``camera`` too).
     background_exposure : float
         The empty scene taken at this times the photos' exposure (a camera setting its own).
+    scene_set : dict, optional
+        Scene knobs set in every scene (:func:`pipeline.synth.scene_from` keys, e.g.
+        ``{"shadow": 0.5}``: darker shadows).
 
     Returns
     -------
@@ -138,6 +142,7 @@ def body_cases(
             continue
         if sealed_end_mm is not None:
             overrides = {**overrides, "sealed_end_mm": sealed_end_mm}
+        overrides = {**overrides, **(scene_set or {})}
         scene = scene_from(_PRESET.get(name, name), width=width, height=height, **overrides)
         for i, psi in enumerate(np.linspace(215.0, -220.0, n)):
             r, empty = render_with_background(
@@ -281,6 +286,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="only the first analogue table (fixed end given), not the one with "
              "fixed_direction_deg too",
     )
+    parser.add_argument(
+        "--set",
+        dest="scene_set",
+        action="append",
+        metavar="KEY=VALUE",
+        help="set a scene knob in every analogue, e.g. --set shadow=0.5 (darker shadows; any key "
+        "of python -m pipeline synth --set)",
+    )
     args = parser.parse_args(argv)
     try:
         width, height = (int(v) for v in args.size.lower().split("x"))
@@ -317,6 +330,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(s.to_string())
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
+    from pipeline.synth.cli import key_value_pairs
+
+    scene_set = key_value_pairs(args.scene_set, "--set")
     if args.n < 0:
         parser.error(f"--n {args.n}: give 0 or more rendered photos per scene")
     gain = args.background_exposure
@@ -325,7 +341,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
             give_sealed_end=args.give_sealed_end, background=args.background,
-            background_exposure=gain,
+            background_exposure=gain, scene_set=scene_set,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
@@ -335,6 +351,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{'' if args.sealed_end_mm is None else f', sealed end {args.sealed_end_mm:g} mm'}"
             f"{', sealed_end_mm given' if args.give_sealed_end else ''}"
             f"{', background photo given' if args.background else ''}"
+            f"{''.join(f', {k}={v}' for k, v in scene_set.items())}"
             f"{f' at {gain:g}x exposure' if gain != 1 else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )

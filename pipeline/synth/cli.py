@@ -9,7 +9,14 @@ import time
 from pipeline.errors import UserInputError
 
 
-def _pairs(values: list[str] | None, what: str) -> dict[str, str]:
+def key_value_pairs(values: list[str] | None, what: str) -> dict[str, str]:
+    """``KEY=VALUE`` command-line items as a dict (``what`` names the option in the error).
+
+    Examples
+    --------
+    >>> key_value_pairs(["shadow=0.5", " width = 640"], "--set")
+    {'shadow': '0.5', 'width': '640'}
+    """
     out: dict[str, str] = {}
     for item in values or []:
         key, sep, value = item.partition("=")
@@ -96,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.synth.photoset_writer import render_photoset
 
     fields = {f.name for f in dataclasses.fields(ActuatorBehaviour)}
-    beh_raw = _pairs(args.behaviour_set, "--behaviour")
+    beh_raw = key_value_pairs(args.behaviour_set, "--behaviour")
     unknown = sorted(set(beh_raw) - fields)
     if unknown:
         raise UserInputError(f"--behaviour key(s) {unknown} unknown; valid keys: {sorted(fields)}")
@@ -116,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         scene=args.scene,
         step_kpa=args.step_kpa,
         max_kpa=args.max_kpa,
-        scene_overrides=_pairs(args.scene_set, "--set"),
+        scene_overrides=key_value_pairs(args.scene_set, "--set"),
         jobs=args.jobs,
         behaviour=beh,
         l0_mm=args.l0_mm,

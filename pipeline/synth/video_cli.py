@@ -109,7 +109,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Render and print a one-line summary."""
-    from pipeline.synth.cli import _pairs
+    from pipeline.synth.cli import key_value_pairs
     from pipeline.synth.video import Dynamics, render_video
     from pipeline.video.profile import PressureProfile
 
@@ -132,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         rest_s=args.rest_s,
         clock_offset_s=args.clock_offset_s,
         scene=args.scene,
-        scene_overrides=_pairs(args.scene_set, "--set"),
+        scene_overrides=key_value_pairs(args.scene_set, "--set"),
         seed=args.seed,
         codec=args.codec,
         log_hz=args.log_hz,
