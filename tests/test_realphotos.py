@@ -145,8 +145,9 @@ def test_the_realscenes_bench_scores_the_real_photos_alone_with_n_0(capsys):
     assert main(["--n", "0"]) == 0
     out = capsys.readouterr().out
     assert "xia2023_strips" in out and "synthetic analogues" not in out
-    with pytest.raises(SystemExit):
-        main(["--n", "-1", "--dev-set", "none"])
+    with pytest.raises(SystemExit):  # refused before the real photos run
+        main(["--n", "-1"])
+    assert "xia2023_strips" not in capsys.readouterr().out
 
 
 def test_the_realscenes_bench_sets_a_scene_knob_in_every_analogue(capsys):
@@ -160,5 +161,6 @@ def test_the_realscenes_bench_sets_a_scene_knob_in_every_analogue(capsys):
     plain = body_cases(1, scenes=("grey_dots",), width=640, height=480)
     dark = body_cases(1, scenes=("grey_dots",), width=640, height=480, scene_set={"shadow": 0.9})
     assert plain["psi_deg"].iloc[0] != dark["psi_deg"].iloc[0]
-    with pytest.raises(UserInputError, match="nokey"):
-        main(["--dev-set", "none", "--n", "1", "--set", "nokey=1"])
+    with pytest.raises(UserInputError, match="nokey"):  # refused before the real photos run
+        main(["--n", "1", "--set", "nokey=1"])
+    assert "xia2023_strips" not in capsys.readouterr().out

@@ -295,6 +295,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         "of python -m pipeline synth --set)",
     )
     args = parser.parse_args(argv)
+    if args.n < 0:
+        parser.error(f"--n {args.n}: give 0 or more rendered photos per scene")
+    from pipeline.synth import scene_from
+    from pipeline.synth.cli import key_value_pairs
+
+    scene_set = key_value_pairs(args.scene_set, "--set")
+    scene_from("lab", **scene_set)  # a bad knob is refused before anything is measured
     try:
         width, height = (int(v) for v in args.size.lower().split("x"))
     except ValueError:
@@ -330,11 +337,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(s.to_string())
     else:
         print(f"(no labels.csv in {args.dev_set}: real photos skipped)")
-    from pipeline.synth.cli import key_value_pairs
-
-    scene_set = key_value_pairs(args.scene_set, "--set")
-    if args.n < 0:
-        parser.error(f"--n {args.n}: give 0 or more rendered photos per scene")
     gain = args.background_exposure
     for fixed in () if args.n == 0 else (False,) if args.no_fixed_direction else (False, True):
         df = body_cases(
