@@ -27,7 +27,9 @@ from pipeline.ramp_check import check_ramps
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
 #: :class:`~pipeline.measure.AngleResult`;
-#: empty on failed rows; ``width_px``: the line's or body's width, edge to edge; ``l0_mm``: the
+#: empty on failed rows; ``width_px``: the line's or body's width, edge to edge;
+#: ``base_direction_deg``: the direction a body's psi is measured from, see
+#: :func:`pipeline.ramp_check.share_base_direction`; ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -37,6 +39,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "length_mm",
     "length_px",
     "width_px",
+    "base_direction_deg",
     "method",
     "residual_px",
     "status",

@@ -20,6 +20,10 @@ neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in i
 
 Nothing is changed for a leg of fewer than 3 measured photos.
 
+First, the bodies of a ramp whose clamp holds their base in one direction are all measured from
+that one direction (:func:`share_base_direction`): the start of a body's centre line, next to the
+clamp, is where a shadow or a bulge tilts it most.
+
 Examples
 --------
 >>> import pandas as pd
@@ -39,7 +43,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from pipeline.measure.quality import COSMETIC_FLAGS
+from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
@@ -50,6 +54,12 @@ AGREE_DEG = 3.0
 #: measured length outside [LENGTH_LOW, LENGTH_HIGH] x the ramp's median -> partial line
 LENGTH_LOW, LENGTH_HIGH = 0.85, 1.15
 RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
+#: a ramp's bodies share one base direction when at least this many were measured ...
+BASE_MIN_PHOTOS = 5
+#: ... and their own base directions lie this close (deg, median absolute deviation)
+BASE_SPREAD_DEG = 3.0
+#: a photo whose psi moved by at least this (deg) says so in its reason
+BASE_NOTE_DEG = 1.0
 
 
 def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
@@ -76,7 +86,8 @@ def _join(*parts: str) -> str:
 
 
 def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
-    """Flag photos that break their ramp's trend and trust cosmetically flagged ones that follow it.
+    """Measure a ramp's bodies from its shared base direction, flag photos that break their
+    ramp's trend and trust cosmetically flagged ones that follow it.
 
     Parameters
     ----------
@@ -89,7 +100,7 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
     pandas.DataFrame
         A copy with ``status`` and ``reason`` updated (rows in the same order).
     """
-    out = angles.copy()
+    out = share_base_direction(angles)
     if out.empty or not set(RAMP_KEYS) <= set(out.columns):
         return out
     status, reason = (
@@ -121,6 +132,87 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
         for _, leg in measured.groupby(legs, sort=False):
             _check_leg(leg, position, status, reason)
     out["status"], out["reason"] = status, reason
+    return out
+
+
+def _wrap_deg(angle: np.ndarray) -> np.ndarray:
+    """Angles (deg) brought into [-180, 180)."""
+    return (np.asarray(angle, float) + 180.0) % 360.0 - 180.0
+
+
+def share_base_direction(
+    angles: pd.DataFrame, keys: tuple[str, ...] = RAMP_KEYS
+) -> pd.DataFrame:
+    """Measure every body of a ramp from the ramp's one base direction, where the clamp holds it.
+
+    A body's psi is its free end's direction minus the direction in which it leaves the fixed
+    end (``base_direction_deg``).  That start is read from a short stretch next to the clamp,
+    where a shadow, a bulge or the clamp's face can tilt it by several degrees in one photo,
+    while the clamp holds the body's base in the same direction in every photo of the ramp.
+    Where a ramp has at least :data:`BASE_MIN_PHOTOS` measured bodies whose own base
+    directions agree (median absolute deviation at most :data:`BASE_SPREAD_DEG`: a clamp, not
+    free strips), each photo's psi is taken against their median instead, as with a known
+    ``fixed_direction_deg``; a photo whose psi moved by :data:`BASE_NOTE_DEG` or more says so,
+    and one whose own base is more than ``BASE_MISMATCH_DEG`` off the ramp's is flagged.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        The angles.csv table (``psi_deg``, ``status``, ``reason``, ``base_direction_deg``, the
+        ``keys``; ``kappa_per_mm`` and ``l0_mm`` are kept consistent when present).
+    keys : tuple of str
+        The columns naming one ramp (one clamping of one actuator).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy; rows of the ramps that share a direction have ``psi_deg``, ``kappa_per_mm``
+        and ``base_direction_deg`` (now the ramp's) updated.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"psi_deg": [200.0, 100.0, 0.0, -100.0, -193.0],
+    ...     "base_direction_deg": [0.5, -0.5, 0.0, 1.0, -7.0], "status": "ok", "reason": "",
+    ...     "material": "DS20", "actuator": "A1", "trial": "1"})
+    >>> out = share_base_direction(df)
+    >>> out["psi_deg"].tolist()
+    [200.5, 99.5, 0.0, -99.0, -200.0]
+    >>> out["reason"].iloc[4]
+    "psi against its ramp's base direction (+0.0 deg, the median of 5 photos; its own -7.0)"
+    """
+    out = angles.copy()
+    if out.empty or "base_direction_deg" not in out.columns or not set(keys) <= set(out.columns):
+        return out
+    for _, ramp in out.groupby(list(keys), sort=False):
+        own = ramp["base_direction_deg"].to_numpy(float)
+        use = (ramp["status"] != "failed").to_numpy() & np.isfinite(own)
+        if use.sum() < BASE_MIN_PHOTOS:
+            continue
+        ref = own[use][0]
+        shared = float(ref + np.median(_wrap_deg(own[use] - ref)))
+        dev = _wrap_deg(own - shared)
+        if float(np.median(np.abs(dev[use]))) > BASE_SPREAD_DEG:
+            continue  # the bases scatter: no clamp holds them (free strips) or a clamp let go
+        for ix, moved, base in zip(ramp.index[use], dev[use], own[use], strict=True):
+            psi = float(out.at[ix, "psi_deg"]) + float(moved)
+            out.at[ix, "psi_deg"] = psi
+            out.at[ix, "base_direction_deg"] = shared
+            if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
+                out.at[ix, "kappa_per_mm"] = float(np.deg2rad(psi)) / float(out.at[ix, "l0_mm"])
+            notes = []
+            if abs(moved) >= BASE_NOTE_DEG:
+                notes.append(
+                    f"psi against its ramp's base direction ({shared:+.1f} deg, the median of "
+                    f"{int(use.sum())} photos; its own {base:+.1f})"
+                )
+            if abs(moved) > BASE_MISMATCH_DEG:
+                out.at[ix, "status"] = "flagged"
+                notes.append(
+                    f"the body leaves the fixed end {moved:+.0f} deg off its ramp's direction: a "
+                    "hook at the clamp, or fixed_end is off; check with photoset preview"
+                )
+            before = out.at[ix, "reason"]
+            out.at[ix, "reason"] = _join("" if pd.isna(before) else str(before), *notes)
     return out
 
 

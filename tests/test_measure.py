@@ -315,13 +315,14 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:15]) == [
+    assert list(par.columns[:16]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
         "length_mm",
         "length_px",
         "width_px",
+        "base_direction_deg",
         "method",
         "residual_px",
         "status",
@@ -332,7 +333,8 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "calibration_px",
         "calibration_mm",
     ]
-    assert list(par.columns[15:21]) == [
+    assert par["base_direction_deg"].isna().all()  # drawn lines: no body base to share
+    assert list(par.columns[16:22]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -376,7 +378,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "6 ok" in run.stdout and "1 failed" in run.stdout
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[10:16]) == [
+    assert list(angles.columns[11:17]) == [
         "seconds",
         "degree",
         "l0_mm",

@@ -133,3 +133,61 @@ def test_of_two_photos_that_break_each_others_range_the_doubtful_one_is_blamed()
     out = check_ramps(df)
     assert out["reason"].iloc[0].startswith("breaks its ramp")
     assert out["status"].iloc[1] == "ok" and "breaks" not in out["reason"].iloc[1]
+
+
+# ---- the ramp's shared base direction -----------------------------------------------------
+
+def _bodies(psi, base, **columns) -> pd.DataFrame:
+    df = _ramp(psi, base_direction_deg=np.asarray(base, float), **columns)
+    df["l0_mm"] = 250.0
+    df["kappa_per_mm"] = np.deg2rad(df["psi_deg"]) / 250.0
+    return df
+
+
+def test_a_body_whose_start_is_tilted_is_measured_from_its_ramps_base_direction():
+    psi = _ds20_like()
+    base = [0.4, -0.3, 0.1, 0.0, -0.6, 0.2, 7.0, 0.3, -0.2, 0.5, 0.1, -0.4]
+    psi_read = [p - b for p, b in zip(psi, base, strict=True)]  # psi = free end - own base
+    out = check_ramps(_bodies(psi_read, base))
+    shared = float(np.median(base))
+    np.testing.assert_allclose(out["psi_deg"], np.asarray(psi) - shared, atol=1e-9)
+    np.testing.assert_allclose(out["base_direction_deg"], shared)
+    np.testing.assert_allclose(out["kappa_per_mm"], np.deg2rad(out["psi_deg"]) / 250.0)
+    assert "its own +7.0" in out["reason"].iloc[6] and out["status"].iloc[6] == "ok"
+    assert out["reason"].iloc[0] == ""  # moved by less than a degree: nothing to say
+
+
+def test_a_body_leaving_far_off_its_ramps_direction_is_flagged():
+    base = [0.0] * 11 + [-30.0]
+    out = check_ramps(_bodies(_ds20_like(), base))
+    assert out["status"].iloc[11] == "flagged"
+    assert "-30 deg off its ramp's direction" in out["reason"].iloc[11]
+
+
+def test_bases_across_the_wrap_share_their_direction():
+    base = [179.0, -179.5, 179.5, -178.0, 178.5, 180.0]
+    out = check_ramps(_bodies([100.0, 80.0, 60.0, 40.0, 20.0, 0.0], base))
+    assert abs(float(out["base_direction_deg"].iloc[0]) - 179.75) < 1e-6
+    assert out["psi_deg"].round(2).tolist() == [99.25, 80.75, 59.75, 42.25, 18.75, 0.25]
+
+
+@pytest.mark.parametrize(
+    "base, why",
+    [
+        ([0.0, 5.0, -5.0, 10.0, -8.0, 4.0], "scattered: free strips, no clamp"),
+        ([0.0, 1.0, np.nan, np.nan, np.nan, np.nan], "too few bodies (lines have none)"),
+    ],
+)
+def test_a_ramp_without_one_base_direction_is_left_alone(base, why):
+    df = _bodies([100.0, 80.0, 60.0, 40.0, 20.0, 0.0], base)
+    out = check_ramps(df)
+    pd.testing.assert_series_equal(out["psi_deg"], df["psi_deg"], obj=why)
+
+
+def test_failed_rows_and_other_ramps_do_not_share_a_base():
+    a = _bodies(_ds20_like(), [0.0] * 12)
+    b = _bodies(_ds20_like(), [10.0] * 12, actuator="A2")
+    b.loc[3, ["status", "psi_deg", "base_direction_deg"]] = ["failed", np.nan, 50.0]
+    out = check_ramps(pd.concat([a, b], ignore_index=True))
+    np.testing.assert_allclose(out["psi_deg"].dropna(), pd.concat([a, b])["psi_deg"].dropna())
+    assert out["status"].iloc[15] == "failed"

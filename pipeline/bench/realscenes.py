@@ -29,6 +29,8 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.ramp_check import share_base_direction
+
 #: a synthetic body photo is right within this (deg)
 TOLERANCE_DEG = 5.0
 #: the scenes of part 2: preset name -> scene overrides
@@ -92,6 +94,7 @@ def body_cases(
     background: bool = False,
     background_exposure: float = 1.0,
     scene_set: dict[str, Any] | None = None,
+    shared_base: bool = True,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -126,6 +129,10 @@ def body_cases(
     scene_set : dict, optional
         Scene knobs set in every scene (:func:`pipeline.synth.scene_from` keys, e.g.
         ``{"shadow": 0.5}``: darker shadows).
+    shared_base : bool
+        Measure each scene's bodies from their shared base direction, as the ramp check of a
+        photo set does (:func:`pipeline.ramp_check.share_base_direction`: the scene's clamp
+        holds every photo's body in one direction); False: each photo from its own.
 
     Returns
     -------
@@ -175,10 +182,15 @@ def body_cases(
                     "status": res.status,
                     "reason": res.reason,
                     "ms": 1000 * (time.perf_counter() - t0),
+                    "base_direction_deg": res.base_direction_deg,
                 }
             )
     empties.cleanup()
-    return pd.DataFrame(rows)
+    df = pd.DataFrame(rows)
+    if shared_base and not df.empty:
+        df = share_base_direction(df, keys=("scene",))
+        df["error_deg"] = df["psi_deg"] - df["psi_true_deg"]
+    return df
 
 
 def score(df: pd.DataFrame, tolerance: float | pd.Series, by: str = "scene") -> pd.DataFrame:
@@ -287,6 +299,12 @@ def main(argv: Sequence[str] | None = None) -> int:
              "fixed_direction_deg too",
     )
     parser.add_argument(
+        "--own-base",
+        action="store_true",
+        help="measure each analogue from its own base direction, not its scene's shared one "
+             "(what a photo set's ramp check does; to compare)",
+    )
+    parser.add_argument(
         "--set",
         dest="scene_set",
         action="append",
@@ -343,7 +361,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
             give_sealed_end=args.give_sealed_end, background=args.background,
-            background_exposure=gain, scene_set=scene_set,
+            background_exposure=gain, scene_set=scene_set, shared_base=not args.own_base,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
@@ -354,7 +372,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{', sealed_end_mm given' if args.give_sealed_end else ''}"
             f"{', background photo given' if args.background else ''}"
             f"{''.join(f', {k}={v}' for k, v in scene_set.items())}"
-            f"{f' at {gain:g}x exposure' if gain != 1 else ''} "
+            f"{f' at {gain:g}x exposure' if gain != 1 else ''}"
+            f"{', each from its own base direction' if args.own_base else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())

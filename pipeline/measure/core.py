@@ -85,6 +85,12 @@ class AngleResult:
         Complexity of the curve model the estimator used: 1 for a circular arc (constant
         curvature, also the ``paper`` averages), higher for the turning-angle series actually
         chosen (``turning``, and ``auto`` when it switched to it); 0 when failed.
+    base_direction_deg : float
+        A body's measured direction where it leaves the fixed end (deg, counter-clockwise from
+        +x on screen, clockwise with ``positive_turn: cw``, so that psi is the free end's
+        direction minus it; on the plane when calibrated): what
+        :func:`pipeline.ramp_check.share_base_direction` compares across a ramp.  NaN for a
+        line, with ``fixed_direction_deg`` given, or when failed.
     """
 
     psi_deg: float
@@ -98,6 +104,7 @@ class AngleResult:
     line_width_px: float = float("nan")
     degree: int = 0
     length_px: float = float("nan")
+    base_direction_deg: float = float("nan")
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -439,9 +446,12 @@ def measure_body(
         short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method
-    return _measured(
+    measured = _measured(
         carried_on_psi_deg(psi, body.ridge_tip_deg, sign), est, line, quality, settings, used
     )
+    if base is not None or est is not tip:
+        return measured
+    return replace(measured, base_direction_deg=float(np.rad2deg(sign * start)))
 
 
 def carried_on_psi_deg(psi_deg: float, ridge_tip_deg: float, sign: float) -> float:

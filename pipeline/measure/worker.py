@@ -88,6 +88,7 @@ def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
         "length_mm": res.length_mm,
         "length_px": res.length_px,
         "width_px": res.line_width_px,
+        "base_direction_deg": res.base_direction_deg,
         "method": res.method,
         "residual_px": res.residual_px,
         "status": res.status,

@@ -138,6 +138,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
             "length_mm",
             "length_px",
             "width_px",
+            "base_direction_deg",
             "residual_px",
             "degree",
         ):

@@ -44,6 +44,7 @@ CHUNK_COLUMNS: tuple[str, ...] = (
     "length_mm",
     "length_px",
     "width_px",
+    "base_direction_deg",
     "method",
     "residual_px",
     "status",
