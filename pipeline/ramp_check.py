@@ -177,8 +177,11 @@ def share_base_direction(
     >>> out = share_base_direction(df)
     >>> out["psi_deg"].tolist()
     [200.5, 99.5, 0.0, -99.0, -200.0]
-    >>> out["reason"].iloc[4]
-    "psi against its ramp's base direction (+0.0 deg, the median of 5 photos; its own -7.0)"
+    >>> reason = out["reason"].iloc[4]
+    >>> reason.startswith("psi -200.0 deg against its ramp's base direction (+0.0 deg")
+    True
+    >>> reason.endswith("the median of 5 photos; -193.0 from its own, -7.0)")
+    True
     """
     out = angles.copy()
     if out.empty or "base_direction_deg" not in out.columns or not set(keys) <= set(out.columns):
@@ -194,16 +197,17 @@ def share_base_direction(
         if float(np.median(np.abs(dev[use]))) > BASE_SPREAD_DEG:
             continue  # the bases scatter: no clamp holds them (free strips) or a clamp let go
         for ix, moved, base in zip(ramp.index[use], dev[use], own[use], strict=True):
-            psi = float(out.at[ix, "psi_deg"]) + float(moved)
+            old = float(out.at[ix, "psi_deg"])
+            psi = old + float(moved)
             out.at[ix, "psi_deg"] = psi
             out.at[ix, "base_direction_deg"] = shared
             if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
                 out.at[ix, "kappa_per_mm"] = float(np.deg2rad(psi)) / float(out.at[ix, "l0_mm"])
             notes = []
             if abs(moved) >= BASE_NOTE_DEG:
-                notes.append(
-                    f"psi against its ramp's base direction ({shared:+.1f} deg, the median of "
-                    f"{int(use.sum())} photos; its own {base:+.1f})"
+                notes.append(  # the photo's overlay shows the psi of its own base
+                    f"psi {psi:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, "
+                    f"the median of {int(use.sum())} photos; {old:+.1f} from its own, {base:+.1f})"
                 )
             if abs(moved) > BASE_MISMATCH_DEG:
                 out.at[ix, "status"] = "flagged"

@@ -535,7 +535,7 @@ def test_a_ramps_bodies_are_measured_from_its_one_base_direction(tmp_path):
         scores[ramp_check] = int(((got["status"] == "ok") & wrong).sum())
         if ramp_check:
             assert got.groupby("trial")["base_direction_deg"].nunique().eq(1).all()  # one clamp
-            assert got["reason"].str.contains("psi against its ramp's base direction").any()
+            assert got["reason"].str.contains("deg against its ramp's base direction").any()
             assert (got["status"] == "ok").all(), got["reason"].tolist()
     assert scores[False] >= 4 and scores[True] <= 1, scores
 

@@ -153,7 +153,8 @@ def test_a_body_whose_start_is_tilted_is_measured_from_its_ramps_base_direction(
     np.testing.assert_allclose(out["psi_deg"], np.asarray(psi) - shared, atol=1e-9)
     np.testing.assert_allclose(out["base_direction_deg"], shared)
     np.testing.assert_allclose(out["kappa_per_mm"], np.deg2rad(out["psi_deg"]) / 250.0)
-    assert "its own +7.0" in out["reason"].iloc[6] and out["status"].iloc[6] == "ok"
+    assert "from its own, +7.0" in out["reason"].iloc[6] and out["status"].iloc[6] == "ok"
+    assert out["reason"].iloc[6].startswith(f"psi {out['psi_deg'].iloc[6]:+.1f} deg against")
     assert out["reason"].iloc[0] == ""  # moved by less than a degree: nothing to say
 
 
