@@ -196,27 +196,31 @@ def share_base_direction(
         dev = _wrap_deg(own - shared)
         if float(np.median(np.abs(dev[use]))) > BASE_SPREAD_DEG:
             continue  # the bases scatter: no clamp holds them (free strips) or a clamp let go
-        for ix, moved, base in zip(ramp.index[use], dev[use], own[use], strict=True):
-            old = float(out.at[ix, "psi_deg"])
-            psi = old + float(moved)
-            out.at[ix, "psi_deg"] = psi
-            out.at[ix, "base_direction_deg"] = shared
-            if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
-                out.at[ix, "kappa_per_mm"] = float(np.deg2rad(psi)) / float(out.at[ix, "l0_mm"])
-            notes = []
-            if abs(moved) >= BASE_NOTE_DEG:
-                notes.append(  # the photo's overlay shows the psi of its own base
-                    f"psi {psi:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, "
-                    f"the median of {int(use.sum())} photos; {old:+.1f} from its own, {base:+.1f})"
-                )
-            if abs(moved) > BASE_MISMATCH_DEG:
-                out.at[ix, "status"] = "flagged"
-                notes.append(
-                    f"the body leaves the fixed end {moved:+.0f} deg off its ramp's direction: a "
-                    "hook at the clamp, or fixed_end is off; check with photoset preview"
-                )
-            before = out.at[ix, "reason"]
-            out.at[ix, "reason"] = _join("" if pd.isna(before) else str(before), *notes)
+        rows, moved, n = ramp.index[use], dev[use], int(use.sum())
+        old = out.loc[rows, "psi_deg"].to_numpy(float)
+        psi = old + moved
+        out.loc[rows, "psi_deg"] = psi
+        out.loc[rows, "base_direction_deg"] = shared
+        if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
+            out.loc[rows, "kappa_per_mm"] = np.deg2rad(psi) / out.loc[rows, "l0_mm"].to_numpy(float)
+        off = np.abs(moved) > BASE_MISMATCH_DEG
+        out.loc[rows[off], "status"] = "flagged"
+        reasons = out.loc[rows, "reason"].fillna("").astype(str).to_numpy()
+        out.loc[rows, "reason"] = [
+            _join(
+                before,
+                # the photo's overlay shows the psi of its own base
+                f"psi {p:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, the "
+                f"median of {n} photos; {o:+.1f} from its own, {b:+.1f})"
+                if abs(m) >= BASE_NOTE_DEG
+                else "",
+                f"the body leaves the fixed end {m:+.0f} deg off its ramp's direction: a hook at "
+                "the clamp, or fixed_end is off; check with photoset preview"
+                if abs(m) > BASE_MISMATCH_DEG
+                else "",
+            )
+            for before, p, o, b, m in zip(reasons, psi, old, own[use], moved, strict=True)
+        ]
     return out
 
 
