@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import cv2
@@ -28,6 +29,17 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         key=lambda it: 0 if it.get_closest_marker("slow") or it.get_closest_marker("xdist_group")
         else 1
     )
+
+
+@pytest.fixture
+def sigint_as_in_a_terminal():
+    """Children started during the test take Ctrl-C as from a terminal, whatever the test runner
+    does: a runner started in the background (``nohup ... &``) ignores SIGINT, and an ignored
+    signal is passed on to every child (a handled one is reset to the default), so a Ctrl-C test
+    would reach nothing."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
 
 
 @pytest.fixture

@@ -365,7 +365,9 @@ def test_cli_writes_a_photoset_and_rejects_bad_keys(tmp_path, capsys):
     assert main(["synth", str(out), "--material", "SS50", "--behaviour", "hysteresis=0.9"]) == 2
 
 
-def test_ctrl_c_mid_synth_leaves_no_partial_set_and_keeps_the_previous_one(tmp_path):
+def test_ctrl_c_mid_synth_leaves_no_partial_set_and_keeps_the_previous_one(
+    sigint_as_in_a_terminal, tmp_path
+):
     """SIGINT to the process group (Ctrl-C in a terminal) while `synth` renders with two workers."""
     out = tmp_path / "set"
     cmd = [

@@ -351,7 +351,7 @@ def test_slurm_profile_plans_the_workflow(repo, tmp_path):
 
 @ON_THE_FINISHED_RUN
 def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_finishes(
-    finished_run, tmp_path
+    finished_run, sigint_as_in_a_terminal, tmp_path
 ):
     """A re-taken photo re-runs its set's jobs only; Ctrl-C mid-measure; a plain re-run
     completes."""
