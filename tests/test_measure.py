@@ -81,6 +81,24 @@ def test_turning_follows_nonconstant_curvature_where_arc_fits_cannot() -> None:
     assert abs(np.rad2deg(hyper(pts, rng).turning_rad) + 200.0) > 20.0
 
 
+@pytest.mark.parametrize("ends", [(0.0, 0.0), (12.0, 30.0)])
+def test_the_turning_fits_jacobian_is_the_models_derivative(ends) -> None:
+    # the turning fit gives Levenberg-Marquardt the model's exact Jacobian (not finite
+    # differences): it must be the derivative of the chunk means, for every parameter
+    from scipy.optimize._numdiff import approx_derivative
+
+    from pipeline.measure.estimators import _shape_model
+
+    params = np.array([3.0, -2.0, 0.05, 0.4, -2.5, 0.8, -0.3, 0.2])
+    n, q, span = 30, 6, 500.0
+    _, exact = _shape_model(params, n, q, span, ends)
+    numeric = approx_derivative(
+        lambda p: _shape_model(p, n, q, span, ends)[0].ravel(), params, method="3-point"
+    )
+    assert exact.shape == (2 * n, len(params))
+    np.testing.assert_allclose(exact, numeric, rtol=1e-6, atol=1e-6)
+
+
 # ---------------------------------------------------------------------------------------------
 # synthetic photos
 

@@ -355,31 +355,52 @@ def turning_fit(
     return s_mid, coef, deg, float(rss[k])
 
 
-def _cosine_theta(u: np.ndarray, coef: np.ndarray) -> np.ndarray:
-    """theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi): curvature psi + sum b_k cos(k pi
-    u)."""
-    theta = coef[0] + coef[1] * u
-    for k, b in enumerate(coef[2:], start=1):
-        theta = theta + b * np.sin(k * np.pi * u) / (k * np.pi)
-    return theta
+def _theta_basis(u: np.ndarray, n_coef: int) -> np.ndarray:
+    """Columns ``1, u, sin(k pi u) / (k pi)`` (k = 1 .. n_coef - 2): theta(u) is linear in them.
+
+    Examples
+    --------
+    >>> _theta_basis(np.array([0.0, 0.5, 1.0]), 3).round(3).tolist()
+    [[1.0, 0.0, 0.0], [1.0, 0.5, 0.318], [1.0, 1.0, 0.0]]
+    """
+    k = np.arange(1, n_coef - 1) * np.pi
+    return np.column_stack([np.ones_like(u), u, np.sin(np.outer(u, k)) / k])
 
 
 def _shape_model(
     params: np.ndarray, n: int, q: int, span: float, ends: tuple[float, float]
-) -> np.ndarray:
-    """Chunk means of the curve p(s) = p0 + stretch * int (cos theta, sin theta) ds.
+) -> tuple[np.ndarray, np.ndarray]:
+    """Chunk means of the curve p(s) = p0 + stretch * int (cos theta, sin theta) ds, and their
+    derivatives by ``params``.
 
-    ``u`` runs over the whole line, [0, 1] from the fixed end to the free end; the data (the
-    ``n`` chunk means, ``q`` fine points each) cover its part ``[ends[0], ends[0] + span]``.
+    ``params`` are p0 (x, y), log stretch and the coefficients of theta(u) = theta0 + psi u +
+    sum_k b_k sin(k pi u) / (k pi).  ``u`` runs over the whole line, [0, 1] from the fixed end to
+    the free end; the data (the ``n`` chunk means, ``q`` fine points each) cover its part
+    ``[ends[0], ends[0] + span]``.
+
+    Returns
+    -------
+    means : ndarray (n, 2)
+    jacobian : ndarray (2 n, len(params))
+        d means.ravel() / d params, exact (theta is linear in its coefficients).
     """
     p0, stretch, coef = params[:2], np.exp(params[2]), params[3:]
     total = span + ends[0] + ends[1]
     ds = span / (n * q)
     s_f = (np.arange(n * q) + 0.5) * ds
-    theta = _cosine_theta((s_f + ends[0]) / total, coef)
-    step = np.c_[np.cos(theta), np.sin(theta)] * (ds * stretch)
+    basis = _theta_basis((s_f + ends[0]) / total, len(coef))
+    theta = basis @ coef
+    cos, sin = np.cos(theta), np.sin(theta)
+    step = np.c_[cos, sin] * (ds * stretch)
     pos = p0 + np.cumsum(step, axis=0) - 0.5 * step
-    return pos.reshape(n, q, 2).mean(axis=1)
+    means = pos.reshape(n, q, 2).mean(axis=1)
+    # a coefficient turns every step by its basis value: d step = (-sin, cos) ds stretch basis
+    d_step = np.stack([-sin, cos], axis=1)[:, :, None] * (ds * stretch) * basis[:, None, :]
+    d_pos = np.cumsum(d_step, axis=0) - 0.5 * d_step
+    d_coef = d_pos.reshape(n, q, 2, len(coef)).mean(axis=1).reshape(2 * n, len(coef))
+    d_p0 = np.tile(np.eye(2), (n, 1))
+    d_stretch = (means - p0).reshape(2 * n, 1)
+    return means, np.hstack([d_p0, d_stretch, d_coef])
 
 
 def turning(
@@ -396,7 +417,8 @@ def turning(
     so the tangent angle is ``theta(u) = theta0 + psi u + sum_k b_k sin(k pi u) / (k pi)`` and
     ``theta(1) - theta(0) = psi`` exactly, whatever the shape terms.  For K = 0, 1, ... terms
     the curve it defines (integrated tangent, free start point and length scale) is fitted to
-    the centre line's chunk means by Levenberg-Marquardt (:func:`scipy.optimize.least_squares`);
+    the centre line's chunk means by Levenberg-Marquardt (:func:`scipy.optimize.least_squares`,
+    with the model's exact Jacobian: half the time of finite differences);
     the K with the lowest BIC on the positional residuals wins: K = 0 is a circular arc, more
     terms only when the photo demands them.  Fitting positions (an integral of theta) rather than
     noisy chord angles, and reading psi as the mean curvature rather than from the end
@@ -421,8 +443,9 @@ def turning(
     worse = 0
     for k in range(min(MAX_DEGREE if max_degree is None else max_degree, n - 4)):
         fit = least_squares(
-            lambda p: (_shape_model(p, n, q, span, ends_px) - means).ravel(),
+            lambda p: (_shape_model(p, n, q, span, ends_px)[0] - means).ravel(),
             x0,
+            jac=lambda p: _shape_model(p, n, q, span, ends_px)[1],
             method="lm",
             xtol=1e-10,
             ftol=1e-10,
