@@ -130,10 +130,7 @@ def lab_distance(lab: np.ndarray, ref: np.ndarray) -> np.ndarray:
     >>> lab_distance(lab, lab).tolist()
     [[0.0, 0.0]]
     """
-    if ref.ndim == 1:
-        d = cv2.subtract(lab, (float(ref[0]), float(ref[1]), float(ref[2]), 0.0))
-    else:
-        d = cv2.subtract(lab, np.ascontiguousarray(ref, np.float32))
+    d = lab - np.asarray(ref, np.float32)
     summed = cv2.transform(cv2.multiply(d, d), _SUM_CHANNELS)
     return np.asarray(cv2.sqrt(summed), np.float32).reshape(lab.shape[:2])
 
