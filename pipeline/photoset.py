@@ -44,6 +44,7 @@ from pipeline.constants import DIRECTIONS, VACUUM_KPA
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.calibration import CalibrationCache
+from pipeline.measure.formats import undecodable
 from pipeline.measure.settings import (
     KEYS,
     OVERRIDE_COLUMNS,
@@ -582,13 +583,9 @@ def file_problems(
         size = sizes.get(str(image)) if str(image) in sizes else _image_size(path)
         sizes[str(image)] = size
         if size is None:
+            why, fix = undecodable(str(image))
             problems.append(
-                Problem(
-                    mpath,
-                    int(line),
-                    f"image {image!r} cannot be decoded (corrupt, truncated or not an image)",
-                    "re-export or re-take the photo, or remove the row",
-                )
+                Problem(mpath, int(line), f"image {image!r} cannot be decoded ({why})", fix)
             )
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
@@ -771,8 +768,18 @@ def geometry_problems(
         try:  # keyed by the file's time too: a replaced photo is read again
             bsize = _background_size(s.background_path, os.stat(s.background_path).st_mtime_ns)
         except OSError:
-            bsize = None  # a missing background is the settings' problem
-        if bsize is not None and not same_aspect(bsize, (w, h)):
+            bsize = (w, h)  # a missing background is the settings' problem
+        if bsize is None:
+            why, fix = undecodable(s.background_path)
+            out.append(
+                Problem(
+                    file,
+                    line,
+                    f"background photo {Path(s.background_path).name} cannot be decoded ({why})",
+                    fix,
+                )
+            )
+        elif not same_aspect(bsize, (w, h)):
             out.append(
                 Problem(
                     file,

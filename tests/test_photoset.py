@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from pipeline import photoset as ps
 from pipeline import photoset_init
@@ -70,6 +71,37 @@ def test_check_names_every_bad_row_and_its_fix(photo_folder):
         text=True, check=False,
     )
     assert out.returncode == 1 and "direction 'sideways'" in out.stderr
+
+
+def test_a_phones_heic_photo_is_named_as_such_with_the_export_fix(photo_folder):
+    # OpenCV reads no HEIC (a phone's default) nor camera raw: "corrupt" would send the user
+    # looking for damage; check names the format and the fix, measure fails that row alone
+    from pipeline.photoset_measure import measure_photoset
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    m = pd.read_csv(photo_folder / "manifest.csv")
+    for row, name in ((1, "IMG_0042.HEIC"), (2, "DSC_0007.NEF")):
+        (photo_folder / name).write_bytes(os.urandom(3000))
+        m.loc[row, "image"] = name
+    m.to_csv(photo_folder / "manifest.csv", index=False)
+    text = "\n".join(map(str, ps.validate_photoset(photo_folder)))
+    assert "line 3: image 'IMG_0042.HEIC' cannot be decoded (a HEIC/HEIF photo, which" in text
+    assert "export the photos as JPEG" in text and "Most Compatible" in text
+    assert "'DSC_0007.NEF' cannot be decoded (a camera raw file, which OpenCV cannot read)" in text
+    # an empty scene from the same phone: check says so on every row that uses it
+    (photo_folder / "empty.heic").write_bytes(os.urandom(3000))
+    settings = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
+    settings["background"] = "empty.heic"
+    (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(settings))
+    text = "\n".join(map(str, ps.validate_photoset(photo_folder)))
+    assert "line 2: background photo empty.heic cannot be decoded (a HEIC/HEIF photo" in text
+    angles = measure_photoset(photo_folder).set_index("image")
+    assert angles.loc["IMG_0042.HEIC", "status"] == "failed"
+    assert "a HEIC/HEIF photo" in angles.loc["IMG_0042.HEIC", "reason"]
+    assert "a camera raw file" in angles.loc["DSC_0007.NEF", "reason"]
+    others = angles.drop(index=["IMG_0042.HEIC", "DSC_0007.NEF"])  # blank photos: measured,
+    assert len(others) == len(m) - 2  # found no line, and said so
+    assert not others["reason"].str.contains("cannot be decoded").any(), others["reason"].tolist()
 
 
 def test_missing_l0_is_reported_unless_every_row_has_it(photo_folder):

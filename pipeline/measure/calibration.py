@@ -56,6 +56,8 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pipeline.measure.formats import undecodable
+
 #: a calibration whose reprojection error is above this (px) is doubtful: every row using it is
 #: flagged
 MAX_RMS_PX = 1.0
@@ -357,7 +359,11 @@ def calibrate_files(
         data = np.fromfile(str(path), np.uint8)
         decoded = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
         if decoded is None:
-            raise CalibrationError(f"calibration board photo {name!r} cannot be decoded")
+            raise CalibrationError(
+                "calibration board photo {!r} cannot be decoded ({}; {})".format(
+                    name, *undecodable(name)
+                )
+            )
         grey = np.asarray(decoded, np.uint8)
         this = (grey.shape[1], grey.shape[0])
         if size is not None and this != size:

@@ -36,6 +36,7 @@ from pipeline.measure.estimators import (
     turning_quick,
 )
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
+from pipeline.measure.formats import undecodable
 from pipeline.measure.quality import RIDGE_TIP_DEG, Quality, assess, assess_body
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
@@ -326,7 +327,7 @@ def load_background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
     img = cv2.imread(path, cv2.IMREAD_COLOR)
     name = Path(path).name
     if img is None:
-        return f"background photo {name} cannot be decoded"
+        return "background photo {} cannot be decoded ({}; {})".format(name, *undecodable(name))
     bh, bw = img.shape[:2]
     if not same_aspect((bw, bh), (shape[1], shape[0])):
         return (

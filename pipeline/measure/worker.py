@@ -21,6 +21,7 @@ from pipeline.measure.core import (
     failed,
     measure_decoded,
 )
+from pipeline.measure.formats import undecodable
 from pipeline.measure.settings import MeasureSettings
 
 
@@ -52,7 +53,12 @@ def run_task(task: Task) -> dict[str, Any]:
             if data.size:
                 img, f = decode_for_work(data, grey=decodes_grey(task.settings))
             res = (
-                failed(task.method, f"unreadable image: {task.path} cannot be decoded")
+                failed(
+                    task.method,
+                    "unreadable image: {} cannot be decoded ({}; {})".format(
+                        task.path, *undecodable(str(task.path))
+                    ),
+                )
                 if img is None
                 else measure_decoded(data, img, f, task.settings, method=task.method)
             )
