@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import IMAGE_SUFFIXES, MANIFEST, SETTINGS, write_manifest, write_settings
 
 _FIELD_PATTERNS: dict[str, str] = {
@@ -160,9 +161,16 @@ def init_photoset(
             row["direction"] = _DIRECTION_WORDS[word]
         rows.append(row)
     if not rows:
+        unreadable = sorted(p.name for p in folder.iterdir() if unreadable_format(p.name))
         raise UserInputError(
             f"no image in {folder} matches pattern {pattern!r}"
             + (f" (e.g. {unmatched[0]!r} does not)" if unmatched else " (no images found)")
+            + (
+                f"; it holds {len(unreadable)} photo(s) such as {unreadable[0]!r}: "
+                + "{}; {}".format(*undecodable(unreadable[0]))
+                if unreadable
+                else ""
+            )
         )
     df = pd.DataFrame(rows)
     if "direction" not in df.columns:

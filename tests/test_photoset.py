@@ -73,6 +73,13 @@ def test_check_names_every_bad_row_and_its_fix(photo_folder):
     assert out.returncode == 1 and "direction 'sideways'" in out.stderr
 
 
+def test_init_on_a_folder_of_heic_photos_says_to_export_them(tmp_path):
+    for i in range(3):
+        (tmp_path / f"IMG_00{i}.HEIC").write_bytes(b"....ftypheic")
+    with pytest.raises(UserInputError, match=r"holds 3 photo\(s\) such as 'IMG_000.HEIC': a HEIC"):
+        photoset_init.init_photoset(tmp_path, PATTERN)
+
+
 def test_a_phones_heic_photo_is_named_as_such_with_the_export_fix(photo_folder):
     # OpenCV reads no HEIC (a phone's default) nor camera raw: "corrupt" would send the user
     # looking for damage; check names the format and the fix, measure fails that row alone

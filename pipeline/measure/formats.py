@@ -32,6 +32,17 @@ _EXPORT = "export the photos as JPEG (or PNG / TIFF) and name those in manifest.
 _PHONE = " (an iPhone takes JPEGs with Settings > Camera > Formats > Most Compatible)"
 
 
+def unreadable_format(name: str) -> str | None:
+    """What the file is when OpenCV cannot read its format (by its extension), else None.
+
+    Examples
+    --------
+    >>> unreadable_format("IMG_0042.heic"), unreadable_format("a.JPG")
+    ('a HEIC/HEIF photo', None)
+    """
+    return _KIND.get(PurePath(name).suffix.lower())
+
+
 def undecodable(name: str) -> tuple[str, str]:
     """(why, fix) for a photo that could not be decoded, from its file name.
 
@@ -47,9 +58,8 @@ def undecodable(name: str) -> tuple[str, str]:
     >>> undecodable("p_20kPa.jpg")
     ('corrupt, truncated or not an image', 're-export or re-take the photo, or remove the row')
     """
-    suffix = PurePath(name).suffix.lower()
-    kind = _KIND.get(suffix)
+    kind = unreadable_format(name)
     if kind is None:
         return _DAMAGED
-    phone = _PHONE if suffix in (".heic", ".heif") else ""
+    phone = _PHONE if "HEIC" in kind else ""
     return f"{kind}, which OpenCV cannot read", _EXPORT + phone
