@@ -28,7 +28,7 @@ _DAMAGED = (
     "re-export or re-take the photo, or remove the row",
 )
 #: the fix for a photo of a format OpenCV cannot read
-_EXPORT = "export the photos as JPEG (or PNG / TIFF) and name those in manifest.csv"
+_EXPORT = "export the photos as JPEG (or PNG / TIFF) and use those instead"
 _PHONE = " (an iPhone takes JPEGs with Settings > Camera > Formats > Most Compatible)"
 
 
