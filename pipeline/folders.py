@@ -24,7 +24,7 @@ import hashlib
 import json
 import os
 import shutil
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -116,9 +116,13 @@ def folder_files(folder: str | os.PathLike[str]) -> list[Path]:
 
 
 def update_folder_digest(
-    folder: str | os.PathLike[str], digest_file: str | os.PathLike[str]
+    folder: str | os.PathLike[str],
+    digest_file: str | os.PathLike[str],
+    extra_files: Sequence[str | os.PathLike[str]] = (),
 ) -> Path:
-    """Write ``digest_file`` with a SHA-256 over every file of ``folder``, only when it changed.
+    """Write ``digest_file`` with a SHA-256 over every file of ``folder`` (and ``extra_files``, the
+    files outside it that it names: :func:`pipeline.photoset.referenced_files`), only when it
+    changed.
 
     The digest covers each file's path (relative to ``folder``), size and content hash, so it
     changes exactly when a file is replaced, added, removed or renamed; touching a file (same
@@ -160,9 +164,13 @@ def update_folder_digest(
         cache = {}
     new_cache: dict[str, list[object]] = {}
     lines = []
-    for path in folder_files(folder) if folder.is_dir() else []:
+    inside = folder_files(folder) if folder.is_dir() else []
+    outside = sorted({Path(f).resolve() for f in extra_files})
+    # a file outside the folder under its absolute path (no relative name can clash with it)
+    named = [(p, p.relative_to(folder).as_posix()) for p in inside]
+    named += [(p, p.as_posix()) for p in outside if p.is_file()]
+    for path, rel in named:
         st = path.stat()
-        rel = path.relative_to(folder).as_posix()
         key = [st.st_size, st.st_mtime_ns, st.st_ctime_ns]
         hit = cache.get(rel)
         known = isinstance(hit, list) and len(hit) == 4 and hit[:3] == key

@@ -246,6 +246,63 @@ def is_video_manifest(manifest: pd.DataFrame) -> bool:
     return "video" in manifest.columns and "image" not in manifest.columns
 
 
+def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
+    """Files outside ``folder`` that its settings name: a ``background`` photo or calibration
+    board photos given as ``../...`` or an absolute path, in ``photoset.yaml`` or a
+    ``manifest.csv`` column.
+
+    The workflow digests them with the folder, so replacing such a file re-measures the set
+    (results are never stale).  Read leniently: a set whose files cannot be parsed names nothing
+    here (``measure`` and ``check`` report it); paths that do not exist are left out.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp()); (root / "set").mkdir()
+    >>> for name in ("empty.jpg", "set/board.jpg"):
+    ...     _ = (root / name).write_bytes(b"x")
+    >>> _ = (root / "set" / SETTINGS).write_text(
+    ...     "background: ../empty.jpg\\ncalibration: {board: [board.jpg], square_mm: 5}\\n")
+    >>> [p.name for p in referenced_files(root / "set")]
+    ['empty.jpg']
+    """
+    folder = Path(folder)
+    values: list[Any] = []
+    try:
+        raw = yaml.safe_load((folder / SETTINGS).read_text()) or {}
+    except (OSError, yaml.YAMLError):
+        raw = {}
+    if isinstance(raw, dict):
+        values += [raw.get("background"), raw.get("calibration")]
+    try:
+        manifest = pd.read_csv(folder / MANIFEST, dtype=str)
+    except (OSError, ValueError, pd.errors.ParserError):
+        manifest = pd.DataFrame()
+    for column in ("background", "calibration"):
+        if column in manifest.columns:
+            values += manifest[column].dropna().unique().tolist()
+    names: list[str] = []
+    for value in values:
+        if isinstance(value, str) and value.strip().startswith(("{", "[")):
+            try:  # a manifest cell holds YAML
+                value = yaml.safe_load(value)
+            except yaml.YAMLError:
+                continue
+        if isinstance(value, dict):
+            value = value.get("board")
+        items = [value] if isinstance(value, str) else value if isinstance(value, list) else []
+        names += [v for v in items if isinstance(v, str)]
+    inside = folder.resolve()
+    found = {
+        path.resolve()
+        for name in names
+        if name.strip()
+        for path in [folder / name.strip()]  # an absolute name stays absolute
+        if path.is_file()
+    }
+    return tuple(sorted(p for p in found if not p.is_relative_to(inside)))
+
+
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """Read ``manifest.csv`` as written (text columns kept as text), adding ``manifest_line``.
 

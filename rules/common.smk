@@ -14,7 +14,7 @@ from snakemake.exceptions import WorkflowError
 from pipeline.config import validate_config
 from pipeline.errors import UserInputError
 from pipeline.folders import update_folder_digest
-from pipeline.photoset import read_manifest
+from pipeline.photoset import read_manifest, referenced_files
 
 try:
     _validated = validate_config(config, workdir=Path.cwd(), source="config")
@@ -69,12 +69,15 @@ def logged(command):
 
 
 def _digest(kind, name, folder):
-    """Digest file of a photo-set folder, rewritten (at DAG build) only when a file changed."""
-    return str(update_folder_digest(folder, f"{RESULTS}/digests/{kind}/{name}.sha256"))
+    """Digest file of a photo-set folder and of the files outside it that it names (a background
+    or calibration board photo), rewritten (at DAG build) only when one of them changed."""
+    digest = f"{RESULTS}/digests/{kind}/{name}.sha256"
+    return str(update_folder_digest(folder, digest, referenced_files(folder)))
 
 
 # A folder's measure job depends on the bytes of every file in it (a photo replaced, added or
-# removed, or manifest.csv/photoset.yaml edited), through a digest kept under results/digests/.
+# removed, or manifest.csv/photoset.yaml edited) and of a background or board photo it names
+# outside it, through a digest kept under results/digests/.
 FOLDER_DIGESTS = {
     n: _digest("datasets", n, ds["path"]) for n, ds in DATASETS.items() if ds["source"] == "folder"
 }

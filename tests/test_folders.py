@@ -79,6 +79,21 @@ def test_digest_changes_with_the_bytes_of_any_file(tmp_path, change):
     assert update_folder_digest(folder, digest).read_text() != before
 
 
+def test_digest_covers_the_files_outside_the_folder_that_the_set_names(tmp_path):
+    from pipeline.photoset import referenced_files
+
+    folder = _photos(tmp_path / "set")
+    (tmp_path / "empty.png").write_bytes(b"the empty scene")
+    (folder / "photoset.yaml").write_text("l0_mm: 200\n")
+    (folder / "manifest.csv").write_text("image,background\na.jpg,../empty.png\nb.jpg,\n")
+    assert referenced_files(folder) == ((tmp_path / "empty.png").resolve(),)
+    digest = update_folder_digest(folder, tmp_path / "d" / "set.sha256", referenced_files(folder))
+    before = digest.read_text()
+    assert str((tmp_path / "empty.png").resolve()) in before
+    (tmp_path / "empty.png").write_bytes(b"the empty scene, re-taken")
+    assert update_folder_digest(folder, digest, referenced_files(folder)).read_text() != before
+
+
 def test_digest_is_rewritten_only_when_it_changes_and_reads_only_changed_files(
     tmp_path, monkeypatch
 ):

@@ -16,6 +16,7 @@ import sys
 import time
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import pypdfium2 as pdfium
@@ -399,6 +400,30 @@ def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_fin
     assert before.loc[fixed, "psi_deg"] != pytest.approx(before.loc[donor, "psi_deg"], abs=1.0)
     others = before.index.drop(fixed)
     assert (after.loc[others, "psi_deg"] == before.loc[others, "psi_deg"]).all()
+
+
+@ON_THE_FINISHED_RUN
+def test_a_background_photo_outside_the_folder_is_watched_like_its_photos(finished_run, tmp_path):
+    """A set may name an empty-scene photo outside its folder (shared by several sets):
+    replacing it re-measures the sets that use it, and only them."""
+    repo, done = finished_run
+    work = tmp_path / "wf"
+    shutil.copytree(done, work)
+    empty = work / "empty_scene.png"
+    cv2.imwrite(str(empty), np.full((300, 400, 3), 200, np.uint8))
+    settings = work / SHORT / "photoset.yaml"
+    settings.write_text(settings.read_text() + "background: ../empty_scene.png\n")
+    # the edited photoset.yaml re-runs its sets; mark them done without measuring (--touch)
+    out = _snakemake(work, repo, "--cores", "1", "--touch")
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert _snakemake(work, repo, "-n", "--cores", "1").stdout.count("rule measure") == 0
+    cv2.imwrite(str(empty), np.full((300, 400, 3), 90, np.uint8))  # the empty scene re-taken
+    plan = _snakemake(work, repo, "-n", "--cores", "1")
+    assert plan.returncode == 0, plan.stderr[-3000:]
+    # 'short' and 'soft' read that folder; 'sample', 'tiny' and the video do not
+    assert _planned_jobs(plan.stdout).get("measure") == 2, plan.stdout[-3000:]
+    measured = set(re.findall(r"output: results/datasets/(\w+)/angles\.csv", plan.stdout))
+    assert measured == {"short", "soft"}
 
 
 def test_a_failed_job_shows_the_end_of_its_log_on_the_console(tmp_path, repo):
