@@ -287,6 +287,24 @@ def _paint_gap(img, psi, gap_px, at=0.6, length=600.0, width=46.0, backdrop=(190
     return img
 
 
+def test_two_actuators_in_one_photo_are_flagged_with_the_roi_fix_and_measured_with_it():
+    # a lab photographs several actuators at once: each row's body is then one of two, which is
+    # flagged, the reason saying how to tell them apart; a roi per row measures each alone
+    a, fe_a, _ = body_photo(120.0, seed=3)
+    b, fe_b, _ = body_photo(-150.0, seed=4)
+    both = np.vstack([a, b])
+    h, w = a.shape[:2]
+    fe_b = (fe_b[0], fe_b[1] + h)
+    res = measure_image(both, settings_for(fe_a))
+    assert res.status == "flagged" and res.reason.startswith("2 candidate bodies"), res.reason
+    assert "set roi around this one" in res.reason
+    rows = ((fe_a, [0, 0, w - 1, h - 1], 120.0), (fe_b, [0, h, w - 1, 2 * h - 1], -150.0))
+    for fe, roi, psi in rows:
+        res = measure_image(both, settings_for(fe, roi=roi))
+        assert res.status == "ok", res.reason
+        assert res.psi_deg == pytest.approx(psi, abs=2.5)
+
+
 @pytest.mark.parametrize("psi", [150.0, -120.0, 200.0])
 @pytest.mark.parametrize("gap", [20, 40])
 def test_a_stretch_the_selection_misses_is_bridged_along_the_body(psi, gap):

@@ -227,7 +227,12 @@ def assess_body(
             "(photoset preview shows the outlines)"
         )
     if line.n_candidates > 1:
-        flags.append(f"{line.n_candidates} candidate bodies")
+        flags.append(
+            f"{line.n_candidates} candidate bodies: another selection as large as this body lies "
+            "elsewhere (another actuator in view, or part of this one beyond a gap?); for another "
+            "actuator, set roi around this one (per row in manifest.csv when each photo shows "
+            "several); check with photoset preview"
+        )
     if not line.fixed_end_found:
         flags.append("no body reaches fixed_end; used the largest")
     elif line.fixed_end_auto:
