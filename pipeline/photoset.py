@@ -363,7 +363,8 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                     mpath,
                     line,
                     f"image {image!r} is listed twice (also line {first_line[image]})",
-                    "remove the duplicate row",
+                    "remove the duplicate row (a photo of several actuators: one photo set per "
+                    "actuator, each with its roi)",
                 )
             )
         else:

@@ -230,8 +230,8 @@ def assess_body(
         flags.append(
             f"{line.n_candidates} candidate bodies: another selection as large as this body lies "
             "elsewhere (another actuator in view, or part of this one beyond a gap?); for another "
-            "actuator, set roi around this one (per row in manifest.csv when each photo shows "
-            "several); check with photoset preview"
+            "actuator, set roi around this one (a photo of several actuators: one photo set per "
+            "actuator, each with its roi); check with photoset preview"
         )
     if not line.fixed_end_found:
         flags.append("no body reaches fixed_end; used the largest")
