@@ -60,6 +60,56 @@ BASE_MIN_PHOTOS = 5
 BASE_SPREAD_DEG = 3.0
 #: a photo whose psi moved by at least this (deg) says so in its reason
 BASE_NOTE_DEG = 1.0
+#: the base directions of a ramp's photos jump by more than this (deg) between two runs of at
+#: least BASE_SHIFT_PHOTOS consecutive photos that each agree within BASE_SPREAD_DEG: the camera or
+#: the clamp moved, and each run is measured from its own shared direction (on the rendered
+#: analogues, 30 ramps over two sizes, two seeds and three camera faults, no such jump passed 3 deg)
+BASE_SHIFT_DEG = 5.0
+BASE_SHIFT_PHOTOS = 3
+
+
+def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
+    """Split a ramp's base directions (deg, in acquisition order) where the setup moved.
+
+    The ramp is cut where the median directions of the photos before and after differ by more
+    than :data:`BASE_SHIFT_DEG`, both sides hold at least :data:`BASE_SHIFT_PHOTOS` photos, each
+    agrees within :data:`BASE_SPREAD_DEG` (median absolute deviation) and every photo lies nearer
+    its own side's direction than the other side's; of such places, the
+    one that leaves the photos closest to their side's median (least absolute deviation).  Each
+    side is split again the same way.
+
+    Returns
+    -------
+    list of ndarray
+        Index arrays (into ``own_deg``) of the consecutive runs, in order.
+
+    Examples
+    --------
+    >>> [r.tolist() for r in base_runs(np.array([0.5, -0.5, 0.0, 1.0, 9.0, 8.0, 8.5]))]
+    [[0, 1, 2, 3], [4, 5, 6]]
+    >>> [r.tolist() for r in base_runs(np.array([0.5, -0.5, 0.0, 6.0, 0.2, 0.0]))]  # one photo
+    [[0, 1, 2, 3, 4, 5]]
+    """
+    d = _wrap_deg(own_deg - own_deg[0])
+    best: tuple[float, int] | None = None
+    for k in range(BASE_SHIFT_PHOTOS, len(d) - BASE_SHIFT_PHOTOS + 1):
+        sides = (d[:k], d[k:])
+        medians = [float(np.median(side)) for side in sides]
+        jump = abs(medians[1] - medians[0])
+        spread = [np.abs(side - m) for side, m in zip(sides, medians, strict=True)]
+        # each side agrees, and each photo lies nearer its own side's direction than the other's
+        nearer = all(
+            (np.abs(side - m) < np.abs(side - other)).all()
+            for side, m, other in zip(sides, medians, medians[::-1], strict=True)
+        )
+        consistent = nearer and all(float(np.median(a)) <= BASE_SPREAD_DEG for a in spread)
+        cost = float(sum(a.sum() for a in spread))
+        if jump > BASE_SHIFT_DEG and consistent and (best is None or cost < best[0]):
+            best = (cost, k)
+    if best is None:
+        return [np.arange(len(d))]
+    k = best[1]
+    return [*base_runs(own_deg[:k]), *(run + k for run in base_runs(own_deg[k:]))]
 
 
 def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
@@ -153,7 +203,11 @@ def share_base_direction(
     directions agree (median absolute deviation at most :data:`BASE_SPREAD_DEG`: a clamp, not
     free strips), each photo's psi is taken against their median instead, as with a known
     ``fixed_direction_deg``; a photo whose psi moved by :data:`BASE_NOTE_DEG` or more says so,
-    and one whose own base is more than ``BASE_MISMATCH_DEG`` off the ramp's is flagged.
+    and one whose own base is more than ``BASE_MISMATCH_DEG`` off the ramp's is flagged.  Where
+    the base direction jumps part-way through the ramp (in step order) and stays there, the
+    camera or the clamp moved: each run of photos (:func:`base_runs`) is measured from its own
+    direction (a run of fewer than :data:`BASE_MIN_PHOTOS`, each photo from its own) and the
+    photos after the move say so.
 
     Parameters
     ----------
@@ -186,42 +240,67 @@ def share_base_direction(
     out = angles.copy()
     if out.empty or "base_direction_deg" not in out.columns or not set(keys) <= set(out.columns):
         return out
-    for _, ramp in out.groupby(list(keys), sort=False):
-        own = ramp["base_direction_deg"].to_numpy(float)
-        use = (ramp["status"] != "failed").to_numpy() & np.isfinite(own)
-        if use.sum() < BASE_MIN_PHOTOS:
+    order = [c for c in ("step", "time_s") if c in out.columns]  # as the photos were taken
+    for _, whole in out.groupby(list(keys), sort=False):
+        ramp = whole.sort_values(order, kind="stable") if order else whole
+        own_all = ramp["base_direction_deg"].to_numpy(float)
+        used = (ramp["status"] != "failed").to_numpy() & np.isfinite(own_all)
+        if used.sum() < BASE_MIN_PHOTOS:
             continue
-        ref = own[use][0]
-        shared = float(ref + np.median(_wrap_deg(own[use] - ref)))
-        dev = _wrap_deg(own - shared)
-        if float(np.median(np.abs(dev[use]))) > BASE_SPREAD_DEG:
-            continue  # the bases scatter: no clamp holds them (free strips) or a clamp let go
-        rows, moved, n = ramp.index[use], dev[use], int(use.sum())
-        old = out.loc[rows, "psi_deg"].to_numpy(float)
-        psi = old + moved
+        runs = base_runs(own_all[used])
+        first = float(np.median(own_all[used][runs[0]]))
+        for number, run in enumerate(runs):
+            _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None)
+    return out
+
+
+def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None) -> None:
+    """Measure the bodies of one run of a ramp (one setting of camera and clamp) from their
+    shared base direction, in place in ``out``.
+
+    ``first_base_deg``: the base direction of the ramp's first run, when this run comes after the
+    setup moved (every photo of it says so).
+    """
+    own = run["base_direction_deg"].to_numpy(float)
+    rows, n = run.index, len(own)
+    shared = float(own[0] + np.median(_wrap_deg(own - own[0])))
+    moved = _wrap_deg(own - shared)
+    if n < BASE_MIN_PHOTOS or float(np.median(np.abs(moved))) > BASE_SPREAD_DEG:
+        # too few to share, or they scatter (free strips, a clamp that let go): each its own
+        shared, moved = float("nan"), np.zeros(n)
+    reasons = out.loc[rows, "reason"].fillna("").astype(str).to_numpy()
+    setup = (
+        ""
+        if first_base_deg is None
+        else f"the base direction is {_wrap_deg(np.array(own[0] - first_base_deg)):+.0f} deg off "
+        "the ramp's first photos from here on (the camera or the clamp moved?): psi is measured "
+        "from these photos' own"
+    )
+    old = out.loc[rows, "psi_deg"].to_numpy(float)
+    psi = old + moved
+    off = np.abs(moved) > BASE_MISMATCH_DEG
+    if np.isfinite(shared):
         out.loc[rows, "psi_deg"] = psi
         out.loc[rows, "base_direction_deg"] = shared
         if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
             out.loc[rows, "kappa_per_mm"] = np.deg2rad(psi) / out.loc[rows, "l0_mm"].to_numpy(float)
-        off = np.abs(moved) > BASE_MISMATCH_DEG
         out.loc[rows[off], "status"] = "flagged"
-        reasons = out.loc[rows, "reason"].fillna("").astype(str).to_numpy()
-        out.loc[rows, "reason"] = [
-            _join(
-                before,
-                # the photo's overlay shows the psi of its own base
-                f"psi {p:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, the "
-                f"median of {n} photos; {o:+.1f} from its own, {b:+.1f})"
-                if abs(m) >= BASE_NOTE_DEG
-                else "",
-                f"the body leaves the fixed end {m:+.0f} deg off its ramp's direction: a hook at "
-                "the clamp, or fixed_end is off; check with photoset preview"
-                if abs(m) > BASE_MISMATCH_DEG
-                else "",
-            )
-            for before, p, o, b, m in zip(reasons, psi, old, own[use], moved, strict=True)
-        ]
-    return out
+    out.loc[rows, "reason"] = [
+        _join(
+            before,
+            setup,
+            # the photo's overlay shows the psi of its own base
+            f"psi {p:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, the "
+            f"median of {n} photos; {o:+.1f} from its own, {b:+.1f})"
+            if abs(m) >= BASE_NOTE_DEG
+            else "",
+            f"the body leaves the fixed end {m:+.0f} deg off its ramp's direction: a hook at "
+            "the clamp, or fixed_end is off; check with photoset preview"
+            if abs(m) > BASE_MISMATCH_DEG
+            else "",
+        )
+        for before, p, o, b, m in zip(reasons, psi, old, own, moved, strict=True)
+    ]
 
 
 def layer_lengths(measured: pd.DataFrame) -> np.ndarray:

@@ -560,6 +560,35 @@ def test_a_ramps_bodies_are_measured_from_its_one_base_direction(tmp_path):
     assert scores[False] >= 4 and scores[True] <= 1, scores
 
 
+def test_a_camera_turned_mid_ramp_is_not_measured_from_the_ramps_first_direction(tmp_path):
+    # the last 4 photos of a ramp were taken after the camera turned by 9 deg about the clamp:
+    # psi is unchanged by that, but measured against the first photos' base direction it would
+    # read 9 deg off, `ok`; the ramp check splits the ramp where its base direction moved
+    import pandas as pd
+
+    from pipeline.photoset import write_manifest
+    from pipeline.photoset_measure import measure_photoset
+
+    psis = np.linspace(150.0, -150.0, 11)
+    rows = []
+    for i, psi in enumerate(psis):
+        img, fe, _ = body_photo(float(psi), seed=i)
+        if i >= 7:
+            turn = cv2.getRotationMatrix2D(fe, 9.0, 1.0)
+            img = cv2.warpAffine(img, turn, (W, H), borderMode=cv2.BORDER_REPLICATE)
+        cv2.imwrite(str(tmp_path / f"p{i:02d}.png"), img)
+        rows.append({"image": f"p{i:02d}.png", "pressure_kpa": 10 * i, "direction": "up",
+                     "material": "DS20", "actuator": "A1", "trial": 1, "step": i,
+                     "fixed_end_x": fe[0], "fixed_end_y": fe[1]})
+    write_manifest(tmp_path, pd.DataFrame(rows))
+    (tmp_path / "photoset.yaml").write_text("l0_mm: 180\ntarget: body\n")
+    got = measure_photoset(tmp_path)
+    assert (got["status"] == "ok").all(), got["reason"].tolist()
+    assert (got["psi_deg"] - psis).abs().max() < 2.5, (got["psi_deg"] - psis).round(1).tolist()
+    moved = got["reason"].iloc[7:].str.contains("+9 deg off the ramp's first photos", regex=False)
+    assert moved.all(), got["reason"].tolist()
+
+
 @pytest.mark.parametrize("turn, base", [("ccw", 90.0), ("cw", -90.0)])
 def test_a_body_reports_the_direction_it_leaves_the_fixed_end_in_psis_sense(turn, base):
     # the photo turned a quarter counter-clockwise: the body leaves its clamp upwards on screen

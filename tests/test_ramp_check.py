@@ -165,6 +165,43 @@ def test_a_body_leaving_far_off_its_ramps_direction_is_flagged():
     assert "-30 deg off its ramp's direction" in out["reason"].iloc[11]
 
 
+def test_a_camera_turned_mid_ramp_splits_the_ramp_where_it_turned():
+    # the last 5 photos were taken after the camera (or the clamp) turned by 9 deg: their own
+    # bases agree with each other, not with the first 7; psi from their own run's direction
+    # is right, from the whole ramp's it would be 9 deg off (and `ok`)
+    psi = _ds20_like()
+    base = [0.4, -0.3, 0.1, 0.0, -0.6, 0.2, 0.3, 9.3, 9.5, 8.9, 9.1, 8.6]
+    out = check_ramps(_bodies(psi, base).iloc[::-1])  # in any order: the runs follow the steps
+    out = out.sort_values("step")
+    np.testing.assert_allclose(out["psi_deg"].iloc[:7], np.asarray(psi[:7]) + _moved(base[:7]))
+    np.testing.assert_allclose(out["psi_deg"].iloc[7:], np.asarray(psi[7:]) + _moved(base[7:]))
+    assert float(out["base_direction_deg"].iloc[9]) == pytest.approx(float(np.median(base[7:])))
+    assert out["base_direction_deg"].iloc[7:].nunique() == 1
+    assert (out["status"] == "ok").all(), out["reason"].tolist()
+    assert out["reason"].iloc[7:].str.contains("+9 deg off the ramp's first photos from here on",
+                                               regex=False).all()
+    assert not out["reason"].iloc[:7].str.contains("first photos").any()
+    # a run too short to share (4 photos) keeps each photo's own base, and says why
+    base = [0.4, -0.3, 0.1, 0.0, -0.6, 0.2, 0.3, 0.1, 9.5, 8.9, 9.1, 8.6]
+    out = check_ramps(_bodies(psi, base))
+    np.testing.assert_allclose(out["psi_deg"].iloc[8:], psi[8:])
+    np.testing.assert_allclose(out["base_direction_deg"].iloc[8:], base[8:])
+    assert out["reason"].iloc[8:].str.contains("from these photos' own").all()
+
+
+def _moved(base):
+    """Each photo's own base minus its run's median: what sharing adds to psi."""
+    b = np.asarray(base, float)
+    return b - np.median(b)
+
+
+def test_two_photos_off_the_ramps_direction_are_no_run_of_their_own():
+    base = [0.4, -0.3, 0.1, 0.0, -0.6, 0.2, 0.3, -0.2, 0.5, 6.9, 7.1, 0.0]
+    out = check_ramps(_bodies(_ds20_like(), base))
+    np.testing.assert_allclose(out["base_direction_deg"], np.median(base))
+    assert not out["reason"].str.contains("first photos").any()
+
+
 def test_bases_across_the_wrap_share_their_direction():
     base = [179.0, -179.5, 179.5, -178.0, 178.5, 180.0]
     out = check_ramps(_bodies([100.0, 80.0, 60.0, 40.0, 20.0, 0.0], base))
