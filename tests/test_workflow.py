@@ -379,19 +379,22 @@ def test_a_replaced_photo_is_remeasured_alone_and_a_plain_rerun_after_ctrl_c_fin
         and not (partial.is_dir() and any(partial.iterdir()))
     ):
         time.sleep(0.01)
-    assert run.poll() is None, "the run ended before it could be interrupted"
+    assert run.poll() is None, "the run ended before it could be interrupted: " + (
+        run.communicate()[0][-4000:]
+    )
     os.killpg(run.pid, signal.SIGINT)
     interrupted, _ = run.communicate(timeout=120)
-    assert run.returncode != 0
+    said = interrupted[-4000:]  # what Snakemake printed: the cause, should an assert fail
+    assert run.returncode != 0, said
     only_this_set = {"measure": 1, "aggregate": 1, "compare": 1, "report": 1, "all": 1}
     # what the photo set off
-    assert _planned_jobs(interrupted.split("Terminating")[0]) == only_this_set
+    assert _planned_jobs(interrupted.split("Terminating")[0]) == only_this_set, said
     outputs = re.findall(r"output: (\S+)", interrupted)
     assert "results/datasets/sample/angles.csv," in outputs and not [
         o for o in outputs if "/tiny/" in o
-    ]
-    assert any((work / ".snakemake" / "incomplete").iterdir())  # a job was cut short ...
-    assert not partial.exists()  # ... and its half-written overlays are gone
+    ], said
+    assert any((work / ".snakemake" / "incomplete").iterdir()), said  # a job was cut short ...
+    assert not partial.exists(), said  # ... and its half-written overlays are gone
     out = _snakemake(work, repo, "--cores", "2")  # ... and a plain re-run finishes it
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     assert _planned_jobs(out.stderr) == only_this_set
