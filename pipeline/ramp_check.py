@@ -265,6 +265,7 @@ def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | Non
     rows, n = run.index, len(own)
     shared = float(own[0] + np.median(_wrap_deg(own - own[0])))
     moved = _wrap_deg(own - shared)
+    run_base = shared  # the run's direction, for the note (one outlying photo does not set it)
     if n < BASE_MIN_PHOTOS or float(np.median(np.abs(moved))) > BASE_SPREAD_DEG:
         # too few to share, or they scatter (free strips, a clamp that let go): each its own
         shared, moved = float("nan"), np.zeros(n)
@@ -272,7 +273,7 @@ def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | Non
     setup = (
         ""
         if first_base_deg is None
-        else f"the base direction is {_wrap_deg(np.array(own[0] - first_base_deg)):+.0f} deg off "
+        else f"the base direction is {_wrap_deg(np.array(run_base - first_base_deg)):+.0f} deg off "
         "the ramp's first photos from here on (the camera or the clamp moved?): psi is measured "
         "from these photos' own"
     )
