@@ -5,7 +5,9 @@ After the photos of a set are measured, each ramp (material, actuator, trial) is
 legs (``up`` then ``down``, in step order).  On a leg psi is monotone in pressure, however fast it
 changes (DS20 passes psi = 0 at more than 100 deg per 10 kPa step), so every measured photo
 should lie between its two neighbours on the leg, and an end photo no farther beyond its
-neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in its fastest part):
+neighbour than :data:`END_STEPS` times the neighbouring step (a leg may end in its fastest part),
+or else near an ``ok`` photo of another leg of its ramp at the same pressure (a coarse ramp's
+rest photos: DS20 turns through 300 deg between 0 and 80 kPa, and 70 deg from 80 to 160):
 
 - a photo more than :data:`SLACK_DEG` outside that range is ``flagged``, with the reason
   ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
@@ -179,8 +181,9 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
                         "may be missing or extra",
                     )
         legs = (measured["direction"] != measured["direction"].shift()).cumsum()
-        for _, leg in measured.groupby(legs, sort=False):
-            _check_leg(leg, position, status, reason)
+        for number, leg in measured.groupby(legs, sort=False):
+            others = measured[(legs != number) & (measured["status"] == "ok")]
+            _check_leg(leg, position, status, reason, _same_pressure(leg, others))
     out["status"], out["reason"] = status, reason
     return out
 
@@ -346,7 +349,47 @@ def layer_lengths(measured: pd.DataFrame) -> np.ndarray:
     return best
 
 
-def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np.ndarray) -> None:
+def _same_pressure(leg: pd.DataFrame, others: pd.DataFrame) -> list[np.ndarray]:
+    """psi of the ``others`` (another leg's photos) at each of ``leg``'s photos' pressures.
+
+    Pressures within a quarter of the leg's median step are the same (a rig's measured pressure
+    is not exactly the set point).
+
+    >>> leg = pd.DataFrame({"pressure_kpa": [160.0, 80.0, 0.4], "psi_deg": [-220.0, -150.0, 208.0]})
+    >>> others = pd.DataFrame({"pressure_kpa": [0.0, 80.0], "psi_deg": [210.0, -95.0]})
+    >>> [a.tolist() for a in _same_pressure(leg, others)]
+    [[], [-95.0], [210.0]]
+    """
+    pressure = leg["pressure_kpa"].to_numpy(float)
+    steps = np.abs(np.diff(pressure))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    if not steps.size or others.empty:
+        return [np.empty(0)] * len(leg)
+    near = 0.25 * float(np.median(steps))
+    other_p, other_psi = others["pressure_kpa"].to_numpy(float), others["psi_deg"].to_numpy(float)
+    return [other_psi[np.abs(other_p - p) <= near] for p in pressure]
+
+
+def _allowed_in_leg(
+    psi: np.ndarray, i: int, same_pressure: np.ndarray
+) -> tuple[float, float, float]:
+    """(how far outside, lo, hi): photo ``i`` against its neighbours' range [lo, hi], or for an
+    end photo against the nearest ``ok`` photo of another leg at its pressure, if that is nearer.
+    """
+    lo, hi = _allowed(psi, i)
+    off = _outside(psi[i], lo, hi)
+    if i in (0, len(psi) - 1) and same_pressure.size:
+        off = min(off, float(np.min(np.abs(same_pressure - psi[i]))))
+    return off, lo, hi
+
+
+def _check_leg(
+    leg: pd.DataFrame,
+    position: dict,
+    status: np.ndarray,
+    reason: np.ndarray,
+    same_pressure: list[np.ndarray],
+) -> None:
     """Flag the leg's outliers one at a time (worst first, then check again without it);
     re-trust."""
     keep = list(range(len(leg)))
@@ -354,10 +397,11 @@ def _check_leg(leg: pd.DataFrame, position: dict, status: np.ndarray, reason: np
     doubtful = (leg["status"] != "ok").to_numpy()  # flagged on its own, before the ramp
     while len(keep) >= 3:
         psi = psi_all[keep]
-        breaking = [
-            (_outside(psi[i], *_allowed(psi, i)), i, *_allowed(psi, i)) for i in range(len(keep))
-        ]
-        breaking = [b for b in breaking if b[0] > SLACK_DEG]
+        breaking = []
+        for i in range(len(keep)):
+            off, lo, hi = _allowed_in_leg(psi, i, same_pressure[keep[i]])
+            if off > SLACK_DEG:
+                breaking.append((off, i, lo, hi))
         if not breaking:
             break
         # a photo already doubtful on its own is blamed before one that is not (two photos that

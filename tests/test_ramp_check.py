@@ -229,3 +229,27 @@ def test_failed_rows_and_other_ramps_do_not_share_a_base():
     out = check_ramps(pd.concat([a, b], ignore_index=True))
     np.testing.assert_allclose(out["psi_deg"].dropna(), pd.concat([a, b])["psi_deg"].dropna())
     assert out["status"].iloc[15] == "failed"
+
+
+# a coarse DS20 ramp (80 kPa steps, measured on a rendered 8000x6000 set): it turns through 306 deg
+# from 0 to 80 kPa and 71 deg from 80 to 160, so the rest photo ending the down leg lies far beyond
+# what its neighbours' step allows; the rest photo starting the up leg says it is right
+COARSE_UP, COARSE_DOWN = [210.6, -95.3, -203.7, -251.0], [-226.8, -155.4, 208.6]
+
+
+def test_a_coarse_ramps_rest_photo_that_agrees_with_the_other_legs_is_not_flagged():
+    out = check_ramps(_ramp(COARSE_UP, COARSE_DOWN))
+    assert (out["status"] == "ok").all(), out[["psi_deg", "reason"]]
+
+
+@pytest.mark.parametrize("own_flag", [False, True])
+def test_a_coarse_ramps_rest_photo_is_flagged_when_the_other_legs_disagree_or_are_doubtful(
+    own_flag,
+):
+    down = [*COARSE_DOWN[:2], -208.6] if not own_flag else COARSE_DOWN
+    df = _ramp(COARSE_UP, down)
+    if own_flag:  # the up leg's rest photo, flagged on its own, vouches for nothing
+        df.loc[0, ["status", "reason"]] = ["flagged", "body partly hidden"]
+    out = check_ramps(df)
+    assert out["status"].iloc[-1] == "flagged"
+    assert out["reason"].iloc[-1].startswith("breaks its ramp"), out["reason"].iloc[-1]
