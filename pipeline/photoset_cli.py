@@ -282,11 +282,10 @@ def _init(args: argparse.Namespace) -> int:
 
 
 def _pick(args: argparse.Namespace) -> int:
-    import cv2
-
     from pipeline.measure.colors import color_mask, pick_color
+    from pipeline.measure.formats import read_image
 
-    img = cv2.imread(args.image, cv2.IMREAD_COLOR)
+    img = read_image(args.image)
     if img is None:
         raise UserInputError(f"{args.image}: cannot be read as an image")
     x, y = _xy(args.at, "--at")

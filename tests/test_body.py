@@ -602,3 +602,29 @@ def test_a_body_reports_the_direction_it_leaves_the_fixed_end_in_psis_sense(turn
     # with the direction given, or on a drawn line, there is nothing to share
     given = measure_image(turned, settings_for(fixed_end, fixed_direction_deg=90.0))
     assert np.isnan(given.base_direction_deg)
+
+
+@pytest.mark.parametrize("bits", [10, 12, 16])
+def test_a_scientific_cameras_16_bit_photo_is_measured_and_picked_like_its_8_bit_export(
+    tmp_path, capsys, bits
+):
+    # a 16-bit PNG holding 10 or 12 bits: OpenCV's 8-bit decoding keeps the top 8 of 16 bits, so
+    # 12-bit data came out in grey levels 0-15 (on a rendered 720p ramp set: 37 ok and right of 38
+    # as 8-bit JPEGs, 27 as 12-bit PNGs with 10 flagged; now 36)
+    from pipeline.cli import main
+    from pipeline.measure.core import measure_file
+
+    img, fe, _ = body_photo(-120.0, texture=True, seed=4)
+    cv2.imwrite(str(tmp_path / "eight.png"), img)
+    scale = ((1 << bits) - 1) / 255.0
+    cv2.imwrite(str(tmp_path / "wide.png"), np.round(img * scale).astype(np.uint16))
+    eight, _ = measure_file(tmp_path / "eight.png", settings_for(fe))
+    wide, _ = measure_file(tmp_path / "wide.png", settings_for(fe))
+    assert eight.status == wide.status == "ok", (eight.reason, wide.reason)
+    assert abs(wide.psi_deg - eight.psi_deg) < 0.5 and abs(wide.psi_deg + 120.0) < 2.5
+    on_body = f"{fe[0] + 40:.0f},{fe[1] - 23:.0f}"
+    picked = []
+    for name in ("eight.png", "wide.png"):
+        assert main(["photoset", "pick-color", str(tmp_path / name), "--at", on_body]) == 0
+        picked.append(capsys.readouterr().out.splitlines()[0])
+    assert picked[0] == picked[1] and picked[0].startswith("line_color:"), picked

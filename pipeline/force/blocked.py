@@ -34,6 +34,7 @@ import pandas as pd
 
 from pipeline.force.ellipse import EllipseFit, Refine, fit_ellipse
 from pipeline.measure.colors import BLACK, ColorSpec
+from pipeline.measure.formats import read_image
 from pipeline.measure.settings import MeasureSettings
 
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -271,18 +272,6 @@ def measure_blocked_image(
     )
 
 
-def _read_image(path: Path) -> np.ndarray | None:
-    import cv2
-
-    try:
-        data = np.fromfile(str(path), dtype=np.uint8)
-    except OSError:
-        return None
-    if data.size == 0:
-        return None
-    return cv2.imdecode(data, cv2.IMREAD_COLOR)
-
-
 @dataclass(frozen=True)
 class _Task:
     path: str
@@ -301,7 +290,7 @@ def _measure_row(task: _Task) -> dict[str, Any]:
         result = _failed(f"image file {p.name} not found")
     else:
         result = measure_blocked_image(
-            _read_image(p), task.settings, refine=task.refine, **task.fit_options
+            read_image(p), task.settings, refine=task.refine, **task.fit_options
         )
     row = result.row()
     row["seconds"] = round(time.perf_counter() - t0, 4)

@@ -56,7 +56,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pipeline.measure.formats import undecodable
+from pipeline.measure.formats import read_image, undecodable
 
 #: a calibration whose reprojection error is above this (px) is doubtful: every row using it is
 #: flagged
@@ -356,8 +356,7 @@ def calibrate_files(
     corners, size = [], None
     for path in boards:
         name = Path(path).name
-        data = np.fromfile(str(path), np.uint8)
-        decoded = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE) if data.size else None
+        decoded = read_image(path, grey=True)
         if decoded is None:
             raise CalibrationError(
                 "calibration board photo {!r} cannot be decoded ({}; {})".format(

@@ -36,7 +36,7 @@ from pipeline.measure.estimators import (
     turning_quick,
 )
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
-from pipeline.measure.formats import undecodable
+from pipeline.measure.formats import decode_image, read_image, undecodable
 from pipeline.measure.quality import RIDGE_TIP_DEG, Quality, assess, assess_body
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
@@ -324,7 +324,7 @@ def plane_centreline(
 def load_background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
     """The empty-scene photo, resized to the work image (cached per worker: one decode), or why
     it cannot be used."""
-    img = cv2.imread(path, cv2.IMREAD_COLOR)
+    img = read_image(path)
     name = Path(path).name
     if img is None:
         return "background photo {} cannot be decoded ({}; {})".format(name, *undecodable(name))
@@ -669,7 +669,7 @@ def decode_for_work(
     if size is not None:
         f = factor if factor is not None else reduction_for(size[0], work_width_px)
         return cv2.imdecode(data, (_REDUCED_GREY if grey else _REDUCED)[f]), f
-    img = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE if grey else cv2.IMREAD_COLOR)
+    img = decode_image(data, grey)
     if img is None:
         return None, 1
     f = factor if factor is not None else reduction_for(img.shape[1], work_width_px)

@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.measure.formats import read_image
 from pipeline.report.data import Dataset, ReportData, mixed_materials
 
 #: photos per strip
@@ -112,8 +113,7 @@ def load_thumbnail(
     """
     if not path.is_file():
         return None
-    data = np.fromfile(str(path), dtype=np.uint8)
-    bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    bgr = read_image(path)
     if bgr is None:
         return None
     h, w = bgr.shape[:2]
