@@ -33,7 +33,7 @@ import functools
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 import numpy as np
@@ -100,7 +100,23 @@ _TEXT_COLUMNS = (
     "frame_times",
 )
 
-IMAGE_SUFFIXES: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp")
+#: photo files OpenCV reads (formats.py names the ones it cannot)
+IMAGE_SUFFIXES: tuple[str, ...] = (
+    ".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp", ".avif", ".jp2"
+)
+
+
+def overlay_name(image: str) -> str:
+    """The overlay file of a manifest's photo, relative to the overlays folder: the photo's own
+    path in the set, as a JPEG (photos in subfolders keep them: two subfolders may hold photos of
+    the same name).
+
+    Examples
+    --------
+    >>> overlay_name("DS20_A1_t1_0kPa.png"), overlay_name("chamber2/00_0kPa_up.jpg")
+    ('DS20_A1_t1_0kPa.jpg', 'chamber2/00_0kPa_up.jpg')
+    """
+    return PurePosixPath(str(image).replace("\\", "/")).with_suffix(".jpg").as_posix()
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             "DIR. "
             "Fields: {pressure_kpa} (kPa; '12p5' means 12.5), {direction} (up/down, inc/dec), "
             "{trial}, {actuator}, {material}, {step}, {_} or * (ignored). Without {direction}, "
-            "photos before the highest pressure of each ramp are 'up', after it 'down'."
+            "photos before the highest pressure of each ramp are 'up', after it 'down'. A "
+            "pattern with '/' matches the photos' paths in DIR's subfolders, e.g. "
+            "'chamber{actuator}/{step}_{pressure_kpa}kPa.jpg'."
         ),
     )
     init.add_argument("folder", metavar="DIR", help="folder holding the photos")

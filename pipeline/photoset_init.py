@@ -87,6 +87,31 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
     return re.compile("".join(out) + r"\Z")
 
 
+def photo_names(folder: Path, subfolders: bool = False) -> list[str]:
+    """The photos of ``folder`` by name, sorted; with ``subfolders``, also those in its
+    subfolders, by their path in it (``chamber2/00_0kPa.jpg``). Hidden files and folders are left
+    out.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("b.jpg", "a.PNG", "c2/a.jpg", ".x/d.jpg", "notes.txt"):
+    ...     (root / name).parent.mkdir(exist_ok=True)
+    ...     _ = (root / name).write_bytes(b"")
+    >>> photo_names(root), photo_names(root, subfolders=True)
+    (['a.PNG', 'b.jpg'], ['a.PNG', 'b.jpg', 'c2/a.jpg'])
+    """
+    paths = folder.rglob("*") if subfolders else folder.iterdir()
+    return sorted(
+        p.relative_to(folder).as_posix()
+        for p in paths
+        if p.is_file()
+        and p.suffix.lower() in IMAGE_SUFFIXES
+        and not any(part.startswith(".") for part in p.relative_to(folder).parts)
+    )
+
+
 def init_photoset(
     folder: str | os.PathLike[str],
     pattern: str,
@@ -133,18 +158,18 @@ def init_photoset(
     regex = pattern_to_regex(pattern)
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     rows, unmatched = [], []
-    for path in sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES):
-        m = regex.match(path.name)
+    for name in photo_names(folder, subfolders="/" in pattern):
+        m = regex.match(name)
         if not m:
-            unmatched.append(path.name)
+            unmatched.append(name)
             continue
         fields = m.groupdict()
-        row: dict[str, Any] = {"image": path.name}
+        row: dict[str, Any] = {"image": name}
         for key in ("material", "actuator", "trial"):
             row[key] = fields.get(key) or defaults.get(key)
             if row[key] is None:
                 raise UserInputError(
-                    f"{path.name}: no {key} in the file name and no default; pass --{key}"
+                    f"{name}: no {key} in the file name and no default; pass --{key}"
                 )
         row["pressure_kpa"] = float(fields["pressure_kpa"].replace("p", "."))
         if fields.get("step") is not None:
@@ -155,13 +180,17 @@ def init_photoset(
             word = fields["direction"].lower()
             if word not in _DIRECTION_WORDS:
                 raise UserInputError(
-                    f"{path.name}: direction {fields['direction']!r} unknown; use up/down (or "
+                    f"{name}: direction {fields['direction']!r} unknown; use up/down (or "
                     "inc/dec)"
                 )
             row["direction"] = _DIRECTION_WORDS[word]
         rows.append(row)
     if not rows:
-        unreadable = sorted(p.name for p in folder.iterdir() if unreadable_format(p.name))
+        unreadable = sorted(
+            p.relative_to(folder).as_posix()
+            for p in (folder.rglob("*") if "/" in pattern else folder.iterdir())
+            if unreadable_format(p.name)
+        )
         raise UserInputError(
             f"no image in {folder} matches pattern {pattern!r}"
             + (f" (e.g. {unmatched[0]!r} does not)" if unmatched else " (no images found)")

@@ -20,7 +20,7 @@ from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
 from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task, run_task
-from pipeline.photoset import PhotoSet, load_photoset
+from pipeline.photoset import PhotoSet, load_photoset, overlay_name
 from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
 
@@ -67,7 +67,7 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
         zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])
     ):
         image = str(image)
-        overlay = None if overlays_dir is None else str(overlays_dir / f"{Path(image).stem}.jpg")
+        overlay = None if overlays_dir is None else str(overlays_dir / overlay_name(image))
         title = f"{image}  {pressure:g} kPa {direction}"
         row = ps.rows[i]
         cal = None if row is None else row.calibration
@@ -158,7 +158,7 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
         drawn.loc[changed, "reason"],
         strict=True,
     ):
-        path = overlays_dir / f"{Path(str(image)).stem}.jpg"
+        path = overlays_dir / overlay_name(str(image))
         img = cv2.imread(str(path))
         if img is None:
             continue
@@ -232,7 +232,7 @@ def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]
             if not paths:
                 continue
         else:
-            paths = [overlays_dir / f"{Path(str(i)).stem}.jpg" for i in g["image"]]
+            paths = [overlays_dir / overlay_name(str(i)) for i in g["image"]]
         sheet = contact_sheet(paths)
         ok, buf = cv2.imencode(".jpg", sheet, [cv2.IMWRITE_JPEG_QUALITY, 85])
         if ok:

@@ -198,3 +198,43 @@ def test_folder_hsv_range_fills_rows_without_their_own_colour(photo_folder):
     assert all(
         r.color.ranges == (((0, 0, 0), (179, 255, 60)),) and not r.color.dark_line for r in rows[1:]
     )
+
+
+def test_photos_in_subfolders_with_the_same_names_keep_their_own_rows_and_overlays(tmp_path):
+    # a lab's three-chamber ramps, one subfolder a chamber, the same file names in each: init
+    # reads a pattern with '/', and each photo gets its own overlay (they were keyed by the
+    # file's stem, so chamber 2's overwrote chamber 1's); chamber 2 is WebP, which init now lists
+    import cv2
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("clean", width=480, height=360)
+    psi = {"1": [200.0, 60.0, -100.0], "2": [200.0, 120.0, 10.0]}
+    for chamber, ext in (("1", "jpg"), ("2", "webp")):
+        (tmp_path / f"chamber{chamber}").mkdir()
+        for step, (kpa, angle) in enumerate(zip((0, 20, 40), psi[chamber])):
+            r = render_actuator(angle, 200.0, scene, seed=step)
+            img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+            cv2.imwrite(str(tmp_path / f"chamber{chamber}" / f"s{step}_{kpa}kPa.{ext}"), img)
+    df = photoset_init.init_photoset(
+        tmp_path, "chamber{actuator}/s{step}_{pressure_kpa}kPa.*", defaults={"material": "DS20"},
+        settings={"l0_mm": 200.0},
+    )
+    assert sorted(df["image"]) == [
+        f"chamber{c}/s{k}_{p}kPa.{e}" for c, e in (("1", "jpg"), ("2", "webp"))
+        for k, p in enumerate((0, 20, 40))
+    ]
+    assert ps.validate_photoset(tmp_path) == []
+    angles = measure_photoset(tmp_path, overlays_dir=tmp_path / "ov", ramp_check=False)
+    assert (angles["status"] == "ok").all(), angles[["image", "reason"]]
+    for chamber in ("1", "2"):
+        got = angles[angles["actuator"] == chamber].sort_values("step")["psi_deg"]
+        assert np.allclose(got, psi[chamber], atol=3.0), (chamber, got.tolist())
+    ov = tmp_path / "ov"
+    overlays = sorted(p.relative_to(ov).as_posix() for p in ov.rglob("s*"))
+    assert overlays == [
+        f"chamber{c}/s{k}_{p}kPa.jpg" for c in "12" for k, p in enumerate((0, 20, 40))
+    ]
+    one, two = (cv2.imread(str(tmp_path / "ov" / f"chamber{c}" / "s2_40kPa.jpg")) for c in "12")
+    assert one is not None and two is not None and np.abs(one.astype(int) - two).mean() > 1.0

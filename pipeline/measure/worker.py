@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -83,6 +84,7 @@ def write_overlay(
     if base.ndim == 2:
         base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
     out = draw_overlay(base, res, scale=float(factor) if img is not None else 1.0, title=title)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)  # a photo in a subfolder of its set
     cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
 
 

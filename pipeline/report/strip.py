@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.measure.formats import read_image
+from pipeline.photoset import overlay_name
 from pipeline.report.data import Dataset, ReportData, mixed_materials
 
 #: photos per strip
@@ -221,7 +222,7 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
         image, source = None, "missing"
         if dataset.overlays_dir is not None:
             image = load_thumbnail(
-                dataset.overlays_dir / (Path(str(row["image"])).stem + ".jpg"), banner=True
+                dataset.overlays_dir / overlay_name(str(row["image"])), banner=True
             )
             source = "overlay" if image is not None else source
         if image is None and dataset.photoset_dir is not None:
