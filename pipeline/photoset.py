@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import functools
 import os
-from collections.abc import Iterable, Mapping
+from collections import Counter
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
@@ -663,6 +664,7 @@ def file_problems(
             )
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
+    problems += size_problems(mpath, images, sizes)
     problems += _calibration_problems(ps)
     unscaled = [
         r for r in ps.rows if r is not None and r.mm_per_px is None and r.calibration is None
@@ -715,6 +717,45 @@ def file_problems(
             )
         )
     return problems
+
+
+def size_problems(
+    manifest: str,
+    images: Sequence[tuple[int, str]],
+    sizes: Mapping[str, tuple[int, int] | None],
+) -> list[Problem]:
+    """A warning for each photo whose size differs from most of its set's: ``fixed_end``,
+    ``roi``, ``exclude``, the background photo and ``mm_per_px`` are pixels of one framing.
+
+    Examples
+    --------
+    >>> sizes = {"a.jpg": (1280, 960), "b.jpg": (960, 1280), "c.jpg": (1280, 960)}
+    >>> [p.line for p in size_problems("m.csv", [(2, "a.jpg"), (3, "b.jpg"), (4, "c.jpg")], sizes)]
+    [3]
+    """
+    known: list[tuple[int, str, tuple[int, int]]] = []
+    for line, image in images:
+        size = sizes.get(str(image))
+        if size is not None:
+            known.append((line, str(image), size))
+    counts = Counter(size for _, _, size in known)
+    if len(counts) < 2:
+        return []
+    (w, h), n = counts.most_common(1)[0]
+    return [
+        Problem(
+            manifest,
+            int(line),
+            f"image {image!r} is {size[0]}x{size[1]} px where {n} photos of the set are {w}x{h}: "
+            "fixed_end, roi, exclude, the background photo and mm_per_px are pixels of one "
+            "framing (a cropped or resized photo, or a phone turned to portrait?)",
+            f"use the photo as taken, at {w}x{h}, or give this row its own fixed_end (and "
+            "mm_per_px) in manifest.csv",
+            warning=True,
+        )
+        for line, image, size in known
+        if size != (w, h)
+    ]
 
 
 def validate_photoset(

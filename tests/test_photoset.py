@@ -238,3 +238,20 @@ def test_photos_in_subfolders_with_the_same_names_keep_their_own_rows_and_overla
     ]
     one, two = (cv2.imread(str(tmp_path / "ov" / f"chamber{c}" / "s2_40kPa.jpg")) for c in "12")
     assert one is not None and two is not None and np.abs(one.astype(int) - two).mean() > 1.0
+
+
+def test_a_photo_of_another_size_than_its_set_is_named_by_check(photo_folder):
+    # fixed_end, roi, exclude and mm_per_px are pixels of one framing: a phone turned to portrait
+    # or a cropped photo puts them elsewhere (measure flagged such photos "no body reaches
+    # fixed_end", without saying why)
+    import cv2
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    assert not [p for p in ps.validate_photoset(photo_folder, warnings=True) if p.line]
+    turned = "DS30_A2_t1_s02_20kPa.jpg"
+    cv2.imwrite(str(photo_folder / turned), np.full((32, 24, 3), 200, np.uint8))
+    sized = [p for p in ps.validate_photoset(photo_folder, warnings=True) if "framing" in p.message]
+    assert len(sized) == 1 and sized[0].warning and sized[0].line == 4, sized
+    assert f"image {turned!r} is 24x32 px where 7 photos of the set are 32x24" in sized[0].message
+    assert "manifest.csv" in sized[0].file and "32x24" in sized[0].fix
+    assert ps.validate_photoset(photo_folder) == []  # a warning: the set is still measured
