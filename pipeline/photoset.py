@@ -712,7 +712,7 @@ def file_problems(
                 "runs on into a sealed end or cap; on rendered bodies one of 8-12 mm read |psi| "
                 "above 150 deg 5-7 deg high",
                 "measure the actuator's end that does not bend (from where the chamber ends to the "
-                "tip, cap included) and set sealed_end_mm (with mm_per_px)",
+                "tip, cap included) and set sealed_end_mm",
                 warning=True,
             )
         )

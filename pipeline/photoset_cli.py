@@ -70,8 +70,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--sealed-end-mm",
         type=float,
         help="body: length of the actuator's end that does not bend, from where its chamber ends "
-             "to its tip (sealed end and cap), mm (needs --mm-per-px; recommended: without it a "
-             "long sealed end reads |psi| high)",
+             "to its tip (sealed end and cap), mm (recommended: without it a long sealed end "
+             "reads |psi| high; without --mm-per-px it is scaled by the body's length against "
+             "l0_mm + this)",
     )
     init.add_argument(
         "--background",

@@ -428,11 +428,12 @@ def test_a_fixed_end_moved_into_the_clamp_moves_the_bench_cases():
     assert "no body reaches fixed_end" in moved["reason"].iloc[0]
 
 
-def _long_sealed_end_cases(give: bool):
+def _long_sealed_end_cases(give: bool, scale: bool = True):
     from pipeline.bench.realscenes import body_cases
 
     return body_cases(
-        4, scenes=("grey_dots", "lab_body"), sealed_end_mm=12.0, give_sealed_end=give, seed=31
+        4, scenes=("grey_dots", "lab_body"), sealed_end_mm=12.0, give_sealed_end=give, seed=31,
+        give_scale=scale,
     )
 
 
@@ -446,6 +447,11 @@ def test_a_long_sealed_end_read_where_the_bending_stops_when_its_length_is_given
     assert over[big].median() > 4.0
     assert (given["status"] == "ok").all(), given["reason"].tolist()
     assert given["error_deg"].abs().max() < 5.5 and given["error_deg"].abs().median() < 2.0
+    # without mm_per_px it is turned into pixels with the body's length against l0_mm +
+    # sealed_end_mm (it was refused: "needs the image scale")
+    unscaled = _long_sealed_end_cases(True, scale=False)
+    assert (unscaled["status"] == "ok").all(), unscaled["reason"].tolist()
+    assert unscaled["error_deg"].abs().max() < 5.5 and unscaled["error_deg"].abs().median() < 2.0
 
 
 def test_the_bodys_shadow_is_not_selected_with_a_background_photo(tmp_path):

@@ -335,7 +335,6 @@ def test_each_kind_of_bad_row_fails_alone_and_the_rest_is_measured(small_set, tm
         ({"sealed_end_mm": -2, "mm_per_px": 0.3}, "must be a length >= 0"),
         ({"sealed_end_mm": "abc", "mm_per_px": 0.3}, "must be a length >= 0"),
         ({"sealed_end_mm": True, "mm_per_px": 0.3}, "must be a length >= 0"),
-        ({"sealed_end_mm": 8}, "needs the image scale"),
         ({"sealed_end_mm": 8, "mm_per_px": 0.3, "free_end": "bends"}, "an end that bends"),
     ],
 )
@@ -345,9 +344,11 @@ def test_a_sealed_end_that_cannot_be_used_is_a_problem_naming_the_key(raw, messa
     assert [p.key for p in problems] == ["sealed_end_mm"] and message in problems[0].message
 
 
-def test_a_sealed_end_on_a_line_row_needs_no_scale():
-    # a line does not use it (check warns of that), so a missing scale is no problem there
-    settings, problems = settings_problems({"l0_mm": 200, "sealed_end_mm": 8})
+@pytest.mark.parametrize("target", ["line", "body"])
+def test_a_sealed_end_needs_no_scale(target):
+    # a line does not use it (check warns of that); a body without mm_per_px turns it into pixels
+    # with its length against l0_mm + sealed_end_mm (tests/test_body.py measures that)
+    settings, problems = settings_problems({"l0_mm": 200, "sealed_end_mm": 8, "target": target})
     assert problems == [] and settings is not None and settings.sealed_end_mm == 8.0
 
 

@@ -91,6 +91,7 @@ def body_cases(
     fixed_end_offset_px: tuple[float, float] = (0.0, 0.0),
     sealed_end_mm: float | None = None,
     give_sealed_end: bool = False,
+    give_scale: bool = True,
     background: bool = False,
     background_exposure: float = 1.0,
     scene_set: dict[str, Any] | None = None,
@@ -121,6 +122,9 @@ def body_cases(
     give_sealed_end : bool
         Also give ``sealed_end_mm`` (the scene's sealed end plus its tip cap, as the user who
         built the actuator knows it) and ``mm_per_px`` (the scene's).
+    give_scale : bool
+        With ``give_sealed_end``: give ``mm_per_px`` too (else the sealed end is turned into
+        pixels with the body's length against ``l0_mm + sealed_end_mm``).
     background : bool
         Also give each photo its empty scene (``background``: same camera and light, its own
         noise; passed through ``camera`` too).
@@ -168,7 +172,8 @@ def body_cases(
                 extra["fixed_direction_deg"] = r.fixed_direction_deg
             if give_sealed_end:
                 extra["sealed_end_mm"] = scene.sealed_end_mm + scene.tip_cap_mm
-                extra["mm_per_px"] = scene.mm_per_px
+                if give_scale:
+                    extra["mm_per_px"] = scene.mm_per_px
             fixed_end = [float(v) + o for v, o in zip(r.fixed_end_px, fixed_end_offset_px)]
             settings = resolve_settings(l0_mm=270.0, target="body", fixed_end=fixed_end, **extra)
             t0 = time.perf_counter()
@@ -280,6 +285,12 @@ def main(argv: Sequence[str] | None = None) -> int:
              "mm_per_px, as a user who knows the actuator writes them",
     )
     parser.add_argument(
+        "--no-scale",
+        action="store_true",
+        help="with --give-sealed-end: give no mm_per_px (the sealed end is then turned into "
+             "pixels with the body's length against l0_mm + sealed_end_mm)",
+    )
+    parser.add_argument(
         "--background",
         action="store_true",
         help="give each analogue its empty-scene photo (background:), as a user who took one",
@@ -360,7 +371,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         df = body_cases(
             args.n, seed=args.seed, width=width, height=height, fixed_direction=fixed,
             camera=args.camera, fixed_end_offset_px=(dx, dy), sealed_end_mm=args.sealed_end_mm,
-            give_sealed_end=args.give_sealed_end, background=args.background,
+            give_sealed_end=args.give_sealed_end, give_scale=not args.no_scale,
+            background=args.background,
             background_exposure=gain, scene_set=scene_set, shared_base=not args.own_base,
         )
         print(
@@ -370,6 +382,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{'' if (dx, dy) == (0.0, 0.0) else f', fixed end moved by ({dx:g}, {dy:g}) px'}"
             f"{'' if args.sealed_end_mm is None else f', sealed end {args.sealed_end_mm:g} mm'}"
             f"{', sealed_end_mm given' if args.give_sealed_end else ''}"
+            f"{' without mm_per_px' if args.give_sealed_end and args.no_scale else ''}"
             f"{', background photo given' if args.background else ''}"
             f"{''.join(f', {k}={v}' for k, v in scene_set.items())}"
             f"{f' at {gain:g}x exposure' if gain != 1 else ''}"

@@ -382,9 +382,12 @@ def measure_body(
         return failed(method, str(exc))
     sealed_px = 0.0  # the known sealed end, image px
     if settings.sealed_end_mm is not None:
-        assert settings.mm_per_px is not None  # settings: sealed_end_mm needs a scale
         per_image_px = _work_per_image_px(line, pts)
-        sealed_px = settings.sealed_end_mm / settings.mm_per_px / per_image_px
+        mm_per_work_px = settings.mm_per_px or length_scale_mm_per_px(
+            float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) + body.tip_face_px * per_image_px,
+            settings.l0_mm + settings.sealed_end_mm,
+        )
+        sealed_px = settings.sealed_end_mm / mm_per_work_px / per_image_px
         ends = _read_before_sealed_end(body.tip_face_px, ends, sealed_px, per_image_px)
     rng = np.random.default_rng(SEED)
     base = (
@@ -489,6 +492,23 @@ def _work_per_image_px(line: LineExtraction, points: NDArray[np.float64]) -> flo
     image_len = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
     work_len = float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
     return work_len / image_len if image_len > 0 else 1.0
+
+
+def length_scale_mm_per_px(body_px: float, body_mm: float) -> float:
+    """The scale of a photo without ``mm_per_px``: the body's length along its centre line, from
+    the fixed end to its tip's face, against its length in mm (``l0_mm + sealed_end_mm``).
+
+    The centre line runs half the body's width beside the layer that does not stretch, so as the
+    body bends it is shorter (bending towards its own side) or longer than that layer: by 10 %
+    for a body 1/20 as wide as it is long at psi = 220 deg. The scale is used for the sealed end
+    only, whose read-off place it moves by as much (a pixel or two).
+
+    Examples
+    --------
+    >>> length_scale_mm_per_px(1000.0, 300.0)
+    0.3
+    """
+    return body_mm / body_px if body_px > 0 else float("nan")
 
 
 def _read_before_sealed_end(

@@ -472,24 +472,21 @@ def _calibration(
 
 
 def _sealed_end(
-    raw: Mapping[str, Any],
-    problems: list[SettingProblem],
-    free_end: str,
-    mpp: float | None,
-    target: str = "body",
+    raw: Mapping[str, Any], problems: list[SettingProblem], free_end: str
 ) -> float | None:
     """``sealed_end_mm`` as a length >= 0 (mm), or None when not given; a problem when it is no
-    such length, when the body's end bends (``free_end: bends``) or when a body has no scale to
-    turn it into pixels (a line does not use it: ``photoset check`` warns of that instead).
+    such length or when the body's end bends (``free_end: bends``). Without ``mm_per_px`` it is
+    turned into pixels with the body's length against ``l0_mm + sealed_end_mm``
+    (:func:`pipeline.measure.core.length_scale_mm_per_px`); a line does not use it
+    (``photoset check`` warns of that instead).
 
     Examples
     --------
     >>> problems = []
-    >>> _sealed_end({"sealed_end_mm": "8"}, problems, "capped", 0.3), problems
+    >>> _sealed_end({"sealed_end_mm": "8"}, problems, "capped"), problems
     (8.0, [])
-    >>> _sealed_end({"sealed_end_mm": 8}, problems, "capped", None)
-    >>> problems[0].fix
-    'give mm_per_px (or a calibration): the length is turned into pixels with it'
+    >>> _sealed_end({"sealed_end_mm": 8}, problems, "bends"), problems[0].key
+    (None, 'sealed_end_mm')
     """
     value: Any = raw.get("sealed_end_mm")
     if is_missing(value):
@@ -514,15 +511,6 @@ def _sealed_end(
                 "sealed_end_mm is given but free_end is 'bends' (an end that bends has no sealed "
                 "end)",
                 "leave sealed_end_mm out, or use free_end: capped",
-            )
-        )
-        return None
-    if mpp is None and is_missing(raw.get("calibration")) and target == "body":
-        problems.append(
-            SettingProblem(
-                "sealed_end_mm",
-                f"sealed_end_mm = {value!r} needs the image scale",
-                "give mm_per_px (or a calibration): the length is turned into pixels with it",
             )
         )
         return None
@@ -603,7 +591,7 @@ def settings_problems(
         "use 'capped' (a sealed end that does not bend) or 'bends' (a free strip that bends right "
         "to its cut end)",
     )
-    sealed_end = _sealed_end(raw, problems, free_end, mpp, target)
+    sealed_end = _sealed_end(raw, problems, free_end)
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
