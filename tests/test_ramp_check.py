@@ -253,3 +253,17 @@ def test_a_coarse_ramps_rest_photo_is_flagged_when_the_other_legs_disagree_or_ar
     out = check_ramps(df)
     assert out["status"].iloc[-1] == "flagged"
     assert out["reason"].iloc[-1].startswith("breaks its ramp"), out["reason"].iloc[-1]
+
+
+def test_two_doubtful_photos_read_wrong_alike_do_not_outvote_a_right_one_between_them():
+    # measured on a rendered 720p ramp with one photo resized and the next cropped: both were
+    # flagged on their own ("no body reaches fixed_end") and read +181, which made the right
+    # photo before them (+108) "break its ramp"; a photo ok on its own is judged by neighbours
+    # ok on their own
+    up = [210.0, 176.8, 108.4, 181.4, 180.7, -138.1, -160.0, -180.0]
+    df = _ramp(up)
+    df.loc[[3, 4], ["status", "reason"]] = ["flagged", "no body reaches fixed_end"]
+    out = check_ramps(df)
+    assert out.loc[2, "status"] == "ok", out[["psi_deg", "status", "reason"]]
+    assert (out.loc[[0, 1, 5, 6, 7], "status"] == "ok").all()
+    assert (out.loc[[3, 4], "status"] == "flagged").all()
