@@ -107,6 +107,31 @@ IMAGE_SUFFIXES: tuple[str, ...] = (
 )
 
 
+def photo_names(folder: Path, subfolders: bool = False) -> list[str]:
+    """The photos of ``folder`` by name, sorted; with ``subfolders``, also those in its
+    subfolders, by their path in it (``chamber2/00_0kPa.jpg``). Hidden files and folders are left
+    out.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("b.jpg", "a.PNG", "c2/a.jpg", ".x/d.jpg", "notes.txt"):
+    ...     (root / name).parent.mkdir(exist_ok=True)
+    ...     _ = (root / name).write_bytes(b"")
+    >>> photo_names(root), photo_names(root, subfolders=True)
+    (['a.PNG', 'b.jpg'], ['a.PNG', 'b.jpg', 'c2/a.jpg'])
+    """
+    paths = folder.rglob("*") if subfolders else folder.iterdir()
+    return sorted(
+        p.relative_to(folder).as_posix()
+        for p in paths
+        if p.is_file()
+        and p.suffix.lower() in IMAGE_SUFFIXES
+        and not any(part.startswith(".") for part in p.relative_to(folder).parts)
+    )
+
+
 def overlay_name(image: str) -> str:
     """The overlay file of a manifest's photo, relative to the overlays folder: the photo's own
     path in the set, as a JPEG (photos in subfolders keep them: two subfolders may hold photos of
@@ -263,26 +288,10 @@ def is_video_manifest(manifest: pd.DataFrame) -> bool:
     return "video" in manifest.columns and "image" not in manifest.columns
 
 
-def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
-    """Files outside ``folder`` that its settings name: a ``background`` photo or calibration
-    board photos given as ``../...`` or an absolute path, in ``photoset.yaml`` or a
-    ``manifest.csv`` column.
-
-    The workflow digests them with the folder, so replacing such a file re-measures the set
-    (results are never stale).  Read leniently: a set whose files cannot be parsed names nothing
-    here (``measure`` and ``check`` report it); paths that do not exist are left out.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> root = Path(tempfile.mkdtemp()); (root / "set").mkdir()
-    >>> for name in ("empty.jpg", "set/board.jpg"):
-    ...     _ = (root / name).write_bytes(b"x")
-    >>> _ = (root / "set" / SETTINGS).write_text(
-    ...     "background: ../empty.jpg\\ncalibration: {board: [board.jpg], square_mm: 5}\\n")
-    >>> [p.name for p in referenced_files(root / "set")]
-    ['empty.jpg']
-    """
+def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
+    """Every existing file a set's settings name (a ``background`` photo, calibration board
+    photos; in ``photoset.yaml`` or a ``manifest.csv`` column), resolved, inside the folder or
+    not. Read leniently: a set whose files cannot be parsed names nothing here."""
     folder = Path(folder)
     values: list[Any] = []
     try:
@@ -309,15 +318,37 @@ def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
             value = value.get("board")
         items = [value] if isinstance(value, str) else value if isinstance(value, list) else []
         names += [v for v in items if isinstance(v, str)]
-    inside = folder.resolve()
-    found = {
+    return frozenset(
         path.resolve()
         for name in names
         if name.strip()
         for path in [folder / name.strip()]  # an absolute name stays absolute
         if path.is_file()
-    }
-    return tuple(sorted(p for p in found if not p.is_relative_to(inside)))
+    )
+
+
+def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
+    """Files outside ``folder`` that its settings name: a ``background`` photo or calibration
+    board photos given as ``../...`` or an absolute path, in ``photoset.yaml`` or a
+    ``manifest.csv`` column.
+
+    The workflow digests them with the folder, so replacing such a file re-measures the set
+    (results are never stale).  Read leniently: a set whose files cannot be parsed names nothing
+    here (``measure`` and ``check`` report it); paths that do not exist are left out.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp()); (root / "set").mkdir()
+    >>> for name in ("empty.jpg", "set/board.jpg"):
+    ...     _ = (root / name).write_bytes(b"x")
+    >>> _ = (root / "set" / SETTINGS).write_text(
+    ...     "background: ../empty.jpg\\ncalibration: {board: [board.jpg], square_mm: 5}\\n")
+    >>> [p.name for p in referenced_files(root / "set")]
+    ['empty.jpg']
+    """
+    inside = Path(folder).resolve()
+    return tuple(sorted(p for p in named_files(folder) if not p.is_relative_to(inside)))
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
@@ -664,7 +695,17 @@ def file_problems(
             )
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
-    problems += size_problems(mpath, images, sizes)
+    own_fixed_end = (
+        {int(line) for line, v in zip(ps.manifest["manifest_line"], ps.manifest["fixed_end"])
+         if not is_missing(v)}
+        if "fixed_end" in ps.manifest.columns
+        else set()
+    )
+    problems += size_problems(
+        mpath, [(line, image) for line, image in images if int(line) not in own_fixed_end], sizes
+    )
+    if not ps.is_video:
+        problems += unlisted_problems(ps)
     problems += _calibration_problems(ps)
     unscaled = [
         r for r in ps.rows if r is not None and r.mm_per_px is None and r.calibration is None
@@ -719,13 +760,56 @@ def file_problems(
     return problems
 
 
+def unlisted_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning when photos in the set's folder (or its subfolders) are neither rows of
+    ``manifest.csv`` nor files its settings name (the empty scene, calibration boards): a photo
+    whose name did not match ``photoset init``'s pattern is otherwise left out unseen.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("a_0kPa.jpg", "a_10kpa.jpg", "empty.jpg"):
+    ...     _ = (root / name).write_bytes(b"")
+    >>> _ = (root / SETTINGS).write_text("l0_mm: 200\\nbackground: empty.jpg\\n")
+    >>> _ = (root / MANIFEST).write_text(
+    ...     "image,pressure_kpa,direction,material,actuator,trial\\na_0kPa.jpg,0,up,DS20,A1,1\\n")
+    >>> print(unlisted_problems(load_photoset(root))[0].message)
+    1 photo in the folder is not in manifest.csv and will not be measured: 'a_10kpa.jpg'
+    """
+    listed = {(ps.folder / str(i)).resolve() for i in ps.manifest["image"] if not is_missing(i)}
+    listed |= named_files(ps.folder)
+    left = [
+        name
+        for name in photo_names(ps.folder, subfolders=True)
+        if (ps.folder / name).resolve() not in listed
+    ]
+    if not left:
+        return []
+    shown = ", ".join(repr(n) for n in left[:3]) + (", ..." if len(left) > 3 else "")
+    return [
+        Problem(
+            str(ps.folder / MANIFEST),
+            None,
+            f"{len(left)} photo{'s' if len(left) > 1 else ''} in the folder "
+            f"{'are' if len(left) > 1 else 'is'} not in manifest.csv and will not be measured: "
+            f"{shown}",
+            "add a row for each (or rename them to photoset init's pattern and run it again with "
+            "--overwrite), or move them out of the folder if they do not belong to the set",
+            warning=True,
+        )
+    ]
+
+
 def size_problems(
     manifest: str,
     images: Sequence[tuple[int, str]],
     sizes: Mapping[str, tuple[int, int] | None],
 ) -> list[Problem]:
-    """A warning for each photo whose size differs from most of its set's: ``fixed_end``,
-    ``roi``, ``exclude``, the background photo and ``mm_per_px`` are pixels of one framing.
+    """A warning for each photo whose size differs from that of most of its set's photos (more
+    than half): ``fixed_end``, ``roi``, ``exclude``, the background photo and ``mm_per_px`` are
+    pixels of one framing. Pass the rows without a ``fixed_end`` of their own (a set of crops,
+    each with its own, is not warned of).
 
     Examples
     --------
@@ -742,6 +826,8 @@ def size_problems(
     if len(counts) < 2:
         return []
     (w, h), n = counts.most_common(1)[0]
+    if 2 * n <= len(known):
+        return []
     return [
         Problem(
             manifest,

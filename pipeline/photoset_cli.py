@@ -271,6 +271,19 @@ def _init(args: argparse.Namespace) -> int:
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
         "down)"
     )
+    listed = {*df["image"], args.background}
+    left = [
+        n for n in photoset.photo_names(Path(args.folder), "/" in args.pattern) if n not in listed
+    ]
+    if left:
+        print(
+            f"warning: {len(left)} photo(s) do not match the pattern and are not in the manifest: "
+            + ", ".join(repr(n) for n in left[:5])
+            + (", ..." if len(left) > 5 else "")
+            + " (rename them to the pattern and run init again with --overwrite, or add their rows "
+            "by hand; leave out an empty-scene or calibration photo)",
+            file=sys.stderr,
+        )
     if kept:
         print(
             f"kept the existing {args.folder}/{photoset.SETTINGS} as it is (the setting options "

@@ -18,7 +18,7 @@ import pandas as pd
 
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
-from pipeline.photoset import IMAGE_SUFFIXES, MANIFEST, SETTINGS, write_manifest, write_settings
+from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
 
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.p]\d+)?",
@@ -54,7 +54,13 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
 
     Fields: ``pressure_kpa``, ``direction``, ``trial``, ``actuator``, ``material``, ``step``,
     ``measured_pressure_kpa`` and ``_`` (anything, ignored); ``*`` matches anything too.
-    Decimal points in pressures may be written ``p`` (``12p5`` = 12.5 kPa).
+    Decimal points in pressures may be written ``p`` (``12p5`` = 12.5 kPa). Letters match in
+    either case (``kPa`` or ``kpa``, ``.jpg`` or a camera's ``.JPG``).
+
+    Examples
+    --------
+    >>> pattern_to_regex("{actuator}_{pressure_kpa}kPa.jpg").match("A1_12P5KPA.JPG")["pressure_kpa"]
+    '12P5'
 
     Raises
     ------
@@ -84,32 +90,7 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
             f"pattern {pattern!r} has no {{pressure_kpa}} field; the pressure must come from the "
             "file name"
         )
-    return re.compile("".join(out) + r"\Z")
-
-
-def photo_names(folder: Path, subfolders: bool = False) -> list[str]:
-    """The photos of ``folder`` by name, sorted; with ``subfolders``, also those in its
-    subfolders, by their path in it (``chamber2/00_0kPa.jpg``). Hidden files and folders are left
-    out.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> root = Path(tempfile.mkdtemp())
-    >>> for name in ("b.jpg", "a.PNG", "c2/a.jpg", ".x/d.jpg", "notes.txt"):
-    ...     (root / name).parent.mkdir(exist_ok=True)
-    ...     _ = (root / name).write_bytes(b"")
-    >>> photo_names(root), photo_names(root, subfolders=True)
-    (['a.PNG', 'b.jpg'], ['a.PNG', 'b.jpg', 'c2/a.jpg'])
-    """
-    paths = folder.rglob("*") if subfolders else folder.iterdir()
-    return sorted(
-        p.relative_to(folder).as_posix()
-        for p in paths
-        if p.is_file()
-        and p.suffix.lower() in IMAGE_SUFFIXES
-        and not any(part.startswith(".") for part in p.relative_to(folder).parts)
-    )
+    return re.compile("".join(out) + r"\Z", re.IGNORECASE)  # kPa or kpa, .jpg or .JPG
 
 
 def init_photoset(
@@ -171,11 +152,13 @@ def init_photoset(
                 raise UserInputError(
                     f"{name}: no {key} in the file name and no default; pass --{key}"
                 )
-        row["pressure_kpa"] = float(fields["pressure_kpa"].replace("p", "."))
+        row["pressure_kpa"] = float(fields["pressure_kpa"].lower().replace("p", "."))
         if fields.get("step") is not None:
             row["step"] = int(fields["step"])
         if fields.get("measured_pressure_kpa") is not None:
-            row["measured_pressure_kpa"] = float(fields["measured_pressure_kpa"].replace("p", "."))
+            row["measured_pressure_kpa"] = float(
+                fields["measured_pressure_kpa"].lower().replace("p", ".")
+            )
         if fields.get("direction") is not None:
             word = fields["direction"].lower()
             if word not in _DIRECTION_WORDS:

@@ -255,3 +255,31 @@ def test_a_photo_of_another_size_than_its_set_is_named_by_check(photo_folder):
     assert f"image {turned!r} is 24x32 px where 7 photos of the set are 32x24" in sized[0].message
     assert "manifest.csv" in sized[0].file and "32x24" in sized[0].fix
     assert ps.validate_photoset(photo_folder) == []  # a warning: the set is still measured
+
+
+def test_photos_the_pattern_misses_are_named_by_init_and_check_not_left_out_unseen(
+    photo_folder, capsys
+):
+    # a camera's .JPG, a 'kpa' typed by hand and a copy named '(1)': init matched the first two
+    # only with the exact case and left all three out of the manifest without a word
+    import cv2
+
+    from pipeline.cli import main
+
+    img = np.full((24, 32, 3), 200, np.uint8)
+    names = ("DS30_A2_t3_s00_0KPA.JPG", "DS30_A2_t3_s01_10kpa.jpg", "DS30_A2_t3_s01_10kPa (1).jpg")
+    for name in names:
+        cv2.imwrite(str(photo_folder / name), img)
+    cv2.imwrite(str(photo_folder / "empty.jpg"), img)
+    args = ["photoset", "init", str(photo_folder), "--pattern", PATTERN, "--l0-mm", "200"]
+    assert main([*args, "--background", "empty.jpg"]) == 0
+    out = capsys.readouterr()
+    assert "wrote" in out.out and "10 photos" in out.out, out.out
+    assert "1 photo(s) do not match the pattern" in out.err
+    assert "'DS30_A2_t3_s01_10kPa (1).jpg'" in out.err and "empty.jpg" not in out.err
+    manifest = pd.read_csv(photo_folder / "manifest.csv")
+    assert manifest.set_index("image").loc["DS30_A2_t3_s00_0KPA.JPG", "pressure_kpa"] == 0.0
+    problems = ps.validate_photoset(photo_folder, warnings=True)
+    left = [p for p in problems if "not in manifest" in p.message]
+    assert len(left) == 1 and left[0].warning and "(1).jpg" in left[0].message, left
+    assert "empty.jpg" not in left[0].message  # the empty scene the settings name is not a photo
