@@ -760,6 +760,14 @@ def file_problems(
     return problems
 
 
+def unlisted_photos(folder: Path, listed: Iterable[str], subfolders: bool = True) -> list[str]:
+    """The photos of ``folder`` (:func:`photo_names`) that are neither ``listed`` (the manifest's
+    images) nor files the set's settings name (:func:`named_files`: the empty scene, calibration
+    boards)."""
+    taken = {(folder / name).resolve() for name in listed} | named_files(folder)
+    return [n for n in photo_names(folder, subfolders) if (folder / n).resolve() not in taken]
+
+
 def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     """A warning when photos in the set's folder (or its subfolders) are neither rows of
     ``manifest.csv`` nor files its settings name (the empty scene, calibration boards): a photo
@@ -777,13 +785,9 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     >>> print(unlisted_problems(load_photoset(root))[0].message)
     1 photo in the folder is not in manifest.csv and will not be measured: 'a_10kpa.jpg'
     """
-    listed = {(ps.folder / str(i)).resolve() for i in ps.manifest["image"] if not is_missing(i)}
-    listed |= named_files(ps.folder)
-    left = [
-        name
-        for name in photo_names(ps.folder, subfolders=True)
-        if (ps.folder / name).resolve() not in listed
-    ]
+    left = unlisted_photos(
+        ps.folder, [str(i) for i in ps.manifest["image"] if not is_missing(i)]
+    )
     if not left:
         return []
     shown = ", ".join(repr(n) for n in left[:3]) + (", ..." if len(left) > 3 else "")

@@ -271,10 +271,7 @@ def _init(args: argparse.Namespace) -> int:
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
         "down)"
     )
-    listed = {*df["image"], args.background}
-    left = [
-        n for n in photoset.photo_names(Path(args.folder), "/" in args.pattern) if n not in listed
-    ]
+    left = photoset.unlisted_photos(Path(args.folder), df["image"], "/" in args.pattern)
     if left:
         print(
             f"warning: {len(left)} photo(s) do not match the pattern and are not in the manifest: "

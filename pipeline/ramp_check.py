@@ -397,16 +397,15 @@ def _check_leg(
     doubtful = (leg["status"] != "ok").to_numpy()  # flagged on its own, before the ramp
     while len(keep) >= 3:
         psi = psi_all[keep]
+        # a photo ok on its own is judged among the photos ok on their own (its nearest such
+        # neighbours): two doubtful photos read wrong alike would otherwise outvote a right one
         trusted = [j for j in range(len(keep)) if not doubtful[keep[j]]]
+        rank = {j: r for r, j in enumerate(trusted)} if len(trusted) >= 3 else {}
+        psi_trusted = psi[trusted]
         breaking = []
         for i in range(len(keep)):
-            # a photo ok on its own is judged by its nearest neighbours that are ok on their own
-            # too (two doubtful photos read wrong alike would otherwise outvote a right one)
-            judges = sorted({*trusted, i}) if not doubtful[keep[i]] else []
-            if len(judges) >= 3:
-                off, lo, hi = _allowed_in_leg(
-                    psi[judges], judges.index(i), same_pressure[keep[i]]
-                )
+            if i in rank:
+                off, lo, hi = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
             else:
                 off, lo, hi = _allowed_in_leg(psi, i, same_pressure[keep[i]])
             if off > SLACK_DEG:
