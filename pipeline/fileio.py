@@ -3,12 +3,18 @@
 Every file a stage produces is written atomically (temporary file in the same folder, fsync,
 rename), so an interrupted run never leaves a half-written table, photo or report; tables are
 written with one float format and read back through :func:`read_table`, which refuses a missing,
-unreadable or incomplete file with one clear message.
+unreadable or incomplete file with one clear message.  Tables a person writes (a photo set's
+``manifest.csv``, a pressure log, a grasp log) are read by :func:`read_user_csv`, which also takes
+what a spreadsheet saves: ``;`` between fields and decimal commas (Excel where the decimal mark is
+a comma), tabs, a Windows code page, spaces after the separators.
 """
 
 from __future__ import annotations
 
+import csv
+import io
 import os
+import re
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
@@ -17,6 +23,94 @@ from typing import Any
 import pandas as pd
 
 from pipeline.errors import UserInputError
+
+#: field separators a spreadsheet may save a CSV with: ',' (English locales), ';' (Excel where the
+#: decimal mark is a comma: most of Europe), tab ("text, tab delimited")
+SEPARATORS = (",", ";", "\t")
+#: a cell holding one number with a decimal comma, as such a spreadsheet writes it
+_DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+\s*")
+
+
+def csv_separator(header: str) -> str:
+    """The field separator of a CSV file, judged by its header line: the one of
+    :data:`SEPARATORS` that splits it into the most fields (``,`` on a tie).
+
+    Examples
+    --------
+    >>> csv_separator("image;pressure_kpa;direction"), csv_separator("image,pressure_kpa")
+    (';', ',')
+    >>> csv_separator('"a;b",c')
+    ','
+    """
+    fields = {sep: len(next(csv.reader([header], delimiter=sep), [])) for sep in SEPARATORS}
+    return max(SEPARATORS, key=lambda sep: fields[sep])  # the first of equals: ','
+
+
+def comma_csv_text(text: str) -> str:
+    """``text``, a CSV file's contents, as comma-separated CSV with decimal points.
+
+    A file separated by ``;`` or tabs is rewritten with commas, and in it every cell that is a
+    number with a decimal comma (``60,5``) gets a decimal point; quoted fields stay whole.  A
+    comma-separated file is returned as it is.
+
+    Examples
+    --------
+    >>> print(comma_csv_text("image;pressure_kpa;roi\\na.jpg;60,5;[1, 2, 30, 40]\\n"), end="")
+    image,pressure_kpa,roi
+    a.jpg,60.5,"[1, 2, 30, 40]"
+    """
+    sep = csv_separator(text.split("\n", 1)[0].rstrip("\r"))
+    if sep == ",":
+        return text
+    try:
+        rows = list(csv.reader(io.StringIO(text), delimiter=sep))
+    except csv.Error as exc:
+        raise pd.errors.ParserError(str(exc)) from None
+    out = io.StringIO()
+    csv.writer(out, lineterminator="\n").writerows(
+        [[c.replace(",", ".") if _DECIMAL_COMMA.fullmatch(c) else c for c in row] for row in rows]
+    )
+    return out.getvalue()
+
+
+def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame:
+    """Read a CSV file a person wrote or saved from a spreadsheet.
+
+    Besides a plain comma-separated UTF-8 file this reads what spreadsheets save elsewhere: ``;``
+    or tab between fields with decimal commas (:func:`comma_csv_text`), a byte-order mark, a
+    Windows code page (cp1252, Excel's "CSV (Comma delimited)"), and spaces after the separators
+    (in the header as well).
+
+    Parameters
+    ----------
+    path : path
+        The CSV file.
+    **read_csv
+        Passed to :func:`pandas.read_csv` (e.g. ``dtype``).
+
+    Raises
+    ------
+    FileNotFoundError, pandas.errors.ParserError, pandas.errors.EmptyDataError
+        As :func:`pandas.read_csv` does.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "m.csv"
+    >>> text = "image; pressure_kpa; material\\r\\nä.jpg; 12,5; DS20\\r\\n"
+    >>> _ = p.write_bytes(text.encode("cp1252"))
+    >>> read_user_csv(p).to_dict("records")
+    [{'image': 'ä.jpg', 'pressure_kpa': 12.5, 'material': 'DS20'}]
+    """
+    data = Path(path).read_bytes()
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:  # not UTF-8: a Windows spreadsheet's code page
+        text = data.decode("cp1252", errors="replace")
+    read_csv.setdefault("skipinitialspace", True)
+    df = pd.read_csv(io.StringIO(comma_csv_text(text)), **read_csv)
+    df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
+    return df
 
 
 def read_table(
@@ -60,8 +154,8 @@ def read_table(
     (1, 2)
     """
     try:
-        df = pd.read_csv(path, **read_csv)
-    except FileNotFoundError:
+        df = read_user_csv(path, **read_csv)
+    except (FileNotFoundError, IsADirectoryError):
         raise UserInputError(f"{path}: file not found; pass {what}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise UserInputError(

@@ -43,7 +43,7 @@ import yaml
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes, write_table
+from pipeline.fileio import atomic_write_bytes, read_user_csv, write_table
 from pipeline.measure.calibration import CalibrationCache
 from pipeline.measure.formats import undecodable
 from pipeline.measure.settings import (
@@ -301,7 +301,7 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
     if isinstance(raw, dict):
         values += [raw.get("background"), raw.get("calibration")]
     try:
-        manifest = pd.read_csv(folder / MANIFEST, dtype=str)
+        manifest = read_user_csv(folder / MANIFEST, dtype=str)
     except (OSError, ValueError, pd.errors.ParserError):
         manifest = pd.DataFrame()
     for column in ("background", "calibration"):
@@ -355,36 +355,49 @@ def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     """Read ``manifest.csv`` as written (text columns kept as text), adding ``manifest_line``.
 
     A manifest with a ``video`` column and no ``image`` column is a video manifest and needs
-    :data:`VIDEO_REQUIRED_COLUMNS` instead of :data:`REQUIRED_COLUMNS`.
+    :data:`VIDEO_REQUIRED_COLUMNS` instead of :data:`REQUIRED_COLUMNS`.  A manifest saved by a
+    spreadsheet (``;`` and decimal commas, tabs, a Windows code page) is read as such
+    (:func:`pipeline.fileio.read_user_csv`).
 
     Raises
     ------
     UserInputError
         If the file is missing, unparsable or lacks a required column.
     """
-    path = Path(folder) / MANIFEST
+    df, problem = _read_manifest(Path(folder))
+    if problem is not None:
+        raise UserInputError(str(problem))
+    assert df is not None
+    return df
+
+
+def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
+    """:func:`read_manifest`'s table, or the problem that stops it being read."""
+    path = folder / MANIFEST
     if not path.is_file():
-        raise UserInputError(
-            f"{path}: missing; create it with 'python -m pipeline photoset init {folder} --pattern "
-            "...'"
+        return None, Problem(
+            str(path), None, "missing",
+            f"create it with 'python -m pipeline photoset init {folder} --pattern ...'",
         )
     try:
-        df = pd.read_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise UserInputError(f"{path}: cannot be parsed as CSV ({exc}); fix the file") from exc
+        df = read_user_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, OSError) as exc:
+        return None, Problem(
+            str(path), None, f"cannot be read as CSV ({exc})",
+            "save it as CSV: a header line, then one line per photo",
+        )
     required = VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS
     missing = [c for c in required if c not in df.columns]
     if missing:
-        raise UserInputError(
-            f"{path}: missing column(s) {missing}; the header must contain {list(required)}"
-            + (
-                ""
-                if "video" in df.columns
-                else f" (or, for videos, {list(VIDEO_REQUIRED_COLUMNS)})"
-            )
+        return None, Problem(
+            str(path),
+            1,
+            f"missing column(s) {missing}; the header has {list(map(str, df.columns))}",
+            f"name the columns {list(required)} in the header line (lower case, as written here)"
+            + ("" if "video" in df.columns else f"; for videos {list(VIDEO_REQUIRED_COLUMNS)}"),
         )
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
-    return df
+    return df, None
 
 
 def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
@@ -587,10 +600,9 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
     settings, problems = _read_yaml(folder)
     df: pd.DataFrame | None = None
     if settings is not None:
-        try:
-            df = read_manifest(folder)
-        except UserInputError as exc:
-            problems.append(Problem(str(folder / MANIFEST), None, str(exc), "see message"))
+        df, problem = _read_manifest(folder)
+        if problem is not None:
+            problems.append(problem)
     if settings is None or df is None:
         _refuse(folder, problems)
     assert settings is not None and df is not None
@@ -626,12 +638,21 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
     )
 
 
+class PhotoSetRefused(UserInputError):
+    """A photo set that cannot be loaded at all; ``problems`` are the reasons, each naming its file,
+    line and fix."""
+
+    def __init__(self, folder: Path, problems: Sequence[Problem]) -> None:
+        self.problems = tuple(problems)
+        errors = [p for p in self.problems if not p.warning]
+        super().__init__(
+            f"photo set {folder} is not valid ({len(errors)} problem(s)):\n  "
+            + "\n  ".join(map(str, errors))
+        )
+
+
 def _refuse(folder: Path, problems: list[Problem]) -> None:
-    errors = [p for p in problems if not p.warning]
-    raise UserInputError(
-        f"photo set {folder} is not valid ({len(errors)} problem(s)):\n  "
-        + "\n  ".join(map(str, errors))
-    )
+    raise PhotoSetRefused(folder, problems)
 
 
 def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[Problem]]:
@@ -648,10 +669,8 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
         return None, problems
     try:
         ps = load_photoset(folder)
-    except UserInputError as exc:
-        return None, problems + [
-            Problem(str(folder), None, str(exc).split("\n", 1)[-1].strip(), "see message")
-        ]
+    except PhotoSetRefused as exc:
+        return None, problems + [p for p in exc.problems if p not in problems]
     return ps, problems + list(ps.problems)
 
 

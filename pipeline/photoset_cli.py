@@ -6,10 +6,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pipeline import photoset, photoset_init
 from pipeline.errors import UserInputError
 from pipeline.measure.settings import POSITIVE_TURNS
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -315,11 +319,10 @@ def _check(args: argparse.Namespace) -> int:
 
     problems = check_photoset(args.folder, decode_images=not args.no_decode, warnings=True)
     errors = [p for p in problems if not p.warning]
-    manifest = (
-        photoset.read_manifest(args.folder)
-        if (Path(args.folder) / photoset.MANIFEST).is_file()
-        else None
-    )
+    try:  # an unreadable manifest is one of the problems listed
+        manifest: pd.DataFrame | None = photoset.read_manifest(args.folder)
+    except UserInputError:
+        manifest = None
     video = manifest is not None and photoset.is_video_manifest(manifest)
     if not errors and not args.no_decode and not video:  # previews read photos, not videos
         from pipeline.preview import empty_first_photos
@@ -340,7 +343,7 @@ def _check(args: argparse.Namespace) -> int:
     if errors:
         print(f"{args.folder}: {len(errors)} problem(s)", file=sys.stderr)
         return 1
-    n = len(photoset.read_manifest(args.folder))
+    n = 0 if manifest is None else len(manifest)
     warn = len(problems) - len(errors)
     print(
         f"{args.folder}: OK ({n} "

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from pipeline.errors import UserInputError
-from pipeline.fileio import read_table
+from pipeline.fileio import read_table, read_user_csv
 
 
 def test_reads_a_good_table(tmp_path):
@@ -40,3 +40,20 @@ def test_grasp_log_and_force_tables_use_it(tmp_path):
     (tmp_path / "e.csv").write_text("image,psi\nx,1\n")
     with pytest.raises(UserInputError, match="force_n"):
         read_tables([tmp_path / "e.csv"])
+
+
+def test_a_spreadsheets_csv_keeps_quoted_fields_and_text_with_commas_whole(tmp_path):
+    # only a cell that is one number with a decimal comma gets a decimal point: a quoted field
+    # holding the separator, a list, a name with a comma and an empty cell stay as written
+    p = tmp_path / "grasp.csv"
+    p.write_text(
+        'object;mass_g;note;roi\n"cup; blue";12,5;"held 3,5 s";[1, 2, 30, 40]\negg;-0,5;;\n'
+    )
+    df = read_user_csv(p, dtype=str, keep_default_na=False)
+    assert df.to_dict("records") == [
+        {"object": "cup; blue", "mass_g": "12.5", "note": "held 3,5 s", "roi": "[1, 2, 30, 40]"},
+        {"object": "egg", "mass_g": "-0.5", "note": "", "roi": ""},
+    ]
+    # a comma-separated file is read as pandas reads it (its quoted decimal commas stay text)
+    p.write_text('a,b\n"1,5",2.5\n')
+    assert read_user_csv(p).to_dict("records") == [{"a": "1,5", "b": 2.5}]

@@ -283,3 +283,75 @@ def test_photos_the_pattern_misses_are_named_by_init_and_check_not_left_out_unse
     left = [p for p in problems if "not in manifest" in p.message]
     assert len(left) == 1 and left[0].warning and "(1).jpg" in left[0].message, left
     assert "empty.jpg" not in left[0].message  # the empty scene the settings name is not a photo
+
+
+@pytest.mark.parametrize(
+    ("encoding", "separator", "line_end", "space"),
+    [
+        ("utf-8-sig", ";", "\r\n", ""),  # Excel, "CSV UTF-8", where the decimal mark is a comma
+        ("cp1252", ";", "\r\n", ""),  # Excel's "CSV" on Windows there: its code page, not UTF-8
+        ("utf-8", "\t", "\n", ""),  # "text, tab delimited"
+        ("utf-8", ",", "\n", " "),  # typed by hand, a space after each comma
+    ],
+)
+def test_a_manifest_saved_by_a_spreadsheet_is_read_as_its_comma_separated_twin(
+    tmp_path, encoding, separator, line_end, space
+):
+    # a lab in Germany or France saves manifest.csv from Excel: ';' between the fields and decimal
+    # commas; the set was refused ('missing column(s) [image, pressure_kpa, ...]' although the
+    # header shows them) and nothing was measured
+    import cv2
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("clean", width=480, height=360)
+    rows = [("Aktor_ä_0kPa.jpg", 0.0, "up", 150.0), ("Aktor_ä_12-5kPa.jpg", 12.5, "up", 60.0)]
+    for image, _kpa, _direction, psi in rows:
+        r = render_actuator(psi, 200.0, scene, seed=3)
+        cv2.imwrite(str(tmp_path / image), cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), 1))
+    ps.write_settings(tmp_path, {"l0_mm": 200.0, "mm_per_px": scene.mm_per_px})
+    decimal = "," if separator != "," else "."
+    header = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "mm_per_px"]
+    lines = [header] + [
+        [image, f"{kpa:g}".replace(".", decimal), direction, "DS20", "A1", "1",
+         f"{scene.mm_per_px}".replace(".", decimal)]
+        for image, kpa, direction, _psi in rows
+    ]
+    text = line_end.join((separator + space).join(cells) for cells in lines) + line_end
+    (tmp_path / ps.MANIFEST).write_bytes(text.encode(encoding))
+    assert ps.validate_photoset(tmp_path) == []
+    manifest = ps.read_manifest(tmp_path)
+    assert manifest["image"].tolist() == [r[0] for r in rows]
+    assert manifest["pressure_kpa"].tolist() == [0.0, 12.5]
+    assert manifest["mm_per_px"].tolist() == [scene.mm_per_px] * 2
+    angles = measure_photoset(tmp_path, ramp_check=False)
+    assert (angles["status"] == "ok").all(), angles[["image", "reason"]]
+    assert angles["pressure_kpa"].tolist() == [0.0, 12.5]
+    assert np.allclose(angles["psi_deg"], [r[3] for r in rows], atol=3.0), angles["psi_deg"]
+
+
+def test_a_manifest_whose_header_names_differ_is_one_problem_naming_the_header_and_the_fix(
+    photo_folder,
+):
+    # 'Image' and 'Pressure (kPa)': check listed 'missing column(s)' with '(fix: see message)',
+    # the file named twice, and left the user to guess which names were wrong
+    path = photo_folder / ps.MANIFEST
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    lines = path.read_text().splitlines()
+    lines[0] = lines[0].replace("image", "Image").replace("pressure_kpa", "Pressure (kPa)")
+    path.write_text("\n".join(lines) + "\n")
+    problems = ps.validate_photoset(photo_folder)
+    assert len(problems) == 1, problems
+    (p,) = problems
+    assert (p.file, p.line) == (str(path), 1)
+    assert "['image', 'pressure_kpa']" in p.message and "'Pressure (kPa)'" in p.message
+    assert "see message" not in p.fix and "header" in p.fix
+    assert str(path) not in p.message
+    out = subprocess.run(
+        [sys.executable, "-m", "pipeline", "photoset", "check", str(photo_folder)],
+        capture_output=True, text=True, check=False,
+    )
+    # listed as the set's one problem (exit 1), not the command's error (exit 2)
+    assert out.returncode == 1, out.stderr
+    assert f"{path} line 1: missing column(s) ['image', 'pressure_kpa']" in out.stderr

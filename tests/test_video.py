@@ -309,6 +309,18 @@ def test_pressure_log_problems_name_the_line(tmp_path):
     assert "below absolute vacuum" in read_pressure_log(path)[1][0]
 
 
+def test_a_pressure_log_saved_by_a_european_spreadsheet_is_read(tmp_path):
+    # a logger's export opened and saved in Excel where the decimal mark is a comma: ';' between
+    # the fields, '0,05' for 0.05 s; it was 'lacks column(s) [time_s, pressure_kpa]'
+    path = tmp_path / "log.csv"
+    path.write_bytes("time_s;pressure_kpa;measured_kpa\r\n0;0;0,1\r\n0,05;12,5;11,9\r\n".encode(
+        "utf-8-sig"))
+    log, problems = read_pressure_log(path)
+    assert problems == [] and log is not None
+    assert log.time_s.tolist() == [0.0, 0.05] and log.pressure_kpa.tolist() == [0.0, 12.5]
+    assert log.measured_kpa is not None and log.measured_kpa.tolist() == [0.1, 11.9]
+
+
 def test_first_order_lags_reach_63_percent_after_tau():
     dyn = Dynamics(tau_pressure_s=0.0, tau_psi_s=0.5)
     sim = simulate(

@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import read_user_csv
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -202,7 +203,7 @@ def _calibrate(args: argparse.Namespace) -> int:
 
     if args.readings is not None:
         try:
-            df = pd.read_csv(args.readings)
+            df = read_user_csv(args.readings)
             codes, kpa = df["dac_code"].to_numpy(), df["pressure_kpa"].to_numpy()
         except (OSError, KeyError, pd.errors.ParserError) as exc:
             raise UserInputError(

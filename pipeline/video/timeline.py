@@ -44,6 +44,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA
+from pipeline.fileio import read_user_csv
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
@@ -99,7 +100,7 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     if not path.is_file():
         return None, [f"pressure log {name} does not exist"]
     try:
-        df = pd.read_csv(path)
+        df = read_user_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
@@ -145,7 +146,7 @@ def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, l
     if not path.is_file():
         return None, [f"frame-times file {name} does not exist"]
     try:
-        df = pd.read_csv(path)
+        df = read_user_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"frame-times file {name} cannot be parsed as CSV ({exc})"]
     if any(c not in df.columns for c in FRAME_TIME_COLUMNS):
