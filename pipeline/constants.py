@@ -4,6 +4,11 @@ from __future__ import annotations
 
 #: ramp directions in a manifest: increasing and decreasing pressure
 DIRECTIONS: tuple[str, ...] = ("up", "down")
+#: what a person may write in a manifest's direction column, in any case: a direction or its meaning
+DIRECTION_WORDS: dict[str, str] = {
+    "up": "up", "increasing": "up", "inflating": "up", "loading": "up",
+    "down": "down", "decreasing": "down", "deflating": "down", "unloading": "down",
+}
 #: measurement status of a row: a trusted number, a doubtful number, no number
 STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 #: rest bending angle psi0 of the paper's actuators (deg, DESIGN.md): the fallback where no material
@@ -11,3 +16,17 @@ STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 PSI0_DEG: float = 210.0
 #: absolute vacuum as a gauge pressure (kPa): no pneumatic pressure can be lower
 VACUUM_KPA: float = -101.3
+
+
+def direction_name(value: object) -> object:
+    """The direction (``up``/``down``) a person meant by ``value`` (:data:`DIRECTION_WORDS`, any
+    case, spaces around it); anything else as it is, for the manifest check to name.
+
+    Examples
+    --------
+    >>> direction_name(" Up "), direction_name("Decreasing"), direction_name("sideways")
+    ('up', 'down', 'sideways')
+    """
+    if isinstance(value, str):
+        return DIRECTION_WORDS.get(value.strip().lower(), value)
+    return value

@@ -29,6 +29,7 @@ Examples
 
 from __future__ import annotations
 
+import difflib
 import functools
 import os
 from collections import Counter
@@ -41,7 +42,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from pipeline.constants import DIRECTIONS, VACUUM_KPA
+from pipeline.constants import DIRECTIONS, VACUUM_KPA, direction_name
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, read_user_csv, write_table
 from pipeline.measure.calibration import CalibrationCache
@@ -130,6 +131,26 @@ def photo_names(folder: Path, subfolders: bool = False) -> list[str]:
         and p.suffix.lower() in IMAGE_SUFFIXES
         and not any(part.startswith(".") for part in p.relative_to(folder).parts)
     )
+
+
+def near_name(name: str, names: Sequence[str]) -> str | None:
+    """The one of ``names`` a person probably meant by ``name``: the same in another case (a
+    camera's ``.JPG``), else the closest by :func:`difflib.get_close_matches` (a typo, ``.jpeg``
+    for ``.jpg``); None when none is close.
+
+    Examples
+    --------
+    >>> names = ["DS20_A1_t1_s015_down_60kPa.jpg", "DS20_A1_t1_s016_down_40kPa.jpg"]
+    >>> near_name("ds20_a1_t1_s015_down_60kpa.JPG", names)
+    'DS20_A1_t1_s015_down_60kPa.jpg'
+    >>> near_name("DS20_A1_t1_s016_down_40kPa.jpeg", names), near_name("empty.jpg", names)
+    ('DS20_A1_t1_s016_down_40kPa.jpg', None)
+    """
+    same_case = [n for n in names if n.lower() == name.lower()]
+    if same_case:
+        return same_case[0]
+    close = difflib.get_close_matches(name, names, n=1, cutoff=0.9)
+    return close[0] if close else None
 
 
 def overlay_name(image: str) -> str:
@@ -396,6 +417,8 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             f"name the columns {list(required)} in the header line (lower case, as written here)"
             + ("" if "video" in df.columns else f"; for videos {list(VIDEO_REQUIRED_COLUMNS)}"),
         )
+    if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
+        df["direction"] = df["direction"].map(direction_name)
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
     return df, None
 
@@ -674,6 +697,21 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
     return ps, problems + list(ps.problems)
 
 
+def missing_image_problem(
+    ps: PhotoSet, line: int, image: str, in_folder: Sequence[str]
+) -> Problem:
+    """The problem of manifest line ``line``, whose photo ``image`` is not in the set's folder,
+    naming the photo of the folder (``in_folder``, :func:`photo_names`) it probably means."""
+    near = near_name(image, in_folder)
+    return Problem(
+        str(ps.folder / MANIFEST),
+        line,
+        f"image {image!r} does not exist in {ps.folder}" + (f"; it has {near!r}" if near else ""),
+        (f"correct the name in the 'image' column to {near!r}, or " if near else "")
+        + "copy the photo in or remove the row",
+    )
+
+
 def file_problems(
     ps: PhotoSet, *, decode_images: bool = True, require_images: bool = True
 ) -> list[Problem]:
@@ -688,20 +726,16 @@ def file_problems(
     problems: list[Problem] = []
     sizes: dict[str, tuple[int, int] | None] = {}
     images = [] if ps.is_video else list(zip(ps.manifest["manifest_line"], ps.manifest["image"]))
+    in_folder: list[str] | None = None  # the folder's photos, listed once if a row's is missing
     for (line, image), settings_row in zip(images, ps.rows):
         if is_missing(image):
             continue
         path = folder / str(image)
         if not path.is_file():
             if require_images:
-                problems.append(
-                    Problem(
-                        mpath,
-                        int(line),
-                        f"image {image!r} does not exist in {folder}",
-                        "copy the photo in or remove the row",
-                    )
-                )
+                if in_folder is None:
+                    in_folder = photo_names(folder, subfolders=True) if folder.is_dir() else []
+                problems.append(missing_image_problem(ps, int(line), str(image), in_folder))
             continue
         if not decode_images:
             continue

@@ -20,7 +20,13 @@ from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
 from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task, run_task
-from pipeline.photoset import PhotoSet, load_photoset, overlay_name
+from pipeline.photoset import (
+    PhotoSet,
+    load_photoset,
+    missing_image_problem,
+    overlay_name,
+    photo_names,
+)
 from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
 
@@ -63,6 +69,7 @@ CARRIED_FIRST: tuple[str, ...] = (
 
 def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
     tasks = []
+    in_folder: list[str] | None = None  # the folder's photos, listed once if a row's is missing
     for i, (image, pressure, direction) in enumerate(
         zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])
     ):
@@ -70,6 +77,14 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
         overlay = None if overlays_dir is None else str(overlays_dir / overlay_name(image))
         title = f"{image}  {pressure:g} kPa {direction}"
         row = ps.rows[i]
+        if row is not None and not ps.image_path(image).is_file():
+            if in_folder is None:
+                in_folder = photo_names(ps.folder, subfolders=True) if ps.folder.is_dir() else []
+            line = int(ps.manifest["manifest_line"].iloc[i])
+            p = missing_image_problem(ps, line, image, in_folder)
+            reason = f"manifest line {line}: {p.message} (fix: {p.fix})"
+            tasks.append(Task(str(ps.image_path(image)), None, method, overlay, title, reason))
+            continue
         cal = None if row is None else row.calibration
         if cal is not None and cal.plane is not None:
             title += f"  calibrated ({cal.plane.rms_px:.2f} px)"

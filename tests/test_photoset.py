@@ -355,3 +355,37 @@ def test_a_manifest_whose_header_names_differ_is_one_problem_naming_the_header_a
     # listed as the set's one problem (exit 1), not the command's error (exit 2)
     assert out.returncode == 1, out.stderr
     assert f"{path} line 1: missing column(s) ['image', 'pressure_kpa']" in out.stderr
+
+
+def test_a_mistyped_photo_name_and_a_capitalised_direction_are_named_or_read_as_meant(tmp_path):
+    # a manifest typed by hand: 'Up' and 'decreasing' for the directions, and a photo named with
+    # the camera's '.JPG' and 'kpa' where the file is '..._60kPa.jpg'. Before: 'Up' was a failed
+    # row, and the photo 'does not exist' (measure: 'No such file or directory') with no hint
+    import cv2
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("clean", width=480, height=360)
+    for name, psi in (("A1_0kPa.jpg", 150.0), ("A1_60kPa.jpg", 60.0), ("A1_0kPa_b.jpg", 150.0)):
+        r = render_actuator(psi, 200.0, scene, seed=3)
+        cv2.imwrite(str(tmp_path / name), cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), 1))
+    ps.write_settings(tmp_path, {"l0_mm": 200.0, "mm_per_px": scene.mm_per_px})
+    (tmp_path / ps.MANIFEST).write_text(
+        "image,pressure_kpa,direction,material,actuator,trial\n"
+        "A1_0kPa.jpg,0,Up,DS20,A1,1\n"
+        "a1_60kpa.JPG,60,Up,DS20,A1,1\n"
+        "A1_0kPa_b.jpg,0,decreasing,DS20,A1,1\n"
+    )
+    assert ps.read_manifest(tmp_path)["direction"].tolist() == ["up", "up", "down"]
+    problems = [p for p in ps.validate_photoset(tmp_path) if not p.warning]
+    assert [(p.line, p.message) for p in problems] == [
+        (3, f"image 'a1_60kpa.JPG' does not exist in {tmp_path}; it has 'A1_60kPa.jpg'")
+    ]
+    assert problems[0].fix.startswith("correct the name in the 'image' column to 'A1_60kPa.jpg'")
+    angles = measure_photoset(tmp_path, ramp_check=False).set_index("image")
+    assert angles["status"].to_dict() == {
+        "A1_0kPa.jpg": "ok", "a1_60kpa.JPG": "failed", "A1_0kPa_b.jpg": "ok"
+    }, angles["reason"]
+    assert "it has 'A1_60kPa.jpg'" in angles.loc["a1_60kpa.JPG", "reason"]
+    assert angles["direction"].tolist() == ["up", "up", "down"]
