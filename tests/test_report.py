@@ -564,6 +564,11 @@ def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
         {"image": ["a.jpg", "b.jpg"], "timestamp": ["2025-11-30T23:59:00+00:00", "nonsense"]}
     )
     assert dataset_dates(rows, None) == ("2025-11-30", "2025-11-30", "timestamps")
+    # a German spreadsheet's dates: day first (they read 12 March and 12 April before)
+    dotted = pd.DataFrame(
+        {"image": ["a.jpg", "b.jpg"], "timestamp": ["03.12.2026 14:05", "04.12.26"]}
+    )
+    assert dataset_dates(dotted, None) == ("2026-12-03", "2026-12-04", "timestamps")
     exif = Image.Exif()
     exif[306] = "2024:05:06 10:11:12"
     for name in ("a.jpg", "b.jpg"):

@@ -414,13 +414,22 @@ def dataset_dates(
 ) -> tuple[str | None, str | None, str]:
     """First and last date (``YYYY-MM-DD``) the photos of a dataset were taken.
 
-    From the ``timestamp`` column when it holds dates, else from the EXIF date of the first and
+    From the ``timestamp`` column when it holds dates (``03.12.2026`` is day first, as written
+    with dots), else from the EXIF date of the first and
     last photo (in table order); ``(None, None, "")`` when neither exists (synthetic photos carry
     no date).  Never the clock or file times, so the same inputs give the same report.
     """
     if "timestamp" in angles.columns:
-        stamps = pd.to_datetime(
-            angles["timestamp"], errors="coerce", utc=True, format="mixed"
+        text = angles["timestamp"].astype("string")
+        # a date written with dots is day first wherever it is written so (03.12.2026: 3 December)
+        dotted = text.str.match(r"\s*\d{1,2}\.\d{1,2}\.\d{2,4}(\D|$)", na=False).to_numpy(bool)
+        stamps = pd.concat(
+            [
+                pd.to_datetime(text[~dotted], errors="coerce", utc=True, format="mixed"),
+                pd.to_datetime(
+                    text[dotted], errors="coerce", utc=True, format="mixed", dayfirst=True
+                ),
+            ]
         ).dropna()
         if len(stamps):
             return (
