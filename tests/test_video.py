@@ -304,7 +304,8 @@ def test_pressure_log_problems_name_the_line(tmp_path):
     path.write_text("time_s,pressure_kpa\n0,0\n1,x\n")
     assert read_pressure_log(path)[1] == ["log.csv line 3: pressure_kpa 'x' is not a number"]
     path.write_text("time_s,kpa\n0,0\n")
-    assert "lacks column(s) ['pressure_kpa']" in read_pressure_log(path)[1][0]
+    (problem,) = read_pressure_log(path)[1]
+    assert "lacks column(s) ['pressure_kpa'] (its header is ['time_s', 'kpa'])" in problem
     path.write_text("time_s,pressure_kpa,measured_kpa\n0,0,0\n1,10,-200\n")
     assert "below absolute vacuum" in read_pressure_log(path)[1][0]
 

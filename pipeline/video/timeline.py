@@ -105,10 +105,12 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
+        header = list(map(str, df.columns))
         return None, [
-            (f"pressure log {name} lacks column(s) {missing}; it needs time_s (s) and pressure_kpa "
-             "(kPa), "
-            "optionally measured_kpa")
+            (
+                f"pressure log {name} lacks column(s) {missing} (its header is {header}); it "
+                "needs time_s (s) and pressure_kpa (kPa), optionally measured_kpa"
+            )
         ]
     if len(df) < 2:
         return None, [
@@ -150,7 +152,11 @@ def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, l
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"frame-times file {name} cannot be parsed as CSV ({exc})"]
     if any(c not in df.columns for c in FRAME_TIME_COLUMNS):
-        return None, [f"frame-times file {name} needs columns {list(FRAME_TIME_COLUMNS)}"]
+        header = list(map(str, df.columns))
+        return None, [
+            f"frame-times file {name} needs columns {list(FRAME_TIME_COLUMNS)} (its header is "
+            + f"{header})"
+        ]
     problems: list[str] = []
     frame = _numbers(df, "frame", name, problems)
     t = _numbers(df, "time_s", name, problems)
