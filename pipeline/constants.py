@@ -4,10 +4,13 @@ from __future__ import annotations
 
 #: ramp directions in a manifest: increasing and decreasing pressure
 DIRECTIONS: tuple[str, ...] = ("up", "down")
-#: what a person may write in a manifest's direction column, in any case: a direction or its meaning
+#: what a person may write for a direction (a manifest's column, a file name's ``{direction}``), in
+#: any case: a direction, its meaning or its abbreviation
 DIRECTION_WORDS: dict[str, str] = {
-    "up": "up", "increasing": "up", "inflating": "up", "loading": "up",
-    "down": "down", "decreasing": "down", "deflating": "down", "unloading": "down",
+    "up": "up", "u": "up", "inc": "up", "increasing": "up", "inflating": "up", "load": "up",
+    "loading": "up",
+    "down": "down", "d": "down", "dn": "down", "dec": "down", "decreasing": "down",
+    "deflating": "down", "unload": "down", "unloading": "down",
 }
 #: measurement status of a row: a trusted number, a doubtful number, no number
 STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")

@@ -16,13 +16,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import DIRECTION_WORDS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
 
 _FIELD_PATTERNS: dict[str, str] = {
-    "pressure_kpa": r"[-+]?\d+(?:[.p]\d+)?",
-    "measured_pressure_kpa": r"[-+]?\d+(?:[.p]\d+)?",
+    "pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
+    "measured_pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
     "step": r"\d+",
     "trial": r"[A-Za-z0-9]+",
     "actuator": r"[A-Za-z0-9]+",
@@ -31,21 +32,13 @@ _FIELD_PATTERNS: dict[str, str] = {
     "_": r".*?",
 }
 
-_DIRECTION_WORDS: dict[str, str] = {
-    "up": "up",
-    "u": "up",
-    "inc": "up",
-    "increasing": "up",
-    "load": "up",
-    "loading": "up",
-    "down": "down",
-    "d": "down",
-    "dn": "down",
-    "dec": "down",
-    "decreasing": "down",
-    "unload": "down",
-    "unloading": "down",
-}
+def _decimal(text: str) -> float:
+    """A pressure from a file name: ``12.5``, ``12,5`` or ``12p5``.
+
+    >>> _decimal("12,5"), _decimal("12P5"), _decimal("-3")
+    (12.5, 12.5, -3.0)
+    """
+    return float(text.lower().replace("p", ".").replace(",", "."))
 
 
 def pattern_to_regex(pattern: str) -> re.Pattern[str]:
@@ -54,8 +47,8 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
 
     Fields: ``pressure_kpa``, ``direction``, ``trial``, ``actuator``, ``material``, ``step``,
     ``measured_pressure_kpa`` and ``_`` (anything, ignored); ``*`` matches anything too.
-    Decimal points in pressures may be written ``p`` (``12p5`` = 12.5 kPa). Letters match in
-    either case (``kPa`` or ``kpa``, ``.jpg`` or a camera's ``.JPG``).
+    Decimal points in pressures may be written ``p`` or ``,`` (``12p5``, ``12,5`` = 12.5 kPa).
+    Letters match in either case (``kPa`` or ``kpa``, ``.jpg`` or a camera's ``.JPG``).
 
     Examples
     --------
@@ -152,21 +145,19 @@ def init_photoset(
                 raise UserInputError(
                     f"{name}: no {key} in the file name and no default; pass --{key}"
                 )
-        row["pressure_kpa"] = float(fields["pressure_kpa"].lower().replace("p", "."))
+        row["pressure_kpa"] = _decimal(fields["pressure_kpa"])
         if fields.get("step") is not None:
             row["step"] = int(fields["step"])
         if fields.get("measured_pressure_kpa") is not None:
-            row["measured_pressure_kpa"] = float(
-                fields["measured_pressure_kpa"].lower().replace("p", ".")
-            )
+            row["measured_pressure_kpa"] = _decimal(fields["measured_pressure_kpa"])
         if fields.get("direction") is not None:
             word = fields["direction"].lower()
-            if word not in _DIRECTION_WORDS:
+            if word not in DIRECTION_WORDS:
                 raise UserInputError(
                     f"{name}: direction {fields['direction']!r} unknown; use up/down (or "
                     "inc/dec)"
                 )
-            row["direction"] = _DIRECTION_WORDS[word]
+            row["direction"] = DIRECTION_WORDS[word]
         rows.append(row)
     if not rows:
         unreadable = sorted(

@@ -47,6 +47,27 @@ def test_pressure_with_p_as_decimal_point():
     assert m and m["pressure_kpa"] == "12p5" and m["direction"] == "dec"
 
 
+def test_a_decimal_comma_in_a_file_name_is_a_pressure_and_directions_are_one_vocabulary(tmp_path):
+    # 'A1_12,5kPa.jpg' (a German lab's file names) did not match the pattern and was left out; the
+    # directions a file name and a manifest may say are the same words
+    from pipeline.constants import direction_name
+
+    for name in ("A1_0kPa_u.jpg", "A1_12,5kPa_inc.jpg", "A1_0kPa_Unloading.jpg"):
+        (tmp_path / name).write_bytes(b"")
+    df = photoset_init.init_photoset(
+        tmp_path, "{actuator}_{pressure_kpa}kPa_{direction}.jpg", defaults={"material": "DS20"}
+    )
+    got = df.set_index("image")[["pressure_kpa", "direction"]].to_dict("index")
+    assert got == {
+        "A1_0kPa_u.jpg": {"pressure_kpa": 0.0, "direction": "up"},
+        "A1_12,5kPa_inc.jpg": {"pressure_kpa": 12.5, "direction": "up"},
+        "A1_0kPa_Unloading.jpg": {"pressure_kpa": 0.0, "direction": "down"},
+    }
+    assert [direction_name(w) for w in ("u", "INC", "Unloading", "sideways")] == [
+        "up", "up", "down", "sideways"
+    ]
+
+
 def test_check_names_every_bad_row_and_its_fix(photo_folder):
     photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
     m = pd.read_csv(photo_folder / "manifest.csv")
