@@ -357,3 +357,12 @@ def test_a_sealed_end_is_a_length_in_mm_or_not_given():
     s = resolve_settings(l0_mm=200, target="body", mm_per_px=0.3, sealed_end_mm="8.5")
     assert s.sealed_end_mm == 8.5
     assert resolve_settings(l0_mm=200, mm_per_px=0.3, sealed_end_mm=0).sealed_end_mm == 0.0
+
+
+def test_a_number_written_with_a_decimal_comma_is_read_and_a_list_of_them_is_not():
+    # 'mm_per_px: 0,3' in photoset.yaml (or a manifest cell) was refused: 'must be a positive
+    # number'
+    s = resolve_settings(l0_mm="255", mm_per_px="0,3", sealed_end_mm="4,5")
+    assert (s.l0_mm, s.mm_per_px, s.sealed_end_mm) == (255.0, 0.3, 4.5)
+    with pytest.raises(SettingsError, match="l0_mm = '1,2,3' must be a positive number"):
+        resolve_settings(l0_mm="1,2,3")

@@ -212,17 +212,35 @@ def is_missing(value: Any) -> bool:
     return isinstance(value, str) and not value.strip()
 
 
+def user_float(value: Any) -> float:
+    """A number as a person wrote it (a YAML number, or text with a decimal point or comma); NaN
+    when it is none (``True`` is none either).
+
+    Examples
+    --------
+    >>> user_float("0,3"), user_float(" 12.5 "), user_float(4)
+    (0.3, 12.5, 4.0)
+    >>> [math.isnan(user_float(v)) for v in ("1,2,3", "255 mm", True, None)]
+    [True, True, True, True]
+    """
+    if isinstance(value, bool):
+        return float("nan")
+    if isinstance(value, str):
+        value = value.replace(",", ".", 1)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return float("nan")
+
+
 def _number(
     raw: Mapping[str, Any], key: str, problems: list[SettingProblem], fix: str
 ) -> float | None:
     value: Any = raw.get(key)  # anything a user wrote; float() refuses what is no number
     if is_missing(value):
         return None
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = float("nan")
-    if isinstance(value, bool) or not math.isfinite(number) or number <= 0:
+    number = user_float(value)
+    if not math.isfinite(number) or number <= 0:
         problems.append(SettingProblem(key, f"{key} = {value!r} must be a positive number", fix))
         return None
     return number
@@ -296,12 +314,9 @@ def _fixed_end(
     if "fixed_end_x" in raw or "fixed_end_y" in raw:
         x, y = raw.get("fixed_end_x"), raw.get("fixed_end_y")
         if not (is_missing(x) and is_missing(y)):
-            try:
-                fx, fy = float(x), float(y)  # type: ignore[arg-type]
-                if math.isfinite(fx) and math.isfinite(fy):
-                    return fx, fy
-            except (TypeError, ValueError):
-                pass
+            fx, fy = user_float(x), user_float(y)
+            if math.isfinite(fx) and math.isfinite(fy):
+                return fx, fy
             problems.append(
                 SettingProblem(
                     "fixed_end",
@@ -491,15 +506,12 @@ def _sealed_end(
     value: Any = raw.get("sealed_end_mm")
     if is_missing(value):
         return None
-    try:
-        length = float(value)
-    except (TypeError, ValueError):
-        length = float("nan")
+    length = user_float(value)
     fix = (
         "give the length in mm from where the chamber ends to the tip (sealed end and cap), or "
         "leave sealed_end_mm out"
     )
-    if isinstance(value, bool) or not math.isfinite(length) or length < 0:
+    if not math.isfinite(length) or length < 0:
         problems.append(
             SettingProblem("sealed_end_mm", f"sealed_end_mm = {value!r} must be a length >= 0", fix)
         )
@@ -572,11 +584,8 @@ def settings_problems(
     direction: Any = raw.get("fixed_direction_deg")
     fixed_direction: float | None = None
     if not is_missing(direction):
-        try:
-            fixed_direction = float(direction)
-        except (TypeError, ValueError):
-            fixed_direction = float("nan")
-        if isinstance(direction, bool) or not math.isfinite(fixed_direction):
+        fixed_direction = user_float(direction)
+        if not math.isfinite(fixed_direction):
             problems.append(
                 SettingProblem(
                     "fixed_direction_deg",
