@@ -42,6 +42,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "'{material}_{actuator}_t{trial}_{step}_{pressure_kpa}kPa.jpg'",
     )
     init.add_argument(
+        "--pressures-kpa",
+        metavar="SPEC",
+        help="for file names without the pressure (a camera's IMG_0001.JPG): each ramp's "
+             "pressures in photo order, '0,20,40,20,0' or LOW:HIGH:STEP ('0:180:20' = 0, 20, ..., "
+             "180 and back down to 0); every actuator and trial has as many photos, in file-name "
+             "order (numbers as numbers) or by {step}",
+    )
+    init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
     )
     init.add_argument(
@@ -268,7 +276,16 @@ def _init(args: argparse.Namespace) -> int:
         settings["background"] = args.background
     kept = (Path(args.folder) / photoset.SETTINGS).is_file()  # never overwritten: the user's
     df = photoset_init.init_photoset(
-        args.folder, args.pattern, defaults=defaults, settings=settings, overwrite=args.overwrite
+        args.folder,
+        args.pattern,
+        defaults=defaults,
+        settings=settings,
+        overwrite=args.overwrite,
+        pressures_kpa=(
+            None
+            if args.pressures_kpa is None
+            else photoset_init.ramp_pressures(args.pressures_kpa)
+        ),
     )
     n_up = int((df["direction"] == "up").sum())
     print(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +41,52 @@ def _decimal(text: str) -> float:
     return float(text.lower().replace("p", ".").replace(",", "."))
 
 
-def pattern_to_regex(pattern: str) -> re.Pattern[str]:
+def ramp_pressures(spec: str) -> tuple[float, ...]:
+    """The pressures (kPa) of one ramp's photos in order, from ``--pressures-kpa``: a list
+    ``0,20,40,20,0``, or ``LOW:HIGH:STEP`` for up from LOW to HIGH and back down to LOW.
+
+    Examples
+    --------
+    >>> ramp_pressures("0:60:20")
+    (0.0, 20.0, 40.0, 60.0, 40.0, 20.0, 0.0)
+    >>> ramp_pressures("0, 10, 25.5")
+    (0.0, 10.0, 25.5)
+
+    Raises
+    ------
+    UserInputError
+        When it is neither.
+    """
+    fix = (
+        "give the pressures of one ramp's photos in order (0,20,40,20,0), or LOW:HIGH:STEP "
+        "(0:180:20 goes up to 180 and back down to 0)"
+    )
+    try:
+        if ":" in spec:
+            low, high, step = (float(v) for v in spec.split(":"))
+            if not (step > 0 and high > low):
+                raise ValueError(spec)
+            up = [low + i * step for i in range(int(np.floor((high - low) / step + 1e-9)) + 1)]
+            if not np.isclose(up[-1], high):
+                raise ValueError(spec)
+            return tuple(float(round(v, 9)) for v in up + up[-2::-1])
+        values = tuple(float(v) for v in spec.split(","))
+    except ValueError:
+        raise UserInputError(f"--pressures-kpa {spec!r} cannot be read; {fix}") from None
+    return values
+
+
+def natural_key(name: str) -> tuple[str | int, ...]:
+    """Sort key of a file name with its numbers as numbers (``IMG_9`` before ``IMG_10``).
+
+    >>> sorted(["IMG_10.JPG", "IMG_9.JPG", "IMG_1.JPG"], key=natural_key)
+    ['IMG_1.JPG', 'IMG_9.JPG', 'IMG_10.JPG']
+    """
+    parts = re.split(r"(\d+)", name)
+    return tuple(int(p) if i % 2 else p.lower() for i, p in enumerate(parts))
+
+
+def pattern_to_regex(pattern: str, *, pressure_in_name: bool = True) -> re.Pattern[str]:
     """Compile a file-name pattern such as
     ``'{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'``.
 
@@ -58,7 +103,8 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
     Raises
     ------
     UserInputError
-        On an unknown field or a pattern without ``{pressure_kpa}``.
+        On an unknown field, or a pattern without ``{pressure_kpa}`` (with one, when
+        ``pressure_in_name`` is False: the pressures are given otherwise).
     """
     out, pos = [], 0
     names = []
@@ -78,10 +124,16 @@ def pattern_to_regex(pattern: str) -> re.Pattern[str]:
             out.append(f"(?P<{name}>{_FIELD_PATTERNS[name]})")
         pos = m.end()
     out.append(re.escape(pattern[pos:]).replace(r"\*", ".*?"))
-    if "pressure_kpa" not in names:
+    if pressure_in_name and "pressure_kpa" not in names:
         raise UserInputError(
-            f"pattern {pattern!r} has no {{pressure_kpa}} field; the pressure must come from the "
-            "file name"
+            f"pattern {pattern!r} has no {{pressure_kpa}} field; put it where the file names hold "
+            "the pressure, or (a camera's IMG_0001.JPG) give each ramp's pressures in photo order "
+            "with --pressures-kpa, e.g. 0:180:20 for 0, 20, ..., 180 and back down to 0"
+        )
+    if not pressure_in_name and "pressure_kpa" in names:
+        raise UserInputError(
+            f"pattern {pattern!r} has a {{pressure_kpa}} field and --pressures-kpa gives them too; "
+            "use one of the two"
         )
     return re.compile("".join(out) + r"\Z", re.IGNORECASE)  # kPa or kpa, .jpg or .JPG
 
@@ -93,6 +145,7 @@ def init_photoset(
     defaults: Mapping[str, Any] | None = None,
     settings: Mapping[str, Any] | None = None,
     overwrite: bool = False,
+    pressures_kpa: Sequence[float] | None = None,
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) from image file names.
 
@@ -113,6 +166,11 @@ def init_photoset(
         ``photoset.yaml`` values to write when that file does not exist yet.
     overwrite : bool
         Replace an existing ``manifest.csv``.
+    pressures_kpa : sequence of float, optional
+        For file names without the pressure (a camera's ``IMG_0001.JPG``): the pressures of each
+        ramp's photos in order (:func:`ramp_pressures`); every actuator and trial must have as
+        many photos, taken in that order (by ``step`` if the pattern has it, else by file name,
+        numbers as numbers).
 
     Returns
     -------
@@ -129,10 +187,10 @@ def init_photoset(
         raise UserInputError(f"{folder}: not a folder; give the folder that holds the photos")
     if (folder / MANIFEST).exists() and not overwrite:
         raise UserInputError(f"{folder / MANIFEST} already exists; pass --overwrite to replace it")
-    regex = pattern_to_regex(pattern)
+    regex = pattern_to_regex(pattern, pressure_in_name=pressures_kpa is None)
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     rows, unmatched = [], []
-    for name in photo_names(folder, subfolders="/" in pattern):
+    for name in sorted(photo_names(folder, subfolders="/" in pattern), key=natural_key):
         m = regex.match(name)
         if not m:
             unmatched.append(name)
@@ -145,7 +203,8 @@ def init_photoset(
                 raise UserInputError(
                     f"{name}: no {key} in the file name and no default; pass --{key}"
                 )
-        row["pressure_kpa"] = _decimal(fields["pressure_kpa"])
+        if pressures_kpa is None:
+            row["pressure_kpa"] = _decimal(fields["pressure_kpa"])
         if fields.get("step") is not None:
             row["step"] = int(fields["step"])
         if fields.get("measured_pressure_kpa") is not None:
@@ -176,6 +235,8 @@ def init_photoset(
             )
         )
     df = pd.DataFrame(rows)
+    if pressures_kpa is not None:
+        df = _with_pressures(df, tuple(pressures_kpa))
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
@@ -186,11 +247,34 @@ def init_photoset(
     return df
 
 
+def _with_pressures(df: pd.DataFrame, pressures_kpa: tuple[float, ...]) -> pd.DataFrame:
+    """``df`` with each ramp's photos given ``pressures_kpa`` in order (by step, else by name)."""
+    out = df.copy()
+    out["pressure_kpa"] = np.nan
+    for (material, actuator, trial), g in out.groupby(
+        ["material", "actuator", "trial"], sort=False
+    ):
+        order = g.sort_values("step") if "step" in g.columns else g
+        if len(order) != len(pressures_kpa):
+            raise UserInputError(
+                f"material {material}, actuator {actuator}, trial {trial} has {len(order)} "
+                f"photo(s) ({order['image'].iloc[0]} ... {order['image'].iloc[-1]}) but "
+                "--pressures-kpa "
+                f"gives {len(pressures_kpa)} pressures; give one pressure per photo of a ramp (a "
+                "missing or extra photo: add or move it, or write the manifest by hand)"
+            )
+        out.loc[order.index, "pressure_kpa"] = pressures_kpa
+    return out
+
+
 def _infer_directions(df: pd.DataFrame) -> pd.Series:
     out = pd.Series("up", index=df.index, dtype=object)
-    order = "step" if "step" in df.columns else "image"
     for _, g in df.groupby(["material", "actuator", "trial"], sort=False):
-        g = g.sort_values(order)
+        g = (
+            g.sort_values("step")
+            if "step" in df.columns
+            else g.sort_values("image", key=lambda names: names.map(natural_key))
+        )
         peak = int(np.argmax(g["pressure_kpa"].to_numpy()))
         out.loc[g.index[peak + 1 :]] = "down"
     return out

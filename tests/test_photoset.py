@@ -410,3 +410,42 @@ def test_a_mistyped_photo_name_and_a_capitalised_direction_are_named_or_read_as_
     }, angles["reason"]
     assert "it has 'A1_60kPa.jpg'" in angles.loc["a1_60kpa.JPG", "reason"]
     assert angles["direction"].tolist() == ["up", "up", "down"]
+
+
+def test_a_cameras_numbered_photos_take_the_ramps_pressures_in_number_order(tmp_path):
+    # IMG_1.JPG ... IMG_11.JPG hold no pressure: init refused the pattern ('the pressure must come
+    # from the file name'); now each ramp's pressures are given in photo order, IMG_9 before
+    # IMG_10 (as text IMG_10 sorted before IMG_2, which would put the ramp's top in the middle)
+    for i in range(1, 12):
+        (tmp_path / f"IMG_{i}.JPG").write_bytes(b"")
+    with pytest.raises(UserInputError, match="--pressures-kpa"):
+        photoset_init.init_photoset(tmp_path, "IMG_*.JPG", defaults={"material": "DS20"})
+    assert photoset_init.ramp_pressures("0:100:20") == (0, 20, 40, 60, 80, 100, 80, 60, 40, 20, 0)
+    df = photoset_init.init_photoset(
+        tmp_path, "IMG_*.JPG", defaults={"material": "DS20"},
+        pressures_kpa=photoset_init.ramp_pressures("0:100:20"),
+    )
+    assert df["image"].tolist() == [f"IMG_{i}.JPG" for i in range(1, 12)]
+    assert df["pressure_kpa"].tolist() == [0, 20, 40, 60, 80, 100, 80, 60, 40, 20, 0]
+    assert df["direction"].tolist() == ["up"] * 6 + ["down"] * 5
+    assert ps.read_manifest(tmp_path)["pressure_kpa"].tolist() == df["pressure_kpa"].tolist()
+    with pytest.raises(UserInputError, match=r"has 11 photo\(s\) \(IMG_1.JPG ... IMG_11.JPG\) but "
+                       "--pressures-kpa gives 9 pressures"):
+        photoset_init.init_photoset(
+            tmp_path, "IMG_*.JPG", defaults={"material": "DS20"}, overwrite=True,
+            pressures_kpa=photoset_init.ramp_pressures("0:80:20"),
+        )
+    with pytest.raises(UserInputError, match="use one of the two"):
+        photoset_init.init_photoset(
+            tmp_path, "IMG_{pressure_kpa}.JPG", overwrite=True, pressures_kpa=(0.0,)
+        )
+    with pytest.raises(UserInputError, match="cannot be read"):
+        photoset_init.ramp_pressures("0:100")
+    out = subprocess.run(
+        [sys.executable, "-m", "pipeline", "photoset", "init", str(tmp_path), "--pattern",
+         "IMG_*.JPG", "--material", "DS20", "--pressures-kpa", "0,50,100,100,50,0,0,0,0,0,0",
+         "--overwrite"],
+        capture_output=True, text=True, check=False,
+    )
+    assert out.returncode == 0, out.stderr
+    assert ps.read_manifest(tmp_path)["pressure_kpa"].tolist()[:6] == [0, 50, 100, 100, 50, 0]
