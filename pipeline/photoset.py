@@ -35,7 +35,7 @@ import os
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path, PurePosixPath
+from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
 import numpy as np
@@ -136,7 +136,8 @@ def photo_names(folder: Path, subfolders: bool = False) -> list[str]:
 def near_name(name: str, names: Sequence[str]) -> str | None:
     """The one of ``names`` a person probably meant by ``name``: the same in another case (a
     camera's ``.JPG``), else the closest by :func:`difflib.get_close_matches` (a typo, ``.jpeg``
-    for ``.jpg``); None when none is close.
+    for ``.jpg``); the same for the last part of a full path pasted into a spreadsheet; None when
+    none is close.
 
     Examples
     --------
@@ -145,12 +146,17 @@ def near_name(name: str, names: Sequence[str]) -> str | None:
     'DS20_A1_t1_s015_down_60kPa.jpg'
     >>> near_name("DS20_A1_t1_s016_down_40kPa.jpeg", names), near_name("empty.jpg", names)
     ('DS20_A1_t1_s016_down_40kPa.jpg', None)
+    >>> near_name(r"C:\\Users\\lab\\Fotos\\DS20_A1_t1_s016_down_40kPa.jpg", names)
+    'DS20_A1_t1_s016_down_40kPa.jpg'
     """
-    same_case = [n for n in names if n.lower() == name.lower()]
-    if same_case:
-        return same_case[0]
-    close = difflib.get_close_matches(name, names, n=1, cutoff=0.9)
-    return close[0] if close else None
+    for wanted in dict.fromkeys((name, PureWindowsPath(name).name)):  # also a pasted full path
+        same_case = [n for n in names if n.lower() == wanted.lower()]
+        if same_case:
+            return same_case[0]
+        close = difflib.get_close_matches(wanted, names, n=1, cutoff=0.9)
+        if close:
+            return close[0]
+    return None
 
 
 def overlay_name(image: str) -> str:
