@@ -398,13 +398,52 @@ def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
     return df
 
 
+#: what a spreadsheet saves a manifest as when told to keep its own format
+SPREADSHEET_SUFFIXES: tuple[str, ...] = (".xlsx", ".xlsm", ".xls", ".ods", ".numbers")
+
+
+def manifest_lookalikes(folder: Path) -> list[str]:
+    """Files in ``folder`` that are a manifest under another name: ``Manifest.csv``, or one a
+    spreadsheet saved in its own format (``manifest.xlsx``, ``manifest.csv.xlsx``, ...).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("Manifest.CSV", "manifest.csv.xlsx", "notes.xlsx", "IMG_1.JPG"):
+    ...     _ = (root / name).write_bytes(b"")
+    >>> manifest_lookalikes(root)
+    ['Manifest.CSV', 'manifest.csv.xlsx']
+    """
+    if not folder.is_dir():
+        return []
+    out = []
+    for p in sorted(folder.iterdir()):
+        name = p.name.lower()
+        stem = name.removesuffix(p.suffix.lower()).removesuffix(".csv")
+        if p.name != MANIFEST and (
+            name == MANIFEST or (stem == "manifest" and p.suffix.lower() in SPREADSHEET_SUFFIXES)
+        ):
+            out.append(p.name)
+    return out
+
+
 def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
     """:func:`read_manifest`'s table, or the problem that stops it being read."""
     path = folder / MANIFEST
     if not path.is_file():
+        others = manifest_lookalikes(folder)
         return None, Problem(
-            str(path), None, "missing",
-            f"create it with 'python -m pipeline photoset init {folder} --pattern ...'",
+            str(path),
+            None,
+            "missing" + (f"; the folder has {others}" if others else ""),
+            (
+                f"create it with 'python -m pipeline photoset init {folder} --pattern ...'"
+                if not others
+                else f"rename {others[0]!r} to {MANIFEST}"
+                if others[0].lower() == MANIFEST
+                else f"save {others[0]!r} as CSV named {MANIFEST} (comma- or ';'-separated)"
+            ),
         )
     try:
         df = read_user_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
@@ -703,6 +742,32 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
     return ps, problems + list(ps.problems)
 
 
+def _newer_spreadsheet_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning when a spreadsheet copy of the manifest is newer than ``manifest.csv``: edits
+    saved in the spreadsheet's own format are not read, and the photos would be measured with
+    the manifest as it was."""
+    mpath = ps.folder / MANIFEST
+    try:
+        read_at = mpath.stat().st_mtime
+    except OSError:
+        return []
+    out = []
+    for name in manifest_lookalikes(ps.folder):
+        if Path(name).suffix.lower() in SPREADSHEET_SUFFIXES and (
+            (ps.folder / name).stat().st_mtime > read_at
+        ):
+            out.append(
+                Problem(
+                    str(mpath),
+                    None,
+                    f"{name} is newer than {MANIFEST}: edits saved only there are not read",
+                    f"save {name} as CSV named {MANIFEST} (comma- or ';'-separated), or delete it",
+                    warning=True,
+                )
+            )
+    return out
+
+
 def missing_image_problem(
     ps: PhotoSet, line: int, image: str, in_folder: Sequence[str]
 ) -> Problem:
@@ -766,6 +831,7 @@ def file_problems(
     if not ps.is_video:
         problems += unlisted_problems(ps)
     problems += _calibration_problems(ps)
+    problems += _newer_spreadsheet_problems(ps)
     unscaled = [
         r for r in ps.rows if r is not None and r.mm_per_px is None and r.calibration is None
     ]

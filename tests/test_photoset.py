@@ -449,3 +449,27 @@ def test_a_cameras_numbered_photos_take_the_ramps_pressures_in_number_order(tmp_
     )
     assert out.returncode == 0, out.stderr
     assert ps.read_manifest(tmp_path)["pressure_kpa"].tolist()[:6] == [0, 50, 100, 100, 50, 0]
+
+
+def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_ignored(photo_folder):
+    # the manifest edited in Excel and saved as manifest.xlsx: manifest.csv, unchanged, was read
+    # as it was with no word; a 'Manifest.csv' was only 'missing'
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    path = photo_folder / ps.MANIFEST
+    xlsx = photo_folder / "manifest.xlsx"
+    xlsx.write_bytes(b"PK")
+    os.utime(xlsx, (path.stat().st_mtime + 60,) * 2)
+    (warning,) = [
+        p for p in ps.validate_photoset(photo_folder, warnings=True) if "xlsx" in p.message
+    ]
+    assert warning.warning and warning.message == (
+        "manifest.xlsx is newer than manifest.csv: edits saved only there are not read"
+    )
+    os.utime(xlsx, (path.stat().st_mtime - 60,) * 2)  # older: the CSV was saved after it
+    assert not [
+        p for p in ps.validate_photoset(photo_folder, warnings=True) if "xlsx" in p.message
+    ]
+    path.rename(photo_folder / "Manifest.csv")
+    (problem,) = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
+    assert problem.message == "missing; the folder has ['Manifest.csv', 'manifest.xlsx']"
+    assert problem.fix == "rename 'Manifest.csv' to manifest.csv"
