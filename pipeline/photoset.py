@@ -54,6 +54,7 @@ from pipeline.measure.settings import (
     is_missing,
     merge_calibration,
     settings_problems,
+    user_float,
 )
 
 MANIFEST = "manifest.csv"
@@ -469,9 +470,10 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
 
 
 def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
-    """Problems of the manifest rows themselves (not of their settings or images)."""
+    """Problems of the manifest rows themselves (not of their settings or images); ``df`` as
+    written (a bad pressure is named as it was written)."""
     out: list[Problem] = []
-    pressure = pd.to_numeric(df["pressure_kpa"], errors="coerce")
+    pressure = df["pressure_kpa"].map(user_float)
     first_line: dict[str, int] = {}
     for i, (line, image, direction) in enumerate(
         zip(df["manifest_line"], df["image"], df["direction"])
@@ -696,8 +698,11 @@ def load_photoset(folder: str | os.PathLike[str]) -> PhotoSet:
     if is_video_manifest(df):
         problems = _video_row_problems(df, str(folder / MANIFEST)) + row_problems
     else:
-        df["pressure_kpa"] = pd.to_numeric(df["pressure_kpa"], errors="coerce")
         problems = _row_problems(df, str(folder / MANIFEST)) + row_problems
+        # numbers from here on ('60,5' as a decimal comma writes it, quoted in a comma CSV)
+        for column in ("pressure_kpa", "measured_pressure_kpa"):
+            if column in df.columns:
+                df[column] = df[column].map(user_float).astype(float)
     bad_lines = {p.line for p in problems}
     rows = tuple(None if line in bad_lines else r for line, r in zip(df["manifest_line"], rows))
     problems.sort(key=lambda p: p.line or 0)

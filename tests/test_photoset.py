@@ -473,3 +473,17 @@ def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_igno
     (problem,) = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
     assert problem.message == "missing; the folder has ['Manifest.csv', 'manifest.xlsx']"
     assert problem.fix == "rename 'Manifest.csv' to manifest.csv"
+
+
+def test_a_bad_pressure_is_named_as_written_and_a_quoted_decimal_comma_is_a_number(photo_folder):
+    # the problem said "pressure_kpa np.float64(nan) is not a number" for any bad cell; and a
+    # comma CSV from a German-locale LibreOffice quotes "12,5", which was that same NaN
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    lines = (photo_folder / ps.MANIFEST).read_text().splitlines()
+    cells = [line.split(",") for line in lines]
+    column = cells[0].index("pressure_kpa")
+    cells[1][column], cells[2][column] = "abc", '"12,5"'
+    (photo_folder / ps.MANIFEST).write_text("\n".join(",".join(c) for c in cells) + "\n")
+    problems = [p for p in ps.validate_photoset(photo_folder) if "pressure_kpa" in p.message]
+    assert [(p.line, p.message) for p in problems] == [(2, "pressure_kpa 'abc' is not a number")]
+    assert ps.load_photoset(photo_folder).manifest["pressure_kpa"].iloc[1] == 12.5
