@@ -4,7 +4,9 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 from pipeline.folders import staged_folder
 from pipeline.measure.core import DEFAULT_METHOD
@@ -55,6 +57,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Measure the set, write angles.csv, print a one-line summary."""
+    from pipeline.photoset import newer_spreadsheet_problems
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
@@ -65,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
         with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
             angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
+    for problem in newer_spreadsheet_problems(Path(args.photoset)):
+        print(problem, file=sys.stderr)
     print(
         f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}"
     )

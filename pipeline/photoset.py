@@ -747,19 +747,19 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
     return ps, problems + list(ps.problems)
 
 
-def _newer_spreadsheet_problems(ps: PhotoSet) -> list[Problem]:
+def newer_spreadsheet_problems(folder: Path) -> list[Problem]:
     """A warning when a spreadsheet copy of the manifest is newer than ``manifest.csv``: edits
     saved in the spreadsheet's own format are not read, and the photos would be measured with
-    the manifest as it was."""
-    mpath = ps.folder / MANIFEST
+    the manifest as it was (``check`` lists it; ``measure`` prints it)."""
+    mpath = folder / MANIFEST
     try:
         read_at = mpath.stat().st_mtime
     except OSError:
         return []
     out = []
-    for name in manifest_lookalikes(ps.folder):
+    for name in manifest_lookalikes(folder):
         if Path(name).suffix.lower() in SPREADSHEET_SUFFIXES and (
-            (ps.folder / name).stat().st_mtime > read_at
+            (folder / name).stat().st_mtime > read_at
         ):
             out.append(
                 Problem(
@@ -836,7 +836,7 @@ def file_problems(
     if not ps.is_video:
         problems += unlisted_problems(ps)
     problems += _calibration_problems(ps)
-    problems += _newer_spreadsheet_problems(ps)
+    problems += newer_spreadsheet_problems(ps.folder)
     unscaled = [
         r for r in ps.rows if r is not None and r.mm_per_px is None and r.calibration is None
     ]

@@ -465,6 +465,12 @@ def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_igno
     assert warning.warning and warning.message == (
         "manifest.xlsx is newer than manifest.csv: edits saved only there are not read"
     )
+    out = subprocess.run(  # measure (a Snakemake job's log) says so too
+        [sys.executable, "-m", "pipeline", "measure", str(photo_folder), "--out",
+         str(photo_folder.parent / "angles.csv")],
+        capture_output=True, text=True, check=False,
+    )
+    assert out.returncode == 0 and "manifest.xlsx is newer than manifest.csv" in out.stderr
     os.utime(xlsx, (path.stat().st_mtime - 60,) * 2)  # older: the CSV was saved after it
     assert not [
         p for p in ps.validate_photoset(photo_folder, warnings=True) if "xlsx" in p.message
