@@ -73,6 +73,25 @@ def comma_csv_text(text: str) -> str:
     return out.getvalue()
 
 
+def read_user_text(path: str | os.PathLike[str]) -> str:
+    """The text of a file a person wrote: UTF-8 (a byte-order mark dropped), else the Windows
+    code page cp1252 (what an older Notepad or Excel saves), never a decoding error.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "photoset.yaml"
+    >>> _ = p.write_bytes("# Aktor für Versuch 3\\nl0_mm: 255\\n".encode("cp1252"))
+    >>> read_user_text(p).splitlines()[0]
+    '# Aktor für Versuch 3'
+    """
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("cp1252", errors="replace")
+
+
 def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame:
     """Read a CSV file a person wrote or saved from a spreadsheet.
 
@@ -102,13 +121,8 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     >>> read_user_csv(p).to_dict("records")
     [{'image': 'ä.jpg', 'pressure_kpa': 12.5, 'material': 'DS20'}]
     """
-    data = Path(path).read_bytes()
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError:  # not UTF-8: a Windows spreadsheet's code page
-        text = data.decode("cp1252", errors="replace")
     read_csv.setdefault("skipinitialspace", True)
-    df = pd.read_csv(io.StringIO(comma_csv_text(text)), **read_csv)
+    df = pd.read_csv(io.StringIO(comma_csv_text(read_user_text(path))), **read_csv)
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
     return df
 

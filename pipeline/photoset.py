@@ -44,7 +44,7 @@ import yaml
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA, direction_name
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes, read_user_csv, write_table
+from pipeline.fileio import atomic_write_bytes, read_user_csv, read_user_text, write_table
 from pipeline.measure.calibration import CalibrationCache
 from pipeline.measure.formats import undecodable
 from pipeline.measure.settings import (
@@ -273,7 +273,7 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
             )
         ]
     try:
-        raw = yaml.safe_load(path.read_text()) or {}
+        raw = yaml.safe_load(read_user_text(path)) or {}
     except yaml.YAMLError as exc:
         return None, [Problem(name, None, f"not valid YAML ({exc})", "fix the YAML syntax")]
     if not isinstance(raw, dict):
@@ -323,7 +323,7 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
     folder = Path(folder)
     values: list[Any] = []
     try:
-        raw = yaml.safe_load((folder / SETTINGS).read_text()) or {}
+        raw = yaml.safe_load(read_user_text(folder / SETTINGS)) or {}
     except (OSError, yaml.YAMLError):
         raw = {}
     if isinstance(raw, dict):

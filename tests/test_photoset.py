@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -493,3 +494,23 @@ def test_a_bad_pressure_is_named_as_written_and_a_quoted_decimal_comma_is_a_numb
     problems = [p for p in ps.validate_photoset(photo_folder) if "pressure_kpa" in p.message]
     assert [(p.line, p.message) for p in problems] == [(2, "pressure_kpa 'abc' is not a number")]
     assert ps.load_photoset(photo_folder).manifest["pressure_kpa"].iloc[1] == 12.5
+
+
+def test_settings_and_a_materials_file_saved_by_windows_notepad_are_read(photo_folder, tmp_path):
+    # an older Notepad saves in the Windows code page: 'für' in a comment crashed check, measure
+    # and Snakemake with a UnicodeDecodeError traceback
+    from pipeline.model.materials import load_materials
+
+    photoset_init.init_photoset(photo_folder, PATTERN)
+    (photo_folder / ps.SETTINGS).write_bytes(
+        "# Aktor für Versuch 3 (Dragon Skin 30, Länge gemessen)\nl0_mm: 210\n".encode("cp1252")
+    )
+    assert ps.read_settings(photo_folder)["l0_mm"] == 210
+    problems = ps.validate_photoset(photo_folder, decode_images=False)
+    assert not [p for p in problems if "l0" in p.message or "YAML" in p.message], problems
+    from pipeline.model import materials
+
+    packaged = (Path(materials.__file__).parent / "materials.yaml").read_text()
+    mine = tmp_path / "materials.yaml"
+    mine.write_bytes(("# Härte: Shore 20A, gemessen am 03.12.\n" + packaged).encode("cp1252"))
+    assert load_materials(mine)["DS20"].k_p == load_materials()["DS20"].k_p

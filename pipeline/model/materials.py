@@ -16,6 +16,7 @@ from typing import Any
 import yaml
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import read_user_text
 
 #: the data file shipped with the package
 DEFAULT_MATERIALS_PATH = Path(__file__).with_name("materials.yaml")
@@ -180,8 +181,7 @@ def _parse_material(name: str, raw: Any, geometry: dict[str, Any], where: str) -
 def _load_cached(path: str, mtime_ns: int) -> dict[str, Material]:
     where = path
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = yaml.safe_load(fh)
+        data = yaml.safe_load(read_user_text(path))
     except OSError as exc:
         raise UserInputError(
             f"{where}: cannot read materials file ({exc.strerror}); check the path"
