@@ -31,6 +31,10 @@ SEPARATORS = (",", ";", "\t")
 _DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+\s*")
 
 
+#: how a spreadsheet's own file begins (zip: .xlsx, .ods; OLE: .xls), which is not CSV text
+WORKBOOK_SIGNATURES: tuple[bytes, ...] = (b"PK\x03\x04", b"\xd0\xcf\x11\xe0")
+
+
 def csv_separator(header: str) -> str:
     """The field separator of a CSV file, judged by its header line: the one of
     :data:`SEPARATORS` that splits it into the most fields (``,`` on a tie).
@@ -110,7 +114,8 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     Raises
     ------
     FileNotFoundError, pandas.errors.ParserError, pandas.errors.EmptyDataError
-        As :func:`pandas.read_csv` does.
+        As :func:`pandas.read_csv` does; ParserError also for a spreadsheet's workbook named
+        ``.csv``.
 
     Examples
     --------
@@ -121,6 +126,12 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     >>> read_user_csv(p).to_dict("records")
     [{'image': 'ä.jpg', 'pressure_kpa': 12.5, 'material': 'DS20'}]
     """
+    with open(path, "rb") as fh:
+        if fh.read(8).startswith(WORKBOOK_SIGNATURES):
+            raise pd.errors.ParserError(
+                "it is a spreadsheet workbook (.xlsx, .xls or .ods) named .csv, not CSV text; "
+                "save it again as CSV"
+            )
     read_csv.setdefault("skipinitialspace", True)
     df = pd.read_csv(io.StringIO(comma_csv_text(read_user_text(path))), **read_csv)
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]

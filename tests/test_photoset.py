@@ -480,6 +480,13 @@ def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_igno
     (problem,) = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
     assert problem.message == "missing; the folder has ['Manifest.csv', 'manifest.xlsx']"
     assert problem.fix == "rename 'Manifest.csv' to manifest.csv"
+    # the workbook itself saved under the CSV's name: its zip bytes were shown as the 'header'
+    import zipfile
+
+    with zipfile.ZipFile(path, "w") as book:
+        book.writestr("xl/workbook.xml", "<workbook/>")
+    (problem,) = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
+    assert "it is a spreadsheet workbook (.xlsx, .xls or .ods) named .csv" in problem.message
 
 
 def test_a_bad_pressure_is_named_as_written_and_a_quoted_decimal_comma_is_a_number(photo_folder):
