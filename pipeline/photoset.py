@@ -70,6 +70,13 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
     "trial",
 )
 OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa")
+#: a manifest may give the pressure in another unit instead of ``pressure_kpa`` (a regulator or
+#: gauge that shows bar or psi): the column and its kPa, turned into ``pressure_kpa`` where the
+#: manifest is read
+PRESSURE_UNITS_KPA: dict[str, float] = {
+    "pressure_bar": 100.0, "pressure_mbar": 0.1, "pressure_psi": 6.894757293168361,
+    "pressure_mpa": 1000.0,
+}
 #: manifest columns of a video photo set (one row per video; see :mod:`pipeline.video`)
 VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", "actuator", "trial")
 #: ``clock_offset_s``: log time of video time 0 (s, default 0); ``frame_times``: a ``frame, time_s``
@@ -453,6 +460,9 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             str(path), None, f"cannot be read as CSV ({exc})",
             "save it as CSV: a header line, then one line per photo",
         )
+    units = [c for c in PRESSURE_UNITS_KPA if c in df.columns]
+    if "pressure_kpa" not in df.columns and len(units) == 1 and not is_video_manifest(df):
+        df = _with_pressure_kpa(df, units[0])
     required = VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS
     missing = [c for c in required if c not in df.columns]
     if missing:
@@ -467,6 +477,23 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
         df["direction"] = df["direction"].map(direction_name)
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
     return df, None
+
+
+def _with_pressure_kpa(df: pd.DataFrame, column: str) -> pd.DataFrame:
+    """``df`` with ``pressure_kpa`` from a pressure in another unit (:data:`PRESSURE_UNITS_KPA`),
+    beside it; a cell that is no number is kept as written, for the row check to name.
+
+    Examples
+    --------
+    >>> m = pd.DataFrame({"image": ["a.jpg", "b.jpg", "c.jpg"], "pressure_bar": [0.35, "0,7", "x"]})
+    >>> _with_pressure_kpa(m, "pressure_bar")["pressure_kpa"].tolist()
+    [35.0, 70.0, 'x']
+    """
+    values = df[column].map(user_float) * PRESSURE_UNITS_KPA[column]
+    kpa = [round(float(v), 6) if np.isfinite(v) else w for v, w in zip(values, df[column])]
+    out = df.copy()
+    out.insert(int(out.columns.get_loc(column)) + 1, "pressure_kpa", kpa)
+    return out
 
 
 def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
@@ -506,7 +533,11 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                 Problem(
                     mpath,
                     line,
-                    f"pressure_kpa {df['pressure_kpa'].iloc[i]!r} is not a number",
+                    (
+                        "pressure_kpa is missing (an empty or n/a cell), not a number"
+                        if is_missing(written := df["pressure_kpa"].iloc[i])
+                        else f"pressure_kpa {written!r} is not a number"
+                    ),
                     "write the gauge pressure in kPa, e.g. 40",
                 )
             )

@@ -521,3 +521,29 @@ def test_settings_and_a_materials_file_saved_by_windows_notepad_are_read(photo_f
     mine = tmp_path / "materials.yaml"
     mine.write_bytes(("# Härte: Shore 20A, gemessen am 03.12.\n" + packaged).encode("cp1252"))
     assert load_materials(mine)["DS20"].k_p == load_materials()["DS20"].k_p
+
+
+def test_a_manifest_in_bar_or_psi_is_read_as_kpa_and_a_bad_cell_is_named(photo_folder):
+    # a regulator that shows bar: 'missing column(s) [pressure_kpa]' refused the set
+    from pipeline.photoset_measure import measure_photoset
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    m = pd.read_csv(photo_folder / ps.MANIFEST)
+    kpa = m.pop("pressure_kpa")
+    for column, per_kpa in (("pressure_psi", 6.894757293168361), ("pressure_bar", 100.0)):
+        m.insert(1, column, kpa / per_kpa)
+        m.to_csv(photo_folder / ps.MANIFEST, index=False)
+        assert ps.read_manifest(photo_folder)["pressure_kpa"].tolist() == kpa.tolist()
+        del m[column]
+    assert ps.validate_photoset(photo_folder, decode_images=False) == []
+    angles = measure_photoset(photo_folder, ramp_check=False)
+    assert angles["pressure_kpa"].tolist() == kpa.tolist()
+    assert angles["pressure_bar"].tolist() == (kpa / 100.0).tolist()  # as written, beside it
+    m.insert(1, "pressure_bar", (kpa / 100.0).astype(object))
+    m.loc[2, "pressure_bar"], m.loc[3, "pressure_bar"] = "0.4 bar", ""
+    m.to_csv(photo_folder / ps.MANIFEST, index=False)
+    problems = ps.validate_photoset(photo_folder, decode_images=False)
+    assert [(p.line, p.message) for p in problems] == [
+        (4, "pressure_kpa '0.4 bar' is not a number"),
+        (5, "pressure_kpa is missing (an empty or n/a cell), not a number"),  # was 'nan'
+    ]
