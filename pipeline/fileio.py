@@ -89,7 +89,10 @@ def read_user_text(path: str | os.PathLike[str]) -> str:
     >>> read_user_text(p).splitlines()[0]
     '# Aktor für Versuch 3'
     """
-    data = Path(path).read_bytes()
+    return _user_text(Path(path).read_bytes())
+
+
+def _user_text(data: bytes) -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -126,14 +129,14 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     >>> read_user_csv(p).to_dict("records")
     [{'image': 'ä.jpg', 'pressure_kpa': 12.5, 'material': 'DS20'}]
     """
-    with open(path, "rb") as fh:
-        if fh.read(8).startswith(WORKBOOK_SIGNATURES):
-            raise pd.errors.ParserError(
-                "it is a spreadsheet workbook (.xlsx, .xls or .ods) named .csv, not CSV text; "
-                "save it again as CSV"
-            )
+    data = Path(path).read_bytes()
+    if data.startswith(WORKBOOK_SIGNATURES):
+        raise pd.errors.ParserError(
+            "it is a spreadsheet workbook (.xlsx, .xls or .ods) named .csv, not CSV text; "
+            "save it again as CSV"
+        )
     read_csv.setdefault("skipinitialspace", True)
-    df = pd.read_csv(io.StringIO(comma_csv_text(read_user_text(path))), **read_csv)
+    df = pd.read_csv(io.StringIO(comma_csv_text(_user_text(data))), **read_csv)
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
     return df
 
