@@ -786,8 +786,11 @@ def model_callables(
     def _material(name: str) -> Any:
         if name not in table:
             raise UserInputError(
-                f"{materials_path or 'packaged materials.yaml'}: no material {name!r}; "
-                "add it to a materials file and pass --materials PATH"
+                f"{materials_path or 'the packaged materials.yaml'} has no material {name!r}, "
+                "so its photos are measured and not compared with the model; to compare, copy "
+                "an entry of pipeline/model/materials.yaml into your own materials file with the "
+                "material's Ogden fit and name that file in config.yaml (model.materials_file, "
+                "or the dataset's materials_file; --materials PATH without Snakemake)"
             )
         return table[name]
 

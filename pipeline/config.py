@@ -11,6 +11,7 @@ runs.
 from __future__ import annotations
 
 import copy
+import difflib
 import hashlib
 import json
 from collections.abc import Mapping
@@ -247,6 +248,30 @@ def _semantic_errors(
 def known_materials(materials_file: str | Path | None = None) -> set[str]:
     """Names of the materials the model knows (built-in table, or ``materials_file``)."""
     return set(load_materials(materials_file) if materials_file else load_materials())
+
+
+def unmodelled_material_note(dataset: str, material: str, known: set[str]) -> str:
+    """What a run says of a dataset's material that the model's materials file lacks.
+
+    Its photos are measured, aggregated and reported all the same; only the model comparison
+    is left out (a lab's own actuator), so this is a note, not a refusal, and it names a close
+    known name in case of a typo.
+
+    Examples
+    --------
+    >>> unmodelled_material_note("mine", "DS 20", {"DS20", "SS40"})[:60]
+    "note: dataset 'mine' names material 'DS 20', which the model"
+    >>> "did you mean 'DS20'" in unmodelled_material_note("mine", "DS 20", {"DS20"})
+    True
+    """
+    close = difflib.get_close_matches(material, sorted(known), n=1, cutoff=0.6)
+    typo = f" (did you mean {close[0]!r}? then correct manifest.csv)" if close else ""
+    return (
+        f"note: dataset {dataset!r} names material {material!r}, which the model does not have "
+        f"(it has {', '.join(sorted(known))}){typo}: its photos are measured and reported, but "
+        "not compared with the model; to compare, add the material to a materials file and name "
+        "it in config.yaml (model.materials_file, or the dataset's materials_file)"
+    )
 
 
 def validate_config(

@@ -7,11 +7,12 @@
 # Every value that reaches a shell command from the config is quoted: placeholders carry `:q`, and
 # the option helpers below return lists of arguments, which `{params.x:q}` quotes one by one.
 import re
+import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from pipeline.config import validate_config
+from pipeline.config import known_materials, unmodelled_material_note, validate_config
 from pipeline.errors import UserInputError
 from pipeline.folders import update_folder_digest
 from pipeline.photoset import read_manifest, referenced_files
@@ -123,7 +124,14 @@ def materials_file(ds):
 
 # Model curves: one per material in results/model/ for datasets on the run's materials file, and one
 # per material of each dataset with its own file under its results folder (never the same path).
-MATERIALS = sorted({m for ds in DATASETS.values() if not ds.get("materials_file") for m in dataset_materials(ds)})
+# A lab's own material that the materials file lacks has no curve: its photos are measured and
+# reported, and the comparison says the model has no such material (how to add it).
+MODEL_MATERIALS = known_materials(config["model"]["materials_file"])
+_NAMED = {(name, m) for name, ds in DATASETS.items() if not ds.get("materials_file") for m in dataset_materials(ds)}
+MATERIALS = sorted({m for _, m in _NAMED} & MODEL_MATERIALS)
+for _name, _m in sorted(_NAMED):
+    if _m not in MODEL_MATERIALS:
+        print(unmodelled_material_note(_name, _m, MODEL_MATERIALS), file=sys.stderr)
 OWN_MODEL_CURVES = [
     f"{RESULTS}/datasets/{name}/model/{m}.csv"
     for name, ds in DATASETS.items()

@@ -444,6 +444,32 @@ def test_a_failed_job_shows_the_end_of_its_log_on_the_console(tmp_path, repo):
     assert message in out.stderr  # ... and the console shows it, not only an exit status
 
 
+def test_a_labs_own_material_is_measured_and_reported_without_the_model(tmp_path, repo):
+    """A material the materials file lacks (a lab's own actuator, or a typo) stopped the run at
+    its model curve job, so no report: now its photos are measured and reported, the console
+    says why it is not compared with the model (a close known name too), and so does rms.csv."""
+    cfg = _tiny_config()
+    cfg["datasets"] = cfg["datasets"][:1]
+    _workdir(tmp_path, repo, cfg)
+    manifest = tmp_path / PHOTOS / "manifest.csv"
+    rows = pd.read_csv(manifest, dtype=str)
+    rows["material"] = "OurGel"
+    rows.loc[rows.index[:2], "material"] = "DS-20"  # a typo on two rows
+    rows.to_csv(manifest, index=False)
+    out = _snakemake(tmp_path, repo, "--cores", "2")
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert "names material 'OurGel', which the model does not have" in out.stderr
+    assert "names material 'DS-20'" in out.stderr and "did you mean 'DS20'" in out.stderr
+    res = tmp_path / "results"
+    assert (res / "report.pdf").read_bytes().startswith(b"%PDF")
+    assert not (res / "model").exists()
+    angles = pd.read_csv(res / "datasets" / "sample" / "angles.csv")
+    assert (angles["status"] == "ok").sum() >= len(rows) - 1
+    rms = pd.read_csv(res / "rms.csv").set_index("material")
+    assert "has no material 'OurGel'" in rms.loc["OurGel", "note"]
+    assert np.isnan(rms.loc["OurGel", "rms_deg"]) and rms.loc["OurGel", "range_deg"] > 100
+
+
 def test_rig_dataset_is_acquired_through_the_emulator_and_measured(tmp_path, repo):
     """A `rig` dataset: Snakemake runs `acquire` against the pty emulator, photos land outside
     results/."""
