@@ -14,6 +14,7 @@ import copy
 import difflib
 import hashlib
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import fields
 from importlib import resources
@@ -250,6 +251,37 @@ def known_materials(materials_file: str | Path | None = None) -> set[str]:
     return set(load_materials(materials_file) if materials_file else load_materials())
 
 
+def _home_expanded(config: dict[str, Any]) -> dict[str, Any]:
+    """``config`` with ``~`` in its paths turned into the home folder (``path: ~/data/june``).
+
+    Examples
+    --------
+    >>> cfg = _home_expanded({"datasets": [{"path": "~/june"}], "force": {"grasp_log": None}})
+    >>> cfg["datasets"][0]["path"] == os.path.expanduser("~/june")
+    True
+    """
+
+    def home(value: Any) -> Any:
+        return os.path.expanduser(value) if isinstance(value, str) else value
+
+    out = copy.deepcopy(config)
+    for section in (out, out.get("force") or {}):
+        for ds in section.get("datasets") or []:
+            if isinstance(ds, dict):
+                for key in ("path", "materials_file"):
+                    if key in ds:
+                        ds[key] = home(ds[key])
+    tops = (
+        (out, "results_dir"),
+        (out.get("model") or {}, "materials_file"),
+        (out.get("force") or {}, "grasp_log"),
+    )
+    for parent, key in tops:
+        if isinstance(parent, dict) and key in parent:
+            parent[key] = home(parent[key])
+    return out
+
+
 def unmodelled_material_note(dataset: str, material: str, known: set[str]) -> str:
     """What a run says of a dataset's material that the model's materials file lacks.
 
@@ -302,7 +334,7 @@ def validate_config(
         Listing every problem, each naming the key path and the fix.
     """
     schema = load_schema()
-    filled = fill_defaults(dict(config), schema)
+    filled = _home_expanded(fill_defaults(dict(config), schema))
     problems = _schema_errors(filled, schema)
     if not problems:
         workdir = Path(workdir)

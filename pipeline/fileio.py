@@ -35,6 +35,21 @@ _DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+\s*")
 WORKBOOK_SIGNATURES: tuple[bytes, ...] = (b"PK\x03\x04", b"\xd0\xcf\x11\xe0")
 
 
+def user_path(name: str | os.PathLike[str], folder: str | os.PathLike[str] | None = None) -> Path:
+    """A path as a person wrote it: ``~`` is their home folder, and a relative path is taken
+    from ``folder`` (an absolute one stays as written).
+
+    Examples
+    --------
+    >>> user_path("empty.jpg", "set").as_posix(), user_path("/data/a.jpg", "set").as_posix()
+    ('set/empty.jpg', '/data/a.jpg')
+    >>> user_path("~/a.jpg", "set") == Path.home() / "a.jpg"
+    True
+    """
+    path = Path(os.path.expanduser(os.fspath(name).strip()))
+    return path if folder is None or path.is_absolute() else Path(folder) / path
+
+
 def csv_separator(header: str) -> str:
     """The field separator of a CSV file, judged by its header line: the one of
     :data:`SEPARATORS` that splits it into the most fields (``,`` on a tie).

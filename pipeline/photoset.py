@@ -44,7 +44,13 @@ import yaml
 
 from pipeline.constants import DIRECTIONS, VACUUM_KPA, direction_name
 from pipeline.errors import UserInputError
-from pipeline.fileio import atomic_write_bytes, read_user_csv, read_user_text, write_table
+from pipeline.fileio import (
+    atomic_write_bytes,
+    read_user_csv,
+    read_user_text,
+    user_path,
+    write_table,
+)
 from pipeline.measure.calibration import CalibrationCache
 from pipeline.measure.formats import undecodable
 from pipeline.measure.settings import (
@@ -357,7 +363,7 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
         path.resolve()
         for name in names
         if name.strip()
-        for path in [folder / name.strip()]  # an absolute name stays absolute
+        for path in [user_path(name, folder)]  # an absolute name stays absolute
         if path.is_file()
     )
 

@@ -6,11 +6,14 @@ import os
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from pipeline.config import config_digest, load_schema, validate_config
 from pipeline.errors import UserInputError
+from pipeline.measure.settings import resolve_settings
+from pipeline.photoset import referenced_files
 
 
 def _walk(schema, path="config", required=frozenset()):
@@ -337,3 +340,25 @@ def test_a_bad_global_materials_file_is_refused_and_synthetic_sets_need_a_packag
         "datasets[0].material: synthetic photos are rendered from the packaged model, which has "
         "no material 'EF30'" in out
     )
+
+
+def test_a_path_written_from_the_home_folder_is_found(tmp_path, repo, monkeypatch):
+    """``path: ~/photos/june`` was 'does not exist (relative to ...)': ``~`` is the home folder in
+    the config, and in a set's ``background``, which the digest then watches."""
+    home = tmp_path / "home"
+    monkeypatch.setenv("HOME", str(home))
+    june = home / "photos" / "june"
+    shutil.copytree(repo / "sample_images", june)
+    (home / "empty.jpg").write_bytes((june / "DS20_A1_t1_s000_up_0kPa.jpg").read_bytes())
+    work = tmp_path / "work"
+    work.mkdir()
+    cfg = validate_config(
+        {"datasets": [{"name": "june", "source": "folder", "path": "~/photos/june"}]},
+        workdir=work,
+    )
+    assert cfg["datasets"][0]["path"] == str(june)
+    settings = resolve_settings({"l0_mm": 200, "background": "~/empty.jpg"}, folder=june)
+    assert settings.background_path is not None
+    assert Path(settings.background_path) == home / "empty.jpg"
+    (june / "photoset.yaml").write_text("l0_mm: 270\nbackground: ~/empty.jpg\n")
+    assert referenced_files(june) == ((home / "empty.jpg").resolve(),)

@@ -70,6 +70,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from pipeline.fileio import user_path
 from pipeline.measure.calibration import (
     Calibration,
     CalibrationCache,
@@ -389,8 +390,6 @@ def _calibration(
     cache: CalibrationCache | None,
 ) -> Calibration | None:
     """The ``calibration`` setting, computed (or read from the store) -- or its problems."""
-    from pathlib import Path
-
     value = raw.get("calibration")
     if is_missing(value):
         return None
@@ -429,9 +428,7 @@ def _calibration(
         )
     else:
         for b in boards:
-            path = Path(b.strip())
-            if folder is not None and not path.is_absolute():
-                path = Path(folder) / path
+            path = user_path(b, folder)
             if not path.is_file():
                 problems.append(
                     SettingProblem(
@@ -550,8 +547,6 @@ def settings_problems(
     settings : MeasureSettings or None
     problems : list of SettingProblem
     """
-    from pathlib import Path
-
     problems: list[SettingProblem] = []
     l0 = _number(raw, "l0_mm", problems, "set l0_mm to the length of the marked layer in mm")
     if l0 is None and not any(p.key == "l0_mm" for p in problems):
@@ -653,9 +648,7 @@ def settings_problems(
             )
     background: str | None = None
     if not is_missing(raw.get("background")):
-        path = Path(str(raw["background"]))
-        if folder is not None and not path.is_absolute():
-            path = Path(folder) / path
+        path = user_path(str(raw["background"]), folder)
         if not path.is_file():
             problems.append(
                 SettingProblem(
