@@ -59,6 +59,7 @@ from pipeline.measure.settings import (
     MeasureSettings,
     is_missing,
     merge_calibration,
+    number_doubt,
     settings_problems,
     user_float,
 )
@@ -535,18 +536,37 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
             first_line[image] = line
         p = pressure.iloc[i]
         if not np.isfinite(p):
+            written = df["pressure_kpa"].iloc[i]
+            doubt = number_doubt(written)
             out.append(
                 Problem(
                     mpath,
                     line,
                     (
                         "pressure_kpa is missing (an empty or n/a cell), not a number"
-                        if is_missing(written := df["pressure_kpa"].iloc[i])
+                        if is_missing(written)
+                        else f"pressure_kpa {written!r} could be either number: {doubt}"
+                        if doubt
                         else f"pressure_kpa {written!r} is not a number"
                     ),
-                    "write the gauge pressure in kPa, e.g. 40",
+                    "write the gauge pressure in kPa, e.g. 40"
+                    + (", without a thousands separator, with a decimal point" if doubt else ""),
                 )
             )
+        if "measured_pressure_kpa" in df.columns:
+            read_back = df["measured_pressure_kpa"].iloc[i]
+            if not is_missing(read_back) and not np.isfinite(user_float(read_back)):
+                doubt = number_doubt(read_back)
+                out.append(
+                    Problem(
+                        mpath,
+                        line,
+                        f"measured_pressure_kpa {read_back!r} "
+                        + (f"could be either number: {doubt}" if doubt else "is not a number"),
+                        "write the pressure read back in kPa with a decimal point, or leave the "
+                        "cell empty (the setpoint pressure_kpa is then used)",
+                    )
+                )
         elif p < VACUUM_KPA:
             out.append(
                 Problem(

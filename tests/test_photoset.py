@@ -503,6 +503,28 @@ def test_a_bad_pressure_is_named_as_written_and_a_quoted_decimal_comma_is_a_numb
     assert ps.load_photoset(photo_folder).manifest["pressure_kpa"].iloc[1] == 12.5
 
 
+def test_a_number_that_could_be_either_of_two_is_named_not_guessed(photo_folder):
+    # '1,500' is 1500 to an English spreadsheet and 1.5 to a German one: it was read as 1.5
+    # without a word; a measured pressure that was no number was dropped without one
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    m = pd.read_csv(photo_folder / ps.MANIFEST, dtype=str)
+    m["measured_pressure_kpa"] = ["1,234.5", "abc"] + [""] * (len(m) - 2)
+    m.loc[m.index[2], "pressure_kpa"] = "1,500"
+    m.to_csv(photo_folder / ps.MANIFEST, index=False)
+    problems = {p.line: p for p in ps.validate_photoset(photo_folder) if "pressure" in p.message}
+    assert sorted(problems) == [3, 4]
+    assert problems[3].message == "measured_pressure_kpa 'abc' is not a number"
+    assert problems[4].message == (
+        "pressure_kpa '1,500' could be either number: 1500 with a thousands separator, or 1.5 "
+        "with a decimal comma?"
+    )
+    assert "without a thousands separator" in problems[4].fix
+    assert ps.load_photoset(photo_folder).manifest["measured_pressure_kpa"].iloc[0] == 1234.5
+    (photo_folder / ps.SETTINGS).write_text("l0_mm: '1,250'\n")
+    problems = [p for p in ps.validate_photoset(photo_folder) if "l0_mm" in p.message]
+    assert problems and "1250 with a thousands separator, or 1.25" in problems[0].message
+
+
 def test_settings_and_a_materials_file_saved_by_windows_notepad_are_read(photo_folder, tmp_path):
     # an older Notepad saves in the Windows code page: 'für' in a comment crashed check, measure
     # and Snakemake with a UnicodeDecodeError traceback

@@ -66,6 +66,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -213,25 +214,61 @@ def is_missing(value: Any) -> bool:
     return isinstance(value, str) and not value.strip()
 
 
+#: digit groups: 1,234,567 or 1,234.5 (English); 1.234.567 or 1.234,5 (German)
+_GROUPED_POINT = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+\.\d+|[+-]?\d{1,3}(?:,\d{3}){2,}")
+_GROUPED_COMMA = re.compile(r"[+-]?\d{1,3}(?:\.\d{3})+,\d+|[+-]?\d{1,3}(?:\.\d{3}){2,}")
+#: one comma before three digits: 1,500 is 1500 in English and 1.5 in German
+_AMBIGUOUS = re.compile(r"[+-]?[1-9]\d{0,2},\d{3}")
+
+
 def user_float(value: Any) -> float:
-    """A number as a person wrote it (a YAML number, or text with a decimal point or comma); NaN
-    when it is none (``True`` is none either).
+    """A number as a person wrote it (a YAML number, or text with a decimal point or comma, or
+    with digit groups); NaN when it is none (``True`` is none either) or when it could be either
+    of two numbers (see :func:`number_doubt`).
 
     Examples
     --------
     >>> user_float("0,3"), user_float(" 12.5 "), user_float(4)
     (0.3, 12.5, 4.0)
-    >>> [math.isnan(user_float(v)) for v in ("1,2,3", "255 mm", True, None)]
-    [True, True, True, True]
+    >>> user_float("1,234.5"), user_float("1.234,5"), user_float("2,500,000")
+    (1234.5, 1234.5, 2500000.0)
+    >>> [math.isnan(user_float(v)) for v in ("1,2,3", "255 mm", True, None, "1,500")]
+    [True, True, True, True, True]
     """
     if isinstance(value, bool):
         return float("nan")
     if isinstance(value, str):
-        value = value.replace(",", ".", 1)
+        text = value.strip()
+        if _AMBIGUOUS.fullmatch(text):
+            return float("nan")
+        if _GROUPED_POINT.fullmatch(text):
+            value = text.replace(",", "")
+        elif _GROUPED_COMMA.fullmatch(text):
+            value = text.replace(".", "").replace(",", ".")
+        else:
+            value = text.replace(",", ".", 1)
     try:
         return float(value)
     except (TypeError, ValueError):
         return float("nan")
+
+
+def number_doubt(value: Any) -> str:
+    """Why a written number is not read, when it is neither number nor nonsense; else "".
+
+    Examples
+    --------
+    >>> number_doubt("1,500")
+    '1500 with a thousands separator, or 1.5 with a decimal comma?'
+    >>> number_doubt("1.5"), number_doubt("abc")
+    ('', '')
+    """
+    text = value.strip() if isinstance(value, str) else ""
+    if not _AMBIGUOUS.fullmatch(text):
+        return ""
+    whole, part = text.split(",")
+    decimal = f"{whole}.{part.rstrip('0') or '0'}"
+    return f"{whole}{part} with a thousands separator, or {decimal} with a decimal comma?"
 
 
 def _number(
@@ -242,7 +279,17 @@ def _number(
         return None
     number = user_float(value)
     if not math.isfinite(number) or number <= 0:
-        problems.append(SettingProblem(key, f"{key} = {value!r} must be a positive number", fix))
+        doubt = number_doubt(value)
+        problems.append(
+            SettingProblem(
+                key,
+                f"{key} = {value!r} "
+                + (f"could be either number: {doubt}" if doubt else "must be a positive number"),
+                f"write it without a thousands separator, with a decimal point; {fix}"
+                if doubt
+                else fix,
+            )
+        )
         return None
     return number
 
