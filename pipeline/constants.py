@@ -19,6 +19,11 @@ STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 PSI0_DEG: float = 210.0
 #: absolute vacuum as a gauge pressure (kPa): no pneumatic pressure can be lower
 VACUUM_KPA: float = -101.3
+#: kPa in one of each other pressure unit a regulator may show (``pressure_bar`` in a manifest,
+#: ``pressure_bar``/``measured_bar`` in a video's pressure log)
+KPA_PER_UNIT: dict[str, float] = {
+    "bar": 100.0, "mbar": 0.1, "psi": 6.894757293168361, "mpa": 1000.0,
+}
 
 
 def direction_name(value: object) -> object:

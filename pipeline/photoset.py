@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from pipeline.constants import DIRECTIONS, VACUUM_KPA, direction_name
+from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA, direction_name
 from pipeline.errors import UserInputError
 from pipeline.fileio import (
     atomic_write_bytes,
@@ -80,10 +80,7 @@ OPTIONAL_COLUMNS: tuple[str, ...] = ("step", "timestamp", "measured_pressure_kpa
 #: a manifest may give the pressure in another unit instead of ``pressure_kpa`` (a regulator or
 #: gauge that shows bar or psi): the column and its kPa, turned into ``pressure_kpa`` where the
 #: manifest is read
-PRESSURE_UNITS_KPA: dict[str, float] = {
-    "pressure_bar": 100.0, "pressure_mbar": 0.1, "pressure_psi": 6.894757293168361,
-    "pressure_mpa": 1000.0,
-}
+PRESSURE_UNITS_KPA: dict[str, float] = {f"pressure_{u}": f for u, f in KPA_PER_UNIT.items()}
 #: manifest columns of a video photo set (one row per video; see :mod:`pipeline.video`)
 VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", "actuator", "trial")
 #: ``clock_offset_s``: log time of video time 0 (s, default 0); ``frame_times``: a ``frame, time_s``

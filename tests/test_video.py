@@ -322,6 +322,27 @@ def test_a_pressure_log_saved_by_a_european_spreadsheet_is_read(tmp_path):
     assert log.measured_kpa is not None and log.measured_kpa.tolist() == [0.1, 11.9]
 
 
+def test_a_pressure_log_in_bar_or_psi_is_read_as_kpa(video_set, tmp_path):
+    # a regulator that logs bar: the set was refused, 'lacks column(s) ['pressure_kpa']'
+    folder = tmp_path / "steps"
+    shutil.copytree(video_set, folder)
+    log_path = next(folder.glob("*_pressure.csv"))
+    kpa = pd.read_csv(log_path)
+    bar = pd.DataFrame({"time_s": kpa["time_s"], "pressure_bar": kpa["pressure_kpa"] / 100,
+                        "measured_psi": kpa["measured_kpa"] / 6.894757293168361})
+    bar.to_csv(log_path, index=False)
+    log, problems = read_pressure_log(log_path)
+    assert problems == [] and log is not None and log.measured_kpa is not None
+    assert np.allclose(log.pressure_kpa, kpa["pressure_kpa"], atol=1e-6)
+    assert np.allclose(log.measured_kpa, kpa["measured_kpa"], atol=1e-6)
+    assert not [p for p in photoset.validate_photoset(folder, decode_images=False) if not p.warning]
+    bar["pressure_bar"] = bar["pressure_bar"].astype(object)
+    bar.loc[3, "pressure_bar"] = "n/a"
+    bar.to_csv(log_path, index=False)
+    problem = read_pressure_log(log_path)[1][0]
+    assert "line 5: pressure_kpa is missing (an empty or n/a cell)" in problem
+
+
 def test_first_order_lags_reach_63_percent_after_tau():
     dyn = Dynamics(tau_pressure_s=0.0, tau_psi_s=0.5)
     sim = simulate(

@@ -43,8 +43,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import DIRECTIONS, VACUUM_KPA
+from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA
 from pipeline.fileio import read_user_csv
+from pipeline.measure.settings import is_missing, user_float
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
@@ -73,12 +74,40 @@ class PressureLog:
         return float(self.time_s[0]), float(self.time_s[-1])
 
 
+def _in_kpa(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with ``pressure_kpa`` (``measured_kpa``) from a log in bar, mbar, psi or MPa
+    (``pressure_bar``, ``measured_bar``, ...); a cell that is no number is kept as written, for
+    :func:`_numbers` to name.
+
+    Examples
+    --------
+    >>> log = pd.DataFrame({"time_s": [0, 1], "pressure_bar": ["0,5", "x"], "measured_psi": [1, 2]})
+    >>> out = _in_kpa(log)
+    >>> out["pressure_kpa"].tolist(), out["measured_kpa"].round(2).tolist()
+    ([50.0, 'x'], [6.89, 13.79])
+    """
+    out = df.copy()
+    for stem, kpa in (("pressure", "pressure_kpa"), ("measured", "measured_kpa")):
+        units = [u for u in KPA_PER_UNIT if f"{stem}_{u}" in out.columns]
+        if kpa in out.columns or len(units) != 1:
+            continue
+        written = out[f"{stem}_{units[0]}"]
+        values = written.map(user_float) * KPA_PER_UNIT[units[0]]
+        out[kpa] = [round(float(v), 6) if np.isfinite(v) else w for v, w in zip(values, written)]
+    return out
+
+
 def _numbers(df: pd.DataFrame, column: str, name: str, problems: list[str]) -> np.ndarray:
-    values = pd.to_numeric(df[column], errors="coerce").to_numpy(float)
+    values = df[column].map(user_float).to_numpy(float)
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         i = int(bad[0])
-        problems.append(f"{name} line {i + 2}: {column} {df[column].iloc[i]!r} is not a number"
+        written = df[column].iloc[i]
+        what = (
+            "is missing (an empty or n/a cell)" if is_missing(written)
+            else f"{written!r} is not a number"
+        )
+        problems.append(f"{name} line {i + 2}: {column} {what}"
                         + (f" ({bad.size} such rows)" if bad.size > 1 else ""))
     return values
 
@@ -103,13 +132,15 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         df = read_user_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
+    df = _in_kpa(df)
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
         header = list(map(str, df.columns))
         return None, [
             (
                 f"pressure log {name} lacks column(s) {missing} (its header is {header}); it "
-                "needs time_s (s) and pressure_kpa (kPa), optionally measured_kpa"
+                "needs time_s (s) and pressure_kpa (kPa; or pressure_bar, pressure_mbar, "
+                "pressure_psi or pressure_mpa), optionally measured_kpa (or measured_bar, ...)"
             )
         ]
     if len(df) < 2:
