@@ -13,6 +13,7 @@ import dataclasses
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -28,8 +29,15 @@ from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
 from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
 from pipeline.layout.typeset import NA, fmt
 from pipeline.report.build import build_report, report_figures
-from pipeline.report.data import Dataset, ReportInputs, dataset_dates, load_report_data
+from pipeline.report.data import (
+    Dataset,
+    DatasetInfo,
+    ReportInputs,
+    dataset_dates,
+    load_report_data,
+)
 from pipeline.report.reasons import top_reasons, words
+from pipeline.report.summary import date_line
 from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
 from pipeline.study import analysis
 
@@ -569,6 +577,16 @@ def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
         {"image": ["a.jpg", "b.jpg"], "timestamp": ["03.12.2026 14:05", "04.12.26"]}
     )
     assert dataset_dates(dotted, None) == ("2026-12-03", "2026-12-04", "timestamps")
+    # with slashes the set's own dates say which comes first (pandas read them month first)
+    european = pd.DataFrame({"image": ["a", "b"], "timestamp": ["03/12/2026 14:05", "14/12/2026"]})
+    assert dataset_dates(european, None) == ("2026-12-03", "2026-12-14", "timestamps")
+    american = pd.DataFrame({"image": ["a", "b"], "timestamp": ["12/03/2026", "12/14/2026"]})
+    assert dataset_dates(american, None) == ("2026-12-03", "2026-12-14", "timestamps")
+    either = pd.DataFrame({"image": ["a", "b"], "timestamp": ["03/12/2026", "04/12/2026"]})
+    first, last, why = dataset_dates(either, None)
+    assert (first, last) == (None, None) and "'03/12/2026' could be day or month first" in why
+    line = date_line(SimpleNamespace(datasets=[DatasetInfo("lab", "real", None, None, why)]))
+    assert line.startswith("Photos taken: not known (lab: timestamps like '03/12/2026' could")
     exif = Image.Exif()
     exif[306] = "2024:05:06 10:11:12"
     for name in ("a.jpg", "b.jpg"):

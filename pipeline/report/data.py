@@ -97,7 +97,8 @@ class DatasetInfo:
         ``YYYY-MM-DD`` of the first and last photo, from the manifest's ``timestamp`` column
         or else the photos' EXIF dates; ``None`` when the inputs hold no date.
     date_source : str
-        Where the dates come from (``"timestamps"``, ``"EXIF"`` or ``""``).
+        Where the dates come from (``"timestamps"``, ``"EXIF"`` or ``""``); without dates, why
+        the timestamps could not be read as dates, or ``""``.
     """
 
     name: str
@@ -415,19 +416,39 @@ def dataset_dates(
     """First and last date (``YYYY-MM-DD``) the photos of a dataset were taken.
 
     From the ``timestamp`` column when it holds dates (``03.12.2026`` is day first, as written
-    with dots), else from the EXIF date of the first and
-    last photo (in table order); ``(None, None, "")`` when neither exists (synthetic photos carry
-    no date).  Never the clock or file times, so the same inputs give the same report.
+    with dots; with slashes, ``03/12/2026``, the set's own dates must show which comes first: a
+    13th or later in one place), else from the EXIF date of the first and last photo (in table
+    order); ``(None, None, "")`` when neither exists (synthetic photos carry no date), or
+    ``(None, None, why)`` when slashed dates could be read either way.  Never the clock or file
+    times, so the same inputs give the same report.
     """
+    unclear = ""
     if "timestamp" in angles.columns:
         text = angles["timestamp"].astype("string")
         # a date written with dots is day first wherever it is written so (03.12.2026: 3 December)
         dotted = text.str.match(r"\s*\d{1,2}\.\d{1,2}\.\d{2,4}(\D|$)", na=False).to_numpy(bool)
+        # with slashes it is day first in Europe and month first in the US: the set's own dates
+        # say which (a 13th or later in one place), else they are not read as dates
+        parts = text.str.extract(r"^\s*(\d{1,2})/(\d{1,2})/\d{2,4}(?:\D|$)").astype(float)
+        slashed = parts[0].notna().to_numpy(bool)
+        day_first = bool((parts[0] > 12).any())
+        month_first = bool((parts[1] > 12).any())
+        if slashed.any() and day_first == month_first:
+            unclear = (
+                "timestamps like "
+                + repr(str(text[slashed].iloc[0]).strip())
+                + " could be day or month first; write them as 2026-12-03"
+            )
+            slashed_first = None
+        else:
+            slashed_first = day_first
+        first = dotted | (slashed & (slashed_first is True))
+        plain = ~dotted & ~slashed | (slashed & (slashed_first is False))
         stamps = pd.concat(
             [
-                pd.to_datetime(text[~dotted], errors="coerce", utc=True, format="mixed"),
+                pd.to_datetime(text[plain], errors="coerce", utc=True, format="mixed"),
                 pd.to_datetime(
-                    text[dotted], errors="coerce", utc=True, format="mixed", dayfirst=True
+                    text[first], errors="coerce", utc=True, format="mixed", dayfirst=True
                 ),
             ]
         ).dropna()
@@ -438,11 +459,11 @@ def dataset_dates(
                 "timestamps",
             )
     if photoset_dir is None or angles.empty:
-        return None, None, ""
+        return None, None, unclear
     dates = [exif_date(photoset_dir / str(angles["image"].iloc[i])) for i in (0, -1)]
     found = sorted(d for d in dates if d)
     if not found:
-        return None, None, ""
+        return None, None, unclear
     return found[0], found[-1], "EXIF"
 
 

@@ -48,11 +48,22 @@ def date_line(data: ReportData) -> str:
     """When the photos were taken (from the inputs), or that the inputs hold no date."""
     firsts = [d.first_date for d in data.datasets if d.first_date]
     lasts = [d.last_date for d in data.datasets if d.last_date]
+    unclear = [
+        f"{d.name}: {d.date_source}" for d in data.datasets if not d.first_date and d.date_source
+    ]
     if not firsts:
-        return "Photos taken: no date in the inputs (synthetic photo sets carry no timestamp)"
+        return "Photos taken: " + (
+            f"not known ({'; '.join(unclear)})"
+            if unclear
+            else "no date in the inputs (synthetic photo sets carry no timestamp)"
+        )
     first, last = min(firsts), max(lasts)
-    sources = sorted({d.date_source for d in data.datasets if d.date_source})
-    undated = [d.name for d in data.datasets if not d.first_date]
+    sources = sorted({d.date_source for d in data.datasets if d.first_date and d.date_source})
+    undated = [
+        f"{d.name} ({d.date_source})" if d.date_source else d.name
+        for d in data.datasets
+        if not d.first_date
+    ]
     span = first if first == last else f"{first} to {last}"
     extra = f"; no date for {', '.join(undated)}" if undated else ""
     return f"Photos taken: {span} (from the {' and '.join(sources)}{extra})"
