@@ -15,7 +15,7 @@ from snakemake.exceptions import WorkflowError
 from pipeline.config import known_materials, unmodelled_material_note, validate_config
 from pipeline.errors import UserInputError
 from pipeline.folders import update_folder_digest
-from pipeline.photoset import read_manifest, referenced_files
+from pipeline.photoset import newer_spreadsheet_problems, read_manifest, referenced_files
 
 try:
     _validated = validate_config(config, workdir=Path.cwd(), source="config")
@@ -132,6 +132,12 @@ MATERIALS = sorted({m for _, m in _NAMED} & MODEL_MATERIALS)
 for _name, _m in sorted(_NAMED):
     if _m not in MODEL_MATERIALS:
         print(unmodelled_material_note(_name, _m, MODEL_MATERIALS), file=sys.stderr)
+# a manifest edited in a spreadsheet and saved in its own format: said on the console, not only in
+# the measure job's log
+for _ds in [*DATASETS.values(), *FORCE_DATASETS.values()]:
+    if _ds["source"] == "folder":
+        for _problem in newer_spreadsheet_problems(Path(_ds["path"])):
+            print(f"dataset {_ds['name']!r}: {_problem}", file=sys.stderr)
 OWN_MODEL_CURVES = [
     f"{RESULTS}/datasets/{name}/model/{m}.csv"
     for name, ds in DATASETS.items()

@@ -232,6 +232,23 @@ def test_model_readings_in_the_config_reach_model_and_compare(finished_run):
     assert all("--jacobian deformed --l0-factor metres" in c for c in commands)
 
 
+def test_a_manifest_saved_only_in_a_spreadsheets_format_is_said_on_the_console(tmp_path, repo):
+    """Edits saved in manifest.xlsx are not read: the warning was only in measure's job log."""
+    cfg = _tiny_config()
+    cfg["datasets"] = cfg["datasets"][:1]
+    _workdir(tmp_path, repo, cfg)
+    workbook = tmp_path / PHOTOS / "manifest.xlsx"
+    workbook.write_bytes(b"PK\x03\x04")
+    later = (tmp_path / PHOTOS / "manifest.csv").stat().st_mtime + 60
+    os.utime(workbook, (later, later))
+    out = _snakemake(tmp_path, repo, "-n", "--cores", "1")
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert "dataset 'sample': " in out.stderr
+    assert "manifest.xlsx is newer than manifest.csv: edits saved only there are not read" in (
+        out.stderr
+    )
+
+
 def test_broken_config_is_refused_before_any_job(tmp_path, repo):
     cfg = _tiny_config()
     cfg["datasets"][1]["material"] = "DS25"
