@@ -129,15 +129,17 @@ def materials_file(ds):
 MODEL_MATERIALS = known_materials(config["model"]["materials_file"])
 _NAMED = {(name, m) for name, ds in DATASETS.items() if not ds.get("materials_file") for m in dataset_materials(ds)}
 MATERIALS = sorted({m for _, m in _NAMED} & MODEL_MATERIALS)
-for _name, _m in sorted(_NAMED):
-    if _m not in MODEL_MATERIALS:
-        print(unmodelled_material_note(_name, _m, MODEL_MATERIALS), file=sys.stderr)
-# a manifest edited in a spreadsheet and saved in its own format: said on the console, not only in
-# the measure job's log
-for _ds in [*DATASETS.values(), *FORCE_DATASETS.values()]:
-    if _ds["source"] == "folder":
-        for _problem in newer_spreadsheet_problems(Path(_ds["path"])):
-            print(f"dataset {_ds['name']!r}: {_problem}", file=sys.stderr)
+# said once on the console (a job run inside Snakemake parses this file again): materials the
+# model lacks, and a manifest edited in a spreadsheet and saved in its own format (not only in
+# the measure job's log)
+if workflow.is_main_process:
+    for _name, _m in sorted(_NAMED):
+        if _m not in MODEL_MATERIALS:
+            print(unmodelled_material_note(_name, _m, MODEL_MATERIALS), file=sys.stderr)
+    for _ds in [*DATASETS.values(), *FORCE_DATASETS.values()]:
+        if _ds["source"] == "folder":
+            for _problem in newer_spreadsheet_problems(Path(_ds["path"])):
+                print(f"dataset {_ds['name']!r}: {_problem}", file=sys.stderr)
 OWN_MODEL_CURVES = [
     f"{RESULTS}/datasets/{name}/model/{m}.csv"
     for name, ds in DATASETS.items()
