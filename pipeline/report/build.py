@@ -161,8 +161,15 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
+                unmodelled = "note" in data.rms.columns and data.rms.loc[
+                    data.rms["material"].astype(str) == m, "note"
+                ].astype(str).str.contains("has no material").any()
                 warnings.append(
-                    f"{m}: no model curve in --model-curves; its plot has no dashed model line"
+                    f"{m}: the model has no such material, so there is no model line, RMS or "
+                    "fitted k_P (to compare, add it to a materials file named in config.yaml: "
+                    "model.materials_file)"
+                    if unmodelled
+                    else f"{m}: no model curve in --model-curves; its plot has no dashed model line"
                 )
     for m in data.materials:
         if not (data.rms["material"].astype(str) == m).any():

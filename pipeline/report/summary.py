@@ -55,7 +55,8 @@ def date_line(data: ReportData) -> str:
         return "Photos taken: " + (
             f"not known ({'; '.join(unclear)})"
             if unclear
-            else "no date in the inputs (synthetic photo sets carry no timestamp)"
+            else "no date in the inputs (no timestamp column in manifest.csv, no EXIF date in "
+            "the photos; synthetic photo sets carry neither)"
         )
     first, last = min(firsts), max(lasts)
     sources = sorted({d.date_source for d in data.datasets if d.first_date and d.date_source})
