@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
@@ -143,6 +144,9 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     >>> _ = p.write_bytes(text.encode("cp1252"))
     >>> read_user_csv(p).to_dict("records")
     [{'image': 'ä.jpg', 'pressure_kpa': 12.5, 'material': 'DS20'}]
+    >>> _ = p.write_text("time_s,pressure_kpa\\n0,0\\n1,5\\n,\\n,\\n")  # rows a spreadsheet left
+    >>> len(read_user_csv(p))
+    2
     """
     data = Path(path).read_bytes()
     if data.startswith(WORKBOOK_SIGNATURES):
@@ -153,7 +157,11 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     read_csv.setdefault("skipinitialspace", True)
     df = pd.read_csv(io.StringIO(comma_csv_text(_user_text(data))), **read_csv)
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
-    return df
+    # the ',,,,' rows a spreadsheet leaves under its data are none (the earlier rows keep their
+    # line numbers)
+    filled = df.notna() & df.astype(str).apply(lambda c: c.str.strip() != "")
+    rows = np.flatnonzero(filled.any(axis=1).to_numpy(bool))
+    return df.iloc[: int(rows[-1]) + 1 if rows.size else 0]
 
 
 def read_table(

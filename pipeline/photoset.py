@@ -458,7 +458,13 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             ),
         )
     try:
-        df = read_user_csv(path, dtype={c: str for c in _TEXT_COLUMNS}, keep_default_na=True)
+        # blank lines kept as rows, so that every row keeps its line number in the file
+        df = read_user_csv(
+            path,
+            dtype={c: str for c in _TEXT_COLUMNS},
+            keep_default_na=True,
+            skip_blank_lines=False,
+        )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, OSError) as exc:
         return None, Problem(
             str(path), None, f"cannot be read as CSV ({exc})",
@@ -480,7 +486,12 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
     if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
         df["direction"] = df["direction"].map(direction_name)
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
-    return df, None
+    # rows with every cell empty (a blank line, or the ',,,,,' a spreadsheet leaves under its
+    # data) are no photos: left out, not each one 'image name is empty'
+    blank = np.column_stack(
+        [df[c].map(is_missing).to_numpy(bool) for c in df.columns if c != "manifest_line"]
+    ).all(axis=1)
+    return df.loc[~blank].reset_index(drop=True), None
 
 
 def _with_pressure_kpa(df: pd.DataFrame, column: str) -> pd.DataFrame:

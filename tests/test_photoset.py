@@ -503,6 +503,24 @@ def test_a_bad_pressure_is_named_as_written_and_a_quoted_decimal_comma_is_a_numb
     assert ps.load_photoset(photo_folder).manifest["pressure_kpa"].iloc[1] == 12.5
 
 
+def test_blank_rows_a_spreadsheet_leaves_are_no_photos_and_line_numbers_stay_true(photo_folder):
+    # Excel leaves ',,,,,' rows under the data: each was five problems ('image name is empty',
+    # 'material is empty', ...) and a refused set; a blank line in the middle shifted every later
+    # line number by one
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    lines = (photo_folder / ps.MANIFEST).read_text().splitlines()
+    n = len(lines) - 1
+    empty = "," * (lines[0].count(","))
+    lines.insert(2, "")
+    lines.insert(4, empty)
+    lines[6] = lines[6].replace(",up,", ",sideways,").replace(",down,", ",sideways,")
+    lines += [empty, empty]
+    (photo_folder / ps.MANIFEST).write_text("\n".join(lines) + "\n")
+    problems = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
+    assert [(p.line, "sideways" in p.message) for p in problems] == [(7, True)]
+    assert len(ps.read_manifest(photo_folder)) == n
+
+
 def test_a_number_that_could_be_either_of_two_is_named_not_guessed(photo_folder):
     # '1,500' is 1500 to an English spreadsheet and 1.5 to a German one: it was read as 1.5
     # without a word; a measured pressure that was no number was dropped without one

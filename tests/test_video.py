@@ -314,8 +314,12 @@ def test_a_pressure_log_saved_by_a_european_spreadsheet_is_read(tmp_path):
     # a logger's export opened and saved in Excel where the decimal mark is a comma: ';' between
     # the fields, '0,05' for 0.05 s; it was 'lacks column(s) [time_s, pressure_kpa]'
     path = tmp_path / "log.csv"
-    path.write_bytes("time_s;pressure_kpa;measured_kpa\r\n0;0;0,1\r\n0,05;12,5;11,9\r\n".encode(
-        "utf-8-sig"))
+    # with the ';;' rows Excel leaves under the data (they were 'time_s ... is not a number')
+    path.write_bytes(
+        "time_s;pressure_kpa;measured_kpa\r\n0;0;0,1\r\n0,05;12,5;11,9\r\n;;\r\n;;\r\n".encode(
+            "utf-8-sig"
+        )
+    )
     log, problems = read_pressure_log(path)
     assert problems == [] and log is not None
     assert log.time_s.tolist() == [0.0, 0.05] and log.pressure_kpa.tolist() == [0.0, 12.5]
