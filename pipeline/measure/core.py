@@ -37,7 +37,14 @@ from pipeline.measure.estimators import (
 )
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.formats import decode_image, read_image, undecodable
-from pipeline.measure.quality import RIDGE_TIP_DEG, Quality, assess, assess_body
+from pipeline.measure.quality import (
+    RIDGE_TIP_DEG,
+    TIP_UNSTABLE_DEG,
+    Quality,
+    assess,
+    assess_body,
+    tip_out_of_reach,
+)
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
 
@@ -404,6 +411,13 @@ def measure_body(
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
+    # the part of the body past the centre line's end, less what is not bend (half a width of
+    # cap, the stretch already carried on to a cut end, the sealed end), turned through at the
+    # free end's curvature (image axes, deg)
+    missed_tip_deg = float(
+        np.rad2deg(end_curvature(line.centreline_px))
+        * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px))
+    )
     # the same turning from a smooth fit of the whole centre line: the check of a wobbly line
     try:
         smooth_turning = turning(pts, np.random.default_rng(SEED), ends_px=ends).turning_rad
@@ -438,43 +452,47 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
-        # the part of the body past the centre line's end, less what is not bend: half a width
-        # of cap, or the stretch already carried on to a cut end (free_end: bends)
-        missed_tip_deg=float(
-            np.rad2deg(abs(end_curvature(line.centreline_px)))
-            * max(
-                0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px)
-            )
-        ),
+        missed_tip_deg=abs(missed_tip_deg),
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method
+    # carried on over a tip the selection fades at, not past an uneven outline
+    carried = 0.0 if tip_out_of_reach(body.end_short_px, line.width_px) else missed_tip_deg
     measured = _measured(
-        carried_on_psi_deg(psi, body.ridge_tip_deg, sign), est, line, quality, settings, used
+        carried_on_psi_deg(psi, body.ridge_tip_deg, carried, sign),
+        est, line, quality, settings, used,
     )
     if base is not None or est is not tip:
         return measured
     return replace(measured, base_direction_deg=float(np.rad2deg(sign * start)))
 
 
-def carried_on_psi_deg(psi_deg: float, ridge_tip_deg: float, sign: float) -> float:
-    """psi with the free end carried on along the selection's ridge, where the centre line stops
-    short of the body's end and the ridge turns on by more than :data:`RIDGE_TIP_DEG` (the row
-    is flagged for it; else ``psi_deg`` unchanged).
+def carried_on_psi_deg(
+    psi_deg: float, ridge_tip_deg: float, missed_tip_deg: float, sign: float
+) -> float:
+    """psi with the free end carried on over the part of the body the centre line stops short
+    of (the row is flagged for either; else ``psi_deg`` unchanged).
 
-    ``ridge_tip_deg`` is that turn in image axes (y down), ``sign`` the photo's ``+1``/``-1``
-    (``positive_turn``).  On the rendered analogues (384 photos over three sizes and four
-    camera faults) it moved 13 flagged rows from a total of 370 deg off to 120.
+    Along the selection's ridge, when the ridge turns on by more than :data:`RIDGE_TIP_DEG`
+    (``ridge_tip_deg``: on the rendered analogues, 384 photos over three sizes and four camera
+    faults, it moved 13 flagged rows from a total of 370 deg off to 120); else at the free end's
+    curvature, when that turns the uncovered part by more than :data:`TIP_UNSTABLE_DEG`
+    (``missed_tip_deg``: a faint tip the selection does not reach, whose ridge is lost with it).
+    Both turns are in image axes (y down), ``sign`` the photo's ``+1``/``-1`` (``positive_turn``).
 
     Examples
     --------
-    >>> carried_on_psi_deg(-56.0, 39.0, 1.0), carried_on_psi_deg(-56.0, 3.0, 1.0)
+    >>> carried_on_psi_deg(-56.0, 39.0, 0.0, 1.0), carried_on_psi_deg(-56.0, 3.0, 0.0, 1.0)
     (-95.0, -56.0)
-    >>> carried_on_psi_deg(56.0, 39.0, -1.0)
-    95.0
+    >>> carried_on_psi_deg(56.0, 39.0, 0.0, -1.0), carried_on_psi_deg(-188.0, 0.0, 13.0, 1.0)
+    (95.0, -201.0)
     """
-    return psi_deg - sign * ridge_tip_deg if abs(ridge_tip_deg) > RIDGE_TIP_DEG else psi_deg
+    if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
+        return psi_deg - sign * ridge_tip_deg
+    if abs(missed_tip_deg) > TIP_UNSTABLE_DEG:
+        return psi_deg - sign * missed_tip_deg
+    return psi_deg
 
 
 def _work_per_image_px(line: LineExtraction, points: NDArray[np.float64]) -> float:

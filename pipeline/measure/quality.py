@@ -172,6 +172,19 @@ WIDTH_RATIO = 2.2
 RIDGE_TIP_DEG = 4.0
 #: body: a free end narrower than this fraction of the body's width has lost a side
 NARROW_FREE_END = 0.6
+
+
+def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
+    """Whether the centre line stops so far short of the body's free end (more than one and a
+    half widths) that the outline there is uneven, rather than a tip the selection fades at.
+
+    Examples
+    --------
+    >>> tip_out_of_reach(59.0, 40.0), tip_out_of_reach(134.0, 40.0)
+    (False, True)
+    """
+    return end_short_px > 1.5 * width_px + 4.0
+
 #: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
 BASE_MISMATCH_DEG = 20.0
 
@@ -295,7 +308,7 @@ def assess_body(
             "short of the body's end; psi is carried on along the selection there, which turns "
             f"the end by {abs(ridge_tip_deg):.0f} deg (photoset preview shows it)"
         )
-    elif end_short_px > 1.5 * line.width_px + 4.0:
+    elif tip_out_of_reach(end_short_px, line.width_px):
         flags.append(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven "
             "outline there): check with photoset preview"
@@ -303,8 +316,8 @@ def assess_body(
     elif missed_tip_deg > TIP_UNSTABLE_DEG:
         flags.append(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end where the "
-            f"body still turns: about {missed_tip_deg:.0f} deg of its turning may be missing "
-            "(photoset preview shows it)"
+            f"body still turns: psi is carried on over that part at the free end's curvature, "
+            f"about {missed_tip_deg:.0f} deg (photoset preview shows it)"
         )
     if start_gap_px > 2.0 * line.width_px + 4.0:
         flags.append(
