@@ -115,6 +115,31 @@ def _user_text(data: bytes) -> str:
         return data.decode("cp1252", errors="replace")
 
 
+def header_line(path: str | os.PathLike[str], names: Sequence[str], within: int = 10) -> int | None:
+    """The line (1-based) among the first ``within`` of a CSV file that holds every one of
+    ``names`` as a field (any case): where its header is when a title or blank lines stand above
+    it; None when no line does.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "m.csv"
+    >>> _ = p.write_text("Ramp of 3 June;;\\n\\nImage;pressure_kpa;trial\\na.jpg;0;1\\n")
+    >>> header_line(p, ["image", "pressure_kpa"]), header_line(p, ["step"])
+    (3, None)
+    """
+    try:
+        lines = _user_text(Path(path).read_bytes()).splitlines()[:within]
+    except OSError:
+        return None
+    wanted = {n.lower() for n in names}
+    for number, line in enumerate(lines, start=1):
+        fields = next(csv.reader([line], delimiter=csv_separator(line)), [])
+        if wanted <= {f.strip().lower() for f in fields}:
+            return number
+    return None
+
+
 def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame:
     """Read a CSV file a person wrote or saved from a spreadsheet.
 

@@ -46,6 +46,7 @@ from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA, direction_n
 from pipeline.errors import UserInputError
 from pipeline.fileio import (
     atomic_write_bytes,
+    header_line,
     read_user_csv,
     read_user_text,
     user_path,
@@ -466,7 +467,7 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             skip_blank_lines=False,
         )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, OSError) as exc:
-        return None, Problem(
+        return None, _header_below(path, "") or Problem(
             str(path), None, f"cannot be read as CSV ({exc})",
             "save it as CSV: a header line, then one line per photo",
         )
@@ -476,7 +477,8 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
     required = VIDEO_REQUIRED_COLUMNS if is_video_manifest(df) else REQUIRED_COLUMNS
     missing = [c for c in required if c not in df.columns]
     if missing:
-        return None, Problem(
+        line_one = f" (line 1 reads {list(map(str, df.columns))})"
+        return None, _header_below(path, line_one) or Problem(
             str(path),
             1,
             f"missing column(s) {missing}; the header has {list(map(str, df.columns))}",
@@ -492,6 +494,21 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
         [df[c].map(is_missing).to_numpy(bool) for c in df.columns if c != "manifest_line"]
     ).all(axis=1)
     return df.loc[~blank].reset_index(drop=True), None
+
+
+def _header_below(path: Path, line_one: str) -> Problem | None:
+    """The problem of a manifest whose header stands below line 1 (a title or empty lines above
+    it), or None when no line near the top is a header."""
+    for required in (REQUIRED_COLUMNS, VIDEO_REQUIRED_COLUMNS):
+        below = header_line(path, required)
+        if below is not None and below > 1:
+            return Problem(
+                str(path),
+                1,
+                f"the header is on line {below}, not on line 1{line_one}",
+                f"delete the {below - 1} line(s) above the header (a title or an empty line)",
+            )
+    return None
 
 
 def _with_pressure_kpa(df: pd.DataFrame, column: str) -> pd.DataFrame:

@@ -521,6 +521,19 @@ def test_blank_rows_a_spreadsheet_leaves_are_no_photos_and_line_numbers_stay_tru
     assert len(ps.read_manifest(photo_folder)) == n
 
 
+def test_a_title_above_the_manifests_header_is_named_with_the_fix(photo_folder):
+    # a spreadsheet with a title row: the problem showed 'the header has ['Ramp of 3 June', ...]'
+    # and asked to name the columns, which the file already did
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    text = (photo_folder / ps.MANIFEST).read_text()
+    (photo_folder / ps.MANIFEST).write_text("Ramp of 3 June, DS20\n\n" + text)
+    problems = [p for p in ps.validate_photoset(photo_folder) if not p.warning]
+    assert [(p.line, p.message[:38]) for p in problems] == [
+        (1, "the header is on line 3, not on line 1")
+    ]
+    assert problems[0].fix.startswith("delete the 2 line(s) above the header")
+
+
 def test_a_number_that_could_be_either_of_two_is_named_not_guessed(photo_folder):
     # '1,500' is 1500 to an English spreadsheet and 1.5 to a German one: it was read as 1.5
     # without a word; a measured pressure that was no number was dropped without one
