@@ -117,8 +117,8 @@ def _user_text(data: bytes) -> str:
 
 def header_line(path: str | os.PathLike[str], names: Sequence[str], within: int = 10) -> int | None:
     """The line (1-based) among the first ``within`` of a CSV file that holds every one of
-    ``names`` as a field (any case): where its header is when a title or blank lines stand above
-    it; None when no line does.
+    ``names`` as a field (any case, spaces or brackets: ``Pressure (kPa)`` for ``pressure_kpa``):
+    where its header is when a title or blank lines stand above it; None when no line does.
 
     Examples
     --------
@@ -132,10 +132,13 @@ def header_line(path: str | os.PathLike[str], names: Sequence[str], within: int 
         lines = _user_text(Path(path).read_bytes()).splitlines()[:within]
     except OSError:
         return None
-    wanted = {n.lower() for n in names}
+    def plain(name: str) -> str:  # 'Pressure (kPa)' -> 'pressure_kpa'
+        return re.sub(r"[^a-z0-9]+", "_", name.strip().lower()).strip("_")
+
+    wanted = {plain(n) for n in names}
     for number, line in enumerate(lines, start=1):
         fields = next(csv.reader([line], delimiter=csv_separator(line)), [])
-        if wanted <= {f.strip().lower() for f in fields}:
+        if wanted <= {plain(f) for f in fields}:
             return number
     return None
 

@@ -32,6 +32,7 @@ from __future__ import annotations
 import difflib
 import functools
 import os
+import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -342,6 +343,7 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
         values += [raw.get("background"), raw.get("calibration")]
     try:
         manifest = read_user_csv(folder / MANIFEST, dtype=str)
+        manifest = manifest.rename(columns=header_names(manifest.columns))  # 'Background'
     except (OSError, ValueError, pd.errors.ParserError):
         manifest = pd.DataFrame()
     for column in ("background", "calibration"):
@@ -471,6 +473,7 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             str(path), None, f"cannot be read as CSV ({exc})",
             "save it as CSV: a header line, then one line per photo",
         )
+    df = df.rename(columns=header_names(df.columns))
     units = [c for c in PRESSURE_UNITS_KPA if c in df.columns]
     if "pressure_kpa" not in df.columns and len(units) == 1 and not is_video_manifest(df):
         df = _with_pressure_kpa(df, units[0])
@@ -482,7 +485,8 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             str(path),
             1,
             f"missing column(s) {missing}; the header has {list(map(str, df.columns))}",
-            f"name the columns {list(required)} in the header line (lower case, as written here)"
+            f"name the columns {list(required)} in the header line (any case, a unit in brackets "
+            "may follow: 'Pressure (kPa)')"
             + ("" if "video" in df.columns else f"; for videos {list(VIDEO_REQUIRED_COLUMNS)}"),
         )
     if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
@@ -494,6 +498,33 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
         [df[c].map(is_missing).to_numpy(bool) for c in df.columns if c != "manifest_line"]
     ).all(axis=1)
     return df.loc[~blank].reset_index(drop=True), None
+
+
+def header_names(columns: Iterable[Any]) -> dict[str, str]:
+    """The manifest's own names for header cells a person wrote another way: any case, spaces,
+    a unit in brackets (``Image``, ``Pressure (kPa)``, ``Pressure [bar]``, ``Fixed end X``).
+    A name already written as the manifest writes it is left alone, and so is any other.
+
+    Examples
+    --------
+    >>> header_names(["Image", "Pressure (kPa)", "Direction", "Notes", "trial"])
+    {'Image': 'image', 'Pressure (kPa)': 'pressure_kpa', 'Direction': 'direction'}
+    >>> header_names(["Pressure [bar]", "image", "IMAGE"])
+    {'Pressure [bar]': 'pressure_bar'}
+    """
+    known = {
+        *REQUIRED_COLUMNS, *OPTIONAL_COLUMNS, *VIDEO_REQUIRED_COLUMNS, *VIDEO_OPTIONAL_COLUMNS,
+        *PRESSURE_UNITS_KPA, *OVERRIDE_COLUMNS,
+    }
+    written = [str(c) for c in columns]
+    out: dict[str, str] = {}
+    for name in written:
+        canonical = re.sub(r"[^a-z0-9]+", "_", name.strip().lower()).strip("_")
+        if name in known or canonical not in known or canonical in written:
+            continue
+        if canonical not in out.values():
+            out[name] = canonical
+    return out
 
 
 def _header_below(path: Path, line_one: str) -> Problem | None:

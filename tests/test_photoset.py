@@ -356,18 +356,30 @@ def test_a_manifest_saved_by_a_spreadsheet_is_read_as_its_comma_separated_twin(
 def test_a_manifest_whose_header_names_differ_is_one_problem_naming_the_header_and_the_fix(
     photo_folder,
 ):
-    # 'Image' and 'Pressure (kPa)': check listed 'missing column(s)' with '(fix: see message)',
-    # the file named twice, and left the user to guess which names were wrong
+    # 'Photo' and 'P (kPa)': check listed 'missing column(s)' with '(fix: see message)', the file
+    # named twice, and left the user to guess which names were wrong
     path = photo_folder / ps.MANIFEST
     photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
     lines = path.read_text().splitlines()
-    lines[0] = lines[0].replace("image", "Image").replace("pressure_kpa", "Pressure (kPa)")
+    header = lines[0]
+    # the manifest's names written another way are read as meant ('Image' was refused)
+    lines[0] = header.replace("image", "Image").replace("pressure_kpa", "Pressure (kPa)")
+    path.write_text("\n".join(lines) + "\n")
+    assert not [p for p in ps.validate_photoset(photo_folder) if not p.warning]
+    assert ps.load_photoset(photo_folder).manifest["pressure_kpa"].notna().all()
+    # ... everywhere the manifest is read: a 'Background' column is watched by the digest
+    (photo_folder.parent / "empty.jpg").write_bytes(b"x")
+    m = pd.read_csv(path)
+    m["Background"] = "../empty.jpg"
+    m.to_csv(path, index=False)
+    assert ps.referenced_files(photo_folder) == ((photo_folder.parent / "empty.jpg").resolve(),)
+    lines[0] = header.replace("image", "Photo").replace("pressure_kpa", "P (kPa)")
     path.write_text("\n".join(lines) + "\n")
     problems = ps.validate_photoset(photo_folder)
     assert len(problems) == 1, problems
     (p,) = problems
     assert (p.file, p.line) == (str(path), 1)
-    assert "['image', 'pressure_kpa']" in p.message and "'Pressure (kPa)'" in p.message
+    assert "['image', 'pressure_kpa']" in p.message and "'P (kPa)'" in p.message
     assert "see message" not in p.fix and "header" in p.fix
     assert str(path) not in p.message
     out = subprocess.run(
