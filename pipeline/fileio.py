@@ -132,15 +132,23 @@ def header_line(path: str | os.PathLike[str], names: Sequence[str], within: int 
         lines = _user_text(Path(path).read_bytes()).splitlines()[:within]
     except OSError:
         return None
-    def plain(name: str) -> str:  # 'Pressure (kPa)' -> 'pressure_kpa'
-        return re.sub(r"[^a-z0-9]+", "_", name.strip().lower()).strip("_")
-
-    wanted = {plain(n) for n in names}
+    wanted = {plain_name(n) for n in names}
     for number, line in enumerate(lines, start=1):
         fields = next(csv.reader([line], delimiter=csv_separator(line)), [])
-        if wanted <= {plain(f) for f in fields}:
+        if wanted <= {plain_name(f) for f in fields}:
             return number
     return None
+
+
+def plain_name(name: str) -> str:
+    """A column name as a person may have written it, in the form this package writes names.
+
+    Examples
+    --------
+    >>> plain_name(" Pressure (kPa)"), plain_name("Fixed end X"), plain_name("image")
+    ('pressure_kpa', 'fixed_end_x', 'image')
+    """
+    return re.sub(r"[^a-z0-9]+", "_", name.strip().lower()).strip("_")
 
 
 def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame:
@@ -187,8 +195,7 @@ def read_user_csv(path: str | os.PathLike[str], **read_csv: Any) -> pd.DataFrame
     df.columns = [c.strip() if isinstance(c, str) else c for c in df.columns]
     # the ',,,,' rows a spreadsheet leaves under its data are none (the earlier rows keep their
     # line numbers)
-    filled = df.notna() & df.astype(str).apply(lambda c: c.str.strip() != "")
-    rows = np.flatnonzero(filled.any(axis=1).to_numpy(bool))
+    rows = np.flatnonzero(df.notna().any(axis=1).to_numpy(bool))
     return df.iloc[: int(rows[-1]) + 1 if rows.size else 0]
 
 

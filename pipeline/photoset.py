@@ -32,7 +32,6 @@ from __future__ import annotations
 import difflib
 import functools
 import os
-import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -48,6 +47,7 @@ from pipeline.errors import UserInputError
 from pipeline.fileio import (
     atomic_write_bytes,
     header_line,
+    plain_name,
     read_user_csv,
     read_user_text,
     user_path,
@@ -519,7 +519,7 @@ def header_names(columns: Iterable[Any]) -> dict[str, str]:
     written = [str(c) for c in columns]
     out: dict[str, str] = {}
     for name in written:
-        canonical = re.sub(r"[^a-z0-9]+", "_", name.strip().lower()).strip("_")
+        canonical = plain_name(name)
         if name in known or canonical not in known or canonical in written:
             continue
         if canonical not in out.values():
@@ -609,6 +609,15 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                     + (", without a thousands separator, with a decimal point" if doubt else ""),
                 )
             )
+        elif p < VACUUM_KPA:
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"pressure_kpa {p:g} is below absolute vacuum ({VACUUM_KPA:g} kPa gauge)",
+                    "write the gauge pressure in kPa (>= -101.3)",
+                )
+            )
         if "measured_pressure_kpa" in df.columns:
             read_back = df["measured_pressure_kpa"].iloc[i]
             if not is_missing(read_back) and not np.isfinite(user_float(read_back)):
@@ -623,15 +632,6 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                         "cell empty (the setpoint pressure_kpa is then used)",
                     )
                 )
-        elif p < VACUUM_KPA:
-            out.append(
-                Problem(
-                    mpath,
-                    line,
-                    f"pressure_kpa {p:g} is below absolute vacuum ({VACUUM_KPA:g} kPa gauge)",
-                    "write the gauge pressure in kPa (>= -101.3)",
-                )
-            )
         if direction not in DIRECTIONS:
             out.append(
                 Problem(

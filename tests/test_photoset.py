@@ -553,9 +553,11 @@ def test_a_number_that_could_be_either_of_two_is_named_not_guessed(photo_folder)
     m = pd.read_csv(photo_folder / ps.MANIFEST, dtype=str)
     m["measured_pressure_kpa"] = ["1,234.5", "abc"] + [""] * (len(m) - 2)
     m.loc[m.index[2], "pressure_kpa"] = "1,500"
+    m.loc[m.index[3], "pressure_kpa"] = "-150"  # checked with a measured_pressure_kpa column too
     m.to_csv(photo_folder / ps.MANIFEST, index=False)
     problems = {p.line: p for p in ps.validate_photoset(photo_folder) if "pressure" in p.message}
-    assert sorted(problems) == [3, 4]
+    assert sorted(problems) == [3, 4, 5]
+    assert "below absolute vacuum" in problems[5].message
     assert problems[3].message == "measured_pressure_kpa 'abc' is not a number"
     assert problems[4].message == (
         "pressure_kpa '1,500' could be either number: 1500 with a thousands separator, or 1.5 "

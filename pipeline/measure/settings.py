@@ -71,6 +71,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+import pandas as pd
+
 from pipeline.fileio import user_path
 from pipeline.measure.calibration import (
     Calibration,
@@ -251,6 +254,20 @@ def user_float(value: Any) -> float:
         return float(value)
     except (TypeError, ValueError):
         return float("nan")
+
+
+def user_floats(values: pd.Series) -> np.ndarray:
+    """:func:`user_float` of every cell, the plain numbers read at once (a long pressure log).
+
+    Examples
+    --------
+    >>> user_floats(pd.Series([1, "2,5", "x", None])).tolist()[:3]
+    [1.0, 2.5, nan]
+    """
+    out = pd.to_numeric(values, errors="coerce").to_numpy(float, copy=True)
+    odd = ~np.isfinite(out)
+    out[odd] = [user_float(v) for v in values[odd]]
+    return out
 
 
 def number_doubt(value: Any) -> str:

@@ -45,7 +45,7 @@ import pandas as pd
 
 from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA
 from pipeline.fileio import read_user_csv
-from pipeline.measure.settings import is_missing, user_float
+from pipeline.measure.settings import is_missing, user_floats
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
@@ -92,13 +92,13 @@ def _in_kpa(df: pd.DataFrame) -> pd.DataFrame:
         if kpa in out.columns or len(units) != 1:
             continue
         written = out[f"{stem}_{units[0]}"]
-        values = written.map(user_float) * KPA_PER_UNIT[units[0]]
+        values = user_floats(written) * KPA_PER_UNIT[units[0]]
         out[kpa] = [round(float(v), 6) if np.isfinite(v) else w for v, w in zip(values, written)]
     return out
 
 
 def _numbers(df: pd.DataFrame, column: str, name: str, problems: list[str]) -> np.ndarray:
-    values = df[column].map(user_float).to_numpy(float)
+    values = user_floats(df[column])
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         i = int(bad[0])
