@@ -352,6 +352,27 @@ def test_an_underexposed_photo_is_measured_like_a_well_exposed_one():
     assert all(err <= 10.0 for err, status in rows if status == "ok"), rows
 
 
+def test_a_photo_taken_upright_is_measured_like_the_same_photo_taken_across():
+    # a camera held upright (a body hanging from its clamp) gives a portrait photo: it was
+    # measured at full size, as the work image was chosen by the width alone (960 px < 2 x 640),
+    # where the same photo taken across was halved; on the translucent body on grey at psi -220
+    # that read -228.7, ok; on rendered analogues turned by 90 deg (5 scenes, seeds 30 and 77,
+    # 240 photos) ok but more than 5 deg off went from 18 to 7
+    from pipeline.measure.core import decode_for_work, measure_decoded
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("grey_dots_clear", width=1280, height=960)
+    r = render_actuator(-220.0, 270.0, scene, seed=77 + 11, bulge=0.4)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    upright = cv2.rotate(img, cv2.ROTATE_90_COUNTERCLOCKWISE)
+    x, y = r.fixed_end_px
+    data = np.frombuffer(cv2.imencode(".png", upright)[1].tobytes(), np.uint8)
+    work, f = decode_for_work(data)
+    assert f == decode_for_work(np.frombuffer(r.jpeg_bytes, np.uint8))[1] == 2
+    res = measure_decoded(data, work, f, settings_for((y, img.shape[1] - 1 - x)))
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=5.0), (res.psi_deg, res.reason)
+
+
 def test_translucent_body_on_grey_without_a_background_photo():
     # the rendered analogue of silicone with dots on a grey backdrop, no empty-scene photo: the
     # faint side of the body fades towards the tip; measured to its end, not cut where it thins

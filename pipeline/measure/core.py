@@ -50,7 +50,9 @@ from pipeline.measure.settings import MeasureSettings
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
-#: work on images at least this wide (px); larger ones are decoded / reduced by 2, 4 or 8
+#: work on images whose longer side is at least this long (px); larger ones are decoded / reduced
+#: by 2, 4 or 8 (the longer side, not the width: a photo taken upright is measured at the
+#: resolution of the same photo taken across, as it is the same scene)
 WORK_WIDTH_PX = 640
 #: re-decode at twice the resolution when the line is thinner than this in the work image (px)
 MIN_WORK_LINE_WIDTH_PX = 2.5
@@ -150,16 +152,20 @@ def _measured(
     )
 
 
-def reduction_for(width_px: int, work_width_px: int = WORK_WIDTH_PX) -> int:
-    """Largest factor in (1, 2, 4, 8) keeping the work image at least ``work_width_px`` wide.
+def reduction_for(size_px: Sequence[int], work_width_px: int = WORK_WIDTH_PX) -> int:
+    """Largest factor in (1, 2, 4, 8) keeping the work image's longer side at least
+    ``work_width_px`` long; ``size_px`` is the photo's (width, height) or (height, width).
 
     Examples
     --------
-    >>> reduction_for(4000), reduction_for(1280), reduction_for(640), reduction_for(4000, 320)
-    (4, 2, 1, 8)
+    >>> reduction_for((4000, 3000)), reduction_for((1280, 960)), reduction_for((960, 1280))
+    (4, 2, 2)
+    >>> reduction_for((640, 480)), reduction_for((4000, 3000), 320)
+    (1, 8)
     """
+    long_side = max(size_px[:2])
     f = 1
-    while f < 8 and width_px / (2 * f) >= work_width_px:
+    while f < 8 and long_side / (2 * f) >= work_width_px:
         f *= 2
     return f
 
@@ -595,7 +601,7 @@ def measure_image(
     """
     if image_bgr is None or image_bgr.ndim != 3:
         return measure_work_image(image_bgr, settings, scale=1.0, method=method)
-    f = reduction_for(image_bgr.shape[1], work_width_px)
+    f = reduction_for(image_bgr.shape, work_width_px)
     res = measure_work_image(reduce_image(image_bgr, f), settings, scale=float(f), method=method)
     while f > 1 and (res.status == "failed" or res.line_width_px / f < MIN_WORK_LINE_WIDTH_PX):
         f //= 2
@@ -705,12 +711,12 @@ def decode_for_work(
     """
     size = jpeg_size(data)
     if size is not None:
-        f = factor if factor is not None else reduction_for(size[0], work_width_px)
+        f = factor if factor is not None else reduction_for(size, work_width_px)
         return cv2.imdecode(data, (_REDUCED_GREY if grey else _REDUCED)[f]), f
     img = decode_image(data, grey)
     if img is None:
         return None, 1
-    f = factor if factor is not None else reduction_for(img.shape[1], work_width_px)
+    f = factor if factor is not None else reduction_for(img.shape, work_width_px)
     return reduce_image(img, f), f
 
 
@@ -773,15 +779,15 @@ def measure_decoded(
     """Measure an image decoded at reduced size; re-decode finer when the line came out too thin.
 
     ``data`` are the file's bytes, ``img`` their decoding reduced by ``factor``; or, for a frame
-    already decoded at full size (a video that is not MJPEG), ``full`` is that frame (grey or
-    BGR as ``img``), ``data`` is unused and finer images are reduced from ``full``.  A grey image at
-    least ``2 * COARSE_WIDTH_PX`` wide is first measured on a halved copy with the centre line
-    refined on ``img`` (3x less work); that result is kept only when its status is ``ok``.  While
-    the line is narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not found) and the
-    image was reduced, it is decoded again at twice the resolution: thin lines cost a second
-    decode, the usual photo only one small one.
+    already decoded at full size (a video that is not MJPEG), ``full`` is that frame (grey or BGR as
+    ``img``), ``data`` is unused and finer images are reduced from ``full``.  A grey image whose
+    longer side is at least ``2 * COARSE_WIDTH_PX`` is first measured on a halved copy with the
+    centre line refined on ``img`` (3x less work); that result is kept only when its status is
+    ``ok``.  While the line is narrower than :data:`MIN_WORK_LINE_WIDTH_PX` work pixels (or not
+    found) and the image was reduced, it is decoded again at twice the resolution: thin lines cost a
+    second decode, the usual photo only one small one.
     """
-    if img.ndim == 2 and img.shape[1] >= 2 * COARSE_WIDTH_PX:
+    if img.ndim == 2 and max(img.shape) >= 2 * COARSE_WIDTH_PX:
         coarse = reduce_image(img, 2)
         res = measure_work_image(
             coarse, settings, scale=2.0 * factor, method=method, fine=img, fine_scale=float(factor)

@@ -98,7 +98,7 @@ class LineExtraction:
 
 def _kernel_px(shape: tuple[int, ...]) -> int:
     """Side of the black-hat square: wider than any marker line, narrower than the clamp."""
-    return int(max(11, shape[1] // 40) | 1)
+    return int(max(11, max(shape[:2]) // 40) | 1)
 
 
 def line_mask(image_bgr: np.ndarray, color: ColorSpec) -> tuple[np.ndarray, np.ndarray]:

@@ -96,7 +96,7 @@ def measure_frame(
             )
         return measure_decoded(frame.data, img, f, settings, method=method), img, f
     full = cv2.cvtColor(frame.data, cv2.COLOR_BGR2GRAY) if grey else frame.data
-    f = reduction_for(full.shape[1])
+    f = reduction_for(full.shape)
     img = reduce_image(full, f)
     return measure_decoded(None, img, f, settings, method=method, full=full), img, f
 
