@@ -373,6 +373,40 @@ def test_a_photo_taken_upright_is_measured_like_the_same_photo_taken_across():
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=5.0), (res.psi_deg, res.reason)
 
 
+def test_the_ridge_does_not_run_through_the_clamp_to_the_tube_behind_it():
+    # a selection holding the body (a band leaving the clamp face at x = 300), the clamp block
+    # behind the face and the tube behind the block, longer than the body: the farthest pixel is
+    # the tube's end, reached only across the block; the ridge follows the body
+    from pipeline.measure.body import _ridge_path
+
+    comp = np.zeros((300, 700), np.uint8)
+    comp[140:160, 300:520] = 1  # the body, 220 px
+    comp[80:220, 220:300] = 1  # the block behind the face
+    comp[145:155, 0:220] = 1  # the tube: 220 px + the block's 80
+    path, guessed = _ridge_path(comp, cv2.distanceTransform(comp, cv2.DIST_L2, 5), (300.0, 150.0))
+    assert not guessed
+    assert path[:, 0].min() >= 295 and path[-1, 0] >= 515, (path[0], path[-1])
+    # where the tube is the body (no block on the way), the farthest part is taken as before
+    comp[80:220, 220:300] = 0
+    comp[140:160, 220:300] = 1
+    path, _ = _ridge_path(comp, cv2.distanceTransform(comp, cv2.DIST_L2, 5), (300.0, 150.0))
+    assert path[-1, 0] <= 5
+
+
+@pytest.mark.parametrize("scene", ["grey_dots", "green_fibre"])
+def test_a_body_in_a_view_that_shows_the_clamp_and_the_tube_is_measured(scene):
+    # the camera further back (0.6 mm/px): the black plate or the white clamp, and the tube
+    # behind it, are in the selection, and the tube's end is its farthest point; the centre line
+    # ran from the clamp face back through the clamp along the tube (-9 and -10 deg for 215,
+    # flagged; 12-19 of 60 rendered photos within 5 deg; now 58-59)
+    from pipeline.synth import render_actuator, scene_from
+
+    r = render_actuator(215.0, 270.0, scene_from(scene, mm_per_px=0.6), seed=30)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=5.0), (res.psi_deg, res.reason)
+
+
 def test_translucent_body_on_grey_without_a_background_photo():
     # the rendered analogue of silicone with dots on a grey backdrop, no empty-scene photo: the
     # faint side of the body fades towards the tip; measured to its end, not cut where it thins

@@ -526,10 +526,53 @@ def _component(
     return (labels == pick).astype(np.uint8), rivals, reached
 
 
+#: the ridge's far end is not one reached only across a block: when the widest point on the way
+#: to the selection's farthest pixel is more than :data:`BLOB_THICKNESS` times the ridge's median
+#: thickness, the way crosses a clamp block or plate that the selection took in, with the tube
+#: behind it (in a view that shows more of the rig the tube is the farthest part: 0-19 of 60
+#: rendered bodies within 5 deg at 0.6 mm/px).  The far end is then the farthest pixel reached
+#: without crossing anything within this factor of that width ...
+CROSSING_MARGIN = 1.15
+#: ... provided that part is long: at least this fraction of the way to the farthest pixel ...
+OTHER_BRANCH_FRACTION = 0.25
+#: ... and this many times the widest point on its own way (a body, not a stub of the outline)
+OTHER_BRANCH_HALF_WIDTHS = 8.0
+
+
+def _max_along(values: np.ndarray, pred: np.ndarray) -> np.ndarray:
+    """Largest of ``values`` on each node's way back to the root of a shortest-path tree
+    (``pred``: each node's predecessor, negative at the root and unreached nodes).
+
+    Examples
+    --------
+    >>> _max_along(np.array([1.0, 5.0, 2.0, 3.0]), np.array([-9999, 0, 1, 0])).tolist()
+    [1.0, 5.0, 5.0, 3.0]
+    """
+    m = values.astype(float).copy()
+    p = np.where(pred < 0, np.arange(len(pred)), pred)
+    while True:  # pointer doubling: each pass looks twice as far back
+        m2, p2 = np.maximum(m, m[p]), p[p]
+        if np.array_equal(p2, p) and np.array_equal(m2, m):
+            return m
+        m, p = m2, p2
+
+
+def _walk(pred: np.ndarray, start: int, end: int) -> list[int]:
+    """Nodes from ``start`` back along ``pred`` (a tree rooted at ``end``) to ``end``."""
+    path = [start]
+    while path[-1] != end and pred[path[-1]] >= 0:
+        path.append(int(pred[path[-1]]))
+    return path
+
+
 def _ridge_path(
     comp: np.ndarray, dt: np.ndarray, start_xy: tuple[float, float] | None
 ) -> tuple[np.ndarray, bool]:
-    """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end."""
+    """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end.
+
+    The far end is the pixel farthest from the start within the selection, unless the way there
+    crosses a block (see :data:`CROSSING_MARGIN`).
+    """
     ys, xs = np.nonzero(comp)
     graph = _pixel_graph(ys, xs, comp.shape)
     # edge cost: length / (distance to the edge)^2 -> the path keeps to the middle of the body
@@ -545,13 +588,21 @@ def _ridge_path(
         seed = int(np.argmax(d0))
     else:
         seed = int(np.argmin((xs - start_xy[0]) ** 2 + (ys - start_xy[1]) ** 2))
-    geo = dijkstra(plain, directed=True, indices=seed)
+    geo, way = dijkstra(plain, directed=True, indices=seed, return_predecessors=True)
     geo[~np.isfinite(geo)] = -1
     far = int(np.argmax(geo))
     _, pred = dijkstra(graph, directed=True, indices=far, return_predecessors=True)
-    path = [seed]
-    while path[-1] != far and pred[path[-1]] >= 0:
-        path.append(int(pred[path[-1]]))
+    path = _walk(pred, seed, far)
+    if not guessed:
+        crossed = _max_along(dt[ys, xs], way)
+        if crossed[far] > BLOB_THICKNESS * float(np.median(dt[ys[path], xs[path]])):
+            thin = (crossed <= crossed[far] / CROSSING_MARGIN) & (geo >= 0)
+            alt = int(np.flatnonzero(thin)[np.argmax(geo[thin])]) if thin.any() else far
+            if geo[alt] >= max(
+                OTHER_BRANCH_FRACTION * geo[far], OTHER_BRANCH_HALF_WIDTHS * crossed[alt]
+            ):
+                _, pred = dijkstra(graph, directed=True, indices=alt, return_predecessors=True)
+                path = _walk(pred, seed, alt)
     idx = np.array(path)
     return np.c_[xs[idx], ys[idx]].astype(float), guessed
 
