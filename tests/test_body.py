@@ -393,15 +393,31 @@ def test_the_ridge_does_not_run_through_the_clamp_to_the_tube_behind_it():
     assert path[-1, 0] <= 5
 
 
-@pytest.mark.parametrize("scene", ["grey_dots", "green_fibre"])
-def test_a_body_in_a_view_that_shows_the_clamp_and_the_tube_is_measured(scene):
+def test_the_ridge_does_not_run_into_a_plate_that_reaches_the_border():
+    # a black plate whose face holds the body and which runs out of the photo at the top and the
+    # bottom: its far corners are farther from the fixed end than the body's tip; the ridge
+    # follows the body
+    from pipeline.measure.body import _ridge_path
+
+    comp = np.zeros((600, 700), np.uint8)
+    comp[:, 40:300] = 1  # the plate, its face at x = 300
+    comp[290:310, 300:660] = 1  # the body, 360 px
+    path, _ = _ridge_path(comp, cv2.distanceTransform(comp, cv2.DIST_L2, 5), (300.0, 300.0))
+    assert path[:, 0].min() >= 295 and path[-1, 0] >= 655, (path[0], path[-1])
+
+
+@pytest.mark.parametrize(
+    ("scene", "mm_per_px"), [("grey_dots", 0.6), ("green_fibre", 0.6), ("grey_dots", 0.4)]
+)
+def test_a_body_in_a_view_that_shows_the_clamp_and_the_tube_is_measured(scene, mm_per_px):
     # the camera further back (0.6 mm/px): the black plate or the white clamp, and the tube
     # behind it, are in the selection, and the tube's end is its farthest point; the centre line
     # ran from the clamp face back through the clamp along the tube (-9 and -10 deg for 215,
-    # flagged; 12-19 of 60 rendered photos within 5 deg; now 58-59)
+    # flagged; 12-19 of 60 rendered photos within 5 deg; now 57-58); at 0.4 mm/px the plate's
+    # far corner was the farthest point (-0.9 deg, flagged)
     from pipeline.synth import render_actuator, scene_from
 
-    r = render_actuator(215.0, 270.0, scene_from(scene, mm_per_px=0.6), seed=30)
+    r = render_actuator(215.0, 270.0, scene_from(scene, mm_per_px=mm_per_px), seed=30)
     img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
     res = measure_image(img, settings_for(r.fixed_end_px))
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=5.0), (res.psi_deg, res.reason)

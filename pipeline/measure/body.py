@@ -537,6 +537,11 @@ CROSSING_MARGIN = 1.15
 OTHER_BRANCH_FRACTION = 0.25
 #: ... and this many times the widest point on its own way (a body, not a stub of the outline)
 OTHER_BRANCH_HALF_WIDTHS = 8.0
+#: a way to the farthest pixel shorter than this many times the median thickness along its ridge
+#: runs through a plate that reaches the photo's border, not along a body (a body is 20-40 times
+#: as long as its half-width); the other, long part is taken instead when its ridge is more than
+#: :data:`BLOB_THICKNESS` times thinner
+PLATE_HALF_WIDTHS = 10.0
 
 
 def _max_along(values: np.ndarray, pred: np.ndarray) -> np.ndarray:
@@ -571,7 +576,8 @@ def _ridge_path(
     """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end.
 
     The far end is the pixel farthest from the start within the selection, unless the way there
-    crosses a block (see :data:`CROSSING_MARGIN`).
+    crosses a block or runs through a plate (see :data:`CROSSING_MARGIN` and
+    :data:`PLATE_HALF_WIDTHS`).
     """
     ys, xs = np.nonzero(comp)
     graph = _pixel_graph(ys, xs, comp.shape)
@@ -595,14 +601,19 @@ def _ridge_path(
     path = _walk(pred, seed, far)
     if not guessed:
         crossed = _max_along(dt[ys, xs], way)
-        if crossed[far] > BLOB_THICKNESS * float(np.median(dt[ys[path], xs[path]])):
-            thin = (crossed <= crossed[far] / CROSSING_MARGIN) & (geo >= 0)
-            alt = int(np.flatnonzero(thin)[np.argmax(geo[thin])]) if thin.any() else far
-            if geo[alt] >= max(
-                OTHER_BRANCH_FRACTION * geo[far], OTHER_BRANCH_HALF_WIDTHS * crossed[alt]
-            ):
+        thin = (crossed <= crossed[far] / CROSSING_MARGIN) & (geo >= 0)
+        alt = int(np.flatnonzero(thin)[np.argmax(geo[thin])]) if thin.any() else far
+        if geo[alt] >= max(
+            OTHER_BRANCH_FRACTION * geo[far], OTHER_BRANCH_HALF_WIDTHS * crossed[alt]
+        ):
+            along = float(np.median(dt[ys[path], xs[path]]))
+            block = crossed[far] > BLOB_THICKNESS * along  # a block on the way (to the tube)
+            plate = geo[far] < PLATE_HALF_WIDTHS * along  # the way runs through a plate
+            if block or plate:
                 _, pred = dijkstra(graph, directed=True, indices=alt, return_predecessors=True)
-                path = _walk(pred, seed, alt)
+                other = _walk(pred, seed, alt)
+                if block or along > BLOB_THICKNESS * float(np.median(dt[ys[other], xs[other]])):
+                    path = other
     idx = np.array(path)
     return np.c_[xs[idx], ys[idx]].astype(float), guessed
 
