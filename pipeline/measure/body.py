@@ -529,18 +529,18 @@ def _component(
 #: the ridge's far end is not one reached only across a block: when the widest point on the way
 #: to the selection's farthest pixel is more than :data:`BLOB_THICKNESS` times the ridge's median
 #: thickness, the way crosses a clamp block or plate that the selection took in, with the tube
-#: behind it (in a view that shows more of the rig the tube is the farthest part: 0-19 of 60
-#: rendered bodies within 5 deg at 0.6 mm/px).  The far end is then the farthest pixel reached
-#: without crossing anything within this factor of that width ...
+#: behind it (in a view that shows more of the rig the tube is the farthest part: 12 and 16 of 60
+#: rendered bodies ok and within 5 deg at 0.6 mm/px, seeds 30 and 77).  The far end is then the
+#: farthest pixel reached without crossing anything within this factor of that width ...
 CROSSING_MARGIN = 1.15
 #: ... provided that part is long: at least this fraction of the way to the farthest pixel ...
 OTHER_BRANCH_FRACTION = 0.25
 #: ... and this many times the widest point on its own way (a body, not a stub of the outline)
 OTHER_BRANCH_HALF_WIDTHS = 8.0
 #: a way to the farthest pixel shorter than this many times the median thickness along its ridge
-#: runs through a plate that reaches the photo's border, not along a body (a body is 20-40 times
-#: as long as its half-width); the other, long part is taken instead when its ridge is more than
-#: :data:`BLOB_THICKNESS` times thinner
+#: runs through a plate that reaches the photo's border, not along a body (the rendered bodies
+#: are 18-40 times as long as their half-width); the other, long part is taken instead when its
+#: ridge is more than :data:`BLOB_THICKNESS` times thinner
 PLATE_HALF_WIDTHS = 10.0
 
 
