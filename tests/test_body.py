@@ -423,6 +423,15 @@ def test_a_body_in_a_view_that_shows_the_clamp_and_the_tube_is_measured(scene, m
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=5.0), (res.psi_deg, res.reason)
 
 
+def test_the_realscenes_bench_turns_its_analogues_upright():
+    # bench realscenes --upright: the photos turned to portrait with their fixed ends and empty
+    # scenes, psi unchanged (a fixed end left where it was would land off the body)
+    from pipeline.bench.realscenes import body_cases
+
+    df = body_cases(2, scenes=("lab_body",), upright=True, background=True, shared_base=False)
+    assert (df["error_deg"].abs() <= 5.0).all() and (df["status"] == "ok").all(), df
+
+
 def test_translucent_body_on_grey_without_a_background_photo():
     # the rendered analogue of silicone with dots on a grey backdrop, no empty-scene photo: the
     # faint side of the body fades towards the tip; measured to its end, not cut where it thins

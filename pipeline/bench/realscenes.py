@@ -96,6 +96,7 @@ def body_cases(
     background_exposure: float = 1.0,
     scene_set: dict[str, Any] | None = None,
     shared_base: bool = True,
+    upright: bool = False,
 ) -> pd.DataFrame:
     """Measure ``n`` rendered photos per body scene; one row per photo (truth, psi, status, reason).
 
@@ -137,6 +138,9 @@ def body_cases(
         Measure each scene's bodies from their shared base direction, as the ramp check of a
         photo set does (:func:`pipeline.ramp_check.share_base_direction`: the scene's clamp
         holds every photo's body in one direction); False: each photo from its own.
+    upright : bool
+        Turn every photo (and its empty scene) by 90 deg counter-clockwise: the camera held
+        upright, a portrait photo of the same scene (psi is unchanged).
 
     Returns
     -------
@@ -162,19 +166,26 @@ def body_cases(
             img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
             assert img is not None  # the photo just rendered
             img = through_camera(img, camera, seed=i)
+            fixed_xy = r.fixed_end_px
+            if upright:  # (x, y) -> (y, width - 1 - x)
+                img = cv2.rotate(img, cv2.ROTATE_90_COUNTERCLOCKWISE)
+                fixed_xy = (r.fixed_end_px[1], scene.width - 1 - r.fixed_end_px[0])
             extra: dict[str, Any] = {}
             if background:
                 path = Path(empties.name) / f"{name}_{i}.png"
                 exposed_empty = cv2.convertScaleAbs(empty, alpha=background_exposure)
-                cv2.imwrite(str(path), through_camera(exposed_empty, camera, seed=1000 + i))
+                shot = through_camera(exposed_empty, camera, seed=1000 + i)
+                if upright:
+                    shot = cv2.rotate(shot, cv2.ROTATE_90_COUNTERCLOCKWISE)
+                cv2.imwrite(str(path), shot)
                 extra["background"] = str(path)
             if fixed_direction and r.fixed_direction_deg is not None:
-                extra["fixed_direction_deg"] = r.fixed_direction_deg
+                extra["fixed_direction_deg"] = r.fixed_direction_deg + (90.0 if upright else 0.0)
             if give_sealed_end:
                 extra["sealed_end_mm"] = scene.sealed_end_mm + scene.tip_cap_mm
                 if give_scale:
                     extra["mm_per_px"] = scene.mm_per_px
-            fixed_end = [float(v) + o for v, o in zip(r.fixed_end_px, fixed_end_offset_px)]
+            fixed_end = [float(v) + o for v, o in zip(fixed_xy, fixed_end_offset_px)]
             settings = resolve_settings(l0_mm=270.0, target="body", fixed_end=fixed_end, **extra)
             t0 = time.perf_counter()
             res = measure_image(img, settings)
@@ -316,6 +327,13 @@ def main(argv: Sequence[str] | None = None) -> int:
              "(what a photo set's ramp check does; to compare)",
     )
     parser.add_argument(
+        "--upright",
+        action="store_true",
+        help="turn every analogue by 90 deg counter-clockwise, as a camera held upright takes it "
+             "(a portrait photo; the bodies then leave the clamp upwards, so --fixed-end-offset "
+             "0,20 is 20 px into the clamp)",
+    )
+    parser.add_argument(
         "--set",
         dest="scene_set",
         action="append",
@@ -374,6 +392,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             give_sealed_end=args.give_sealed_end, give_scale=not args.no_scale,
             background=args.background,
             background_exposure=gain, scene_set=scene_set, shared_base=not args.own_base,
+            upright=args.upright,
         )
         print(
             "\n== synthetic analogues, body mode, fixed end "
@@ -386,11 +405,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{', background photo given' if args.background else ''}"
             f"{''.join(f', {k}={v}' for k, v in scene_set.items())}"
             f"{f' at {gain:g}x exposure' if gain != 1 else ''}"
-            f"{', each from its own base direction' if args.own_base else ''} "
+            f"{', each from its own base direction' if args.own_base else ''}"
+            f"{', photos turned upright (portrait)' if args.upright else ''} "
             f"(right: |error| <= {TOLERANCE_DEG:g} deg)"
         )
         print(score(df, TOLERANCE_DEG).round(2).to_string())
-        print(f"   median time per {width}x{height} photo: {df['ms'].median():.0f} ms")
+        size = f"{height}x{width}" if args.upright else f"{width}x{height}"
+        print(f"   median time per {size} photo: {df['ms'].median():.0f} ms")
         big = df[df["psi_true_deg"].abs() > 150]
         print(
             "   median signed error at |psi| > 150 deg: "
