@@ -430,6 +430,9 @@ def test_the_realscenes_bench_turns_its_analogues_upright():
 
     df = body_cases(2, scenes=("lab_body",), upright=True, background=True, shared_base=False)
     assert (df["error_deg"].abs() <= 5.0).all() and (df["status"] == "ok").all(), df
+    # and the clamp's known direction turned with them
+    df = body_cases(2, scenes=("lab_body",), upright=True, fixed_direction=True, shared_base=False)
+    assert (df["error_deg"].abs() <= 5.0).all(), df
 
 
 def test_translucent_body_on_grey_without_a_background_photo():
