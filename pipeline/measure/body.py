@@ -653,6 +653,13 @@ def _normals(points: np.ndarray) -> np.ndarray:
 #: edge-to-edge width outside [END_WIDTH_LOW, END_WIDTH_HIGH] x the median at an end of the centre
 #: line: the normal there runs into the clamp or round the tip, and that end is dropped
 END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
+#: ... and at the fixed end, the first points whose width is more than this times the body's:
+#: a clamp block hardly wider than a fat body (25-30 mm wide) is not cut off as a blob, and where
+#: a profile there reaches into it, its middle slides off towards the block's side, more so with
+#: each pass (the centre line hooked 4-8 px over its first 15 and read the base 5-8 deg off,
+#: either way; such profiles are 1.13-1.18x the body's width, those of a body without a block
+#: at most 1.07x)
+FACE_WIDTH_HIGH = 1.1
 #: the centre line holds where the body is at least this fraction of its usual half-width ...
 TIP_THICKNESS = 0.95
 #: ... and at most this multiple of it (thicker: the clamp or a blob the body runs into)
@@ -782,6 +789,17 @@ def _continues(others: np.ndarray, pts: np.ndarray, half: float) -> bool:
     across = np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
     ahead = (along > 0) & (along <= 6.0 * half + 10.0) & (across <= half + 0.6 * along)
     return int(ahead.sum()) >= max(10, int(half * half))
+
+
+def _leading_run(flags: np.ndarray) -> int:
+    """How many of ``flags`` are True before the first False.
+
+    Examples
+    --------
+    >>> _leading_run(np.array([True, True, False, True]))
+    2
+    """
+    return len(flags) if flags.all() else int(np.argmin(flags))
 
 
 def _good_span(good: np.ndarray, run: int) -> tuple[int, int] | None:
@@ -1227,6 +1245,8 @@ def extract_body(
         med = float(np.nanmedian(wid)) if np.isfinite(wid).any() else 2.0 * half
         ref = local_widths(wid, window)
         bad = ~np.isfinite(wid) | (wid > END_WIDTH_HIGH * ref) | (wid < END_WIDTH_LOW * ref)
+        if fe is not None and reached:
+            bad[: _leading_run(wid > FACE_WIDTH_HIGH * ref)] = True
         moved[bad] = pts[bad]  # where the normal does not span the body, keep the ridge point
         span = _good_span(~bad, max(3, int(round(half))))  # noqa: RUF046 (numpy scalar)
         # the ends where the profile runs into the clamp or round the tip: dropped
