@@ -3,8 +3,9 @@
 The committed photo set is measured as a lab runs it (``measure`` on the folder, one
 photoset.yaml, a fixed end per row because the strips are free) and scored against labels.csv.
 What must hold: no row is ``ok`` outside its tolerance (a wrong number is flagged or failed, with a
-reason in words), and at least as many rows are within tolerance as today (6 of 10; the issue's
-target of 9 is not reached: see ``python -m pipeline bench realscenes``).
+reason in words), and at least as many rows are within tolerance as today (7 of 10, d_20C among
+them, flagged; the issue's target of 9 is not reached: see ``python -m pipeline bench
+realscenes``).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ def test_no_wrong_ok_on_real_photos(measured):
 
 def test_real_photos_within_tolerance(measured):
     within = (measured["error_deg"].abs() <= measured["tolerance_deg"]).sum()
-    assert within >= 6, measured[["image", "psi_deg", "psi_signed_net_deg", "status", "reason"]]
+    assert within >= 7, measured[["image", "psi_deg", "psi_signed_net_deg", "status", "reason"]]
 
 
 def test_a_cut_strip_is_measured_to_its_end(tmp_path):
