@@ -658,7 +658,7 @@ END_WIDTH_LOW, END_WIDTH_HIGH = 0.8, 1.2
 #: a profile there reaches into it, its middle slides off towards the block's side, more so with
 #: each pass (the centre line hooked 4-8 px over its first 15 and read the base 5-8 deg off,
 #: either way; such profiles are 1.13-1.18x the body's width, those of a body without a block
-#: at most 1.07x)
+#: at most 1.07x in the rendered photos looked at)
 FACE_WIDTH_HIGH = 1.1
 #: the centre line holds where the body is at least this fraction of its usual half-width ...
 TIP_THICKNESS = 0.95
