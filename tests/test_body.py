@@ -438,6 +438,20 @@ def test_a_fat_body_is_read_from_its_own_middle_at_the_clamp_face(psi, seed):
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=2.5), (res.psi_deg, res.reason)
 
 
+@pytest.mark.parametrize(("psi", "seed"), [(175.6, 31), (135.9, 32)])
+def test_a_fat_bodys_march_stops_where_it_swings_into_the_cap(psi, seed):
+    # a translucent body 25 mm wide: the last steps of the march to the free end reached into
+    # the cap's profile, widened and swung sideways, and the tip read 6-7 deg high (182.5 and
+    # 141.7 deg, both ok)
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("dark_translucent", body_width_mm=25.0)
+    r = render_actuator(psi, 270.0, scene, seed=seed, bulge=0.4 if seed % 2 else 0.0)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=3.0), (res.psi_deg, res.reason)
+
+
 def test_the_realscenes_bench_turns_its_analogues_upright():
     # bench realscenes --upright: the photos turned to portrait with their fixed ends and empty
     # scenes, psi unchanged (a fixed end left where it was would land off the body)

@@ -759,6 +759,11 @@ RIDGE_TIP_HALF_WIDTHS = 2.0
 #: 5-7 deg at |psi| ~ 220 on rendered capped bodies); a blurred, rounded tip is (1.1 stopped short
 #: of a faint translucent tip)
 MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH = 0.8, 1.15
+#: ... and it stops at a step both wider than this times that width and more than
+#: MARCH_SWING_DEG off its course: a profile reaching into a cap or across an oblique end face,
+#: whose middle slides sideways (a fat body's tip swung 5-10 deg off over its last few steps;
+#: a faint tip narrows, and noise alone swings at the body's own width)
+MARCH_SWING_WIDTH, MARCH_SWING_DEG = 1.05, 8.0
 #: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
@@ -855,6 +860,10 @@ def _march(
                 np.deg2rad(25.0)
             ) * np.hypot(*d):
                 break  # not moving on, or turning off the line's course (a corner, a cap)
+            if wid[1] > MARCH_SWING_WIDTH * med and float(d @ t) < np.cos(
+                np.deg2rad(MARCH_SWING_DEG)
+            ) * np.hypot(*d):
+                break  # widening and swinging off the course: into a cap or across an end face
             new.append(step)
             new_w.append(float(wid[1]))
             hist = np.vstack([line[-k:], np.array(new)])
