@@ -831,7 +831,8 @@ def _march(
     """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
     edges": each new point is the middle of the profile across the body ahead, kept while the
     body's width there is within [MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH] of its median near that end
-    (``end_med``: start, end).
+    (``end_med``: start, end), and not at a step both wider than :data:`MARCH_SWING_WIDTH` of
+    it and more than :data:`MARCH_SWING_DEG` off the course (into a cap or across an end face).
 
     The ridge path stops about a half-width short of each end (there the medial axis forks into
     the corners); marching recovers that part, so a tip that curls to its end is measured to its
@@ -856,13 +857,12 @@ def _march(
                 break
             step = mid[1]
             d = step - prev  # the course over the last few points, not one step's jitter
-            if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or float(d @ t) < np.cos(
-                np.deg2rad(25.0)
-            ) * np.hypot(*d):
+            off_deg = float(np.rad2deg(np.arccos(np.clip(
+                float(d @ t) / max(float(np.hypot(*d)), 1e-9), -1.0, 1.0
+            ))))
+            if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or off_deg > 25.0:
                 break  # not moving on, or turning off the line's course (a corner, a cap)
-            if wid[1] > MARCH_SWING_WIDTH * med and float(d @ t) < np.cos(
-                np.deg2rad(MARCH_SWING_DEG)
-            ) * np.hypot(*d):
+            if wid[1] > MARCH_SWING_WIDTH * med and off_deg > MARCH_SWING_DEG:
                 break  # widening and swinging off the course: into a cap or across an end face
             new.append(step)
             new_w.append(float(wid[1]))
