@@ -1086,6 +1086,10 @@ def _midpoints(
 BRIDGE_HALF_WIDTHS = 6.0
 #: ... in a piece at least this many half-widths squared in area (a stretch of body, not a speck)
 BRIDGE_MIN_AREA_HALF2 = 8.0
+#: ... or, within this many half-widths of the free end, a piece of at least this many: the tip
+#: of a translucent body beyond a faint stretch (on the analogue without its empty scene, 1.0-1.4
+#: half-widths squared, 0.3-0.6 half-widths ahead)
+TIP_PIECE_HALF_WIDTHS, TIP_PIECE_AREA_HALF2 = 1.0, 1.0
 #: at most this many gaps are bridged
 MAX_BRIDGES = 3
 
@@ -1100,8 +1104,10 @@ def _bridge_gaps(
     A faint stretch (a translucent body where the light is dim, a highlight, a shadow) splits the
     selection; the piece at the fixed end then stops short and the rest is a rival.  While
     another piece of at least :data:`BRIDGE_MIN_AREA_HALF2` half-widths squared lies ahead of the
-    free end of the ridge path, on its course, within :data:`BRIDGE_HALF_WIDTHS` half-widths,
-    the gap is filled with a band of the body's width and the ridge is walked again.
+    free end of the ridge path, on its course, within :data:`BRIDGE_HALF_WIDTHS` half-widths
+    (or a smaller one, down to :data:`TIP_PIECE_AREA_HALF2`, within
+    :data:`TIP_PIECE_HALF_WIDTHS`: the tip itself, past the last faint stretch), the gap is
+    filled with a band of the body's width and the ridge is walked again.
 
     Returns
     -------
@@ -1137,8 +1143,10 @@ def _bridge_gaps(
         along = d @ t
         across = np.abs(d[:, 0] * t[1] - d[:, 1] * t[0])
         ahead = (along > 0) & (along <= BRIDGE_HALF_WIDTHS * half) & (across <= half + 0.5 * along)
-        big = stats[:, cv2.CC_STAT_AREA] >= BRIDGE_MIN_AREA_HALF2 * half * half
-        ahead &= big[labels[ys, xs]]
+        area = stats[labels[ys, xs], cv2.CC_STAT_AREA]
+        ahead &= (area >= BRIDGE_MIN_AREA_HALF2 * half * half) | (
+            (area >= TIP_PIECE_AREA_HALF2 * half * half) & (along <= TIP_PIECE_HALF_WIDTHS * half)
+        )
         if not ahead.any():
             return comp, dt, path, gaps
         k = int(np.flatnonzero(ahead)[np.argmin(np.hypot(along[ahead], across[ahead]))])
