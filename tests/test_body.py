@@ -336,6 +336,22 @@ def test_the_tip_of_a_faint_body_beyond_a_gap_is_joined_to_it(camera, mm_per_px)
     assert res.status == "flagged" and "body partly hidden" in res.reason, res.reason
 
 
+@pytest.mark.parametrize(("width_mm", "seed"), [(30.0, 38), (25.0, 85)])
+def test_a_tip_carried_on_along_the_selection_is_carried_to_its_end(width_mm, seed):
+    # a fat translucent body on grey without its empty scene, at -102 deg: the centre line stops
+    # short of a faint tip, and psi was carried on along the selection's ridge only, which stops
+    # two half-widths short of the ridge's end: 12-14 deg short (flagged); the free end's
+    # curvature, which turns the whole uncovered part further the same way, now carries it on
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("grey_dots_clear", body_width_mm=width_mm)
+    r = render_actuator(float(np.linspace(215.0, -220.0, 12)[8]), 270.0, scene, seed=seed)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+    res = measure_image(img, settings_for(r.fixed_end_px))
+    assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=4.0), (res.psi_deg, res.reason)
+    assert res.status == "flagged" and "and on at the free end's curvature" in res.reason
+
+
 def test_a_centre_line_stopping_short_of_a_tip_that_still_turns_is_flagged_and_carried_on():
     # the translucent body on grey, curled to 215 deg, saved at JPEG quality 40: the centre line
     # stops a body width short of the tip while the body there turns 0.6 deg per px (the turning

@@ -38,12 +38,11 @@ from pipeline.measure.estimators import (
 from pipeline.measure.extract import LineExtraction, NoLineFound, extract_centreline, region_mask
 from pipeline.measure.formats import decode_image, read_image, undecodable
 from pipeline.measure.quality import (
-    RIDGE_TIP_DEG,
-    TIP_UNSTABLE_DEG,
     Quality,
     assess,
     assess_body,
     tip_out_of_reach,
+    tip_turn_deg,
 )
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
@@ -458,15 +457,18 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
-        missed_tip_deg=abs(missed_tip_deg),
+        missed_tip_deg=missed_tip_deg,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
         short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method
-    # carried on over a tip the selection fades at, not past an uneven outline
-    carried = 0.0 if tip_out_of_reach(body.end_short_px, line.width_px) else missed_tip_deg
+    # carried on over a tip the selection fades at, not past an uneven outline (unless along
+    # the selection's ridge)
     measured = _measured(
-        carried_on_psi_deg(psi, body.ridge_tip_deg, carried, sign),
+        carried_on_psi_deg(
+            psi, body.ridge_tip_deg, missed_tip_deg, sign,
+            out_of_reach=tip_out_of_reach(body.end_short_px, line.width_px),
+        ),
         est, line, quality, settings, used,
     )
     if base is not None or est is not tip:
@@ -475,17 +477,28 @@ def measure_body(
 
 
 def carried_on_psi_deg(
-    psi_deg: float, ridge_tip_deg: float, missed_tip_deg: float, sign: float
+    psi_deg: float,
+    ridge_tip_deg: float,
+    missed_tip_deg: float,
+    sign: float,
+    *,
+    out_of_reach: bool = False,
 ) -> float:
     """psi with the free end carried on over the part of the body the centre line stops short
     of (the row is flagged for either; else ``psi_deg`` unchanged).
 
-    Along the selection's ridge, when the ridge turns on by more than :data:`RIDGE_TIP_DEG`
+    Along the selection's ridge, when the ridge turns on by more than
+    :data:`~pipeline.measure.quality.RIDGE_TIP_DEG`
     (``ridge_tip_deg``: on the rendered analogues, 384 photos over three sizes and four camera
-    faults, it moved 13 flagged rows from a total of 370 deg off to 120); else at the free end's
-    curvature, when that turns the uncovered part by more than :data:`TIP_UNSTABLE_DEG`
-    (``missed_tip_deg``: a faint tip the selection does not reach, whose ridge is lost with it).
-    Both turns are in image axes (y down), ``sign`` the photo's ``+1``/``-1`` (``positive_turn``).
+    faults, it moved 13 flagged rows from a total of 370 deg off to 120); the ridge is followed
+    only to :data:`~pipeline.measure.body.RIDGE_TIP_HALF_WIDTHS` half-widths short of its end, so
+    where the free end's curvature turns the whole uncovered part further the same way
+    (``missed_tip_deg``), that turn is taken (:func:`~pipeline.measure.quality.tip_turn_deg`).
+    Else at the free end's curvature, when that turns the uncovered part by more than
+    :data:`~pipeline.measure.quality.TIP_UNSTABLE_DEG` and the tip is within reach
+    (``out_of_reach``: see :func:`~pipeline.measure.quality.tip_out_of_reach`; a faint tip the
+    selection does not reach, whose ridge is lost with it).  Both turns are in image axes (y
+    down), ``sign`` the photo's ``+1``/``-1`` (``positive_turn``).
 
     Examples
     --------
@@ -493,12 +506,11 @@ def carried_on_psi_deg(
     (-95.0, -56.0)
     >>> carried_on_psi_deg(56.0, 39.0, 0.0, -1.0), carried_on_psi_deg(-188.0, 0.0, 13.0, 1.0)
     (95.0, -201.0)
+    >>> carried_on_psi_deg(-160.0, 13.0, 32.0, 1.0), carried_on_psi_deg(-188.0, 0.0, 13.0, 1.0,
+    ...                                                                   out_of_reach=True)
+    (-192.0, -188.0)
     """
-    if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
-        return psi_deg - sign * ridge_tip_deg
-    if abs(missed_tip_deg) > TIP_UNSTABLE_DEG:
-        return psi_deg - sign * missed_tip_deg
-    return psi_deg
+    return psi_deg - sign * tip_turn_deg(ridge_tip_deg, missed_tip_deg, out_of_reach=out_of_reach)
 
 
 def _work_per_image_px(line: LineExtraction, points: NDArray[np.float64]) -> float:

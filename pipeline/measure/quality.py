@@ -185,6 +185,26 @@ def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
     """
     return end_short_px > 1.5 * width_px + 4.0
 
+
+def tip_turn_deg(
+    ridge_tip_deg: float, missed_tip_deg: float, *, out_of_reach: bool = False
+) -> float:
+    """The turn (deg, image axes) psi is carried on by past the centre line's free end: see
+    :func:`pipeline.measure.core.carried_on_psi_deg`.
+
+    Examples
+    --------
+    >>> tip_turn_deg(13.0, 32.0), tip_turn_deg(13.0, -32.0), tip_turn_deg(3.0, 6.0)
+    (32.0, 13.0, 0.0)
+    """
+    if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
+        further = missed_tip_deg * ridge_tip_deg > 0 and abs(missed_tip_deg) > abs(ridge_tip_deg)
+        return missed_tip_deg if further else ridge_tip_deg
+    if not out_of_reach and abs(missed_tip_deg) > TIP_UNSTABLE_DEG:
+        return missed_tip_deg
+    return 0.0
+
+
 #: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
 BASE_MISMATCH_DEG = 20.0
 
@@ -303,21 +323,28 @@ def assess_body(
             "(faint), which turns its direction; check with photoset preview"
         )
     if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
+        further = tip_turn_deg(ridge_tip_deg, missed_tip_deg) != ridge_tip_deg
         flags.append(
             f"the free end's direction is uncertain: the centre line stops {end_short_px:.0f} px "
             "short of the body's end; psi is carried on along the selection there, which turns "
-            f"the end by {abs(ridge_tip_deg):.0f} deg (photoset preview shows it)"
+            f"the end by {abs(ridge_tip_deg):.0f} deg"
+            + (
+                f", and on at the free end's curvature to its end, {abs(missed_tip_deg):.0f} deg"
+                if further
+                else ""
+            )
+            + " (photoset preview shows it)"
         )
     elif tip_out_of_reach(end_short_px, line.width_px):
         flags.append(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end (uneven "
             "outline there): check with photoset preview"
         )
-    elif missed_tip_deg > TIP_UNSTABLE_DEG:
+    elif abs(missed_tip_deg) > TIP_UNSTABLE_DEG:
         flags.append(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end where the "
             f"body still turns: psi is carried on over that part at the free end's curvature, "
-            f"about {missed_tip_deg:.0f} deg (photoset preview shows it)"
+            f"about {abs(missed_tip_deg):.0f} deg (photoset preview shows it)"
         )
     if start_gap_px > 2.0 * line.width_px + 4.0:
         flags.append(
