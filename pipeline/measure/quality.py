@@ -172,6 +172,11 @@ WIDTH_RATIO = 2.2
 RIDGE_TIP_DEG = 4.0
 #: body: a free end narrower than this fraction of the body's width has lost a side
 NARROW_FREE_END = 0.6
+#: body: where the free end is narrower than this fraction of the body's width (a faint side),
+#: its curvature says less of how far the uncovered tip turns, and a centre line stopping short
+#: of a tip that turns more than FAINT_TIP_TURN_DEG (deg) at that curvature is flagged (not
+#: carried on)
+FAINT_TIP_WIDTH, FAINT_TIP_TURN_DEG = 0.9, 5.0
 
 
 def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
@@ -239,7 +244,9 @@ def assess_body(
     on fitting half as much of it (``short_end_shift_deg``: a hook in the last few pixels, where
     the body meets the clamp or the tip, that a longer fit smooths over); the centre line stops
     short of a tip that still turns (``missed_tip_deg``: the free end's curvature times the part
-    of the body beyond the centre line's end, less half a width for a cap); the body closes on
+    of the body beyond the centre line's end, less half a width for a cap, signed as the turn;
+    over :data:`TIP_UNSTABLE_DEG`, or over :data:`FAINT_TIP_TURN_DEG` where the free end is
+    narrower than :data:`FAINT_TIP_WIDTH` of the body: a faint side); the body closes on
     itself; or it is much shorter than ``l0`` (partly hidden).  Notes (status stays ``ok``) say
     how psi was taken.
     """
@@ -345,6 +352,14 @@ def assess_body(
             f"the centre line stops {end_short_px:.0f} px short of the body's free end where the "
             f"body still turns: psi is carried on over that part at the free end's curvature, "
             f"about {abs(missed_tip_deg):.0f} deg (photoset preview shows it)"
+        )
+    elif abs(missed_tip_deg) > FAINT_TIP_TURN_DEG and free_end_width_ratio < FAINT_TIP_WIDTH:
+        flags.append(
+            f"the centre line stops {end_short_px:.0f} px short of the body's free end, which "
+            f"still turns (about {abs(missed_tip_deg):.0f} deg at its curvature, not carried on) "
+            f"and is {100 * free_end_width_ratio:.0f}% as wide as the body there (a faint side?): "
+            "psi may miss part of the tip's turn; check with photoset preview, or give the empty "
+            "scene (background)"
         )
     if start_gap_px > 2.0 * line.width_px + 4.0:
         flags.append(
