@@ -362,6 +362,38 @@ def _problems(s: SceneParams) -> list[str]:
     return out
 
 
+#: (B) an opaque pigmented silicone actuator with retro-reflective motion-capture dots, clamped in
+#: a black plate on a grey board; curvature concentrated towards the tip
+_GREY_DOTS = SceneParams(
+    background="textured",
+    table_bgr=NAMED_BGR["grey"],
+    texture_strength=3.0,
+    lighting_gradient=0.25,
+    vignetting=0.25,
+    marker_line=False,
+    target="body",
+    shape="distal",
+    straight_base_fraction=0.3,
+    body_width_mm=20.0,
+    body_bgr=NAMED_BGR["pink"],
+    body_translucency=0.08,
+    body_shading=0.7,
+    specular=0.35,
+    dots=8,
+    dot_color="white",
+    dot_diameter_mm=5.0,
+    clamp_style="plate",
+    tube=True,
+    shadow=0.2,
+    tilt_deg=1.0,
+    noise_sigma=3.0,
+    blur_sigma_px=0.8,
+    jpeg_quality=88,
+    rotation_jitter_deg=1.5,
+    known_fixed_direction=True,
+)
+
+
 #: named scenes: ``clean`` (ideal photo), ``lab`` (a realistic bench photo), ``hard`` (worst case)
 SCENE_PRESETS: dict[str, SceneParams] = {
     "clean": SceneParams(
@@ -440,65 +472,17 @@ SCENE_PRESETS: dict[str, SceneParams] = {
         rotation_jitter_deg=1.5,
         background_photo=True,
     ),
-    # (B) an opaque pigmented silicone actuator with retro-reflective motion-capture dots, clamped
-    # in a black plate on a grey board; curvature concentrated towards the tip
-    "grey_dots": SceneParams(
-        background="textured",
-        table_bgr=NAMED_BGR["grey"],
-        texture_strength=3.0,
-        lighting_gradient=0.25,
-        vignetting=0.25,
-        marker_line=False,
-        target="body",
-        shape="distal",
-        straight_base_fraction=0.3,
-        body_width_mm=20.0,
-        body_bgr=NAMED_BGR["pink"],
-        body_translucency=0.08,
-        body_shading=0.7,
-        specular=0.35,
-        dots=8,
-        dot_color="white",
-        dot_diameter_mm=5.0,
-        clamp_style="plate",
-        tube=True,
-        shadow=0.2,
-        tilt_deg=1.0,
-        noise_sigma=3.0,
-        blur_sigma_px=0.8,
-        jpeg_quality=88,
-        rotation_jitter_deg=1.5,
-        known_fixed_direction=True,
-    ),
+    # (B) an opaque pigmented silicone actuator with motion-capture dots on grey (_GREY_DOTS)
+    "grey_dots": _GREY_DOTS,
     # (B) the same rig with a translucent (clear) silicone actuator: the body over the plate is
     # faint
-    "grey_dots_clear": SceneParams(
-        background="textured",
-        table_bgr=NAMED_BGR["grey"],
-        texture_strength=3.0,
-        lighting_gradient=0.25,
-        vignetting=0.25,
-        marker_line=False,
-        target="body",
-        shape="distal",
-        straight_base_fraction=0.3,
+    "grey_dots_clear": dataclasses.replace(
+        _GREY_DOTS,
         body_width_mm=18.0,
         body_bgr=NAMED_BGR["clear"],
         body_translucency=0.7,
-        body_shading=0.7,
         specular=0.5,
-        dots=8,
-        dot_color="white",
-        dot_diameter_mm=5.0,
-        clamp_style="plate",
-        tube=True,
         shadow=0.15,
-        tilt_deg=1.0,
-        noise_sigma=3.0,
-        blur_sigma_px=0.8,
-        jpeg_quality=88,
-        rotation_jitter_deg=1.5,
-        known_fixed_direction=True,
         background_photo=True,
     ),
     # (B) a translucent ribbed silicone actuator over a black backdrop, with a printed tip cap
