@@ -375,7 +375,42 @@ def test_a_faint_tip_the_centre_line_stops_short_of_is_flagged_not_an_ok_psi(tmp
         res, _ = measure_file(folder / image, ps.rows[list(ps.manifest["image"]).index(image)])
         assert abs(res.psi_deg - truth.loc[image, "psi_deg"]) > 5.0  # what the flag is for
         assert res.status == "flagged", (image, res.psi_deg, res.reason)
-        assert "a faint side?" in res.reason and "not carried on" in res.reason, res.reason
+        assert "a faint tip?" in res.reason and "not carried on" in res.reason, res.reason
+
+
+def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_on(tmp_path):
+    # a 720p ramp of the translucent body on grey without its empty scene, fixed_direction_deg
+    # given: the selection misses the faint stretch by the clamp, so the centre line starts
+    # 100-200 px from fixed_end.  psi is the free end's tangent against the known direction, but
+    # the start gap, the fixed end's tangent (its window doubled, carried back over the gap) and a
+    # smooth fit carried back over it (run away: "more than a full turn") flagged 33 of 40 photos,
+    # 28 of them within 10 deg.  Lifting those flags let two tips through at 10.1 and 11.3 deg
+    # off: their lines stop a full width short of a faint tip that still turns 7 deg, now
+    # flagged as a faint tip
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth.photoset_writer import render_photoset
+
+    folder = tmp_path / "s"
+    truth = render_photoset(folder, "DS20", actuators=1, trials=2, seed=35,
+                            scene="grey_dots_clear", step_kpa=20,
+                            scene_overrides={"width": 1280, "height": 720})
+    yaml = (folder / "photoset.yaml").read_text()
+    (folder / "photoset.yaml").write_text(
+        "".join(line for line in yaml.splitlines(keepends=True) if "background" not in line)
+    )
+    out = measure_photoset(folder, jobs=2)
+    assert len(out) == len(truth) == 40
+    err = (out["psi_deg"] - out["image"].map(truth.set_index("image")["psi_deg"])).abs()
+    ok = out["status"] == "ok"
+    assert ok.sum() >= 25 and (err[ok] <= 10.0).all(), out.loc[ok & (err > 10.0)]
+    assert not out.loc[ok, "reason"].str.contains("the end tangents and a smooth fit").any()
+    assert out.loc[ok, "reason"].str.contains("psi does not depend on it").sum() >= 10
+    faint = out.set_index("image").loc[
+        ["DS20_A1_t1_s012_down_120kPa.jpg", "DS20_A1_t2_s011_down_180kPa.jpg"]
+    ]
+    assert (faint["status"] == "flagged").all() and faint["reason"].str.contains(
+        "a faint tip?"
+    ).all(), faint["reason"].tolist()
 
 
 def test_a_centre_line_stopping_short_of_a_tip_that_still_turns_is_flagged_and_carried_on():
@@ -714,7 +749,9 @@ def test_a_ramps_bodies_are_measured_from_its_one_base_direction(tmp_path):
     # the base in one direction, so the ramp check measures every photo from the ramp's median
     # (4 -> 1 of them; since the clamp face's profiles are left out, FACE_WIDTH_HIGH, 3 -> 2:
     # the base is steadier by itself, and the two left are off at their free ends, which the
-    # check cannot mend)
+    # check cannot mend).  Since a line stopping a width short of a tip that still turns is
+    # flagged as a faint tip (FAINT_TIP_SHORT_WIDTHS), two right rows here are (2.9 and 3.7 deg
+    # off, where the cap hides the tip): the rule's cost, 1 more in 170 other photos of 4 ramps
     from pipeline.photoset_measure import measure_photoset
     from pipeline.ramp_check import check_ramps
     from pipeline.synth.photoset_writer import render_photoset
@@ -739,7 +776,9 @@ def test_a_ramps_bodies_are_measured_from_its_one_base_direction(tmp_path):
         if ramp_check:
             assert got.groupby("trial")["base_direction_deg"].nunique().eq(1).all()  # one clamp
             assert got["reason"].str.contains("deg against its ramp's base direction").any()
-            assert (got["status"] == "ok").all(), got["reason"].tolist()
+            faint_tip = got["reason"].str.contains("a faint tip?", regex=False)
+            assert ((got["status"] == "ok") | faint_tip).all(), got["reason"].tolist()
+            assert faint_tip.sum() <= 2, got.loc[faint_tip, "reason"].tolist()
     assert scores[False] >= 3 and scores[True] < scores[False], scores
 
 

@@ -423,11 +423,15 @@ def measure_body(
         np.rad2deg(end_curvature(line.centreline_px))
         * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px))
     )
-    # the same turning from a smooth fit of the whole centre line: the check of a wobbly line
+    # the same turning from a smooth fit of the whole centre line: the check of a wobbly line.
+    # With the base known psi does not depend on the fixed end, so neither reading is carried
+    # back over a stretch the centre line stops short of there (on a long one a fit runs away)
+    check_ends = ends if base is None else (0.0, ends[1])
+    check_start, check_end, _ = end_tangents(pts, ends_px=check_ends)
     try:
-        smooth_turning = turning(pts, np.random.default_rng(SEED), ends_px=ends).turning_rad
+        smooth_turning = turning(pts, np.random.default_rng(SEED), ends_px=check_ends).turning_rad
     except (ValueError, np.linalg.LinAlgError):
-        smooth_turning = free.turning_rad  # too short a line for the fit: no check
+        smooth_turning = check_end - check_start  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
@@ -458,7 +462,7 @@ def measure_body(
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
         missed_tip_deg=missed_tip_deg,
-        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - free.turning_rad))),
+        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,
     )
     used = "tangents" if method == "auto" or base is not None else method

@@ -598,7 +598,19 @@ def tangents(
 
     ``base_rad`` is the known direction the line leaves the clamp (y-up, rad); it is taken on the
     branch nearest the measured start tangent.  ``neighbour_turning_rad`` holds the same estimate
-    with end windows twice as long: a stability check (they differ on a wobbly or hooked end).
+    with end windows twice as long: a stability check (they differ on a wobbly or hooked end);
+    with ``base_rad`` only the free end's window doubles, as psi does not depend on the fixed
+    end's tangent then.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, np.pi, 200)
+    >>> arc = np.c_[np.sin(t), 1.0 - np.cos(t)] * 100.0  # leaves at 0 rad, turns 180 deg ccw
+    >>> hooked = np.vstack([arc[:1] + [[-30.0, 30.0], [-20.0, 20.0], [-10.0, 10.0]], arc])
+    >>> est = tangents(hooked, np.random.default_rng(0), base_rad=0.0)
+    >>> print(round(float(np.rad2deg(est.turning_rad)), 1),
+    ...       round(float(np.rad2deg(est.neighbour_turning_rad)), 1))
+    180.0 180.0
     """
     if len(points) < 4:
         raise ValueError("need at least 4 centre-line points")
@@ -607,7 +619,7 @@ def tangents(
     a2, b2, _ = end_tangents(points, ends_px=ends_px, window_fraction=2 * TANGENT_WINDOW_FRACTION)
     if base_rad is not None:
         base = base_rad + 2 * np.pi * np.round((a - base_rad) / (2 * np.pi))
-        a2, a = a2 - a + base, base
+        a2 = a = base
     length = smooth_length(points) + ends_px[0] + ends_px[1]
     psi, check = b - a, b2 - a2
     # angle misfit as a sideways offset

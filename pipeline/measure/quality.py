@@ -177,6 +177,10 @@ NARROW_FREE_END = 0.6
 #: of a tip that turns more than FAINT_TIP_TURN_DEG (deg) at that curvature is flagged (not
 #: carried on)
 FAINT_TIP_WIDTH, FAINT_TIP_TURN_DEG = 0.9, 5.0
+#: body: so is one stopping more than this many of the body's widths short of a tip that turns
+#: more than FAINT_TIP_TURN_DEG: past the half width of a cap, a faint stretch of the tip is lost
+#: (the rendered bodies' lines stop 0.6-0.9 widths short of a tip seen whole)
+FAINT_TIP_SHORT_WIDTHS = 0.9
 
 
 def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
@@ -246,9 +250,11 @@ def assess_body(
     short of a tip that still turns (``missed_tip_deg``: the free end's curvature times the part
     of the body beyond the centre line's end, less half a width for a cap, signed as the turn;
     over :data:`TIP_UNSTABLE_DEG`, or over :data:`FAINT_TIP_TURN_DEG` where the free end is
-    narrower than :data:`FAINT_TIP_WIDTH` of the body: a faint side); the body closes on
-    itself; or it is much shorter than ``l0`` (partly hidden).  Notes (status stays ``ok``) say
-    how psi was taken.
+    narrower than :data:`FAINT_TIP_WIDTH` of the body, a faint side, or the line stops more than
+    :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
+    from ``fixed_end`` (a note when ``fixed_direction_deg`` is given: ``base_mismatch_deg`` not
+    None); the body closes on itself; or it is much shorter than ``l0`` (partly hidden).  Notes
+    (status stays ``ok``) say how psi was taken.
     """
     import numpy as np
 
@@ -353,18 +359,24 @@ def assess_body(
             f"body still turns: psi is carried on over that part at the free end's curvature, "
             f"about {abs(missed_tip_deg):.0f} deg (photoset preview shows it)"
         )
-    elif abs(missed_tip_deg) > FAINT_TIP_TURN_DEG and free_end_width_ratio < FAINT_TIP_WIDTH:
+    elif abs(missed_tip_deg) > FAINT_TIP_TURN_DEG and (
+        free_end_width_ratio < FAINT_TIP_WIDTH
+        or end_short_px > FAINT_TIP_SHORT_WIDTHS * line.width_px
+    ):
         flags.append(
-            f"the centre line stops {end_short_px:.0f} px short of the body's free end, which "
+            f"the centre line stops {end_short_px:.0f} px "
+            f"({end_short_px / line.width_px:.1f} widths) short of the body's free end, which "
             f"still turns (about {abs(missed_tip_deg):.0f} deg at its curvature, not carried on) "
-            f"and is {100 * free_end_width_ratio:.0f}% as wide as the body there (a faint side?): "
+            f"and is {100 * free_end_width_ratio:.0f}% as wide as the body there (a faint tip?): "
             "psi may miss part of the tip's turn; check with photoset preview, or give the empty "
             "scene (background)"
         )
     if start_gap_px > 2.0 * line.width_px + 4.0:
-        flags.append(
+        # with the base known psi is the free end's tangent against it: the gap cannot change it
+        (flags if base_mismatch_deg is None else notes).append(
             f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or "
             "fixed_end is off"
+            + ("" if base_mismatch_deg is None else " (psi does not depend on it)")
         )
     if expected_length_px and length_px < 0.8 * expected_length_px:
         flags.append(
