@@ -387,6 +387,8 @@ def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_
     # 28 of them within 10 deg.  Lifting those flags let two tips through at 10.1 and 11.3 deg
     # off: their lines stop a full width short of a faint tip that still turns 7 deg, now
     # flagged as a faint tip
+    import pandas as pd
+
     from pipeline.photoset_measure import measure_photoset
     from pipeline.synth.photoset_writer import render_photoset
 
@@ -411,6 +413,13 @@ def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_
     assert (faint["status"] == "flagged").all() and faint["reason"].str.contains(
         "a faint tip?"
     ).all(), faint["reason"].tolist()
+    # without the clamp's direction psi does depend on the missed stretch: flagged, naming the fix
+    manifest = pd.read_csv(folder / "manifest.csv")
+    manifest.drop(columns="fixed_direction_deg").to_csv(folder / "manifest.csv", index=False)
+    alone = measure_photoset(folder, jobs=2, ramp_check=False)
+    gap = alone["reason"].str.contains("the body starts", regex=False)
+    assert gap.sum() >= 20 and (alone.loc[gap, "status"] == "flagged").all()
+    assert alone.loc[gap, "reason"].str.contains("give fixed_direction_deg", regex=False).all()
 
 
 def test_a_centre_line_stopping_short_of_a_tip_that_still_turns_is_flagged_and_carried_on():

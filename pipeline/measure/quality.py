@@ -376,7 +376,12 @@ def assess_body(
         (flags if base_mismatch_deg is None else notes).append(
             f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or "
             "fixed_end is off"
-            + ("" if base_mismatch_deg is None else " (psi does not depend on it)")
+            + (
+                " (give fixed_direction_deg, the clamp's direction, and psi will not depend "
+                "on it)"
+                if base_mismatch_deg is None
+                else " (psi does not depend on it)"
+            )
         )
     if expected_length_px and length_px < 0.8 * expected_length_px:
         flags.append(
