@@ -73,6 +73,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="pixel near the clamped end, e.g. 812,455 (recommended; default: guessed per photo)",
     )
     init.add_argument(
+        "--fixed-direction-deg",
+        type=float,
+        metavar="DEG",
+        help="body: the direction in which the actuator leaves the clamp, on screen, deg "
+             "counter-clockwise from +x (0 = right, 90 = up); psi is then the free end's tangent "
+             "against it and does not depend on the base (recommended where the base is short, "
+             "hidden or faint, as a translucent body's often is)",
+    )
+    init.add_argument(
         "--target",
         choices=("line", "body"),
         default="line",
@@ -265,6 +274,8 @@ def _init(args: argparse.Namespace) -> int:
         settings["line_color"] = args.line_color or "black"
     if args.fixed_end:
         settings["fixed_end"] = list(_xy(args.fixed_end, "--fixed-end"))
+    if args.fixed_direction_deg is not None:
+        settings["fixed_direction_deg"] = args.fixed_direction_deg
     if args.sealed_end_mm is not None:
         settings["sealed_end_mm"] = args.sealed_end_mm
     if args.background is not None:

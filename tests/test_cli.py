@@ -72,11 +72,13 @@ def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
 
     args = ["photoset", "init", str(photo_folder), "--pattern",
             "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
-            "--target", "body", "--mm-per-px", "0.3", "--sealed-end-mm", "6"]
+            "--target", "body", "--mm-per-px", "0.3", "--sealed-end-mm", "6",
+            "--fixed-direction-deg", "46.5"]
     out = _run(*args)
     assert out.returncode == 0, out.stderr
     written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
     assert written["sealed_end_mm"] == 6.0 and written["target"] == "body"
+    assert written["fixed_direction_deg"] == 46.5
     out = _run("photoset", "check", str(photo_folder))
     assert out.returncode == 0 and "no sealed_end_mm" not in out.stdout
     # without the scale it is turned into pixels with the body's length against l0_mm +
