@@ -401,6 +401,20 @@ def measure_body(
         )
         sealed_px = settings.sealed_end_mm / mm_per_work_px / per_image_px
         ends = _read_before_sealed_end(body.tip_face_px, ends, sealed_px, per_image_px)
+    # the part of the body past the centre line's end, less what is not bend (half a width of
+    # cap, the stretch already carried on to a cut end, the sealed end), turned through at the
+    # free end's curvature (image axes, deg)
+    missed_tip_deg = float(
+        np.rad2deg(end_curvature(line.centreline_px))
+        * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px))
+    )
+    out_of_reach = tip_out_of_reach(body.end_short_px, line.width_px)
+    if settings.sealed_end_mm is not None and tip_turn_deg(
+        body.ridge_tip_deg, missed_tip_deg, out_of_reach=out_of_reach
+    ):
+        # psi is carried on over the tip the centre line stops short of (carried_on_psi_deg,
+        # below): its tangent is not also carried on to where the bending stops (twice the turn)
+        ends = (ends[0], min(ends[1], 0.0))
     rng = np.random.default_rng(SEED)
     base = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
@@ -416,13 +430,6 @@ def measure_body(
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
-    # the part of the body past the centre line's end, less what is not bend (half a width of
-    # cap, the stretch already carried on to a cut end, the sealed end), turned through at the
-    # free end's curvature (image axes, deg)
-    missed_tip_deg = float(
-        np.rad2deg(end_curvature(line.centreline_px))
-        * max(0.0, body.end_short_px - max(0.5 * line.width_px, line.trimmed_px[1], sealed_px))
-    )
     # the same turning from a smooth fit of the whole centre line: the check of a wobbly line.
     # With the base known psi does not depend on the fixed end, so neither reading is carried
     # back over a stretch the centre line stops short of there (on a long one a fit runs away)
@@ -470,8 +477,7 @@ def measure_body(
     # the selection's ridge)
     measured = _measured(
         carried_on_psi_deg(
-            psi, body.ridge_tip_deg, missed_tip_deg, sign,
-            out_of_reach=tip_out_of_reach(body.end_short_px, line.width_px),
+            psi, body.ridge_tip_deg, missed_tip_deg, sign, out_of_reach=out_of_reach
         ),
         est, line, quality, settings, used,
     )
