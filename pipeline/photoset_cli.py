@@ -44,10 +44,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument(
         "--pressures-kpa",
         metavar="SPEC",
+        action="append",
         help="for file names without the pressure (a camera's IMG_0001.JPG): each ramp's "
              "pressures in photo order, '0,20,40,20,0' or LOW:HIGH:STEP ('0:180:20' = 0, 20, ..., "
              "180 and back down to 0); every actuator and trial has as many photos, in file-name "
-             "order (numbers as numbers) or by {step}",
+             "order (numbers as numbers) or by {step}.  Repeat it as TRIAL=SPEC (or "
+             "ACTUATOR/TRIAL=SPEC) for ramps of their own: --pressures-kpa 1=0:160:20 "
+             "--pressures-kpa 2=0:180:20",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -148,10 +151,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     preview = sub.add_parser(
         "preview",
-        help="write one contact sheet showing what the settings select and measure, first and last "
-             "photo of every ramp",
-        description="For the first and last photo of every ramp: the photo with the selection "
-                    "tinted, roi/exclude, "
+        help="write one contact sheet showing what the settings select and measure: the first, "
+             "the highest-pressure and the last photo of every ramp",
+        description="For the first, the highest-pressure and the last photo of every ramp: the "
+                    "photo with the selection tinted, roi/exclude, "
         "candidates, the chosen line or body centre line, the fixed end and psi, beside the "
         "selection mask.",
     )
@@ -161,7 +164,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="sheet to write, .jpg or .png (default: <DIR name>_preview.jpg in the current folder)",
     )
     preview.add_argument(
-        "--all", action="store_true", help="every photo, not only the first and last of each ramp"
+        "--all", action="store_true", help="every photo, not only three of each ramp"
     )
     pick = sub.add_parser(
         "pick-color",
@@ -295,7 +298,7 @@ def _init(args: argparse.Namespace) -> int:
         pressures_kpa=(
             None
             if args.pressures_kpa is None
-            else photoset_init.ramp_pressures(args.pressures_kpa)
+            else photoset_init.pressure_specs(args.pressures_kpa)
         ),
     )
     n_up = int((df["direction"] == "up").sum())
@@ -318,10 +321,11 @@ def _init(args: argparse.Namespace) -> int:
             f"kept the existing {args.folder}/{photoset.SETTINGS} as it is (the setting options "
             "were not written into it): edit it, or delete it and run init again"
         )
-    elif args.l0_mm is None:
+    else:
         print(
-            f"next: set l0_mm in {args.folder}/{photoset.SETTINGS}, then run 'python -m pipeline "
-            f"photoset check {args.folder}'"
+            f"wrote {args.folder}/{photoset.SETTINGS}: "
+            + ("next: set l0_mm in it, then run" if args.l0_mm is None else "next: run")
+            + f" 'python -m pipeline photoset check {args.folder}', then 'photoset preview'"
         )
     return 0
 

@@ -145,7 +145,7 @@ def init_photoset(
     defaults: Mapping[str, Any] | None = None,
     settings: Mapping[str, Any] | None = None,
     overwrite: bool = False,
-    pressures_kpa: Sequence[float] | None = None,
+    pressures_kpa: Sequence[float] | Mapping[str | None, Sequence[float]] | None = None,
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) from image file names.
 
@@ -166,11 +166,12 @@ def init_photoset(
         ``photoset.yaml`` values to write when that file does not exist yet.
     overwrite : bool
         Replace an existing ``manifest.csv``.
-    pressures_kpa : sequence of float, optional
+    pressures_kpa : sequence of float, or mapping, optional
         For file names without the pressure (a camera's ``IMG_0001.JPG``): the pressures of each
         ramp's photos in order (:func:`ramp_pressures`); every actuator and trial must have as
         many photos, taken in that order (by ``step`` if the pattern has it, else by file name,
-        numbers as numbers).
+        numbers as numbers).  A mapping gives ramps their own (:func:`pressure_specs`): keyed by
+        trial label, or ``actuator/trial``, or None for every other ramp.
 
     Returns
     -------
@@ -236,7 +237,12 @@ def init_photoset(
         )
     df = pd.DataFrame(rows)
     if pressures_kpa is not None:
-        df = _with_pressures(df, tuple(pressures_kpa))
+        df = _with_pressures(
+            df,
+            {k: tuple(v) for k, v in pressures_kpa.items()}
+            if isinstance(pressures_kpa, Mapping)
+            else {None: tuple(pressures_kpa)},
+        )
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
@@ -247,23 +253,61 @@ def init_photoset(
     return df
 
 
-def _with_pressures(df: pd.DataFrame, pressures_kpa: tuple[float, ...]) -> pd.DataFrame:
-    """``df`` with each ramp's photos given ``pressures_kpa`` in order (by step, else by name)."""
+def pressure_specs(specs: Sequence[str]) -> dict[str | None, tuple[float, ...]]:
+    """Each ``--pressures-kpa`` read: ``SPEC`` for every ramp, or ``LABEL=SPEC`` for the ramps of
+    trial ``LABEL`` (or ``actuator/trial``), whose photos may be more or fewer.
+
+    Examples
+    --------
+    >>> pressure_specs(["1=0:40:20", "A2/1=0,5", "0:20:20"])
+    {'1': (0.0, 20.0, 40.0, 20.0, 0.0), 'A2/1': (0.0, 5.0), None: (0.0, 20.0, 0.0)}
+    """
+    out: dict[str | None, tuple[float, ...]] = {}
+    for spec in specs:
+        label, _, values = spec.rpartition("=")
+        key = label.strip() or None
+        if key in out:
+            raise UserInputError(
+                f"--pressures-kpa {spec!r}: "
+                + ("a second spec for every ramp" if key is None else f"{key} is given twice")
+                + "; give each ramp's pressures once (TRIAL=SPEC for a trial of its own)"
+            )
+        out[key] = ramp_pressures(values)
+    return out
+
+
+def _with_pressures(
+    df: pd.DataFrame, pressures_kpa: Mapping[str | None, tuple[float, ...]]
+) -> pd.DataFrame:
+    """``df`` with each ramp's photos given its pressures in order (by step, else by name):
+    those of its ``actuator/trial``, else of its trial, else those for every ramp (key None)."""
     out = df.copy()
     out["pressure_kpa"] = np.nan
     for (material, actuator, trial), g in out.groupby(
         ["material", "actuator", "trial"], sort=False
     ):
         order = g.sort_values("step") if "step" in g.columns else g
-        if len(order) != len(pressures_kpa):
+        ramp = f"material {material}, actuator {actuator}, trial {trial}"
+        key = next(
+            (k for k in (f"{actuator}/{trial}", str(trial), None) if k in pressures_kpa), "none"
+        )
+        if key == "none":
             raise UserInputError(
-                f"material {material}, actuator {actuator}, trial {trial} has {len(order)} "
+                f"{ramp} ({order['image'].iloc[0]} ...): no --pressures-kpa for it; add "
+                f"--pressures-kpa {trial}=SPEC (or one SPEC for every ramp)"
+            )
+        pressures = pressures_kpa[key]
+        if len(order) != len(pressures):
+            raise UserInputError(
+                f"{ramp} has {len(order)} "
                 f"photo(s) ({order['image'].iloc[0]} ... {order['image'].iloc[-1]}) but "
                 "--pressures-kpa "
-                f"gives {len(pressures_kpa)} pressures; give one pressure per photo of a ramp (a "
-                "missing or extra photo: add or move it, or write the manifest by hand)"
+                + ("" if key is None else f"{key}=... ")
+                + f"gives {len(pressures)} pressures; give one pressure per photo of a ramp (a "
+                "missing or extra photo: add or move it; a trial of its own length: "
+                f"--pressures-kpa {trial}=SPEC; or write the manifest by hand)"
             )
-        out.loc[order.index, "pressure_kpa"] = pressures_kpa
+        out.loc[order.index, "pressure_kpa"] = pressures
     return out
 
 

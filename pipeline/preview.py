@@ -1,14 +1,14 @@
 """``photoset preview``: one contact sheet that shows whether a photo set's settings work.
 
-For the first and the last photo of every ramp, a tile shows the photo with what the settings
-select tinted (the line colour, or the body), the ``roi`` (yellow) and ``exclude`` (red)
-outlines, the other candidates outlined in grey, the chosen line or body centre line (green when
-``ok``, orange when ``flagged``), the fixed end (blue circle), the ``fixed_direction_deg`` arrow,
-and psi with the status and the reason -- beside the bare selection mask, and for a calibrated
-photo the photo rectified to the actuator's plane (undistorted, seen from straight above) with the
-centre line as measured there and the calibration's reprojection error.  It is the measurement
-itself (:func:`pipeline.measure.core.measure_decoded`), drawn, so what the preview shows is what
-``measure`` will do.
+For the first photo of every ramp, the one at its highest pressure and the last, a tile shows the
+photo with what the settings select tinted (the line colour, or the body), the ``roi`` (yellow) and
+``exclude`` (red) outlines, the other candidates outlined in grey, the chosen line or body centre
+line (green when ``ok``, orange when ``flagged``), the fixed end (blue circle), the
+``fixed_direction_deg`` arrow, and psi with the status and the reason -- beside the bare selection
+mask, and for a calibrated photo the photo rectified to the actuator's plane (undistorted, seen
+from straight above) with the centre line as measured there and the calibration's reprojection
+error. It is the measurement itself (:func:`pipeline.measure.core.measure_decoded`), drawn, so what
+the preview shows is what ``measure`` will do.
 """
 
 from __future__ import annotations
@@ -236,14 +236,18 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
 
 
 def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
-    """Positions (0-based) of the photos a preview shows: first and last of every ramp (or all)."""
+    """Positions (0-based) of the photos a preview shows: the first of every ramp, the one at its
+    highest pressure (the most bent: on a ramp up and back down the first and last are both at
+    rest) and the last (or all)."""
     m = ps.manifest.reset_index(drop=True)
     if every:
         return list(range(len(m)))
     order = m.sort_values("step", kind="stable") if "step" in m.columns else m
     rows: list[int] = []
     for _, ramp in order.groupby(["material", "actuator", "trial"], sort=False):
-        for ix in (ramp.index[0], ramp.index[-1]):
+        pressure = pd.to_numeric(ramp["pressure_kpa"], errors="coerce")
+        top = pressure.idxmax() if pressure.notna().any() else ramp.index[0]
+        for ix in (ramp.index[0], top, ramp.index[-1]):
             if int(ix) not in rows:
                 rows.append(int(ix))
     return rows

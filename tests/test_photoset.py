@@ -464,6 +464,38 @@ def test_a_cameras_numbered_photos_take_the_ramps_pressures_in_number_order(tmp_
     assert ps.read_manifest(tmp_path)["pressure_kpa"].tolist()[:6] == [0, 50, 100, 100, 50, 0]
 
 
+def test_trials_of_their_own_length_take_their_own_pressures(tmp_path):
+    # two trials in camera folders, trial 1 up to 40 kPa and back (5 photos), trial 2 up to 60
+    # (7): one --pressures-kpa for every ramp was refused for one of them, and users joined two
+    # manifests by hand; now each trial may have its own
+    for trial, n in ((1, 5), (2, 7)):
+        (tmp_path / f"trial{trial}").mkdir()
+        for i in range(1, n + 1):
+            (tmp_path / f"trial{trial}" / f"IMG_{i:04d}.JPG").write_bytes(b"")
+    base = [sys.executable, "-m", "pipeline", "photoset", "init", str(tmp_path), "--pattern",
+            "trial{trial}/IMG_*.JPG", "--material", "DS20", "--l0-mm", "100"]
+    out = subprocess.run(base + ["--pressures-kpa", "1=0:40:20"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 2 and "trial 2" in out.stderr and "2=SPEC" in out.stderr, out.stderr
+    out = subprocess.run(base + ["--pressures-kpa", "1=0:40:20", "--pressures-kpa", "2=0:60:20"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr
+    assert f"wrote {tmp_path}/photoset.yaml" in out.stdout
+    m = ps.read_manifest(tmp_path)
+    assert m.groupby("trial")["pressure_kpa"].apply(list).to_dict() == {
+        "1": [0, 20, 40, 20, 0], "2": [0, 20, 40, 60, 40, 20, 0]
+    }
+    assert m.groupby("trial")["direction"].apply(list)["2"] == ["up"] * 4 + ["down"] * 3
+    # one spec for every ramp still names the ramp and the per-trial form when it does not fit
+    with pytest.raises(UserInputError, match=r"trial 2 has 7 photo\(s\).*--pressures-kpa 2=SPEC"):
+        photoset_init.init_photoset(
+            tmp_path, "trial{trial}/IMG_*.JPG", defaults={"material": "DS20"}, overwrite=True,
+            pressures_kpa=photoset_init.pressure_specs(["0:40:20"]),
+        )
+    with pytest.raises(UserInputError, match="given twice"):
+        photoset_init.pressure_specs(["1=0:40:20", "1=0:60:20"])
+
+
 def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_ignored(photo_folder):
     # the manifest edited in Excel and saved as manifest.xlsx: manifest.csv, unchanged, was read
     # as it was with no word; a 'Manifest.csv' was only 'missing'
@@ -614,3 +646,18 @@ def test_a_manifest_in_bar_or_psi_is_read_as_kpa_and_a_bad_cell_is_named(photo_f
         (4, "pressure_kpa '0.4 bar' is not a number"),
         (5, "pressure_kpa is missing (an empty or n/a cell), not a number"),  # was 'nan'
     ]
+
+
+def test_the_preview_shows_each_ramps_most_bent_photo_not_only_its_two_rests(photo_folder):
+    # on a ramp up and back down, the first and last photos are both at rest: a user saw four
+    # near-identical resting curls and not the photos where the settings fail; the photo at the
+    # ramp's highest pressure is shown between them
+    from pipeline.preview import preview_rows
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    loaded = ps.load_photoset(photo_folder)
+    shown = loaded.manifest.iloc[preview_rows(loaded)]
+    assert shown[["trial", "pressure_kpa"]].values.tolist() == [
+        ["1", 0.0], ["1", 20.0], ["1", 0.0], ["2", 0.0], ["2", 20.0]
+    ]
+    assert len(preview_rows(loaded, every=True)) == len(loaded.manifest) == 8
