@@ -965,7 +965,8 @@ def file_problems(
                 if any(r.target == "line" for r in unscaled)
                 else "no mm_per_px: a body is not checked against l0_mm, so one partly hidden or "
                 "cut short is not flagged for its length",
-                "measure the image scale (mm per pixel) and set mm_per_px",
+                "with a ruler in view, measure the image scale (mm per pixel) and set "
+                "mm_per_px; without one, leave it out (a reminder only)",
                 warning=True,
             )
         )

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from pipeline.bench.realscenes import dev_set
@@ -120,9 +121,11 @@ def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
         LINE_PX,
         draw_overlay,
         final_status_text,
+        note_final_status,
         overlay_lines,
     )
     from pipeline.photoset import load_photoset
+    from pipeline.report.strip import crop_banner
 
     ps = load_photoset(DEV_SET)
     img = cv2.imread(str(DEV_SET / "c_20C.png"))
@@ -130,9 +133,17 @@ def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
     assert res.status == "flagged" and len(res.reason) > 300
     out = draw_overlay(img, res, title="c_20C.png")
     assert out.shape[1] == 640
-    lines = overlay_lines(res, "c_20C.png", *out.shape[1::-1])
+    photo_h = round(img.shape[0] * 640 / img.shape[1])
+    lines = overlay_lines(res, "c_20C.png", 640, photo_h)
     assert len(lines) >= 5 and lines[-1].endswith("...")
-    assert 10 + LINE_PX * len(lines) <= 0.3 * out.shape[0]
+    # the text is a band above the photo, not over it: the photo's top rows are all in view
+    band = 12 + LINE_PX * len(lines)
+    assert band <= 0.3 * photo_h and out.shape[0] == band + photo_h
+    top = cv2.resize(img, (640, photo_h), interpolation=cv2.INTER_LINEAR)[:band]
+    assert np.abs(out[band : 2 * band].astype(int) - top.astype(int)).mean() < 2.0
+    noted = note_final_status(out, "flagged", "breaks its ramp", "")
+    assert noted.shape[0] > out.shape[0] and (noted[: out.shape[0]] == out).all()
+    assert crop_banner(noted).shape[0] == photo_h
     assert " ".join(lines[2:]).startswith(res.reason.split(";")[0])
     assert final_status_text("flagged", "breaks its ramp; x", "x") == (
         "then flagged: also breaks its ramp"

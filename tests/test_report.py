@@ -28,6 +28,7 @@ from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_v
 from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
 from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
 from pipeline.layout.typeset import NA, fmt
+from pipeline.measure.overlay import BAND_BGR, DIVIDER_BGR
 from pipeline.report.build import build_report, report_figures
 from pipeline.report.data import (
     Dataset,
@@ -128,9 +129,10 @@ def make_dataset(
                         if photos:
                             cv2.imwrite(str(photo_dir / image), img)
                         if overlays and k % 2 == 0:  # some overlays missing: falls back to raw
-                            img[:24] = (img[:24] * 0.35).astype(np.uint8)  # the overlay's text band
+                            band = np.full((24, 160, 3), BAND_BGR, np.uint8)  # its text band
+                            band[-2:] = DIVIDER_BGR
                             cv2.putText(
-                                img,
+                                band,
                                 f"{ang:.0f}",
                                 (5, 18),
                                 cv2.FONT_HERSHEY_SIMPLEX,
@@ -138,7 +140,10 @@ def make_dataset(
                                 (0, 0, 255),
                                 1,
                             )
-                            cv2.imwrite(str(overlay_dir / (Path(image).stem + ".jpg")), img)
+                            cv2.imwrite(
+                                str(overlay_dir / (Path(image).stem + ".jpg")),
+                                np.vstack([band, img]),
+                            )
     table = pd.DataFrame(rows)
     if l0_mm is not None:
         table["l0_mm"] = l0_mm

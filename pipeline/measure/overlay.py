@@ -18,13 +18,16 @@ from pipeline.measure.core import AngleResult
 OVERLAY_WIDTH_PX, MIN_OVERLAY_WIDTH_PX = 640, 480
 #: text size and line height on overlays, and how many lines a reason may take
 TEXT_SCALE, LINE_PX, REASON_LINES = 0.5, 20, 5
+#: the text bands above and below the photo, and the 2-px line between band and photo (BGR; the
+#: report finds the bands by that line: no photo has a whole row of it)
+BAND_BGR, DIVIDER_BGR = (40, 40, 40), (200, 0, 200)
 _COLOURS = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
 
 
 def overlay_lines(result: AngleResult, title: str, width_px: int, height_px: int) -> list[str]:
-    """The text of an overlay ``width_px`` x ``height_px``: the title, psi and the reason,
-    wrapped; the band they fill stays within its top 30 % (the report crops it off its photo
-    strip), what does not fit ends in an ellipsis."""
+    """The text of an overlay of a photo ``width_px`` x ``height_px``: the title, psi and the
+    reason, wrapped; the band they fill, above the photo, is at most 30 % of its height (the
+    report crops it off its photo strip), what does not fit ends in an ellipsis."""
     text = (
         f"psi = {result.psi_deg:+.1f} deg ({result.method})"
         if result.status != "failed"
@@ -38,7 +41,8 @@ def overlay_lines(result: AngleResult, title: str, width_px: int, height_px: int
 def draw_overlay(
     image_bgr: np.ndarray, result: AngleResult, *, scale: float = 1.0, title: str = ""
 ) -> np.ndarray:
-    """The photo with the extracted centre line, the fixed end and psi written on it.
+    """The photo with the extracted centre line and the fixed end drawn on it, and psi written in
+    a band above it (not over it: a tip near the photo's top edge stays in view).
 
     Parameters
     ----------
@@ -54,7 +58,7 @@ def draw_overlay(
     Returns
     -------
     ndarray
-        BGR image at most :data:`OVERLAY_WIDTH_PX` wide.
+        BGR image at most :data:`OVERLAY_WIDTH_PX` wide: the text band, then the photo.
     """
     # small photos are enlarged so that the text leaves most of them visible
     w = image_bgr.shape[1]
@@ -73,11 +77,11 @@ def draw_overlay(
         cv2.polylines(out, [np.round(pts * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
         cv2.circle(out, tuple(int(v) for v in np.round(pts[0])), 6, (255, 80, 0), 2, cv2.LINE_AA)
     lines = overlay_lines(result, title, out.shape[1], out.shape[0])
-    box = out[: 10 + LINE_PX * len(lines), :]
-    box[:] = (box * 0.35).astype(np.uint8)
+    band = np.full((12 + LINE_PX * len(lines), out.shape[1], 3), BAND_BGR, np.uint8)
+    band[-2:] = DIVIDER_BGR
     for i, t in enumerate(lines):
         cv2.putText(
-            out,
+            band,
             t,
             (8, 20 + LINE_PX * i),
             cv2.FONT_HERSHEY_SIMPLEX,
@@ -86,7 +90,7 @@ def draw_overlay(
             1,
             cv2.LINE_AA,
         )
-    return out
+    return np.vstack([band, out])
 
 
 def final_status_text(status: str, reason: str, drawn_reason: str = "") -> str:
@@ -111,31 +115,30 @@ def final_status_text(status: str, reason: str, drawn_reason: str = "") -> str:
 def note_final_status(
     overlay_bgr: np.ndarray, status: str, reason: str, drawn_reason: str = ""
 ) -> np.ndarray:
-    """The overlay with the photo's final status written along its bottom.
+    """The overlay with the photo's final status written in a band below it.
 
     For a status that the checks over the whole set (the ramp check, the calibration check)
     changed after the photo was drawn, so that its overlay never shows ``ok`` for a row the
     table flags, nor the other way round.  Of ``reason``, what the overlay already shows
     (``drawn_reason``) is left out.
     """
-    out = overlay_bgr.copy()
     text = final_status_text(status, reason, drawn_reason)
-    room = max(1, min(REASON_LINES, int(0.25 * out.shape[0] / LINE_PX)))
-    lines = wrap_text(text, out.shape[1] - 16, TEXT_SCALE, room)
-    band = out[out.shape[0] - 12 - LINE_PX * len(lines) :, :]
-    band[:] = (band * 0.35).astype(np.uint8)
+    room = max(1, min(REASON_LINES, int(0.25 * overlay_bgr.shape[0] / LINE_PX)))
+    lines = wrap_text(text, overlay_bgr.shape[1] - 16, TEXT_SCALE, room)
+    band = np.full((14 + LINE_PX * len(lines), overlay_bgr.shape[1], 3), BAND_BGR, np.uint8)
+    band[:2] = DIVIDER_BGR
     for i, t in enumerate(lines):
         cv2.putText(
-            out,
+            band,
             t,
-            (8, out.shape[0] - 12 - LINE_PX * (len(lines) - 1 - i)),
+            (8, 22 + LINE_PX * i),
             cv2.FONT_HERSHEY_SIMPLEX,
             TEXT_SCALE,
             _COLOURS.get(status, (255, 255, 255)),
             1,
             cv2.LINE_AA,
         )
-    return out
+    return np.vstack([overlay_bgr, band])
 
 
 def wrap_text(text: str, width_px: int, scale: float, max_lines: int) -> list[str]:

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.measure.formats import read_image
+from pipeline.measure.overlay import DIVIDER_BGR
 from pipeline.photoset import overlay_name
 from pipeline.report.data import Dataset, ReportData, mixed_materials
 
@@ -86,18 +87,31 @@ class Strip:
 
 
 def crop_banner(bgr: np.ndarray) -> np.ndarray:
-    """Cut off a dark text band at the top of an overlay (rows far darker than the photo below).
+    """Cut off the text bands above and below an overlay's photo (up to and from the lines of
+    :data:`~pipeline.measure.overlay.DIVIDER_BGR` between them and the photo), or, on an overlay
+    drawn before they were bands of their own, a dark text band over the top of the photo (rows
+    far darker than the photo).
 
     A photo without such a band is returned unchanged.
 
     Examples
     --------
     >>> img = np.full((100, 80, 3), 200, np.uint8)
+    >>> band = np.full((30, 80, 3), 40, np.uint8)  # text on dark grey
+    >>> band[-2:] = DIVIDER_BGR
+    >>> crop_banner(np.vstack([band, img, band[::-1]])).shape[0]
+    100
     >>> img[:20] = 60
     >>> crop_banner(img).shape[0], crop_banner(np.full((100, 80, 3), 200, np.uint8)).shape[0]
     (80, 100)
     """
     h = bgr.shape[0]
+    divider = np.nonzero(
+        np.mean(np.all(np.abs(bgr.astype(int) - DIVIDER_BGR) <= 60, axis=2), axis=1) >= 0.9
+    )[0]
+    top, bottom = divider[divider < 0.4 * h], divider[divider > 0.6 * h]
+    if top.size or bottom.size:
+        return bgr[(top.max() + 1 if top.size else 0) : (bottom.min() if bottom.size else h)]
     rows = np.median(bgr.mean(axis=2), axis=1)
     reference = float(np.median(rows[int(0.3 * h):int(0.6 * h)]))
     dark = rows < 0.5 * reference
