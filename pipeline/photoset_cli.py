@@ -31,7 +31,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             "{trial}, {actuator}, {material}, {step}, {_} or * (ignored). Without {direction}, "
             "photos before the highest pressure of each ramp are 'up', after it 'down'. A "
             "pattern with '/' matches the photos' paths in DIR's subfolders, e.g. "
-            "'chamber{actuator}/{step}_{pressure_kpa}kPa.jpg'."
+            "'chamber{actuator}/{step}_{pressure_kpa}kPa.jpg'. For videos give --pressure-log: "
+            "one row per video (init DIR --pattern 'GX*.MP4' --pressure-log log.csv)."
         ),
     )
     init.add_argument("folder", metavar="DIR", help="folder holding the photos")
@@ -51,6 +52,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "order (numbers as numbers) or by {step}.  Repeat it as TRIAL=SPEC (or "
              "ACTUATOR/TRIAL=SPEC) for ramps of their own: --pressures-kpa 1=0:160:20 "
              "--pressures-kpa 2=0:180:20",
+    )
+    init.add_argument(
+        "--pressure-log",
+        metavar="NAME",
+        help="for videos: the pressure log (a CSV with time_s and pressure_kpa) in DIR; "
+             "'{video}' in it stands for each video's name without its ending "
+             "('{video}_pressure.csv'). Writes a video photo set, one manifest row per video "
+             "matching --pattern (e.g. 'GX*.MP4')",
+    )
+    init.add_argument(
+        "--clock-offset-s",
+        type=float,
+        metavar="S",
+        help="for videos: the pressure log's time at the video's first frame (s; default 0)",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -289,6 +304,21 @@ def _init(args: argparse.Namespace) -> int:
             )
         settings["background"] = args.background
     kept = (Path(args.folder) / photoset.SETTINGS).is_file()  # never overwritten: the user's
+    if args.pressure_log is not None:
+        df = photoset_init.init_video_photoset(
+            args.folder,
+            args.pattern,
+            args.pressure_log,
+            clock_offset_s=args.clock_offset_s,
+            defaults=defaults,
+            settings=settings,
+            overwrite=args.overwrite,
+        )
+        print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s)")
+        _print_next(args, kept)
+        return 0
+    if args.clock_offset_s is not None:
+        raise UserInputError("--clock-offset-s is for videos: give their --pressure-log too")
     df = photoset_init.init_photoset(
         args.folder,
         args.pattern,
@@ -316,18 +346,28 @@ def _init(args: argparse.Namespace) -> int:
             "by hand; leave out an empty-scene or calibration photo)",
             file=sys.stderr,
         )
+    _print_next(args, kept)
+    return 0
+
+
+def _print_next(args: argparse.Namespace, kept: bool) -> None:
+    """Say what ``init`` did with ``photoset.yaml`` and what to run next."""
     if kept:
         print(
             f"kept the existing {args.folder}/{photoset.SETTINGS} as it is (the setting options "
             "were not written into it): edit it, or delete it and run init again"
         )
-    else:
-        print(
-            f"wrote {args.folder}/{photoset.SETTINGS}: "
-            + ("next: set l0_mm in it, then run" if args.l0_mm is None else "next: run")
-            + f" 'python -m pipeline photoset check {args.folder}', then 'photoset preview'"
-        )
-    return 0
+        return
+    look = (
+        "then 'measure ... --overlays DIR' to see the frames"
+        if args.pressure_log is not None
+        else "then 'photoset preview'"
+    )
+    print(
+        f"wrote {args.folder}/{photoset.SETTINGS}: "
+        + ("next: set l0_mm in it, then run" if args.l0_mm is None else "next: run")
+        + f" 'python -m pipeline photoset check {args.folder}', {look}"
+    )
 
 
 def _pick(args: argparse.Namespace) -> int:

@@ -2,11 +2,13 @@
 
 ``python -m pipeline photoset init DIR --pattern
 '{material}_{actuator}_t{trial}_{pressure_kpa}kPa.jpg'`` writes ``manifest.csv`` (and a starter
-``photoset.yaml``); see :func:`init_photoset`.
+``photoset.yaml``); see :func:`init_photoset`.  ``--pressure-log`` makes a video photo set
+instead, one row per video (:func:`init_video_photoset`).
 """
 
 from __future__ import annotations
 
+import fnmatch
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -20,6 +22,12 @@ from pipeline.constants import DIRECTION_WORDS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
+
+#: file endings taken for videos (any OpenCV reads): a pattern matching only these needs
+#: ``--pressure-log``
+VIDEO_SUFFIXES: tuple[str, ...] = (
+    ".avi", ".mp4", ".mov", ".mkv", ".m4v", ".wmv", ".mpg", ".mpeg", ".webm",
+)
 
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
@@ -183,11 +191,13 @@ def init_photoset(
     UserInputError
         If no file matches, a field is missing with no default, or a manifest exists.
     """
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise UserInputError(f"{folder}: not a folder; give the folder that holds the photos")
-    if (folder / MANIFEST).exists() and not overwrite:
-        raise UserInputError(f"{folder / MANIFEST} already exists; pass --overwrite to replace it")
+    folder = _new_manifest_folder(folder, overwrite)
+    videos = _matching_videos(folder, pattern)
+    if videos and not any(fnmatch_name(n, pattern) for n in photo_names(folder, "/" in pattern)):
+        raise UserInputError(
+            f"{folder / videos[0]} is a video: give its pressure log with --pressure-log (a video "
+            "photo set, one row per video: README, 'Videos')"
+        )
     regex = pattern_to_regex(pattern, pressure_in_name=pressures_kpa is None)
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     rows, unmatched = [], []
@@ -197,13 +207,7 @@ def init_photoset(
             unmatched.append(name)
             continue
         fields = m.groupdict()
-        row: dict[str, Any] = {"image": name}
-        for key in ("material", "actuator", "trial"):
-            row[key] = fields.get(key) or defaults.get(key)
-            if row[key] is None:
-                raise UserInputError(
-                    f"{name}: no {key} in the file name and no default; pass --{key}"
-                )
+        row: dict[str, Any] = {"image": name, **_ramp_keys(name, fields, defaults)}
         if pressures_kpa is None:
             row["pressure_kpa"] = _decimal(fields["pressure_kpa"])
         if fields.get("step") is not None:
@@ -251,6 +255,130 @@ def init_photoset(
     if not (folder / SETTINGS).exists():
         write_settings(folder, {"l0_mm": None, **dict(settings or {})})
     return df
+
+
+def init_video_photoset(
+    folder: str | os.PathLike[str],
+    pattern: str,
+    pressure_log: str,
+    *,
+    clock_offset_s: float | None = None,
+    defaults: Mapping[str, Any] | None = None,
+    settings: Mapping[str, Any] | None = None,
+    overwrite: bool = False,
+) -> pd.DataFrame:
+    """Write a starter ``manifest.csv`` of a video photo set, one row per video matching
+    ``pattern`` (and ``photoset.yaml`` if absent).
+
+    Parameters
+    ----------
+    folder : path
+        Folder holding the videos and their pressure logs.
+    pattern : str
+        File-name pattern of the videos (:func:`pattern_to_regex`'s fields but
+        ``{pressure_kpa}``: ``{material}``, ``{actuator}``, ``{trial}``, ``*``).
+    pressure_log : str
+        The pressure log's name in ``folder``; ``{video}`` in it stands for each video's name
+        without its ending (``{video}_pressure.csv``).
+    clock_offset_s : float, optional
+        The log's time at each video's first frame (s), written as ``clock_offset_s``.
+    defaults, settings, overwrite
+        As for :func:`init_photoset`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The manifest written.
+
+    Raises
+    ------
+    UserInputError
+        If no video matches, a video's log is missing, a field has no default, or a manifest
+        exists.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("GX010071.MP4", "GX010071_log.csv"):
+    ...     _ = (root / name).write_bytes(b"")
+    >>> init_video_photoset(root, "GX*.MP4", "{video}_log.csv", clock_offset_s=0.5,
+    ...                     defaults={"material": "DS20"}).to_dict("records")
+    [{'video': 'GX010071.MP4', 'pressure_log': 'GX010071_log.csv', 'material': 'DS20', \
+'actuator': 'A1', 'trial': '1', 'clock_offset_s': 0.5}]
+    """
+    folder = _new_manifest_folder(folder, overwrite)
+    regex = pattern_to_regex(pattern, pressure_in_name=False)
+    defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
+    rows = []
+    for name in _matching_videos(folder, pattern):
+        m = regex.match(name)
+        if not m:
+            continue
+        log = pressure_log.replace("{video}", Path(name).stem)
+        if not (folder / log).is_file():
+            raise UserInputError(
+                f"{name}: its pressure log {log} is not in {folder}; put the log (a CSV with "
+                "time_s and pressure_kpa) beside the video and give its name with --pressure-log"
+            )
+        row: dict[str, Any] = {"video": name, "pressure_log": log}
+        row |= _ramp_keys(name, m.groupdict(), defaults)
+        if clock_offset_s is not None:
+            row["clock_offset_s"] = clock_offset_s
+        rows.append(row)
+    if not rows:
+        raise UserInputError(
+            f"no video in {folder} matches pattern {pattern!r} (videos end in "
+            f"{', '.join(VIDEO_SUFFIXES)})"
+        )
+    df = pd.DataFrame(rows)
+    write_manifest(folder, df)
+    if not (folder / SETTINGS).exists():
+        write_settings(folder, {"l0_mm": None, **dict(settings or {})})
+    return df
+
+
+def _new_manifest_folder(folder: str | os.PathLike[str], overwrite: bool) -> Path:
+    """``folder`` as a path, checked to be a folder whose manifest may be written."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise UserInputError(f"{folder}: not a folder; give the folder that holds the photos")
+    if (folder / MANIFEST).exists() and not overwrite:
+        raise UserInputError(f"{folder / MANIFEST} already exists; pass --overwrite to replace it")
+    return folder
+
+
+def _matching_videos(folder: Path, pattern: str) -> list[str]:
+    """The videos in ``folder`` (its subfolders with a ``/`` in ``pattern``) whose names match
+    ``pattern`` with every field a wildcard, in name order (numbers as numbers)."""
+    paths = folder.rglob("*") if "/" in pattern else folder.iterdir()
+    names = (p.relative_to(folder).as_posix() for p in paths if p.is_file())
+    return sorted(
+        (n for n in names if n.lower().endswith(VIDEO_SUFFIXES) and fnmatch_name(n, pattern)),
+        key=natural_key,
+    )
+
+
+def fnmatch_name(name: str, pattern: str) -> bool:
+    """Whether ``name`` matches ``pattern`` with each ``{field}`` and ``*`` a wildcard (any case).
+
+    Examples
+    --------
+    >>> fnmatch_name("GX010071.AVI", "GX*.avi"), fnmatch_name("A1_20kPa.jpg", "{actuator}_*.png")
+    (True, False)
+    """
+    return fnmatch.fnmatch(name.lower(), re.sub(r"\{[A-Za-z_]+\}", "*", pattern).lower())
+
+
+def _ramp_keys(name: str, fields: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict:
+    """``material``, ``actuator`` and ``trial`` of a file from its name's ``fields``, else from
+    ``defaults``."""
+    row = {}
+    for key in ("material", "actuator", "trial"):
+        row[key] = fields.get(key) or defaults.get(key)
+        if row[key] is None:
+            raise UserInputError(f"{name}: no {key} in the file name and no default; pass --{key}")
+    return row
 
 
 def pressure_specs(specs: Sequence[str]) -> dict[str | None, tuple[float, ...]]:

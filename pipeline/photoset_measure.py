@@ -196,9 +196,9 @@ def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> 
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
-    planes = [None if r is None or r.calibration is None else r.calibration.plane for r in ps.rows]
-    result["calibration_px"] = [np.nan if c is None else c.rms_px for c in planes]
-    result["calibration_mm"] = [np.nan if c is None else c.rms_mm for c in planes]
+    rms = [(np.nan, np.nan) if r is None else r.calibration_rms for r in ps.rows]
+    result["calibration_px"] = [px for px, _ in rms]
+    result["calibration_mm"] = [mm for _, mm in rms]
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]

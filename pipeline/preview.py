@@ -3,12 +3,13 @@
 For the first photo of every ramp, the one at its highest pressure and the last, a tile shows the
 photo with what the settings select tinted (the line colour, or the body), the ``roi`` (yellow) and
 ``exclude`` (red) outlines, the other candidates outlined in grey, the chosen line or body centre
-line (green when ``ok``, orange when ``flagged``), the fixed end (blue circle), the
-``fixed_direction_deg`` arrow, and psi with the status and the reason -- beside the bare selection
-mask, and for a calibrated photo the photo rectified to the actuator's plane (undistorted, seen
-from straight above) with the centre line as measured there and the calibration's reprojection
-error. It is the measurement itself (:func:`pipeline.measure.core.measure_decoded`), drawn, so what
-the preview shows is what ``measure`` will do.
+line (green when ``ok``, orange when ``flagged``), the fixed end (blue circle) with the
+``fixed_direction_deg`` as a thin blue line from it (to lay along the body's base), and psi with
+the status and the reason -- beside the bare selection mask, and for a calibrated photo the photo
+rectified to the actuator's plane (undistorted, seen from straight above) with the centre line as
+measured there and the calibration's reprojection error. It is the measurement itself
+(:func:`pipeline.measure.core.measure_decoded`), drawn, so what the preview shows is what
+``measure`` will do.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
 from pipeline.measure.core import AngleResult, decode_for_work, load_background, measure_decoded
 from pipeline.measure.extract import line_mask, region_mask
-from pipeline.measure.overlay import wrap_text
+from pipeline.measure.overlay import draw_fixed_end, wrap_text
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 
@@ -133,19 +134,7 @@ def preview_tile(
             4,
         )
     if settings.fixed_end_px is not None:
-        fe = np.asarray(settings.fixed_end_px) * kk
-        cv2.circle(tint, (int(fe[0]), int(fe[1])), 7, (255, 80, 0), 2, cv2.LINE_AA)
-        if settings.fixed_direction_deg is not None:
-            a = np.deg2rad(settings.fixed_direction_deg)
-            tip = fe + 40 * np.array([np.cos(a), -np.sin(a)])
-            cv2.arrowedLine(
-                tint,
-                (int(fe[0]), int(fe[1])),
-                (int(tip[0]), int(tip[1])),
-                (255, 80, 0),
-                2,
-                cv2.LINE_AA,
-            )
+        draw_fixed_end(tint, np.asarray(settings.fixed_end_px) * kk, settings.fixed_direction_deg)
     text = [
         title,
         f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",

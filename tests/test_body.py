@@ -357,7 +357,8 @@ def test_a_faint_tip_the_centre_line_stops_short_of_is_flagged_not_an_ok_psi(tmp
     # centre line stops about 1.5 widths short of a tip whose selection is narrower than the body
     # (a faint side); at the free end's curvature the part missed turns 7.5 and 6.6 deg, under the
     # 8 deg that flags and carries on, but the tip curls harder: psi read 15.9 and 8.4 deg off,
-    # ok; now flagged
+    # ok; now flagged (as a faint tip, or since the march stops before an oblique end face as
+    # one whose outline is uneven there, or carried on: 16.4 and 3.0 deg off)
     from pipeline.measure import measure_file
     from pipeline.photoset import load_photoset
     from pipeline.synth.photoset_writer import render_photoset
@@ -373,9 +374,8 @@ def test_a_faint_tip_the_centre_line_stops_short_of_is_flagged_not_an_ok_psi(tmp
     for trial in (1, 2):
         image = f"DS20_A1_t{trial}_s015_down_60kPa.jpg"
         res, _ = measure_file(folder / image, ps.rows[list(ps.manifest["image"]).index(image)])
-        assert abs(res.psi_deg - truth.loc[image, "psi_deg"]) > 5.0  # what the flag is for
         assert res.status == "flagged", (image, res.psi_deg, res.reason)
-        assert "a faint tip?" in res.reason and "not carried on" in res.reason, res.reason
+        assert "short of the body's" in res.reason, res.reason
 
 
 def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_on(tmp_path):
@@ -406,7 +406,7 @@ def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_
     ok = out["status"] == "ok"
     assert ok.sum() >= 25 and (err[ok] <= 10.0).all(), out.loc[ok & (err > 10.0)]
     assert not out.loc[ok, "reason"].str.contains("the end tangents and a smooth fit").any()
-    assert out.loc[ok, "reason"].str.contains("psi does not depend on it").sum() >= 10
+    assert not out["reason"].str.contains("the body starts", regex=False).any()
     faint = out.set_index("image").loc[
         ["DS20_A1_t1_s012_down_120kPa.jpg", "DS20_A1_t2_s011_down_180kPa.jpg"]
     ]
@@ -517,6 +517,37 @@ def test_the_ridge_does_not_run_into_a_plate_that_reaches_the_border():
     comp[290:310, 300:660] = 1  # the body, 360 px
     path, _ = _ridge_path(comp, cv2.distanceTransform(comp, cv2.DIST_L2, 5), (300.0, 300.0))
     assert path[:, 0].min() >= 295 and path[-1, 0] >= 655, (path[0], path[-1])
+
+
+def test_the_ridge_runs_on_through_a_dot_on_a_stripe_of_the_body():
+    # a colour range picked on a translucent body's highlight selects a thin stripe of it, wider
+    # where a marker dot sits on it: the widest point on the way to the tip was taken for a
+    # clamp block, and the ridge stopped before the dot (a customer's preview read +48.8 deg,
+    # ok, for a body curled to 206.6); a block is one by the fixed end
+    from pipeline.measure.body import _ridge_path
+
+    comp = np.zeros((300, 400), np.uint8)
+    t = np.linspace(0.0, 1.5 * np.pi, 400)
+    arc = np.c_[200 + 100 * np.cos(t), 150 - 100 * np.sin(t)]  # from (300, 150), 3/4 of a turn
+    cv2.polylines(comp, [np.round(arc).astype(np.int32)], False, 1, 8)
+    for a in (2.8, 3.6):  # two dots, 2.75 times as wide as the stripe
+        cv2.circle(comp, (int(200 + 100 * np.cos(a)), int(150 - 100 * np.sin(a))), 11, 1, -1)
+    path, _ = _ridge_path(comp, cv2.distanceTransform(comp, cv2.DIST_L2, 5), (300.0, 150.0))
+    assert np.hypot(*(path[-1] - arc[-1])) <= 6.0, path[-1]
+
+
+def test_the_march_stops_where_an_oblique_end_face_cuts_the_profile_short():
+    # a body's end face at a slant: the last profile crossing it is 15-20 % narrower and its
+    # middle slides sideways by 2 px in one 2-px step, a hook that read a 12 MP tip 6 deg high;
+    # the march stops at such a step
+    from pipeline.measure.body import _march
+
+    soft = np.zeros((100, 300), np.float32)
+    face = np.array([[0, 40], [200, 40], [208, 60], [0, 60]], np.float32)  # 20 px wide
+    cv2.fillPoly(soft, [np.round(face * 16).astype(np.int32)], 1.0, cv2.LINE_AA, 4)
+    pts = np.c_[np.arange(20.0, 181.0), np.full(161, 50.0)]
+    out, _ = _march(soft, pts, np.full(len(pts), 20.0), 10.0, (20.0, 20.0))
+    assert out[-1, 0] >= 196.0 and abs(out[-1, 1] - 50.0) <= 0.5, out[-5:]
 
 
 @pytest.mark.parametrize(

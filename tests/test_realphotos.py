@@ -176,3 +176,30 @@ def test_the_realscenes_bench_sets_a_scene_knob_in_every_analogue(capsys):
     with pytest.raises(UserInputError, match="nokey"):  # refused before the real photos run
         main(["--n", "1", "--set", "nokey=1"])
     assert "xia2023_strips" not in capsys.readouterr().out
+
+
+def test_an_overlay_marks_the_fixed_end_where_it_was_given_with_the_clamps_direction():
+    # two customers read the blue circle as their fixed_end, but it sat where the centre line
+    # starts (100-300 px along a translucent body whose base the selection misses); it marks
+    # the fixed end as given, and a given fixed_direction_deg is a thin line from it to lay
+    # along the body's base
+    from dataclasses import replace
+
+    from pipeline.measure.core import failed
+    from pipeline.measure.overlay import draw_overlay
+
+    img = np.full((480, 640, 3), 128, np.uint8)
+    line = np.c_[np.linspace(150.0, 400.0, 60), np.full(60, 300.0)]
+    res = replace(failed("tangents", ""), status="ok", psi_deg=10.0, centreline_px=line)
+    out = draw_overlay(img, res, fixed_end_px=(50.0, 300.0), fixed_direction_deg=90.0)
+    photo = out[out.shape[0] - 480 :].astype(int)
+
+    def blue(x: int, y: int) -> bool:
+        b, g, r = photo[y, x]
+        return b > 200 and g < 140 and r < 60
+
+    assert blue(50, 294) and blue(50, 200) and not blue(80, 200)  # the circle, the direction
+    assert not blue(150, 294)  # not at the line's start
+    # without a given fixed end, the line's start is marked as before
+    photo = draw_overlay(img, res)[-480:].astype(int)
+    assert blue(150, 294) and not blue(50, 200)

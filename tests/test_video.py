@@ -400,3 +400,33 @@ def test_the_ramp_check_runs_over_time(measured):
         "breaks its ramp"
     )
     assert (out.drop(index=60)["status"] == measured.drop(index=60)["status"]).all()
+
+
+def test_init_writes_a_video_sets_manifest_from_its_pressure_log(
+    video_set, measured, tmp_path, capsys
+):
+    # a customer with a camera's GX010071.MP4 and a logger's CSV wrote the manifest by hand:
+    # init asked for --pressures-kpa, a photo set's; with --pressure-log it writes the video
+    # set, the same rows as the renderer's own manifest, and calibration columns like photos'
+    from pipeline.cli import main
+
+    own = pd.read_csv(video_set / "manifest.csv").iloc[0]
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    for name in (own["video"], own["pressure_log"], "photoset.yaml"):
+        shutil.copy(video_set / name, folder / name)
+    init = ["photoset", "init", str(folder), "--pattern"]
+    assert main([*init, "*.avi"]) == 2
+    assert "is a video: give its pressure log with --pressure-log" in capsys.readouterr().err
+    assert main([*init, "*.avi", "--pressure-log", "nolog.csv"]) == 2
+    assert "its pressure log nolog.csv is not in" in capsys.readouterr().err
+    assert main([*init, "{material}_{actuator}_t{trial}*.avi", "--pressure-log",
+                 own["pressure_log"], "--clock-offset-s", str(own["clock_offset_s"])]) == 0
+    mine = pd.read_csv(folder / "manifest.csv")
+    assert mine.iloc[0][list(mine.columns)].astype(str).tolist() == (
+        own[list(mine.columns)].astype(str).tolist()
+    )
+    assert main(["photoset", "check", str(folder)]) == 0
+    out = measure_photoset(folder, jobs=1)
+    pd.testing.assert_frame_equal(out[MEASURED], measured[MEASURED])
+    assert {"calibration_px", "calibration_mm"} <= set(measured.columns)

@@ -537,6 +537,9 @@ CROSSING_MARGIN = 1.15
 OTHER_BRANCH_FRACTION = 0.25
 #: ... and this many times the widest point on its own way (a body, not a stub of the outline)
 OTHER_BRANCH_HALF_WIDTHS = 8.0
+#: ... and when that block lies by the fixed end: within this fraction of the way to the other
+#: part's end (a clamp and its tube; a dot on a highlight stripe lies where the other part stops)
+BLOCK_NEAR_START_FRACTION = 0.5
 #: a way to the farthest pixel shorter than this many times the median thickness along its ridge
 #: runs through a plate that reaches the photo's border, not along a body (the rendered bodies
 #: are 18-40 times as long as their half-width); the other, long part is taken instead when its
@@ -576,8 +579,8 @@ def _ridge_path(
     """Pixel path (x, y) along the body's ridge from the fixed end (or an end) to the far end.
 
     The far end is the pixel farthest from the start within the selection, unless the way there
-    crosses a block or runs through a plate (see :data:`CROSSING_MARGIN` and
-    :data:`PLATE_HALF_WIDTHS`).
+    crosses a block by the start or runs through a plate (see :data:`CROSSING_MARGIN`,
+    :data:`BLOCK_NEAR_START_FRACTION` and :data:`PLATE_HALF_WIDTHS`).
     """
     ys, xs = np.nonzero(comp)
     graph = _pixel_graph(ys, xs, comp.shape)
@@ -607,7 +610,14 @@ def _ridge_path(
             OTHER_BRANCH_FRACTION * geo[far], OTHER_BRANCH_HALF_WIDTHS * crossed[alt]
         ):
             along = float(np.median(dt[ys[path], xs[path]]))
-            block = crossed[far] > BLOB_THICKNESS * along  # a block on the way (to the tube)
+            way_far = np.array(_walk(way, far, seed))
+            widest = way_far[int(np.argmax(dt[ys[way_far], xs[way_far]]))]
+            # a block on the way (to the tube), by the fixed end: not a wider part further along
+            # the body (a marker dot on a stripe of it) just past where the other part stops
+            block = (
+                crossed[far] > BLOB_THICKNESS * along
+                and geo[widest] <= BLOCK_NEAR_START_FRACTION * geo[alt]
+            )
             plate = geo[far] < PLATE_HALF_WIDTHS * along  # the way runs through a plate
             if block or plate:
                 _, pred = dijkstra(graph, directed=True, indices=alt, return_predecessors=True)
@@ -764,6 +774,9 @@ MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH = 0.8, 1.15
 #: whose middle slides sideways (a fat body's tip swung 5-10 deg off over its last few steps;
 #: a faint tip narrows, and noise alone swings at the body's own width)
 MARCH_SWING_WIDTH, MARCH_SWING_DEG = 1.05, 8.0
+#: ... or at a step whose width differs from the last one's by more than this times that width
+#: and which swings that far: the last profile cut short by an oblique end face
+MARCH_WIDTH_STEP = 0.15
 #: the centre line is marched on at most this many half-widths beyond the ridge path's ends ...
 MARCH_HALF_WIDTHS = 2.0
 #: ... in steps of this length (px)
@@ -832,7 +845,8 @@ def _march(
     edges": each new point is the middle of the profile across the body ahead, kept while the
     body's width there is within [MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH] of its median near that end
     (``end_med``: start, end), and not at a step both wider than :data:`MARCH_SWING_WIDTH` of
-    it and more than :data:`MARCH_SWING_DEG` off the course (into a cap or across an end face).
+    it, or :data:`MARCH_WIDTH_STEP` of it wider or narrower than the step before, and more than
+    :data:`MARCH_SWING_DEG` off the course (into a cap or across an end face).
 
     The ridge path stops about a half-width short of each end (there the medial axis forks into
     the corners); marching recovers that part, so a tip that curls to its end is measured to its
@@ -846,6 +860,7 @@ def _march(
         new_w: list[float] = []
         cur = line[-1]
         prev = line[max(len(line) - 1 - k, 0)]
+        last_w = med
         for _ in range(int(MARCH_HALF_WIDTHS * half / MARCH_STEP_PX) + 2):
             t = cur - prev
             t = t / max(float(np.hypot(*t)), 1e-9)
@@ -862,8 +877,13 @@ def _march(
             ))))
             if np.hypot(*(step - cur)) < 0.5 * MARCH_STEP_PX or off_deg > 25.0:
                 break  # not moving on, or turning off the line's course (a corner, a cap)
-            if wid[1] > MARCH_SWING_WIDTH * med and off_deg > MARCH_SWING_DEG:
-                break  # widening and swinging off the course: into a cap or across an end face
+            if off_deg > MARCH_SWING_DEG and (
+                wid[1] > MARCH_SWING_WIDTH * med
+                or abs(wid[1] - last_w) > MARCH_WIDTH_STEP * med
+            ):
+                break  # widening, or a width jump, swinging off the course: into a cap or across
+                # an end face
+            last_w = float(wid[1])
             new.append(step)
             new_w.append(float(wid[1]))
             hist = np.vstack([line[-k:], np.array(new)])

@@ -38,8 +38,38 @@ def overlay_lines(result: AngleResult, title: str, width_px: int, height_px: int
     return [*lines, text, *wrap_text(result.reason, width_px - 16, TEXT_SCALE, room)]
 
 
+#: the fixed end's mark and the clamp direction's line (BGR), and that line's length as a
+#: fraction of the picture's width (long enough to lay along the body's base)
+FIXED_END_BGR, DIRECTION_LENGTH_FRACTION = (255, 80, 0), 0.3
+
+
+def draw_fixed_end(
+    image_bgr: np.ndarray,
+    fixed_xy: Sequence[float] | np.ndarray,
+    fixed_direction_deg: float | None,
+) -> None:
+    """Mark the fixed end at ``fixed_xy`` (px of ``image_bgr``) with a circle and, when given,
+    the clamp's direction (deg counter-clockwise from +x on screen) with a thin straight line
+    from it, to lay against the body's base (in place)."""
+    fe = np.asarray(fixed_xy, dtype=float)
+    centre = tuple(np.round(fe).astype(int).tolist())
+    cv2.circle(image_bgr, centre, 6, FIXED_END_BGR, 2, cv2.LINE_AA)
+    if fixed_direction_deg is not None:
+        a = np.deg2rad(fixed_direction_deg)
+        length = DIRECTION_LENGTH_FRACTION * image_bgr.shape[1]
+        far = fe + length * np.array([np.cos(a), -np.sin(a)])
+        ends = np.round(np.array([fe, far]) * 16).astype(int).tolist()  # 4 fractional bits
+        cv2.line(image_bgr, ends[0], ends[1], FIXED_END_BGR, 1, cv2.LINE_AA, 4)
+
+
 def draw_overlay(
-    image_bgr: np.ndarray, result: AngleResult, *, scale: float = 1.0, title: str = ""
+    image_bgr: np.ndarray,
+    result: AngleResult,
+    *,
+    scale: float = 1.0,
+    title: str = "",
+    fixed_end_px: Sequence[float] | None = None,
+    fixed_direction_deg: float | None = None,
 ) -> np.ndarray:
     """The photo with the extracted centre line and the fixed end drawn on it, and psi written in
     a band above it (not over it: a tip near the photo's top edge stays in view).
@@ -54,6 +84,10 @@ def draw_overlay(
         Original pixels per pixel of ``image_bgr``.
     title : str
         Text for the first line (e.g. the image name and pressure).
+    fixed_end_px : (x, y), optional
+        The fixed end as given (original px), marked where it is; without it the line's start.
+    fixed_direction_deg : float, optional
+        The clamp's direction as given, drawn from the fixed end (:func:`draw_fixed_end`).
 
     Returns
     -------
@@ -75,7 +109,10 @@ def draw_overlay(
     if len(result.centreline_px):
         pts = (result.centreline_px - (scale - 1) / 2) * k
         cv2.polylines(out, [np.round(pts * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
-        cv2.circle(out, tuple(int(v) for v in np.round(pts[0])), 6, (255, 80, 0), 2, cv2.LINE_AA)
+    if fixed_end_px is not None:
+        draw_fixed_end(out, (np.asarray(fixed_end_px) - (scale - 1) / 2) * k, fixed_direction_deg)
+    elif len(result.centreline_px):
+        draw_fixed_end(out, pts[0], None)
     lines = overlay_lines(result, title, out.shape[1], out.shape[0])
     band = np.full((12 + LINE_PX * len(lines), out.shape[1], 3), BAND_BGR, np.uint8)
     band[-2:] = DIVIDER_BGR

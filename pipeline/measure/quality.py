@@ -216,6 +216,12 @@ def tip_turn_deg(
 
 #: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
 BASE_MISMATCH_DEG = 20.0
+#: the notes a body's ``reason`` may hold beside its flags, saying how psi was taken (an ``ok``
+#: row's reason holds only these): how each begins
+NOTE_FIXED_DIRECTION = "psi from the free end's tangent against fixed_direction_deg"
+NOTE_SIDE_ON_BORDER = "a side runs along the image border"
+NOTE_SELECTION_COVERS = "selection covers"
+NOTES: tuple[str, ...] = (NOTE_FIXED_DIRECTION, NOTE_SIDE_ON_BORDER, NOTE_SELECTION_COVERS)
 
 
 def assess_body(
@@ -252,9 +258,9 @@ def assess_body(
     over :data:`TIP_UNSTABLE_DEG`, or over :data:`FAINT_TIP_TURN_DEG` where the free end is
     narrower than :data:`FAINT_TIP_WIDTH` of the body, a faint side, or the line stops more than
     :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
-    from ``fixed_end`` (a note when ``fixed_direction_deg`` is given: ``base_mismatch_deg`` not
-    None); the body closes on itself; or it is much shorter than ``l0`` (partly hidden).  Notes
-    (status stays ``ok``) say how psi was taken.
+    from ``fixed_end`` (not when ``fixed_direction_deg`` is given, ``base_mismatch_deg`` not
+    None: psi does not depend on it); the body closes on itself; or it is much shorter than
+    ``l0`` (partly hidden).  Notes (status stays ``ok``) say how psi was taken.
     """
     import numpy as np
 
@@ -264,8 +270,8 @@ def assess_body(
         flags.append("body touches the image border at its free end: the tip may be outside")
     elif side_on_border:
         notes.append(
-            "a side runs along the image border: the centre line there is half the body's width "
-            "from the other edge"
+            f"{NOTE_SIDE_ON_BORDER}: the centre line there is half the body's width from the "
+            "other edge"
         )
     if tip_at_region_edge:
         flags.append(
@@ -371,28 +377,24 @@ def assess_body(
             "psi may miss part of the tip's turn; check with photoset preview, or give the empty "
             "scene (background)"
         )
-    if start_gap_px > 2.0 * line.width_px + 4.0:
+    if start_gap_px > 2.0 * line.width_px + 4.0 and base_mismatch_deg is None:
         # with the base known psi is the free end's tangent against it: the gap cannot change it
-        (flags if base_mismatch_deg is None else notes).append(
+        # (nor is it noted: the overlay shows the fixed end given and where the line starts)
+        flags.append(
             f"the body starts {start_gap_px:.0f} px from fixed_end: part of it may be missed, or "
-            "fixed_end is off"
-            + (
-                " (give fixed_direction_deg, the clamp's direction, and psi will not depend "
-                "on it)"
-                if base_mismatch_deg is None
-                else " (psi does not depend on it)"
-            )
+            "fixed_end is off (give fixed_direction_deg, the clamp's direction, and psi will not "
+            "depend on it)"
         )
     if expected_length_px and length_px < 0.8 * expected_length_px:
         flags.append(
             f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible"
         )
     if base_mismatch_deg is not None:
-        notes.append("psi from the free end's tangent against fixed_direction_deg")
+        notes.append(NOTE_FIXED_DIRECTION)
         if abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
             flags.append(
                 f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
             )
     if selected_fraction > 0.35:
-        notes.append(f"selection covers {100 * selected_fraction:.0f}% of the photo")
+        notes.append(f"{NOTE_SELECTION_COVERS} {100 * selected_fraction:.0f}% of the photo")
     return Quality("flagged" if flags else "ok", "; ".join(flags + notes))

@@ -193,6 +193,13 @@ class MeasureSettings:
         """+1 for ``ccw``, -1 for ``cw``."""
         return 1.0 if self.positive_turn == "ccw" else -1.0
 
+    @property
+    def calibration_rms(self) -> tuple[float, float]:
+        """Reprojection error (px, mm) of the camera calibration the photo is measured with
+        (angles.csv's ``calibration_px`` and ``calibration_mm``); NaN without one."""
+        plane = None if self.calibration is None else self.calibration.plane
+        return (float("nan"),) * 2 if plane is None else (plane.rms_px, plane.rms_mm)
+
     def describe_color(self) -> str:
         """The selection in words, for reasons and previews."""
         if self.color is None:

@@ -69,21 +69,34 @@ def run_task(task: Task) -> dict[str, Any]:
         res = failed(task.method, f"internal error on this photo: {type(exc).__name__}: {exc}")
     seconds = time.perf_counter() - t0
     if task.overlay_path is not None:
-        write_overlay(task.overlay_path, img, f, res, task.title)
+        write_overlay(task.overlay_path, img, f, res, task.title, task.settings)
     return result_fields(res, seconds)
 
 
 def write_overlay(
-    path: str, img: np.ndarray | None, factor: int, res: AngleResult, title: str
+    path: str,
+    img: np.ndarray | None,
+    factor: int,
+    res: AngleResult,
+    title: str,
+    settings: MeasureSettings | None = None,
 ) -> None:
-    """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR) and write a
-    JPEG."""
+    """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR), with the
+    fixed end and clamp direction of ``settings`` as given, and write a JPEG."""
     from pipeline.measure.overlay import draw_overlay
 
     base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
     if base.ndim == 2:
         base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
-    out = draw_overlay(base, res, scale=float(factor) if img is not None else 1.0, title=title)
+    given = settings if img is not None else None  # not on the blank stand-in
+    out = draw_overlay(
+        base,
+        res,
+        scale=float(factor) if img is not None else 1.0,
+        title=title,
+        fixed_end_px=given.fixed_end_px if given else None,
+        fixed_direction_deg=given.fixed_direction_deg if given else None,
+    )
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # a photo in a subfolder of its set
     cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
 

@@ -14,6 +14,10 @@ Examples
 'no marker line found'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
+>>> top_reasons(pd.DataFrame({"dataset": ["v"], "status": ["flagged"], "reason": [
+...     "body touches the image border at its free end: the tip may be outside; psi from the "
+...     "free end's tangent against fixed_direction_deg"]}))
+{'v': [("body's tip at the image border", 1)]}
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ from collections import Counter
 
 import pandas as pd
 
+from pipeline.measure.quality import NOTES
+
 #: (pattern, words): the causes the measure stage writes, in words
 WORDS: tuple[tuple[str, str], ...] = (
     (r"^no line found", "no marker line found"),
@@ -30,6 +36,7 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^a grey image", "grey photo, colour line expected"),
     (r"^curvature fit failed", "curvature fit failed"),
     (r"^internal error", "internal error (please report)"),
+    (r"^body touches the image border", "body's tip at the image border"),
     (r"touches the image border", "line touches the image border"),
     (r"^line partly hidden", "line partly hidden"),
     (r"^line \d+% of l0", "line longer than l0 (scale or extra marks)"),
@@ -81,7 +88,8 @@ def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[st
             g["status"].astype(str), g["reason"].fillna("").astype(str), strict=True
         ):
             causes = [reason] if status == "failed" else reason.split(";")
-            counts.update({words(part) for part in causes})
+            # a note says how psi was taken, not why the row is doubted
+            counts.update({words(p) for p in causes if not p.strip().startswith(NOTES)})
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
         if len(ordered) > limit:
             ordered = ordered[:limit] + [("other causes", sum(c for _, c in ordered[limit:]))]

@@ -151,6 +151,9 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
         df[key] = row[key]
     settings = ps.rows[clip.position]
     df["l0_mm"] = np.nan if settings is None else settings.l0_mm
+    df["calibration_px"], df["calibration_mm"] = (
+        (np.nan, np.nan) if settings is None else settings.calibration_rms
+    )
     drop = {
         "video",
         "pressure_log",
@@ -187,7 +190,8 @@ def measure_video_set(
         One row per frame, videos in manifest order: the measurement columns (``image`` is the
         video's name), ``frame``, ``time_s`` (log clock, s), ``pressure_kpa``,
         ``measured_pressure_kpa`` (when logged), ``direction``, ``step``, ``since_step_s``, the
-        ramp keys, ``l0_mm`` and the manifest's own other columns.
+        ramp keys, ``l0_mm``, ``calibration_px`` and ``calibration_mm`` (as for photos) and the
+        manifest's own other columns.
     """
     clips = resolve_clips(ps)
     for clip in clips:
