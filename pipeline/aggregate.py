@@ -9,7 +9,8 @@ Frames of a video (rows with a ``frame``) have no setpoint levels: without a bin
 binned by :data:`CONTINUOUS_BIN_KPA` of their measured pressure, and the frames of one trial in one
 bin and direction are first averaged, so a video trial counts once per level as a photo ramp does
 (``n`` counts trials there, not frames; :mod:`pipeline.video.continuous` has the per-cycle loops,
-settling curves and step responses).
+settling curves and step responses).  Of a video stepped through held pressures only the frames at
+the end of each hold count (:func:`settled_frames`): those between are the step's response.
 
 Rows whose ``status`` is not ``ok`` (``flagged`` or ``failed``) or whose psi is not finite are
 excluded by default and counted in ``n_excluded``; a level whose rows are all excluded is still
@@ -63,6 +64,9 @@ PER_ACTUATOR_COLUMNS: tuple[str, ...] = (
 )
 #: bin width (kPa) of the frames of a video when no bin width is asked for
 CONTINUOUS_BIN_KPA = 5.0
+#: of a video stepped through held pressures, the frames that settled: each hold's last this
+#: fraction of frames (at least SETTLED_MIN_FRAMES), as the step responses' final value
+SETTLED_FRACTION, SETTLED_MIN_FRAMES = 0.2, 3
 
 
 def read_angles(paths: Sequence[str | os.PathLike[str]]) -> pd.DataFrame:
@@ -181,6 +185,45 @@ def is_used(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Series:
     return angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
 
 
+def settled_frames(angles: pd.DataFrame) -> pd.Series:
+    """Which rows are points of a hysteresis curve: every photo, and every frame of a video
+    ramped continuously; of a video stepped through held pressures (frames with a finite
+    ``since_step_s``: its pressure log steps), only the frames at the end of each hold (its last
+    :data:`SETTLED_FRACTION`, at least :data:`SETTLED_MIN_FRAMES`).
+
+    The frames between holds are the step's response: binned by pressure they drew a loop of
+    how fast the actuator follows, not of hysteresis (a customer's 720p step video: 234 deg
+    "wide" at 55 kPa, a pressure it never held); they stay in the step responses
+    (:mod:`pipeline.video.continuous`).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> rows = pd.DataFrame({"image": ["v.avi"] * 8, "frame": range(8), "step": [0] * 4 + [1] * 4,
+    ...                      "since_step_s": [float("nan")] * 4 + [0.1, 0.2, 0.3, 0.4]})
+    >>> settled_frames(rows).tolist()
+    [False, True, True, True, False, True, True, True]
+    >>> settled_frames(rows.assign(since_step_s=float("nan"))).all()  # a continuous ramp
+    np.True_
+    """
+    keep = pd.Series(True, index=angles.index)
+    if not {"frame", "step", "since_step_s"} <= set(angles.columns):
+        return keep
+    frames = angles[angles["frame"].notna()]
+    video = [c for c in ("dataset", "image") if c in frames.columns]
+    since = pd.to_numeric(frames["since_step_s"], errors="coerce")
+    stepped = np.isfinite(since).groupby([frames[c] for c in video]).transform("any")
+    frames = frames[stepped.to_numpy(bool)]
+    if frames.empty:
+        return keep
+    hold = frames.groupby([*(frames[c] for c in video), frames["step"]], sort=False)["frame"]
+    from_end = hold.rank(method="first", ascending=False)
+    size = hold.transform("size")
+    tail = np.maximum(SETTLED_MIN_FRAMES, np.round(SETTLED_FRACTION * size))
+    keep.loc[frames.index] = (from_end <= tail).to_numpy(bool)
+    return keep
+
+
 def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Series:
     """Pressure level (kPa) of each row.
 
@@ -220,7 +263,7 @@ def pressure_levels(angles: pd.DataFrame, bin_kpa: float | None = None) -> pd.Se
 
 def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool) -> pd.DataFrame:
     check_angles(angles)
-    df = angles.copy()
+    df = angles[settled_frames(angles)].copy()
     df["actuator"] = actuator_keys(df)
     df["trial"] = df["trial"].astype(str)
     df["psi_deg"] = pd.to_numeric(df["psi_deg"], errors="coerce").astype(float)

@@ -42,8 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="W",
         help="group by measured pressure (measured_pressure_kpa, else the setpoint) rounded to "
-             "bins "
-        "of W kPa instead of by the nominal setpoint pressure_kpa (default: setpoints)",
+             "bins of W kPa instead of by the nominal setpoint pressure_kpa (default: setpoints "
+             "for photos; the frames of a video by 5 kPa of measured pressure, a stepped video's "
+             "only at the end of each hold)",
     )
     parser.add_argument(
         "--include-flagged",

@@ -421,4 +421,9 @@ def _check(args: argparse.Namespace) -> int:
         f"{args.folder}: OK ({n} "
         f"{'videos' if video else 'photos'}{f', {warn} warning(s)' if warn else ''})"
     )
+    if video:
+        from pipeline.video.clips import resolve_clips
+
+        for clip in resolve_clips(photoset.load_photoset(args.folder)):
+            print(f"  {clip.describe()}")
     return 0

@@ -364,8 +364,8 @@ def test_a_faint_tip_the_centre_line_stops_short_of_is_flagged_not_an_ok_psi(tmp
     from pipeline.synth.photoset_writer import render_photoset
 
     folder = tmp_path / "s"
-    truth = render_photoset(folder, "DS20", actuators=1, trials=2, seed=1,
-                            scene="grey_dots_clear", step_kpa=20).set_index("image")
+    render_photoset(folder, "DS20", actuators=1, trials=2, seed=1, scene="grey_dots_clear",
+                    step_kpa=20)
     yaml = (folder / "photoset.yaml").read_text()
     (folder / "photoset.yaml").write_text(
         "".join(line for line in yaml.splitlines(keepends=True) if "background" not in line)

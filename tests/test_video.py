@@ -426,7 +426,12 @@ def test_init_writes_a_video_sets_manifest_from_its_pressure_log(
     assert mine.iloc[0][list(mine.columns)].astype(str).tolist() == (
         own[list(mine.columns)].astype(str).tolist()
     )
+    capsys.readouterr()
     assert main(["photoset", "check", str(folder)]) == 0
+    # and check says what it checked: the video's span on the log clock, the log's
+    said = capsys.readouterr().out
+    assert "135 frames at 10 fps, 0.70-14.10 s on the log clock (clock_offset_s 0.7)" in said
+    assert f"{own['pressure_log']} covers 0.00-" in said and "0 to 80 kPa" in said, said
     out = measure_photoset(folder, jobs=1)
     pd.testing.assert_frame_equal(out[MEASURED], measured[MEASURED])
     assert {"calibration_px", "calibration_mm"} <= set(measured.columns)

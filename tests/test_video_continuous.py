@@ -104,7 +104,9 @@ def test_steps_measured_on_the_video_match_the_steps_of_its_truth(video_set, mea
 
 
 def test_loops_and_cycles_of_the_video(measured):
-    binned, cycles = loops(measured, bin_kpa=10)
+    # as the frames of a continuous ramp (no steps in the log): every frame is binned
+    ramped = measured.assign(since_step_s=np.nan)
+    binned, cycles = loops(ramped, bin_kpa=10)
     assert set(binned["direction"]) == {"up", "down"} and (binned["cycle"] == 1).all()
     assert binned.groupby("direction")["n"].sum().sum() == (measured["status"] == "ok").sum()
     assert len(cycles) == 1 and cycles["bins_compared"].iloc[0] >= 3
@@ -113,9 +115,23 @@ def test_loops_and_cycles_of_the_video(measured):
     assert cycles["rate_up_kpa_s"].iloc[0] == pytest.approx(80 / (8.6 - 0.7), rel=0.02)
     with pytest.raises(UserInputError, match="positive"):
         loops(measured, bin_kpa=0)
+    # the video as it is, stepped through held pressures: only the ends of its holds, at the
+    # levels it held (the frames between are the steps' response, not hysteresis)
+    held, held_cycles = loops(measured, bin_kpa=10)
+    assert set(held["pressure_kpa"]) == {0.0, 40.0, 80.0} and held["n"].sum() < 60
+    assert held_cycles["bins_compared"].iloc[0] == 2  # 0 and 40 kPa, both ways
+    assert held_cycles["rate_up_kpa_s"].iloc[0] == cycles["rate_up_kpa_s"].iloc[0]
 
 
 def test_hysteresis_of_frames_is_binned_and_a_video_trial_counts_once_per_level(measured):
+    # of a stepped video, the ends of its holds only: the levels it held
+    held = aggregate_hysteresis(measured)
+    assert sorted(map(tuple, held[["direction", "pressure_kpa"]].to_numpy().tolist())) == [
+        ("down", 0.0), ("down", 40.0), ("up", 0.0), ("up", 40.0), ("up", 80.0)
+    ]
+    assert (held["n"] == 1).all()
+    # as the frames of a continuous ramp (no steps in the log): binned by measured pressure
+    measured = measured.assign(since_step_s=np.nan)
     h = aggregate_hysteresis(measured)
     assert len(h) < 40 and np.allclose(h["pressure_kpa"] % continuous.BIN_KPA, 0)
     # one trial: one value per bin, sd undefined

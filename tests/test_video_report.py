@@ -35,6 +35,7 @@ def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
     )
     assert with_video.pages == len(plain) + 2
     pages = _text(tmp_path / "video.pdf")
+    assert "0 photos, 135 video frames" in pages[0]  # not "135 photos"
     video_pages = [p for p in pages if "Video dataset" in p]
     assert len(video_pages) == 2 and "Video dataset steps_a" in video_pages[0]
     for text in video_pages:
@@ -66,3 +67,34 @@ def test_video_pages_have_no_overlaps_no_small_fonts_nothing_on_the_footer(measu
                 t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5
             ]
             assert on_footer == []
+
+
+def test_the_photo_strip_of_a_video_shows_its_frames(video_set, measured, tmp_path):
+    # a customer's report said "photo not found" under every tile of a video's strip: it looked
+    # for the video's name as an overlay and as a photo; now each tile is a frame's overlay (a
+    # few per video are drawn), else the frame read from the video
+    import shutil
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.report.strip import build_strip
+
+    angles = tmp_path / "angles.csv"
+    measured.to_csv(angles, index=False)
+    raw = load_report_data(
+        ReportInputs(datasets=(Dataset("steps", angles, photoset_dir=video_set),), title="t")
+    )
+    strip = build_strip(raw, "SS40")
+    assert strip is not None and len(strip.photos) >= 4
+    assert all(p.image is not None and p.source == "raw" for p in strip.photos)
+    folder = tmp_path / "set"
+    shutil.copytree(video_set, folder)
+    drawn = measure_photoset(folder, jobs=1, overlays_dir=tmp_path / "ov")
+    drawn.to_csv(angles, index=False)
+    data = load_report_data(
+        ReportInputs(
+            datasets=(Dataset("steps", angles, photoset_dir=folder, overlays_dir=tmp_path / "ov"),),
+            title="t",
+        )
+    )
+    strip = build_strip(data, "SS40")
+    assert strip is not None and all(p.source == "overlay" for p in strip.photos)

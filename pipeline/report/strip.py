@@ -19,6 +19,8 @@ from pipeline.measure.formats import read_image
 from pipeline.measure.overlay import DIVIDER_BGR
 from pipeline.photoset import overlay_name
 from pipeline.report.data import Dataset, ReportData, mixed_materials
+from pipeline.video.measure import frame_overlay_name
+from pipeline.video.reader import probe_video, read_frames
 
 #: photos per strip
 STRIP_PHOTOS = 6
@@ -131,14 +133,33 @@ def load_thumbnail(
     bgr = read_image(path)
     if bgr is None:
         return None
-    h, w = bgr.shape[:2]
-    if w > max_width_px:
-        bgr = cv2.resize(
-            bgr, (max_width_px, max(1, round(h * max_width_px / w))), interpolation=cv2.INTER_AREA
-        )
+    bgr = _narrowed(bgr, max_width_px)
     if banner:
         bgr = crop_banner(bgr)
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+
+
+def _narrowed(bgr: np.ndarray, max_width_px: int) -> np.ndarray:
+    """``bgr`` at most ``max_width_px`` wide (its aspect kept)."""
+    h, w = bgr.shape[:2]
+    if w <= max_width_px:
+        return bgr
+    size = (max_width_px, max(1, round(h * max_width_px / w)))
+    return cv2.resize(bgr, size, interpolation=cv2.INTER_AREA)
+
+
+def video_frame(
+    path: Path, frame: int, max_width_px: int = THUMB_MAX_WIDTH_PX
+) -> np.ndarray | None:
+    """RGB thumbnail of one frame of a video, at most ``max_width_px`` wide; ``None`` if it
+    cannot be read."""
+    if not path.is_file():
+        return None
+    got = next(read_frames(probe_video(path), frame, 1), None)
+    if got is None or got.data is None:
+        return None
+    bgr = cv2.imdecode(got.data, cv2.IMREAD_COLOR) if got.data.ndim == 1 else got.data
+    return None if bgr is None else cv2.cvtColor(_narrowed(bgr, max_width_px), cv2.COLOR_BGR2RGB)
 
 
 def strip_image(
@@ -229,18 +250,27 @@ def build_strip(data: ReportData, material: str, n_photos: int = STRIP_PHOTOS) -
         return None
     first = ramp.iloc[0]
     dataset: Dataset = next(d for d in data.inputs.datasets if d.name == first["dataset"])
+    frames = "frame" in ramp.columns and bool(ramp["frame"].notna().all())
+    if frames:  # a video's frames: the overlay of each, where one was drawn (a few per video)
+        names = [frame_overlay_name(str(v), int(f)) for v, f in zip(ramp["image"], ramp["frame"])]
+        if dataset.overlays_dir is not None:
+            drawn = [(dataset.overlays_dir / n).is_file() for n in names]
+            if any(drawn):
+                ramp = ramp[drawn]
+                names = [n for n, d in zip(names, drawn) if d]
+    else:
+        names = [overlay_name(str(v)) for v in ramp["image"]]
     idx = np.unique(np.round(np.linspace(0, len(ramp) - 1, min(n_photos, len(ramp)))).astype(int))
     photos = []
     for i in idx:
         row = ramp.iloc[int(i)]
         image, source = None, "missing"
         if dataset.overlays_dir is not None:
-            image = load_thumbnail(
-                dataset.overlays_dir / overlay_name(str(row["image"])), banner=True
-            )
+            image = load_thumbnail(dataset.overlays_dir / names[int(i)], banner=True)
             source = "overlay" if image is not None else source
         if image is None and dataset.photoset_dir is not None:
-            image = load_thumbnail(dataset.photoset_dir / str(row["image"]))
+            raw = dataset.photoset_dir / str(row["image"])
+            image = video_frame(raw, int(row["frame"])) if frames else load_thumbnail(raw)
             source = "raw" if image is not None else source
         photos.append(
             StripPhoto(

@@ -284,9 +284,10 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     flow = Flow(fig, top_pt=36.0)
     flow.text(data.inputs.title, size=16.0, weight="bold")
     flow.space(2.0)
-    photos = len(data.angles)
+    frames = int(data.angles["frame"].notna().sum()) if "frame" in data.angles.columns else 0
+    counted = f"{len(data.angles) - frames} photos" + (f", {frames} video frames" if frames else "")
     flow.text(
-        f"Summary of {len(data.datasets)} dataset(s), {photos} photos, {len(data.materials)} "
+        f"Summary of {len(data.datasets)} dataset(s), {counted}, {len(data.materials)} "
         "material(s); "
         f"pipeline {version}.  {date_line(data)}.",
         size=8.5,

@@ -83,6 +83,23 @@ class Clip:
             nominal = np.where(np.isfinite(pts), pts, nominal[: len(pts)])
         return nominal + self.clock_offset_s
 
+    def describe(self) -> str:
+        """The clip in one line for ``photoset check``: its frames, their span on the log's clock
+        and the log's span and pressures (what a wrong ``clock_offset_s`` would show)."""
+        if not self.info.opened:
+            return f"{self.video}: not read"
+        video = (
+            f"{self.video}: {self.n_frames} frames at {self.info.fps:g} fps, "
+            f"{span_text(self.span_s())} on the log clock (clock_offset_s {self.clock_offset_s:g})"
+        )
+        if self.log is None:
+            return video
+        p = self.log.pressure_kpa
+        return (
+            f"{video}; {Path(self.log.path).name} covers {span_text(self.log.span_s)}, "
+            f"{np.nanmin(p):g} to {np.nanmax(p):g} kPa"
+        )
+
     def span_s(self) -> tuple[float, float]:
         """First and last frame time on the log's clock (NaN when the clip has no frames)."""
         t = self.nominal_video_times_s()

@@ -7,7 +7,9 @@ and the ramp keys), using only ``ok`` frames (``flagged`` too with ``include_fla
 ``loops``
     Hysteresis loops binned by pressure: per ramp (material, actuator, trial), cycle (a rise
     and the fall after it) and direction, psi mean / sd / n per pressure bin of ``bin_kpa``
-    (the measured pressure when logged, else the setpoint), with the leg's pressure rate.
+    (the measured pressure when logged, else the setpoint), with the leg's pressure rate; of a
+    video stepped through held pressures only the ends of its holds
+    (:func:`pipeline.aggregate.settled_frames`: the frames between are the step's response).
 ``cycles``
     Per cycle: rise and fall rates (mean rate of the setpoint over the leg, kPa/s), the loop's
     mean and largest width (psi rising minus psi falling at the same pressure, over the bins both
@@ -18,11 +20,11 @@ and the ramp keys), using only ``ok`` frames (``flagged`` too with ``include_fla
     rise time (10 % to 90 % of the change, from the step), overshoot (% of the change beyond its
     final value, 0 within the noise), settling time (from the step until psi stays within
     :data:`SETTLING_BAND` of the change, or 3 noise sd, of its final value); the final value is the
-    mean of the last :data:`FINAL_FRACTION` of the hold, and a hold whose end still drifts (a
-    straight line through that last part moves by more than the band) gives no figures ("did
-    not settle within the hold": its final value, and so its 90 % level, are not known).  The
-    noise sd is the ramp's frame-to-frame noise (second differences, robust).  The same rise and
-    settling times for the measured pressure when logged.
+    mean of the last :data:`~pipeline.aggregate.SETTLED_FRACTION` of the hold, and a hold whose
+    end still drifts (a straight line through that last part moves by more than the band) gives
+    no figures ("did not settle within the hold": its final value, and so its 90 % level, are not
+    known).  The noise sd is the ramp's frame-to-frame noise (second differences, robust).  The
+    same rise and settling times for the measured pressure when logged.
 ``settling``
     Settling curves: psi and its normalised response ``(psi - before) / change`` against the time
     since each step (at most :data:`CURVE_POINTS` per step, medians of equal time bins).
@@ -49,7 +51,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.aggregate import is_used, measured_pressure
+from pipeline.aggregate import (
+    SETTLED_FRACTION,
+    SETTLED_MIN_FRAMES,
+    is_used,
+    measured_pressure,
+    settled_frames,
+)
 from pipeline.errors import UserInputError
 from pipeline.fileio import write_table
 
@@ -58,7 +66,6 @@ BIN_KPA = 5.0
 #: settling band: this fraction of the step's change (or 3 noise sd if larger)
 SETTLING_BAND = 0.02
 #: psi's final value after a step: mean of the last this fraction of the hold (at least 3 frames)
-FINAL_FRACTION = 0.2
 #: psi before a step: mean of the ok frames in this window before it (s)
 BEFORE_WINDOW_S = 0.5
 #: a change smaller than this many noise sd (or 1 deg) has no rise/settling figures
@@ -87,6 +94,7 @@ def _frames(angles: pd.DataFrame, include_flagged: bool) -> pd.DataFrame:
         if column in df.columns:
             df[column] = pd.to_numeric(df[column], errors="coerce")
     df["_used"] = is_used(df, include_flagged) & np.isfinite(df["psi_deg"])
+    df["_settled"] = settled_frames(df)
     df["_pressure"] = measured_pressure(df)
     return df.sort_values([*RAMP_KEYS, "time_s"], kind="stable")
 
@@ -137,7 +145,8 @@ def loops(
         )
         for (c, direction), g in ramp.groupby(["_cycle", "direction"], sort=False):
             rate = _rate(g["time_s"].to_numpy(), g["pressure_kpa"].to_numpy())
-            for level, b in g.groupby("_bin", sort=True):
+            # of a stepped video, the ends of its holds (the frames between are its response)
+            for level, b in g[g["_settled"]].groupby("_bin", sort=True):
                 psi = b.loc[b["_used"], "psi_deg"].to_numpy(float)
                 rows.append(
                     dict(
@@ -274,7 +283,7 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     if t.size < 5 or not math.isfinite(before_deg):
         out["note"] = "too few frames around the step"
         return out
-    tail = max(3, round(FINAL_FRACTION * t.size))
+    tail = max(SETTLED_MIN_FRAMES, round(SETTLED_FRACTION * t.size))
     final = float(np.mean(y[-tail:]))
     change = final - before_deg
     sd = noise_sd(y) if noise is None else noise
