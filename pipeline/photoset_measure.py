@@ -35,7 +35,8 @@ from pipeline.ramp_check import check_ramps
 #: :class:`~pipeline.measure.AngleResult`;
 #: empty on failed rows; ``width_px``: the line's or body's width, edge to edge;
 #: ``base_direction_deg``: the direction a body's psi is measured from, see
-#: :func:`pipeline.ramp_check.share_base_direction`; ``l0_mm``: the
+#: :func:`pipeline.ramp_check.share_base_direction`; ``fixed_direction_deg``: the one given,
+#: which psi is then measured from (in the same convention); ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -46,6 +47,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "length_px",
     "width_px",
     "base_direction_deg",
+    "fixed_direction_deg",
     "method",
     "residual_px",
     "status",
@@ -196,6 +198,7 @@ def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> 
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
+    result["fixed_direction_deg"] = [np.nan if r is None else r.base_given_deg for r in ps.rows]
     rms = [(np.nan, np.nan) if r is None else r.calibration_rms for r in ps.rows]
     result["calibration_px"] = [px for px, _ in rms]
     result["calibration_mm"] = [mm for _, mm in rms]

@@ -68,6 +68,12 @@ BASE_NOTE_DEG = 1.0
 #: analogues, 30 ramps over two sizes, two seeds and three camera faults, no such jump passed 3 deg)
 BASE_SHIFT_DEG = 5.0
 BASE_SHIFT_PHOTOS = 3
+#: with ``fixed_direction_deg`` given, a ramp whose bodies leave the clamp more than this (deg)
+#: off it (the median of their own directions, which agree within BASE_SPREAD_DEG) says so in
+#: every row: psi is measured from the direction given, off by as much if the body sits turned in
+#: its clamp (a customer's second trial: 3.2 deg).  Given their true direction, the bodies' own
+#: read up to 2.7 deg off it on 26 rendered ramps (translucent ones, and at 12 MP)
+GIVEN_OFF_DEG = 3.0
 
 
 def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
@@ -247,6 +253,12 @@ def share_base_direction(
     for _, whole in out.groupby(list(keys), sort=False):
         ramp = whole.sort_values(order, kind="stable") if order else whole
         own_all = ramp["base_direction_deg"].to_numpy(float)
+        given = pd.to_numeric(
+            ramp.get("fixed_direction_deg", pd.Series(np.nan, index=ramp.index)), errors="coerce"
+        ).to_numpy(float)
+        if np.isfinite(given).any():  # psi is measured from the direction given: compared only
+            _compare_given(out, ramp, own_all, given)
+            continue
         used = (ramp["status"] != "failed").to_numpy() & np.isfinite(own_all)
         if used.sum() < BASE_MIN_PHOTOS:
             continue
@@ -255,6 +267,43 @@ def share_base_direction(
         for number, run in enumerate(runs):
             _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None)
     return out
+
+
+def _compare_given(
+    out: pd.DataFrame, ramp: pd.DataFrame, own: np.ndarray, given: np.ndarray
+) -> None:
+    """Note in every row of ``ramp`` (in place in ``out``) when its bodies' own base directions
+    (``own``), agreeing among themselves, lie more than :data:`GIVEN_OFF_DEG` from the
+    ``fixed_direction_deg`` given (``given``, in the same convention).
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"reason": [""] * 6, "status": "ok"})
+    >>> _compare_given(df, df, np.array([18.2, 18.0, 18.4, np.nan, 18.1, 18.3]), np.full(6, 15.0))
+    >>> df["reason"].iloc[0][:78]
+    'the bodies of this ramp leave the clamp at +18.2 deg (the median of 5 photos),'
+    >>> _compare_given(df := df.assign(reason=""), df, np.full(6, 17.5), np.full(6, 15.0))
+    >>> df["reason"].iloc[0]
+    ''
+    """
+    ok = np.isfinite(own) & np.isfinite(given) & (ramp["status"] != "failed").to_numpy()
+    if ok.sum() < BASE_MIN_PHOTOS:
+        return
+    off = _wrap_deg(own[ok] - given[ok])
+    median = float(np.median(off))
+    if abs(median) <= GIVEN_OFF_DEG or float(np.median(np.abs(off - median))) > BASE_SPREAD_DEG:
+        return
+    stated = float(np.median(given[ok]))
+    note = (
+        f"the bodies of this ramp leave the clamp at {stated + median:+.1f} deg (the median of "
+        f"{int(ok.sum())} photos), {median:+.1f} deg off the fixed_direction_deg given "
+        f"({stated:+.1f}), which psi is measured from: if the actuator sits turned in its clamp, "
+        "give its own (photoset preview draws the one given along the base)"
+    )
+    rows = ramp.index
+    out.loc[rows, "reason"] = [
+        _join(r, note) for r in out.loc[rows, "reason"].fillna("").astype(str)
+    ]
 
 
 def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None) -> None:

@@ -131,6 +131,10 @@ def test_fixed_direction_gives_psi_against_the_known_clamp_direction():
     off = measure_image(img, settings_for(fe, fixed_direction_deg=30.0))
     assert off.status == "flagged" and "off fixed_direction_deg" in off.reason
     assert off.psi_deg == pytest.approx(res.psi_deg - 30.0, abs=1.0)
+    # the body's own base direction is still read, beside the one given (the ramp check
+    # compares them), and is the same whichever was given
+    assert res.base_direction_deg == pytest.approx(0.0, abs=2.5)
+    assert off.base_direction_deg == pytest.approx(res.base_direction_deg, abs=1e-6)
 
 
 def test_nothing_selected_fails_naming_the_setting_and_the_preview():
@@ -407,6 +411,12 @@ def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_
     assert ok.sum() >= 25 and (err[ok] <= 10.0).all(), out.loc[ok & (err > 10.0)]
     assert not out.loc[ok, "reason"].str.contains("the end tangents and a smooth fit").any()
     assert not out["reason"].str.contains("the body starts", regex=False).any()
+    # the table says which direction psi was measured from; the body's own is not read where
+    # its start is missed (nor compared with the one given)
+    given = out["image"].map(truth.set_index("image")["fixed_direction_deg"])
+    np.testing.assert_allclose(out["fixed_direction_deg"], given, atol=1e-3)  # as written
+    assert out["base_direction_deg"].isna().sum() >= 30
+    assert not out["reason"].str.contains("leave the clamp at").any()
     faint = out.set_index("image").loc[
         ["DS20_A1_t1_s012_down_120kPa.jpg", "DS20_A1_t2_s011_down_180kPa.jpg"]
     ]
@@ -429,6 +439,7 @@ def test_with_its_base_known_a_ramp_is_not_flagged_for_what_psi_does_not_depend_
     gap = alone["reason"].str.contains("the body starts", regex=False)
     assert gap.sum() >= 20 and (alone.loc[gap, "status"] == "flagged").all()
     assert alone.loc[gap, "reason"].str.contains("give fixed_direction_deg", regex=False).all()
+    assert alone["fixed_direction_deg"].isna().all()
 
 
 def test_a_centre_line_stopping_short_of_a_tip_that_still_turns_is_flagged_and_carried_on():
@@ -870,9 +881,12 @@ def test_a_body_reports_the_direction_it_leaves_the_fixed_end_in_psis_sense(turn
     assert res.status == "ok", res.reason
     assert res.base_direction_deg == pytest.approx(base, abs=2.0)
     assert res.psi_deg == pytest.approx(120.0 if turn == "ccw" else -120.0, abs=2.5)
-    # with the direction given, or on a drawn line, there is nothing to share
-    given = measure_image(turned, settings_for(fixed_end, fixed_direction_deg=90.0))
-    assert np.isnan(given.base_direction_deg)
+    # with the direction given psi is measured from it, and the body's own is still reported
+    # (in psi's sense: it leaves upwards, +90 on screen, read -90 with positive_turn cw)
+    given = measure_image(
+        turned, settings_for(fixed_end, positive_turn=turn, fixed_direction_deg=90.0)
+    )
+    assert given.base_direction_deg == pytest.approx(res.base_direction_deg, abs=1e-6)
 
 
 @pytest.mark.parametrize("bits", [10, 12, 16])

@@ -333,7 +333,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:16]) == [
+    assert list(par.columns[:17]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
@@ -341,6 +341,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "length_px",
         "width_px",
         "base_direction_deg",
+        "fixed_direction_deg",
         "method",
         "residual_px",
         "status",
@@ -352,7 +353,8 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "calibration_mm",
     ]
     assert par["base_direction_deg"].isna().all()  # drawn lines: no body base to share
-    assert list(par.columns[16:22]) == [
+    assert par["fixed_direction_deg"].isna().all()
+    assert list(par.columns[17:23]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -396,7 +398,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "6 ok" in run.stdout and "1 failed" in run.stdout
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[11:17]) == [
+    assert list(angles.columns[12:18]) == [
         "seconds",
         "degree",
         "l0_mm",

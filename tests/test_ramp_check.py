@@ -158,6 +158,26 @@ def test_a_body_whose_start_is_tilted_is_measured_from_its_ramps_base_direction(
     assert out["reason"].iloc[0] == ""  # moved by less than a degree: nothing to say
 
 
+def test_a_ramp_whose_bodies_leave_the_clamp_off_the_direction_given_says_so():
+    # a customer read fixed_direction_deg 15 off the clamp block; in the second trial the
+    # actuator sat 3 deg turned in it, and every psi was 3 deg off, ok, with nothing said: psi
+    # is still measured from the direction given, but every row says where the bodies leave
+    psi = _ds20_like()
+    base = 18.2 + 0.3 * np.sin(np.arange(12.0))
+    out = check_ramps(_bodies(psi, base, fixed_direction_deg=15.0))
+    np.testing.assert_allclose(out["psi_deg"], psi)  # not re-based on the bodies' own
+    assert (out["status"] == "ok").all()
+    assert out["reason"].str.contains(
+        r"leave the clamp at \+18\.\d deg \(the median of 12 photos\), \+3\.\d deg off the "
+        r"fixed_direction_deg given \(\+15\.0\)"
+    ).all(), out["reason"].iloc[0]
+    # within 3 deg of it (the bodies' own read up to 2.7 deg off the true one on rendered
+    # ramps), or its start not seen (no own direction), nothing is said
+    for near in (check_ramps(_bodies(psi, base - 0.5, fixed_direction_deg=15.0)),
+                 check_ramps(_bodies(psi, np.full(12, np.nan), fixed_direction_deg=15.0))):
+        assert (near["reason"] == "").all() and np.allclose(near["psi_deg"], psi)
+
+
 def test_a_body_leaving_far_off_its_ramps_direction_is_flagged():
     base = [0.0] * 11 + [-30.0]
     out = check_ramps(_bodies(_ds20_like(), base))

@@ -41,6 +41,7 @@ from pipeline.measure.quality import (
     Quality,
     assess,
     assess_body,
+    start_seen,
     tip_out_of_reach,
     tip_turn_deg,
 )
@@ -98,8 +99,10 @@ class AngleResult:
         A body's measured direction where it leaves the fixed end (deg, counter-clockwise from
         +x on screen, clockwise with ``positive_turn: cw``, so that psi is the free end's
         direction minus it; on the plane when calibrated): what
-        :func:`pipeline.ramp_check.share_base_direction` compares across a ramp.  NaN for a
-        line, with ``fixed_direction_deg`` given, or when failed.
+        :func:`pipeline.ramp_check.share_base_direction` compares across a ramp.  With
+        ``fixed_direction_deg`` given psi is not measured from it, but it is still read where
+        the body's start is seen (the ramp check compares the two).  NaN for a line, a body
+        whose start is not seen with the direction given, or when failed.
     """
 
     psi_deg: float
@@ -481,9 +484,13 @@ def measure_body(
         ),
         est, line, quality, settings, used,
     )
-    if base is not None or est is not tip:
+    own_base_deg = float(np.rad2deg(sign * start))
+    if base is not None:  # the body's own, beside the one given: where its start is seen
+        seen = start_seen(body.start_gap_px, line.width_px)
+        return replace(measured, base_direction_deg=own_base_deg if seen else float("nan"))
+    if est is not tip:
         return measured
-    return replace(measured, base_direction_deg=float(np.rad2deg(sign * start)))
+    return replace(measured, base_direction_deg=own_base_deg)
 
 
 def carried_on_psi_deg(

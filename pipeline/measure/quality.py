@@ -224,6 +224,18 @@ NOTE_SELECTION_COVERS = "selection covers"
 NOTES: tuple[str, ...] = (NOTE_FIXED_DIRECTION, NOTE_SIDE_ON_BORDER, NOTE_SELECTION_COVERS)
 
 
+def start_seen(start_gap_px: float, width_px: float) -> bool:
+    """Whether the body's centre line starts at ``fixed_end``: within two of its widths (and 4
+    px) of it, so that the direction in which the body leaves the clamp is read there.
+
+    Examples
+    --------
+    >>> start_seen(30.0, 20.0), start_seen(150.0, 20.0)
+    (True, False)
+    """
+    return start_gap_px <= 2.0 * width_px + 4.0
+
+
 def assess_body(
     line: LineExtraction,
     *,
@@ -377,7 +389,7 @@ def assess_body(
             "psi may miss part of the tip's turn; check with photoset preview, or give the empty "
             "scene (background)"
         )
-    if start_gap_px > 2.0 * line.width_px + 4.0 and base_mismatch_deg is None:
+    if not start_seen(start_gap_px, line.width_px) and base_mismatch_deg is None:
         # with the base known psi is the free end's tangent against it: the gap cannot change it
         # (nor is it noted: the overlay shows the fixed end given and where the line starts)
         flags.append(

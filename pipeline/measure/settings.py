@@ -194,6 +194,13 @@ class MeasureSettings:
         return 1.0 if self.positive_turn == "ccw" else -1.0
 
     @property
+    def base_given_deg(self) -> float:
+        """``fixed_direction_deg`` in the convention of a measured base direction (clockwise
+        with ``positive_turn: cw``, as psi); NaN when not given."""
+        given = self.fixed_direction_deg
+        return float("nan") if given is None else self.sign * given
+
+    @property
     def calibration_rms(self) -> tuple[float, float]:
         """Reprojection error (px, mm) of the camera calibration the photo is measured with
         (angles.csv's ``calibration_px`` and ``calibration_mm``); NaN without one."""
