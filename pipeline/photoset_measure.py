@@ -150,7 +150,7 @@ def measure_photoset(
         out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
     else:
         out = _measure_photos(ps, method, jobs, odir)
-    drawn = out[["status", "reason"]].copy()
+    drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
         out = check_ramps(out)
     if "calibration_px" in out.columns:
@@ -163,16 +163,20 @@ def measure_photoset(
 
 
 def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_dir: Path) -> None:
-    """Write the final status on the overlay of each photo whose status or reason the set's
-    checks changed after it was drawn (``drawn``: the per-photo ``status`` and ``reason``)."""
+    """Write the final status on the overlay of each photo whose status, reason or psi (as
+    drawn, to 0.1 deg) the set's checks changed after it was drawn (``drawn``: the per-photo
+    ``status``, ``reason`` and ``psi_deg``)."""
     from pipeline.measure.overlay import note_final_status
 
-    changed = (angles["status"] != drawn["status"]) | (angles["reason"] != drawn["reason"])
-    for image, status, reason, drawn_reason in zip(
+    moved = (angles["psi_deg"] - drawn["psi_deg"]).abs() >= 0.05
+    changed = (angles["status"] != drawn["status"]) | (angles["reason"] != drawn["reason"]) | moved
+    for image, status, reason, drawn_reason, psi, psi_moved in zip(
         angles.loc[changed, "image"],
         angles.loc[changed, "status"],
         angles.loc[changed, "reason"],
         drawn.loc[changed, "reason"],
+        angles.loc[changed, "psi_deg"],
+        moved[changed],
         strict=True,
     ):
         path = overlays_dir / overlay_name(str(image))
@@ -181,7 +185,9 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
             continue
         ok, buf = cv2.imencode(
             ".jpg",
-            note_final_status(img, str(status), str(reason), str(drawn_reason)),
+            note_final_status(
+                img, str(status), str(reason), str(drawn_reason), psi if psi_moved else None
+            ),
             [cv2.IMWRITE_JPEG_QUALITY, 85],
         )
         if ok:

@@ -203,3 +203,24 @@ def test_an_overlay_marks_the_fixed_end_where_it_was_given_with_the_clamps_direc
     # without a given fixed end, the line's start is marked as before
     photo = draw_overlay(img, res)[-480:].astype(int)
     assert blue(150, 294) and not blue(50, 200)
+    # without a direction given, the body's own that psi was measured from is drawn from there
+    photo = draw_overlay(img, res, base_direction_deg=90.0)[-480:].astype(int)
+    assert blue(150, 200) and not blue(50, 200)
+
+
+def test_an_overlay_whose_psi_the_ramps_base_direction_moved_says_its_final_psi(tmp_path):
+    # a customer found an overlay's psi 0.8 deg from angles.csv's with nothing said: the ramp's
+    # shared base direction moved it by less than the 1 deg that writes a reason; the final psi
+    # is written below the photo, and an overlay whose row nothing changed is left as drawn
+    import cv2
+    import pandas as pd
+
+    from pipeline.photoset_measure import note_changed_statuses
+
+    for name in ("a.jpg", "b.jpg"):
+        cv2.imwrite(str(tmp_path / name), np.full((200, 300, 3), 128, np.uint8))
+    drawn = pd.DataFrame({"status": "ok", "reason": "", "psi_deg": [215.2, 100.0]})
+    final = drawn.assign(image=["a.jpg", "b.jpg"], psi_deg=[214.4, 100.0])
+    note_changed_statuses(final, drawn, tmp_path)
+    assert cv2.imread(str(tmp_path / "a.jpg")).shape[0] > 200
+    assert cv2.imread(str(tmp_path / "b.jpg")).shape[0] == 200

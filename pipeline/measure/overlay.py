@@ -55,11 +55,19 @@ def draw_fixed_end(
     centre = tuple(np.round(fe).astype(int).tolist())
     cv2.circle(image_bgr, centre, 6, FIXED_END_BGR, 2, cv2.LINE_AA)
     if fixed_direction_deg is not None:
-        a = np.deg2rad(fixed_direction_deg)
-        length = DIRECTION_LENGTH_FRACTION * image_bgr.shape[1]
-        far = fe + length * np.array([np.cos(a), -np.sin(a)])
-        ends = np.round(np.array([fe, far]) * 16).astype(int).tolist()  # 4 fractional bits
-        cv2.line(image_bgr, ends[0], ends[1], FIXED_END_BGR, 1, cv2.LINE_AA, 4)
+        draw_direction(image_bgr, fe, fixed_direction_deg)
+
+
+def draw_direction(
+    image_bgr: np.ndarray, from_xy: Sequence[float] | np.ndarray, direction_deg: float
+) -> None:
+    """A thin straight line from ``from_xy`` in ``direction_deg`` (counter-clockwise from +x on
+    screen), :data:`DIRECTION_LENGTH_FRACTION` of the picture's width long (in place)."""
+    start = np.asarray(from_xy, dtype=float)
+    a = np.deg2rad(direction_deg)
+    far = start + DIRECTION_LENGTH_FRACTION * image_bgr.shape[1] * np.array([np.cos(a), -np.sin(a)])
+    ends = np.round(np.array([start, far]) * 16).astype(int).tolist()  # 4 fractional bits
+    cv2.line(image_bgr, ends[0], ends[1], FIXED_END_BGR, 1, cv2.LINE_AA, 4)
 
 
 def draw_overlay(
@@ -70,6 +78,7 @@ def draw_overlay(
     title: str = "",
     fixed_end_px: Sequence[float] | None = None,
     fixed_direction_deg: float | None = None,
+    base_direction_deg: float | None = None,
 ) -> np.ndarray:
     """The photo with the extracted centre line and the fixed end drawn on it, and psi written in
     a band above it (not over it: a tip near the photo's top edge stays in view).
@@ -88,6 +97,9 @@ def draw_overlay(
         The fixed end as given (original px), marked where it is; without it the line's start.
     fixed_direction_deg : float, optional
         The clamp's direction as given, drawn from the fixed end (:func:`draw_fixed_end`).
+    base_direction_deg : float, optional
+        Without one given, the body's own base direction psi was measured from (deg
+        counter-clockwise from +x on screen), drawn from the line's start.
 
     Returns
     -------
@@ -113,6 +125,9 @@ def draw_overlay(
         draw_fixed_end(out, (np.asarray(fixed_end_px) - (scale - 1) / 2) * k, fixed_direction_deg)
     elif len(result.centreline_px):
         draw_fixed_end(out, pts[0], None)
+    drawn_from = pts[0] if len(result.centreline_px) else None
+    if fixed_direction_deg is None and base_direction_deg is not None and drawn_from is not None:
+        draw_direction(out, drawn_from, base_direction_deg)
     lines = overlay_lines(result, title, out.shape[1], out.shape[0])
     band = np.full((12 + LINE_PX * len(lines), out.shape[1], 3), BAND_BGR, np.uint8)
     band[-2:] = DIVIDER_BGR
@@ -130,12 +145,19 @@ def draw_overlay(
     return np.vstack([band, out])
 
 
-def final_status_text(status: str, reason: str, drawn_reason: str = "") -> str:
-    """What :func:`note_final_status` writes: the final status and the reason, less the part of
-    it the overlay already shows (``drawn_reason``).
+def final_status_text(
+    status: str, reason: str, drawn_reason: str = "", psi_deg: float | None = None
+) -> str:
+    """What :func:`note_final_status` writes: the final status, psi when the ramp's base direction
+    changed it (``psi_deg``), and the reason, less the part of it the overlay already shows
+    (``drawn_reason``).
 
     Examples
     --------
+    >>> final_status_text("ok", "", "", psi_deg=214.43)
+    "then ok, psi +214.4 deg against its ramp's base direction"
+    >>> final_status_text("ok", "psi +212.0 deg against its ramp's base direction (...)", "", 212.0)
+    "then ok: psi +212.0 deg against its ramp's base direction (...)"
     >>> final_status_text("flagged", "breaks its ramp: psi -188; tip hook", "tip hook")
     'then flagged: also breaks its ramp: psi -188'
     >>> final_status_text("flagged", "a; b; c", "b")
@@ -146,11 +168,17 @@ def final_status_text(status: str, reason: str, drawn_reason: str = "") -> str:
     if drawn_reason and drawn_reason in reason and drawn_reason != reason:
         rest = re.sub(r"(;\s*)+", "; ", reason.replace(drawn_reason, "")).strip("; ")
         reason = f"also {rest}"
-    return f"then {status}" + (f": {reason}" if reason else "")
+    said = "against its ramp's base direction"
+    moved = "" if psi_deg is None or said in reason else f", psi {psi_deg:+.1f} deg {said}"
+    return f"then {status}{moved}" + (f": {reason}" if reason else "")
 
 
 def note_final_status(
-    overlay_bgr: np.ndarray, status: str, reason: str, drawn_reason: str = ""
+    overlay_bgr: np.ndarray,
+    status: str,
+    reason: str,
+    drawn_reason: str = "",
+    psi_deg: float | None = None,
 ) -> np.ndarray:
     """The overlay with the photo's final status written in a band below it.
 
@@ -159,7 +187,7 @@ def note_final_status(
     table flags, nor the other way round.  Of ``reason``, what the overlay already shows
     (``drawn_reason``) is left out.
     """
-    text = final_status_text(status, reason, drawn_reason)
+    text = final_status_text(status, reason, drawn_reason, psi_deg)
     room = max(1, min(REASON_LINES, int(0.25 * overlay_bgr.shape[0] / LINE_PX)))
     lines = wrap_text(text, overlay_bgr.shape[1] - 16, TEXT_SCALE, room)
     band = np.full((14 + LINE_PX * len(lines), overlay_bgr.shape[1], 3), BAND_BGR, np.uint8)

@@ -96,6 +96,11 @@ def write_overlay(
         title=title,
         fixed_end_px=given.fixed_end_px if given else None,
         fixed_direction_deg=given.fixed_direction_deg if given else None,
+        base_direction_deg=(
+            given.sign * res.base_direction_deg  # on screen (not on a calibrated plane)
+            if given and given.calibration is None and np.isfinite(res.base_direction_deg)
+            else None
+        ),
     )
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # a photo in a subfolder of its set
     cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])

@@ -61,8 +61,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=None,
         metavar="DIR",
-        help="'measure --overlays' folder of each dataset (DIR/<image stem>.jpg, extracted line "
-        "drawn)",
+        help="'measure --overlays' folder of each dataset (each photo's path in its set as a "
+        ".jpg, e.g. DIR/trial1/IMG_0001.jpg; extracted line drawn)",
     )
     parser.add_argument(
         "--hysteresis",
