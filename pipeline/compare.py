@@ -342,6 +342,25 @@ def bootstrap_k_p(
     return k_p, float(lo), float(hi), len(fits)
 
 
+def rest_angle_deg(hysteresis: pd.DataFrame) -> float:
+    """psi0 of an actuator the model does not know: the mean psi at the lowest pressure of the
+    rising curve (its rest angle), else :data:`~pipeline.constants.PSI0_DEG` (the paper's).
+
+    Examples
+    --------
+    >>> rest_angle_deg(pd.DataFrame({"direction": ["up", "up", "down"],
+    ...     "pressure_kpa": [0.0, 20.0, 0.0], "psi_mean_deg": [213.1, 190.0, 208.0]}))
+    213.1
+    >>> rest_angle_deg(pd.DataFrame({"direction": ["down"], "pressure_kpa": [0.0],
+    ...     "psi_mean_deg": [208.0]}))
+    210.0
+    """
+    up = hysteresis[(hysteresis["direction"] == "up") & hysteresis["psi_mean_deg"].notna()]
+    if up.empty:
+        return PSI0_DEG
+    return float(up.loc[up["pressure_kpa"].idxmin(), "psi_mean_deg"])
+
+
 def compare_material(
     material: str,
     hyst_material: pd.DataFrame,
@@ -656,8 +675,8 @@ def compare(
         the model does not know, or an l0 it refuses (the callable raises
         :class:`UserInputError`), gets NaN model columns, the reason in ``note`` and a warning.
     psi0_deg : mapping, optional
-        Rest angle per material (deg); :data:`pipeline.constants.PSI0_DEG` (the paper's) for
-        materials not listed.
+        Rest angle per material (deg); materials not listed (not in the model's table) use their
+        own, measured (:func:`rest_angle_deg`), and ``note`` says so.
     default_l0_mm : mapping, optional
         The model's l0 per material for datasets without their own (materials not listed: the
         callables get ``l0_mm=None``, the model's own default).
@@ -721,8 +740,12 @@ def compare(
             if run_fit is not None and usable
             else None
         )
-        material_psi0_deg = float(run_psi0.get(material, PSI0_DEG))
         note = group.note
+        material_psi0_deg = run_psi0.get(material)
+        rest = ""
+        if material_psi0_deg is None:  # a material the model does not know: its own rest angle
+            material_psi0_deg = rest_angle_deg(hm)
+            rest = f"psi0 {material_psi0_deg:.1f} deg: its rest angle, measured"
         try:
             rec = compare_material(
                 material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, psi0_deg=material_psi0_deg,
@@ -739,6 +762,7 @@ def compare(
             )
         if note and group.note:
             warnings.warn(f"{group.curve}: {note}", stacklevel=2)
+        note = "; ".join(n for n in (note, rest) if n)
         data = [sources.get(d, "unknown") for d in group.datasets]
         rec.update(
             curve=group.curve,

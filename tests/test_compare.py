@@ -170,6 +170,8 @@ def test_unknown_material_keeps_data_metrics():
         and out["range_deg"] == 250.0
         and math.isnan(out["paper_rms_deg"])
     )
+    # P at psi = -psi0 from its own rest angle (200 deg at 0 kPa rising), not the paper's 210
+    assert out["psi0_deg"] == 200.0 and "psi0 200.0 deg: its rest angle, measured" in out["note"]
 
 
 def test_bad_hysteresis_table():
