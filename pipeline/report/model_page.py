@@ -40,6 +40,29 @@ RMS_KIND_TEXT: dict[str, str] = {
 }
 
 
+def curve_lines(rms: pd.DataFrame) -> list[str]:
+    """Per model curve of ``rms`` (rms.csv): what its RMS is (only where there is one: a curve
+    without a model compares nothing) and its note.
+
+    Examples
+    --------
+    >>> rms = pd.DataFrame({"curve": ["DS20", "Pink"], "rms_deg": [12.0, float("nan")],
+    ...                     "rms_kind": ["unknown", "unknown"], "note": ["", "no model"]})
+    >>> [line[:30] for line in curve_lines(rms)]
+    ['DS20: source of the photos not', 'Pink: no model.']
+    """
+    lines = []
+    for r in rms.itertuples():
+        kind = str(getattr(r, "rms_kind", ""))
+        rms_deg = pd.to_numeric(getattr(r, "rms_deg", math.nan), errors="coerce")
+        if kind in RMS_KIND_TEXT and math.isfinite(rms_deg):
+            lines.append(f"{r.curve}: {RMS_KIND_TEXT[kind]}.")
+        note = getattr(r, "note", "")
+        if isinstance(note, str) and note:
+            lines.append(f"{r.curve}: {note}.")
+    return lines
+
+
 def _has(data: ReportData, column: str) -> bool:
     return column in data.rms.columns
 
@@ -150,13 +173,7 @@ def model_provenance_page(data: ReportData) -> Figure | None:
             "its own model curve and row."
         ),
     ]
-    for r in data.rms.itertuples():
-        kind = str(getattr(r, "rms_kind", ""))
-        if kind in RMS_KIND_TEXT:
-            lines.append(f"{r.curve}: {RMS_KIND_TEXT[kind]}.")
-        note = getattr(r, "note", "")
-        if isinstance(note, str) and note:
-            lines.append(f"{r.curve}: {note}.")
+    lines += curve_lines(data.rms)
     flow.space(4.0)
     flow.bullets(lines, size=8.0)
     return fig
