@@ -70,7 +70,10 @@ def run(args: argparse.Namespace) -> int:
     write_angles(angles, args.out)
     for problem in newer_spreadsheet_problems(Path(args.photoset)):
         print(problem, file=sys.stderr)
+    used = sorted(set(angles["method"].dropna().astype(str)) - {args.method})
+    took = f" (rows say which it took: {', '.join(used)})" if used else ""
     print(
-        f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method} -> {args.out}"
+        f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method}{took} -> "
+        f"{args.out}"
     )
     return 0

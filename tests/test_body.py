@@ -913,3 +913,19 @@ def test_a_scientific_cameras_16_bit_photo_is_measured_and_picked_like_its_8_bit
         assert main(["photoset", "pick-color", str(tmp_path / name), "--at", on_body]) == 0
         picked.append(capsys.readouterr().out.splitlines()[0])
     assert picked[0] == picked[1] and picked[0].startswith("line_color:"), picked
+
+
+def test_measure_says_which_method_auto_took_for_a_body(tmp_path, capsys):
+    # a customer's body set printed "method auto" while every row said tangents
+    from pipeline.cli import main
+
+    img, fe, _ = body_photo(100.0, seed=5)
+    cv2.imwrite(str(tmp_path / "p.png"), img)
+    (tmp_path / "photoset.yaml").write_text(
+        f"l0_mm: 180\ntarget: body\nfixed_end: [{fe[0]:.1f}, {fe[1]:.1f}]\n"
+    )
+    (tmp_path / "manifest.csv").write_text(
+        "image,pressure_kpa,direction,material,actuator,trial\np.png,0,up,DS20,A1,1\n"
+    )
+    assert main(["measure", str(tmp_path), "--out", str(tmp_path / "a.csv")]) == 0
+    assert "method auto (rows say which it took: tangents) ->" in capsys.readouterr().out

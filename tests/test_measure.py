@@ -396,6 +396,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     )
     assert run.returncode == 0, run.stderr
     assert "6 ok" in run.stdout and "1 failed" in run.stdout
+    assert "method turning ->" in run.stdout  # what was asked is what every row took
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
     assert list(angles.columns[12:18]) == [
