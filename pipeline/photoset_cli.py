@@ -216,8 +216,8 @@ def run(args: argparse.Namespace) -> int:
         out = args.out or f"{Path(args.folder).resolve().name}_preview.jpg"
         path, n = write_preview(args.folder, out, every=args.all)
         print(
-            f"wrote {path}: {n} photo(s); green = ok, orange = flagged, tinted = what the settings "
-            "select"
+            f"wrote {path}: {n} photo(s) or frame(s); green = ok, orange = flagged, tinted = what "
+            "the settings select"
         )
         return 0
     if args.photoset_command == "pick-color":
@@ -358,15 +358,10 @@ def _print_next(args: argparse.Namespace, kept: bool) -> None:
             "were not written into it): edit it, or delete it and run init again"
         )
         return
-    look = (
-        "then 'measure ... --overlays DIR' to see the frames"
-        if args.pressure_log is not None
-        else "then 'photoset preview'"
-    )
     print(
         f"wrote {args.folder}/{photoset.SETTINGS}: "
         + ("next: set l0_mm in it, then run" if args.l0_mm is None else "next: run")
-        + f" 'python -m pipeline photoset check {args.folder}', {look}"
+        + f" 'python -m pipeline photoset check {args.folder}', then 'photoset preview'"
     )
 
 

@@ -29,6 +29,9 @@ from pipeline.measure.extract import line_mask, region_mask
 from pipeline.measure.overlay import draw_fixed_end, wrap_text
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
+from pipeline.video.clips import Clip, resolve_clips
+from pipeline.video.reader import read_frames
+from pipeline.video.timeline import frame_conditions
 
 TILE_WIDTH_PX = 480
 #: size of the words on a tile (OpenCV simplex font scale) and how many lines a reason may take
@@ -75,11 +78,25 @@ def preview_tile(
 ) -> np.ndarray:
     """The preview of one photo: annotated photo beside its selection mask (BGR)."""
     data = np.fromfile(str(path), dtype=np.uint8) if Path(path).is_file() else np.empty(0, np.uint8)
+    return encoded_tile(data, Path(path).name, settings, method=method, title=title, reason=reason)
+
+
+def encoded_tile(
+    data: np.ndarray,
+    name: str,
+    settings: MeasureSettings | None,
+    *,
+    method: str = "auto",
+    title: str = "",
+    reason: str = "",
+) -> np.ndarray:
+    """:func:`preview_tile` of an encoded image (``data``: its bytes, e.g. a video's frame as a
+    JPEG packet; ``name`` for messages)."""
     img, f = decode_for_work(data) if data.size else (None, 1)
     if img is None or settings is None:
         blank = np.full((TILE_WIDTH_PX * 3 // 4, 2 * TILE_WIDTH_PX, 3), 60, np.uint8)
         why = reason or (
-            f"{Path(path).name} cannot be read" if img is None else "row cannot be measured"
+            f"{name} cannot be read" if img is None else "row cannot be measured"
         )
         for i, t in enumerate((title, "failed", why[:110])):
             cv2.putText(
@@ -242,6 +259,60 @@ def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
     return rows
 
 
+def frame_pressures_kpa(clip: Clip) -> np.ndarray:
+    """The logged pressure (kPa) at each frame of a video (NaN without a log)."""
+    if clip.log is None:
+        return np.full(clip.n_frames, np.nan)
+    times = clip.nominal_video_times_s() + clip.clock_offset_s
+    return frame_conditions(clip.log, times)["pressure_kpa"].to_numpy(float)
+
+
+def preview_frames(pressure_kpa: np.ndarray) -> list[int]:
+    """The frames a preview shows of a video whose frames are at ``pressure_kpa``: the first, the
+    last at the highest pressure (the most bent: at the end of a held step, settled) and the last.
+
+    Examples
+    --------
+    >>> preview_frames(np.array([0.0, 40.0, 80.0, 80.0, 40.0, 0.0])), preview_frames(np.zeros(1))
+    ([0, 3, 5], [0])
+    """
+    finite = np.isfinite(pressure_kpa)
+    top = 0
+    if finite.any():
+        top = int(np.flatnonzero(pressure_kpa == np.max(pressure_kpa[finite]))[-1])
+    return list(dict.fromkeys((0, top, len(pressure_kpa) - 1)))
+
+
+def video_tiles(ps: PhotoSet, method: str = "auto") -> list[np.ndarray]:
+    """The preview tiles of a video photo set: of every video its first frame, the one at the
+    highest logged pressure (the most bent) and its last."""
+    tiles = []
+    for clip in resolve_clips(ps):
+        if not clip.info.opened or not clip.n_frames:
+            blank = np.empty(0, np.uint8)
+            why = "; ".join(clip.problems) or "video holds no frame"
+            tiles.append(encoded_tile(blank, clip.video, None, title=clip.video, reason=why))
+            continue
+        pressure = frame_pressures_kpa(clip)
+        for k in preview_frames(pressure):
+            frame = next(read_frames(clip.info, k, 1))
+            data = (
+                np.empty(0, np.uint8)
+                if frame.data is None
+                else frame.data
+                if frame.data.ndim == 1
+                else cv2.imencode(".png", frame.data)[1]
+            )
+            title = f"{clip.video} frame {k}" + (
+                f"  {pressure[k]:g} kPa" if np.isfinite(pressure[k]) else ""
+            )
+            tiles.append(
+                encoded_tile(data, f"{clip.video} frame {k}", ps.rows[clip.position],
+                             method=method, title=title, reason=frame.reason)
+            )
+    return tiles
+
+
 def write_preview(
     folder: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -262,14 +333,8 @@ def write_preview(
             "or .png)"
         )
     ps = load_photoset(folder)
-    if ps.is_video:
-        raise UserInputError(
-            f"{folder}: lists videos; preview reads photos. Measure the set with --overlays DIR: "
-            "it "
-            "draws 24 frames of each video and a contact sheet"
-        )
-    tiles = []
-    for i in preview_rows(ps, every):
+    tiles = video_tiles(ps, method) if ps.is_video else []
+    for i in [] if ps.is_video else preview_rows(ps, every):
         row = ps.manifest.iloc[i]
         title = (
             f"{row['image']}  {row['material']} {row['actuator']} t{row['trial']}  "

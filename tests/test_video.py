@@ -435,3 +435,17 @@ def test_init_writes_a_video_sets_manifest_from_its_pressure_log(
     out = measure_photoset(folder, jobs=1)
     pd.testing.assert_frame_equal(out[MEASURED], measured[MEASURED])
     assert {"calibration_px", "calibration_mm"} <= set(measured.columns)
+
+
+def test_the_preview_of_a_video_set_shows_its_first_most_bent_and_last_frames(video_set, tmp_path):
+    # the README's step 2 is the preview; it refused a video set ("preview reads photos")
+    from pipeline.photoset import load_photoset
+    from pipeline.preview import frame_pressures_kpa, preview_frames, write_preview
+    from pipeline.video.clips import resolve_clips
+
+    path, tiles = write_preview(video_set, tmp_path / "sheet.png")
+    assert tiles == 3 and cv2.imread(str(path)) is not None
+    (clip,) = resolve_clips(load_photoset(video_set))
+    pressure = frame_pressures_kpa(clip)
+    first, top, last = preview_frames(pressure)
+    assert (first, last) == (0, 134) and pressure[top] == 80.0
