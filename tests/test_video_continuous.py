@@ -3,6 +3,7 @@ loops."""
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -33,6 +34,22 @@ def test_first_order_step_gives_its_closed_form_times():
         and r["note"] == ""
         and r["change"] == pytest.approx(30.0, abs=0.01)
     )
+
+
+def test_a_hold_whose_last_frames_are_flagged_has_no_final_value():
+    # a customer's step down to 40 kPa: the tip left the photo once the actuator straightened,
+    # so the hold's last frames were flagged, and its "final value" came from the frames on the
+    # way there (a change of 66 deg where it was about 124); flagged frames come as NaN
+    psi = _first_order(0.3)
+    late = psi.copy()
+    late[T > 4.0] = np.nan  # the last third of the hold not used
+    r = step_response(T, late, step_time_s=1.0, before_deg=50.0)
+    assert math.isnan(r["change"]) and "of the last" in r["note"] and "no final value" in r["note"]
+    # one flagged frame at the end leaves the rest of the end to give it
+    one = psi.copy()
+    one[-1] = np.nan
+    r = step_response(T, one, step_time_s=1.0, before_deg=50.0)
+    assert r["change"] == pytest.approx(30.0, abs=0.01) and r["note"] == ""
 
 
 def test_underdamped_step_gives_its_overshoot_and_settling():

@@ -252,7 +252,9 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     Parameters
     ----------
     time_s, values : ndarray
-        The series over the hold that follows the step (frames at or after ``step_time_s``).
+        The series over the hold that follows the step (frames at or after ``step_time_s``); NaN
+        where a frame is not used (flagged or failed): a hold whose last frames are has no final
+        value.
     step_time_s : float
         When the step was applied (s).
     before_deg : float
@@ -268,7 +270,11 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     """
     t = np.asarray(time_s, float)
     y = np.asarray(values, float)
-    keep = np.isfinite(y) & (t >= step_time_s)
+    after = t >= step_time_s
+    t, y = t[after], y[after]
+    # the end of the hold, over every frame of it: NaN where a frame is not used (flagged)
+    end_ok = np.isfinite(y[-max(SETTLED_MIN_FRAMES, round(SETTLED_FRACTION * t.size)):])
+    keep = np.isfinite(y)
     t, y = t[keep], y[keep]
     nan = math.nan
     out: dict[str, float | str] = {
@@ -283,7 +289,12 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     if t.size < 5 or not math.isfinite(before_deg):
         out["note"] = "too few frames around the step"
         return out
-    tail = max(SETTLED_MIN_FRAMES, round(SETTLED_FRACTION * t.size))
+    tail = int(end_ok.sum())
+    if tail < SETTLED_MIN_FRAMES:  # the frames before it are the way there, not its final value
+        out["note"] = (
+            f"{tail} of the last {end_ok.size} frames of the hold are ok: no final value"
+        )
+        return out
     final = float(np.mean(y[-tail:]))
     change = final - before_deg
     sd = noise_sd(y) if noise is None else noise
@@ -336,8 +347,8 @@ def steps(
             before = float(before_rows["psi_deg"].mean()) if len(before_rows) else math.nan
             mine = hold[hold["_used"]]
             r = step_response(
-                mine["time_s"].to_numpy(),
-                mine["psi_deg"].to_numpy(),
+                hold["time_s"].to_numpy(),
+                hold["psi_deg"].where(hold["_used"]).to_numpy(float),
                 step_time_s=t_step,
                 before_deg=before,
                 noise=sd,
