@@ -316,8 +316,13 @@ def read_settings(folder: str | os.PathLike[str]) -> dict[str, Any]:
 
 
 def write_settings(folder: str | os.PathLike[str], settings: Mapping[str, Any]) -> None:
-    """Write ``photoset.yaml`` atomically (defaults filled in, keys in a stable order)."""
-    data = {**SETTING_DEFAULTS, **dict(settings)}
+    """Write ``photoset.yaml`` atomically (defaults filled in, keys in a stable order; a key with
+    no value is left out, but ``l0_mm``, which has to be set: ``l0_mm: null`` says so)."""
+    data = {
+        k: v
+        for k, v in {**SETTING_DEFAULTS, **dict(settings)}.items()
+        if v is not None or k == "l0_mm"
+    }
     if isinstance(data.get("fixed_end"), tuple):
         data["fixed_end"] = [float(x) for x in data["fixed_end"]]
     text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)

@@ -281,11 +281,9 @@ def _calibrate(args: argparse.Namespace) -> int:
 
 def _init(args: argparse.Namespace) -> int:
     defaults = {k: getattr(args, k) for k in ("material", "actuator", "trial") if getattr(args, k)}
-    settings: dict[str, object] = {
-        "l0_mm": args.l0_mm,
-        "mm_per_px": args.mm_per_px,
-        "positive_turn": args.positive_turn,
-    }
+    settings: dict[str, object] = {"l0_mm": args.l0_mm, "positive_turn": args.positive_turn}
+    if args.mm_per_px is not None:  # without a ruler the key is left out, not written empty
+        settings["mm_per_px"] = args.mm_per_px
     if args.target != "line":
         settings["target"] = args.target
     if args.line_color is not None or args.target == "line":

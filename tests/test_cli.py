@@ -61,6 +61,8 @@ def test_photoset_init_then_check(photo_folder):
     )
     assert out.returncode == 0, out.stderr
     assert "8 photos (6 up, 2 down)" in out.stdout
+    written = (photo_folder / "photoset.yaml").read_text()
+    assert "l0_mm: 200" in written and "mm_per_px" not in written  # not "mm_per_px: null"
     out = _run("photoset", "check", str(photo_folder))
     assert out.returncode == 0, out.stderr
     # warnings (no mm_per_px, an empty first photo) do not fail the check
