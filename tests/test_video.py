@@ -449,3 +449,8 @@ def test_the_preview_of_a_video_set_shows_its_first_most_bent_and_last_frames(vi
     pressure = frame_pressures_kpa(clip)
     first, top, last = preview_frames(pressure)
     assert (first, last) == (0, 134) and pressure[top] == 80.0
+    # a video that cannot be opened is one tile saying so, not a crash
+    broken = _copy(video_set, tmp_path)
+    _video(broken).write_bytes(b"not a video")
+    path, tiles = write_preview(broken, tmp_path / "broken.png")
+    assert tiles == 1 and cv2.imread(str(path)) is not None
