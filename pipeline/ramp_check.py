@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS
+from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
@@ -74,6 +74,11 @@ BASE_SHIFT_PHOTOS = 3
 #: its clamp (a customer's second trial: 3.2 deg).  Given their true direction, the bodies' own
 #: read up to 2.7 deg off it on 26 rendered ramps (translucent ones, and at 12 MP)
 GIVEN_OFF_DEG = 3.0
+#: ... and more than this (deg) off it flags every row: psi may be that far off (a customer's
+#: second trial, remounted turned 4 deg, the direction given once for both: every psi 5-8 deg
+#: off, ``ok``).  Above the bodies' own error (2.7 deg at most, see above) with room to spare,
+#: so a direction given within a degree or two of the truth is never doubted for it
+GIVEN_FLAG_DEG = 5.0
 
 
 def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
@@ -274,17 +279,22 @@ def _compare_given(
 ) -> None:
     """Note in every row of ``ramp`` (in place in ``out``) when its bodies' own base directions
     (``own``), agreeing among themselves, lie more than :data:`GIVEN_OFF_DEG` from the
-    ``fixed_direction_deg`` given (``given``, in the same convention).
+    ``fixed_direction_deg`` given (``given``, in the same convention); flag its measured rows
+    when they lie more than :data:`GIVEN_FLAG_DEG` from it.  psi stays measured from the
+    direction given.
 
     Examples
     --------
     >>> df = pd.DataFrame({"reason": [""] * 6, "status": "ok"})
     >>> _compare_given(df, df, np.array([18.2, 18.0, 18.4, np.nan, 18.1, 18.3]), np.full(6, 15.0))
-    >>> df["reason"].iloc[0][:78]
-    'the bodies of this ramp leave the clamp at +18.2 deg (the median of 5 photos),'
+    >>> df["reason"].iloc[0][:78], df["status"].iloc[0]
+    ('the bodies of this ramp leave the clamp at +18.2 deg (the median of 5 photos),', 'ok')
     >>> _compare_given(df := df.assign(reason=""), df, np.full(6, 17.5), np.full(6, 15.0))
     >>> df["reason"].iloc[0]
     ''
+    >>> _compare_given(df, df, np.full(6, 21.0), np.full(6, 15.0))
+    >>> df["status"].iloc[0], df["reason"].iloc[0][:22]
+    ('flagged', 'psi may be 6.0 deg off')
     """
     ok = np.isfinite(own) & np.isfinite(given) & (ramp["status"] != "failed").to_numpy()
     if ok.sum() < BASE_MIN_PHOTOS:
@@ -294,16 +304,25 @@ def _compare_given(
     if abs(median) <= GIVEN_OFF_DEG or float(np.median(np.abs(off - median))) > BASE_SPREAD_DEG:
         return
     stated = float(np.median(given[ok]))
+    seen = f"{stated + median:+.1f} deg (the median of {int(ok.sum())} photos)"
+    fix = (
+        "if the actuator sits turned in its clamp, give this ramp's rows their own "
+        f"fixed_direction_deg in manifest.csv ({stated + median:+.1f}), or leave the key out "
+        "where the base is seen (photoset preview draws the one given along the base)"
+    )
     note = (
-        f"the bodies of this ramp leave the clamp at {stated + median:+.1f} deg (the median of "
-        f"{int(ok.sum())} photos), {median:+.1f} deg off the fixed_direction_deg given "
-        f"({stated:+.1f}), which psi is measured from: if the actuator sits turned in its clamp, "
-        "give its own (photoset preview draws the one given along the base)"
+        f"psi may be {abs(median):.1f} deg off: it is measured from the fixed_direction_deg "
+        f"given ({stated:+.1f}), but the bodies of this ramp leave the clamp at {seen}, so {fix}"
+        if abs(median) > GIVEN_FLAG_DEG
+        else f"{NOTE_GIVEN_OFF} {seen}, {median:+.1f} deg off the "
+        f"fixed_direction_deg given ({stated:+.1f}), which psi is measured from: {fix}"
     )
     rows = ramp.index
     out.loc[rows, "reason"] = [
         _join(r, note) for r in out.loc[rows, "reason"].fillna("").astype(str)
     ]
+    if abs(median) > GIVEN_FLAG_DEG:
+        out.loc[rows[(ramp["status"] == "ok").to_numpy()], "status"] = "flagged"
 
 
 def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None) -> None:

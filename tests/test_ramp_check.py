@@ -178,6 +178,29 @@ def test_a_ramp_whose_bodies_leave_the_clamp_off_the_direction_given_says_so():
         assert (near["reason"] == "").all() and np.allclose(near["psi_deg"], psi)
 
 
+def test_a_ramp_whose_bodies_leave_the_clamp_far_off_the_direction_given_is_flagged():
+    # a customer gave one direction for two trials; the second was remounted 4 deg turned and
+    # its bodies leave 5.1 deg off it (their own read 1.5 deg off the truth): every psi 5-8 deg
+    # off, ok.  psi stays measured from the direction given, but the rows are flagged, naming
+    # the bodies' own direction and where to give it
+    psi = _ds20_like()
+    base = 43.9 + 0.3 * np.sin(np.arange(12.0))
+    angles = _bodies(psi, base, fixed_direction_deg=49.0)
+    angles.loc[3, "status"] = "failed"
+    out = check_ramps(angles)
+    np.testing.assert_allclose(out["psi_deg"], psi)
+    assert out["status"].tolist() == ["flagged"] * 3 + ["failed"] + ["flagged"] * 8
+    assert out["reason"].str.startswith("psi may be 5.1 deg off: it is measured from the "
+                                        "fixed_direction_deg given (+49.0)").all()
+    assert out["reason"].str.contains(
+        r"their own fixed_direction_deg in manifest\.csv \(\+43\.9\)"
+    ).all(), out["reason"].iloc[0]
+    # 4.5 deg off: said, not flagged (the bodies' own read up to 2.7 deg off the true one)
+    near = check_ramps(_bodies(psi, base + 0.6, fixed_direction_deg=49.0))
+    assert (near["status"] == "ok").all()
+    assert near["reason"].str.contains(r"-4\.\d deg off the fixed_direction_deg given").all()
+
+
 def test_a_body_leaving_far_off_its_ramps_direction_is_flagged():
     base = [0.0] * 11 + [-30.0]
     out = check_ramps(_bodies(_ds20_like(), base))

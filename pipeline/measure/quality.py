@@ -221,7 +221,11 @@ BASE_MISMATCH_DEG = 20.0
 NOTE_FIXED_DIRECTION = "psi from the free end's tangent against fixed_direction_deg"
 NOTE_SIDE_ON_BORDER = "a side runs along the image border"
 NOTE_SELECTION_COVERS = "selection covers"
-NOTES: tuple[str, ...] = (NOTE_FIXED_DIRECTION, NOTE_SIDE_ON_BORDER, NOTE_SELECTION_COVERS)
+#: the ramp check's note where a ramp's bodies leave the clamp a little off fixed_direction_deg
+NOTE_GIVEN_OFF = "the bodies of this ramp leave the clamp at"
+NOTES: tuple[str, ...] = (
+    NOTE_FIXED_DIRECTION, NOTE_SIDE_ON_BORDER, NOTE_SELECTION_COVERS, NOTE_GIVEN_OFF
+)
 
 
 def start_seen(start_gap_px: float, width_px: float) -> bool:

@@ -14,6 +14,8 @@ Examples
 'no marker line found'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
+>>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
+'bodies leave the clamp off fixed_direction_deg'
 >>> top_reasons(pd.DataFrame({"dataset": ["v"], "status": ["flagged"], "reason": [
 ...     "body touches the image border at its free end: the tip may be outside; psi from the "
 ...     "free end's tangent against fixed_direction_deg"]}))
@@ -48,6 +50,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"closes on itself or branches", "line closes on itself or branches"),
     (r"^ends almost touching", "ends almost touching"),
     (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
+    (r"^psi may be [\d.]+ deg off: it is measured from the fixed_direction_deg",
+     "bodies leave the clamp off fixed_direction_deg"),
 )
 
 
