@@ -1006,6 +1006,26 @@ def file_problems(
                 warning=True,
             )
         )
+    unused = sorted({
+        r.method
+        for r in ps.rows
+        if r is not None
+        and r.target == "body"
+        and r.fixed_direction_deg is not None
+        and r.method not in (None, "auto", "tangents")
+    })
+    if unused:
+        problems.append(
+            Problem(
+                str(folder / SETTINGS),
+                None,
+                f"method {', '.join(unused)} is not used where fixed_direction_deg is given: a "
+                "body's psi is then its free end's tangent against that direction (method "
+                "tangents)",
+                "leave method out (or leave fixed_direction_deg out to measure with it)",
+                warning=True,
+            )
+        )
     return problems
 
 

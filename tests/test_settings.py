@@ -176,6 +176,7 @@ def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, t
 
 NO_SEALED_END = "no sealed_end_mm: the tip angle is read where the body's centre line stops"
 UNUSED_BODY_KEYS = "free_end and sealed_end_mm are for a body"
+UNUSED_METHOD = "method turning is not used where fixed_direction_deg is given"
 
 
 @pytest.mark.parametrize(
@@ -189,6 +190,12 @@ UNUSED_BODY_KEYS = "free_end and sealed_end_mm are for a body"
         ({}, set()),
         ({"free_end": "bends"}, {UNUSED_BODY_KEYS}),
         ({"sealed_end_mm": 5, "mm_per_px": 0.2}, {UNUSED_BODY_KEYS}),
+        # a customer's method: turning did nothing, unsaid: with the clamp's direction given a
+        # body's psi is its tip tangent against it
+        ({"target": "body", "free_end": "bends", "method": "turning",
+          "fixed_direction_deg": 90}, {UNUSED_METHOD}),
+        ({"target": "body", "free_end": "bends", "method": "turning"}, set()),
+        ({"method": "turning", "fixed_direction_deg": 90}, set()),
     ],
 )
 def test_check_warns_of_the_free_end_settings_a_set_lacks_or_does_not_use(
@@ -204,7 +211,7 @@ def test_check_warns_of_the_free_end_settings_a_set_lacks_or_does_not_use(
     said = {
         start
         for p in ps.validate_photoset(photo_folder, warnings=True)
-        for start in (NO_SEALED_END, UNUSED_BODY_KEYS)
+        for start in (NO_SEALED_END, UNUSED_BODY_KEYS, UNUSED_METHOD)
         if p.message.startswith(start) and p.warning
     }
     assert said == warnings

@@ -13,7 +13,7 @@ Examples
 ...     print(style, text)
 h Camera calibration
 b lab: calibrated, 2 of 2 photos; reprojection error 0.05 px (0.014 mm on the plane)
-b old: not calibrated: psi measured in the image (mm_per_px or the line's own length)
+b old: not calibrated: psi measured in the image as seen (no correction for the camera's tilt)
 """
 
 from __future__ import annotations
@@ -69,8 +69,8 @@ def _dataset_lines(angles: pd.DataFrame, datasets: Sequence[str]) -> list[tuple[
                 (
                     "b",
                     (
-                        f"{name}: not calibrated: psi measured in the image (mm_per_px or the "
-                        "line's own length)"
+                        f"{name}: not calibrated: psi measured in the image as seen (no "
+                        "correction for the camera's tilt)"
                     ),
                 )
             )

@@ -16,6 +16,12 @@ Examples
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
 'bodies leave the clamp off fixed_direction_deg'
+>>> top_reasons(pd.DataFrame({"dataset": "v", "status": "flagged", "reason": [
+...     "the end tangents and a smooth fit of the whole centre line disagree by 12 deg: the "
+...     "centre line wobbles (a faint or translucent side?); check with photoset preview",
+...     "the free end's direction is uncertain: the centre line stops 86 px short of the body's "
+...     "end; psi is carried on along the selection there, which turns the end by 17 deg"]}))
+{'v': [('centre line wobbles', 1), ("free end's direction uncertain", 1)]}
 >>> top_reasons(pd.DataFrame({"dataset": ["v"], "status": ["flagged"], "reason": [
 ...     "body touches the image border at its free end: the tip may be outside; psi from the "
 ...     "free end's tangent against fixed_direction_deg"]}))
@@ -52,7 +58,23 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
     (r"^psi may be [\d.]+ deg off: it is measured from the fixed_direction_deg",
      "bodies leave the clamp off fixed_direction_deg"),
+    # a body's causes
+    (r"^the free end's direction is uncertain", "free end's direction uncertain"),
+    (r"^the centre line stops \d+ px short of the body's free end where the body still turns",
+     "centre line stops short of a tip that still turns"),
+    (r"^the centre line stops \d+ px short of the body's free end \(uneven outline",
+     "centre line stops short of an uneven tip"),
+    (r"^the centre line stops \d+ px \([\d.]+ widths\) short",
+     "centre line stops short of a faint tip"),
+    (r"^the end tangents and a smooth fit", "centre line wobbles"),
+    (r"direction turns \d+ deg when fitted over half", "hook at an end of the centre line"),
+    (r"^line length \d+% of its ramp's median", "length far from its ramp's median"),
+    (r"^the body starts \d+ px from fixed_end", "body starts away from fixed_end"),
+    (r"^psi [-+\d.]+ deg against its ramp's base direction", "base direction off its ramp's"),
 )
+#: how the parts of a cause that follow a ``;`` inside it begin (a fix, a carried-on figure, a
+#: bracket's second half): not causes of their own
+CONTINUATION = re.compile(r"^(check with photoset preview|psi is carried on|[-+\d.]+ from its own)")
 
 
 def words(cause: str) -> str:
@@ -93,7 +115,13 @@ def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[st
         ):
             causes = [reason] if status == "failed" else reason.split(";")
             # a note says how psi was taken, not why the row is doubted
-            counts.update({words(p) for p in causes if not p.strip().startswith(NOTES)})
+            counts.update(
+                {
+                    words(p)
+                    for p in causes
+                    if not (p.strip().startswith(NOTES) or CONTINUATION.match(p.strip()))
+                }
+            )
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
         if len(ordered) > limit:
             ordered = ordered[:limit] + [("other causes", sum(c for _, c in ordered[limit:]))]
