@@ -23,6 +23,7 @@ the estimators and quality checks of the drawn line apply unchanged.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import cv2
@@ -33,7 +34,7 @@ from scipy.sparse.csgraph import dijkstra
 from pipeline.measure.colors import color_mask
 from pipeline.measure.estimators import end_tangents
 from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
-from pipeline.measure.settings import MeasureSettings
+from pipeline.measure.settings import MeasureSettings, Polygon
 
 #: the body must differ from the backdrop by at least this many noise sigmas (robust, Lab units)
 NOISE_SIGMAS = 6.0
@@ -294,6 +295,68 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     return diff, sigma
 
 
+#: where the ramp's estimate of the empty scene differs from the backdrop by at least this
+#: fraction of the selection threshold it still shows the body (a part that stayed put): there
+#: only the difference from the backdrop counts
+ESTIMATE_SHOWS_BODY = 0.5
+
+
+def _threshold(sigma: float) -> float:
+    """The selection threshold of a difference whose noise is ``sigma``."""
+    return max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
+
+
+@functools.lru_cache(maxsize=4)
+def estimate_looks_like_backdrop(
+    path: str, shape: tuple[int, int], roi: Polygon | None, exclude: tuple[Polygon, ...],
+    scale: float,
+) -> np.ndarray:
+    """Where the ramp's estimate of the empty scene (the file at ``path``, resized to the work
+    image's ``shape``) looks like the backdrop itself (uint8 0/1): not where it still shows the
+    body (a part that stayed put over most of the ramp).  Computed once per estimate in a worker.
+    """
+    read = cv2.imread(path)
+    if read is None:  # gone: the backdrop alone decides
+        return np.zeros(shape, np.uint8)
+    estimate = cv2.resize(read, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+    region = region_mask((*shape, 3), roi, exclude, scale)
+    allowed = np.ones(shape, np.uint8) if region is None else region
+    shows_body, sigma = backdrop_difference(exposed(estimate, allowed), allowed)
+    return cv2.erode(
+        (shows_body < ESTIMATE_SHOWS_BODY * _threshold(sigma)).astype(np.uint8),
+        np.ones((5, 5), np.uint8),
+    )
+
+
+def estimated_background_difference(
+    image_bgr: np.ndarray, estimate_bgr: np.ndarray, allowed: np.ndarray, backdrop_like: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """Difference of each pixel from the empty scene estimated from the ramp's photos, joined
+    with its difference from the backdrop (:func:`backdrop_difference`), and that noise.
+
+    Both differences are scaled so that their selection thresholds (``NOISE_SIGMAS`` times each
+    one's noise, at least ``MIN_DIFFERENCE``) meet at ``MIN_DIFFERENCE``, and the larger counts.
+    The estimate counts only where it looks like the backdrop itself (``backdrop_like``,
+    :func:`estimate_looks_like_backdrop`): where the body stayed put over most of the ramp (its
+    base) the estimate shows it, and the backdrop alone decides.
+
+    Returns
+    -------
+    difference : ndarray (H, W) float32
+    sigma : float
+        The noise that puts the threshold at ``MIN_DIFFERENCE``.
+    """
+    from_backdrop, s_backdrop = backdrop_difference(exposed(image_bgr, allowed), allowed)
+    from_estimate, s_estimate = background_difference(
+        image_bgr, matched_exposure(estimate_bgr, image_bgr)
+    )
+    joined = np.maximum(
+        np.where(backdrop_like > 0, from_estimate / _threshold(s_estimate), 0.0),
+        from_backdrop / _threshold(s_backdrop),
+    )
+    return (MIN_DIFFERENCE * joined).astype(np.float32), MIN_DIFFERENCE / NOISE_SIGMAS
+
+
 #: the exposure gains are measured on about this many pixels, neither near black nor saturated
 GAIN_PIXELS, GAIN_DARKEST, GAIN_BRIGHTEST = 20000, 12, 245
 
@@ -448,7 +511,14 @@ def body_mask(
     if settings.color is not None:
         mask &= color_mask(image_bgr, settings.color)
     if settings.color is None or background_bgr is not None:
-        if background_bgr is not None:
+        if background_bgr is not None and settings.background_estimated:
+            assert settings.background_path is not None
+            like = estimate_looks_like_backdrop(
+                settings.background_path, (h, w), settings.roi, settings.exclude, scale
+            )
+            diff, sigma = estimated_background_difference(image_bgr, background_bgr, allowed, like)
+            background_bgr = None  # an estimate: no shadow to tell from the body
+        elif background_bgr is not None:
             background_bgr = matched_exposure(background_bgr, image_bgr)
             diff, sigma = background_difference(image_bgr, background_bgr)
         else:

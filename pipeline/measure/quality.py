@@ -223,8 +223,14 @@ NOTE_SIDE_ON_BORDER = "a side runs along the image border"
 NOTE_SELECTION_COVERS = "selection covers"
 #: the ramp check's note where a ramp's bodies leave the clamp a little off fixed_direction_deg
 NOTE_GIVEN_OFF = "the bodies of this ramp leave the clamp at"
+#: a doubtful body measured again against its ramp's estimate of the empty scene, and kept
+NOTE_RAMP_BACKGROUND = "measured against the empty scene estimated from its ramp's photos"
 NOTES: tuple[str, ...] = (
-    NOTE_FIXED_DIRECTION, NOTE_SIDE_ON_BORDER, NOTE_SELECTION_COVERS, NOTE_GIVEN_OFF
+    NOTE_FIXED_DIRECTION,
+    NOTE_SIDE_ON_BORDER,
+    NOTE_SELECTION_COVERS,
+    NOTE_GIVEN_OFF,
+    NOTE_RAMP_BACKGROUND,
 )
 
 

@@ -154,6 +154,10 @@ class MeasureSettings:
         A drawn line, or the actuator's body.
     background_path : str or None
         Photo of the empty scene (absolute path).
+    background_estimated : bool
+        ``background_path`` is not a photo of the empty scene but an estimate of it from the
+        other photos of the ramp (:mod:`pipeline.measure.ramp_background`): where it still shows
+        the body, the backdrop decides.
     roi : Polygon or None
         Where the actuator can be (px); None: the whole photo.
     exclude : tuple of Polygon
@@ -180,6 +184,7 @@ class MeasureSettings:
     positive_turn: str = "ccw"
     target: str = "line"
     background_path: str | None = None
+    background_estimated: bool = False
     roi: Polygon | None = None
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None

@@ -70,7 +70,8 @@ def run_task(task: Task) -> dict[str, Any]:
     seconds = time.perf_counter() - t0
     if task.overlay_path is not None:
         write_overlay(task.overlay_path, img, f, res, task.title, task.settings)
-    return result_fields(res, seconds)
+    # the centre line (image px) rides along for the ramp's estimate of its empty scene
+    return {**result_fields(res, seconds), "centreline_px": res.centreline_px}
 
 
 def write_overlay(
