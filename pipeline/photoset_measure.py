@@ -113,6 +113,7 @@ def measure_photoset(
     jobs: int = 1,
     overlays_dir: str | os.PathLike[str] | None = None,
     ramp_check: bool = True,
+    second_look: bool = True,
 ) -> pd.DataFrame:
     """Measure psi on every photo of a photo set; a bad photo or manifest row is a ``failed`` row.
 
@@ -129,6 +130,9 @@ def measure_photoset(
     ramp_check : bool
         Check every photo against its ramp (:mod:`pipeline.ramp_check`): flag the ones that
         break its trend, trust again the cosmetically flagged ones that follow it.
+    second_look : bool
+        Measure a doubtful body again against its ramp's estimate of the empty scene
+        (:func:`estimates_background`); off only to compare (``python -m pipeline bench ramps``).
 
     Returns
     -------
@@ -159,7 +163,7 @@ def measure_photoset(
 
         out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
     else:
-        out = _measure_photos(ps, method, jobs, odir)
+        out = _measure_photos(ps, method, jobs, odir, second_look)
     drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
         out = check_ramps(out)
@@ -204,12 +208,15 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
             atomic_write_bytes(path, buf.tobytes())
 
 
-def _measure_photos(ps: PhotoSet, method: str, jobs: int, odir: Path | None) -> pd.DataFrame:
+def _measure_photos(
+    ps: PhotoSet, method: str, jobs: int, odir: Path | None, second_look: bool = True
+) -> pd.DataFrame:
     """The angles.csv table of a photo set of images (one row per manifest row)."""
     manifest = ps.manifest
     tasks = _tasks(ps, method, odir)
     rows = map_photos(run_task, tasks, jobs=jobs, preload=["pipeline.measure.worker"])
-    rows = _on_ramp_backgrounds(ps, tasks, rows, jobs)
+    if second_look:
+        rows = _on_ramp_backgrounds(ps, tasks, rows, jobs)
     result = pd.DataFrame(rows, index=manifest.index).drop(columns="centreline_px")
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))

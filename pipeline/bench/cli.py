@@ -36,6 +36,13 @@ BENCHES: dict[str, tuple[str, str]] = {
         "pipeline.bench.realscenes",
         "body mode on the committed real strips and on synthetic analogues of real scenes",
     ),
+    "ramps": (
+        "pipeline.bench.ramps",
+        (
+            "rendered body ramp sets measured as a user does, with and without the second "
+            "look against the ramp's own photos"
+        ),
+    ),
     "video": (
         "pipeline.bench.video",
         "a rendered video measured end to end: frames per second, memory, accuracy",
