@@ -1000,7 +1000,8 @@ def file_problems(
                 None,
                 "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
                 "runs on into a sealed end or cap; on rendered bodies one of 8-12 mm read |psi| "
-                "above 150 deg 5-7 deg high",
+                "above 150 deg 5-7 deg high (and without an empty scene, a doubtful body gets no "
+                "second look against its ramp's own photos)",
                 "measure the actuator's end that does not bend (from where the chamber ends to the "
                 "tip, cap included) and set sealed_end_mm",
                 warning=True,
