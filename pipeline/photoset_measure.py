@@ -22,7 +22,6 @@ from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work
 from pipeline.measure.estimators import METHODS
-from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
 from pipeline.measure.ramp_background import (
     RAMP_BACKGROUND_MIN_PHOTOS,
     covered,
@@ -325,9 +324,7 @@ def _on_ramp_backgrounds(
         for (i, task), row in zip(again, measured, strict=True):
             if row["status"] != "ok":
                 continue
-            out[i] = {**row, "reason": "; ".join(
-                r for r in (str(row["reason"] or ""), NOTE_RAMP_BACKGROUND) if r
-            )}
+            out[i] = row  # its reason says how it was measured (NOTE_RAMP_BACKGROUND)
             drawn, final = task.overlay_path, tasks[i].overlay_path
             if drawn is not None and final is not None:
                 shutil.move(drawn, final)  # the temporary folder may be on another disk

@@ -471,6 +471,7 @@ def measure_body(
         free_end_width_ratio=body.free_end_width_ratio,
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
+        background_estimated=settings.background_estimated,
         missed_tip_deg=missed_tip_deg,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,

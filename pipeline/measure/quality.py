@@ -263,6 +263,7 @@ def assess_body(
     free_end_width_ratio: float = 1.0,
     side_on_border: bool = False,
     tip_at_region_edge: bool = False,
+    background_estimated: bool = False,
     missed_tip_deg: float = 0.0,
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
@@ -419,4 +420,6 @@ def assess_body(
             )
     if selected_fraction > 0.35:
         notes.append(f"{NOTE_SELECTION_COVERS} {100 * selected_fraction:.0f}% of the photo")
+    if background_estimated:
+        notes.append(NOTE_RAMP_BACKGROUND)
     return Quality("flagged" if flags else "ok", "; ".join(flags + notes))
