@@ -310,12 +310,18 @@ def _compare_given(
         f"fixed_direction_deg in manifest.csv ({stated + median:+.1f}), or leave the key out "
         "where the base is seen (photoset preview draws the one given along the base)"
     )
+    # up to GIVEN_FLAG_DEG off, either may be the wrong one (a translucent body's own base reads
+    # up to 2.7 deg off: a customer who fitted the clamp's direction to 0.05 deg was told to
+    # give the bodies' own, 3.1 deg off the truth)
     note = (
         f"psi may be {abs(median):.1f} deg off: it is measured from the fixed_direction_deg "
         f"given ({stated:+.1f}), but the bodies of this ramp leave the clamp at {seen}, so {fix}"
         if abs(median) > GIVEN_FLAG_DEG
         else f"{NOTE_GIVEN_OFF} {seen}, {median:+.1f} deg off the "
-        f"fixed_direction_deg given ({stated:+.1f}), which psi is measured from: {fix}"
+        f"fixed_direction_deg given ({stated:+.1f}), which psi is measured from (the bodies' "
+        "own reading may be a few deg off where the base is faint: photoset preview draws the "
+        "one given along the base; if it lies off the base, give the ramp's own in "
+        "manifest.csv)"
     )
     rows = ramp.index
     out.loc[rows, "reason"] = [
