@@ -525,7 +525,7 @@ def body_mask(
             diff, sigma = backdrop_difference(exposed(image_bgr, allowed), allowed)
         # any clear difference is body: a translucent body differs faintly (splitting the
         # differences in two, faint vs strong, cut translucent bodies down to their highlights)
-        thr = max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
+        thr = _threshold(sigma)
         low = max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE)
         differs = _hysteresis(diff, thr, low)
         if background_bgr is not None:  # the body's shadow differs from the empty scene too
