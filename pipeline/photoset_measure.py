@@ -268,23 +268,25 @@ def _ramp_estimates(
             rows[i]["status"] == "ok" for i in members
         ):
             continue
+        used: list[int] = []
         images: list[np.ndarray] = []
         covers: list[np.ndarray] = []
         for i in members:
             img, f = decode_for_work(np.fromfile(tasks[i].path, np.uint8))
             if img is None or (images and img.shape != images[0].shape):
-                break
+                continue  # a photo that cannot be read, or of another size: not in the estimate
             line = np.asarray(rows[i]["centreline_px"], float).reshape(-1, 2)
+            used.append(i)
             images.append(img)
             covers.append(
                 covered(img.shape[:2], (line - (f - 1) / 2) / f, float(rows[i]["width_px"]) / f)
                 if rows[i]["status"] != "failed"
                 else np.ones(img.shape[:2], bool)
             )
-        else:
+        if len(used) >= RAMP_BACKGROUND_MIN_PHOTOS:
             path = folder / f"ramp{number}.png"
             cv2.imwrite(str(path), estimate_background(images, covers))
-            out.update({i: path for i in members})
+            out.update({i: path for i in used})
     return out
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import shutil
 
 import numpy as np
 import pandas as pd
@@ -66,3 +67,19 @@ def test_only_a_body_told_from_the_backdrop_whose_free_end_is_known_is_measured_
                                                      line_color="green", sealed_end_mm=4.0))
     assert not estimates_background(resolve_settings(l0_mm=200.0))
     assert not estimates_background(None)
+
+
+def test_a_photo_that_cannot_be_read_fails_alone_and_the_ramp_still_gets_its_second_look(
+    translucent_ramp, tmp_path
+):
+    folder = tmp_path / "s"
+    shutil.copytree(translucent_ramp, folder)
+    broken = sorted(folder.glob("*.jpg"))[7]
+    broken.write_bytes(broken.read_bytes()[:200])  # cut off in the copy
+    angles = measure_photoset(folder, jobs=1).set_index("image")
+    row = angles.loc[broken.name]
+    assert row["status"] == "failed" and "cannot be decoded" in row["reason"]
+    again = angles["reason"].fillna("").str.contains(NOTE_RAMP_BACKGROUND, regex=False)
+    assert again.sum() >= 7
+    err, ok = _scored(folder, angles.reset_index())  # the failed row: NaN, not ok
+    assert (err <= 5).sum() >= 13 and not (ok & (err > 10)).any()
