@@ -328,7 +328,15 @@ def _on_ramp_backgrounds(
         for (i, task), row in zip(again, measured, strict=True):
             if row["status"] != "ok":
                 continue
-            out[i] = row  # its reason says how it was measured (NOTE_RAMP_BACKGROUND)
+            # its reason says how it was measured (NOTE_RAMP_BACKGROUND, last); and what the
+            # first look read, so that a user sees how much the second one changed
+            first = rows[i]
+            read = (
+                f"{first['psi_deg']:+.1f} deg, {first['status']}"
+                if np.isfinite(first["psi_deg"])
+                else str(first["status"])
+            )
+            out[i] = {**row, "reason": f"{row['reason']} (the first look read {read})"}
             drawn, final = task.overlay_path, tasks[i].overlay_path
             if drawn is not None and final is not None:
                 shutil.move(drawn, final)  # the temporary folder may be on another disk

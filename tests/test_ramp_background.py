@@ -53,6 +53,10 @@ def test_a_translucent_ramp_without_its_empty_scene_is_measured_against_its_own_
     again = angles["reason"].fillna("").str.contains(NOTE_RAMP_BACKGROUND, regex=False)
     assert again.sum() >= 8  # the doubtful first looks, and only those, say so
     assert (angles.loc[again, "status"] == "ok").all()
+    # and what the first look read, so that a user sees how much the second one changed
+    assert angles.loc[again, "reason"].str.contains(
+        r"photos \(the first look read [-+]\d+\.\d deg, flagged\)|first look read failed"
+    ).all(), angles.loc[again, "reason"].tolist()
 
 
 def test_only_a_body_told_from_the_backdrop_whose_free_end_is_known_is_measured_again():

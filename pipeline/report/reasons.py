@@ -70,11 +70,15 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"direction turns \d+ deg when fitted over half", "hook at an end of the centre line"),
     (r"^line length \d+% of its ramp's median", "length far from its ramp's median"),
     (r"^the body starts \d+ px from fixed_end", "body starts away from fixed_end"),
-    (r"^psi [-+\d.]+ deg against its ramp's base direction", "base direction off its ramp's"),
+    (r"^the body leaves the fixed end [-+\d]+ deg off its ramp's direction",
+     "body leaves the clamp off its ramp's direction"),
 )
 #: how the parts of a cause that follow a ``;`` inside it begin (a fix, a carried-on figure, a
-#: bracket's second half): not causes of their own
-CONTINUATION = re.compile(r"^(check with photoset preview|psi is carried on|[-+\d.]+ from its own)")
+#: bracket's second half), and the ramp check's note of the base psi is taken from: not causes
+CONTINUATION = re.compile(
+    r"^(check with photoset preview|psi is carried on|[-+\d.]+ from its own"
+    r"|psi [-+\d.]+ deg against its ramp's base direction)"
+)
 
 
 def words(cause: str) -> str:
