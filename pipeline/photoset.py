@@ -971,7 +971,8 @@ def file_problems(
                 else "no mm_per_px: a body is not checked against l0_mm, so one partly hidden or "
                 "cut short is not flagged for its length",
                 "with a ruler in view, measure the image scale (mm per pixel) and set "
-                "mm_per_px; without one, leave it out (a reminder only)",
+                "mm_per_px; without one, a known length in the photo does (a body's width across "
+                "it, in mm over px), or leave it out (a reminder only)",
                 warning=True,
             )
         )
