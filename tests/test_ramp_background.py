@@ -22,7 +22,7 @@ def _without_background(folder, extra: str = "") -> None:
 
 def _scored(folder, angles: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     truth = pd.read_csv(folder / "truth.csv").set_index("image")["psi_deg"]
-    err = (angles.set_index("image")["psi_deg"] - truth).abs().to_numpy()
+    err = np.abs(angles["psi_deg"].to_numpy(float) - truth.reindex(angles["image"]).to_numpy())
     return err, (angles["status"] == "ok").to_numpy()
 
 

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
@@ -80,9 +81,9 @@ def render(spec: RampSet, folder: Path) -> Path:
 def score(folder: Path, angles: pd.DataFrame) -> dict[str, int]:
     """Counts of one measured set against its ``truth.csv``."""
     truth = pd.read_csv(folder / "truth.csv").set_index("image")["psi_deg"]
-    err = (angles.set_index("image")["psi_deg"] - truth).abs()
+    # in the rows' order (not an index-aligned union, whose order need not be theirs)
+    e = np.abs(angles["psi_deg"].to_numpy(float) - truth.reindex(angles["image"]).to_numpy(float))
     ok = (angles["status"] == "ok").to_numpy()
-    e = err.to_numpy()
     again = angles["reason"].fillna("").astype(str).str.contains(NOTE_RAMP_BACKGROUND, regex=False)
     return {
         "photos": len(angles),
