@@ -7,7 +7,9 @@ rendered (``python -m pipeline synth``), then set up as a lab would from what it
 not bend (the renderer's sealed end and tip cap) and ``fixed_direction_deg`` as rendered.  Both
 measurements run on the same photos in one call (``measure_photoset(second_look=False)`` and
 the default), and are scored against ``truth.csv``: photos within 5 and 10 deg, ``ok`` rows,
-``ok`` rows 5-10 and over 10 deg off, rows measured again (kept), seconds.
+``ok`` rows 5-10 and over 10 deg off, rows measured again (kept), seconds.  ``--camera auto``
+first gives every photo its own exposure and white balance, as a phone left on automatic does
+(:func:`pipeline.bench.realscenes.through_camera`).
 
 Examples
 --------
@@ -24,9 +26,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.bench.realscenes import CAMERAS, through_camera
 from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
 
 
@@ -61,8 +65,10 @@ SETS: tuple[RampSet, ...] = (
 )
 
 
-def render(spec: RampSet, folder: Path) -> Path:
-    """Render ``spec`` into ``folder`` and set it up as a user would (see the module docstring)."""
+def render(spec: RampSet, folder: Path, camera: str = "clean") -> Path:
+    """Render ``spec`` into ``folder`` and set it up as a user would (see the module docstring);
+    each photo then goes through ``camera`` (:func:`pipeline.bench.realscenes.through_camera`,
+    seeded by its place in the set)."""
     from pipeline.synth.photoset_writer import render_photoset
     from pipeline.synth.presets import SCENE_PRESETS
 
@@ -75,6 +81,12 @@ def render(spec: RampSet, folder: Path) -> Path:
     (out / "photoset.yaml").write_text(
         kept + f"sealed_end_mm: {scene.sealed_end_mm + scene.tip_cap_mm:g}\n"
     )
+    if camera != "clean":
+        for i, name in enumerate(pd.read_csv(out / "manifest.csv")["image"]):
+            photo = cv2.imread(str(out / name))
+            assert photo is not None  # just rendered
+            cv2.imwrite(str(out / name), through_camera(photo, camera, seed=i),
+                        [cv2.IMWRITE_JPEG_QUALITY, scene.jpeg_quality])
     return out
 
 
@@ -106,11 +118,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--sets", type=int, default=len(SETS),
                         help=f"the first N of the {len(SETS)} sets (default all)")
     parser.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
+    parser.add_argument("--camera", choices=CAMERAS, default="clean",
+                        help="what the camera does to each photo (auto: its own exposure and "
+                             "white balance; see bench realscenes --help) (default clean)")
     args = parser.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench-ramps-") as tmp:
         for spec in SETS[: args.sets]:
-            folder = render(spec, Path(tmp))
+            folder = render(spec, Path(tmp), args.camera)
             for second_look in (False, True):
                 t0 = time.perf_counter()
                 angles = measure_photoset(folder, jobs=args.jobs, second_look=second_look)

@@ -45,8 +45,11 @@ _PRESET = {"lab_body": "lab"}
 #: what a real camera may do to a photo (``--camera``): the analogues are rendered clean, then
 #: saved again at JPEG quality 40, given sensor noise (sigma 8 grey levels), lit unevenly (0.6x at
 #: the left edge to 1.3x at the right), defocused (Gaussian blur sigma 2.5 px) or underexposed
-#: (0.45x)
-CAMERAS: tuple[str, ...] = ("clean", "jpeg40", "noise", "uneven", "blur", "dark")
+#: (0.45x), or given its own exposure and white balance (``auto``: a phone left on automatic sets
+#: both for each photo; a gain of sd AUTO_EXPOSURE_SD times one of sd AUTO_WHITE_BALANCE_SD per
+#: colour channel, each within 3 sd)
+CAMERAS: tuple[str, ...] = ("clean", "jpeg40", "noise", "uneven", "blur", "dark", "auto")
+AUTO_EXPOSURE_SD, AUTO_WHITE_BALANCE_SD = 0.06, 0.03
 
 
 def through_camera(image: np.ndarray, camera: str, seed: int) -> np.ndarray:
@@ -60,6 +63,8 @@ def through_camera(image: np.ndarray, camera: str, seed: int) -> np.ndarray:
     (45, 130)
     >>> bool((through_camera(img, "noise", 1) == through_camera(img, "noise", 1)).all())
     True
+    >>> [through_camera(img, "auto", s)[0, 0].tolist() for s in (0, 1)]
+    [[100, 103, 101], [105, 103, 98]]
     """
     if camera == "clean":
         return image
@@ -76,6 +81,11 @@ def through_camera(image: np.ndarray, camera: str, seed: int) -> np.ndarray:
         return cv2.GaussianBlur(image, (0, 0), 2.5)
     if camera == "dark":
         return np.clip(image * 0.45, 0, 255).astype(np.uint8)
+    if camera == "auto":
+        rng = np.random.default_rng(seed)
+        gain = 1.0 + np.clip(rng.normal(0.0, 1.0), -3.0, 3.0) * AUTO_EXPOSURE_SD
+        balance = 1.0 + np.clip(rng.normal(0.0, 1.0, 3), -3.0, 3.0) * AUTO_WHITE_BALANCE_SD
+        return np.clip(image * (gain * balance) + 0.5, 0, 255).astype(np.uint8)
     raise ValueError(f"camera {camera!r}: use one of {', '.join(CAMERAS)}")
 
 
@@ -199,6 +209,8 @@ def body_cases(
                     "reason": res.reason,
                     "ms": 1000 * (time.perf_counter() - t0),
                     "base_direction_deg": res.base_direction_deg,
+                    # psi is then measured from it: the shared base only compares (as measure)
+                    "fixed_direction_deg": extra.get("fixed_direction_deg", np.nan),
                 }
             )
     empties.cleanup()
@@ -273,7 +285,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         choices=CAMERAS,
         default="clean",
         help="what a real camera does to the rendered analogues: saved at JPEG quality 40, sensor "
-             "noise, uneven light, defocus, underexposure (default clean)",
+             "noise, uneven light, defocus, underexposure, its own exposure and white balance for "
+             "each photo (auto) (default clean)",
     )
     parser.add_argument(
         "--fixed-end-offset",
