@@ -87,3 +87,20 @@ def test_a_photo_that_cannot_be_read_fails_alone_and_the_ramp_still_gets_its_sec
     assert again.sum() >= 7
     err, ok = _scored(folder, angles.reset_index())  # the failed row: NaN, not ok
     assert (err <= 5).sum() >= 13 and not (ok & (err > 10)).any()
+
+
+def test_each_photo_is_brought_to_the_ramps_exposure_before_the_median():
+    # a camera left on automatic exposes each photo a little differently (here 0.9x to 1.1x):
+    # a pixel's median over the photos free of the body there then came from other photos than
+    # its neighbour's, and the estimate of a plain grey scene was a patchwork of 112 to 127
+    from pipeline.measure.ramp_background import covered, estimate_background
+
+    scene = np.full((40, 80, 3), 120, np.uint8)
+    photos, covers = [], []
+    for x, gain in zip((5, 20, 35, 50, 65), (0.9, 1.1, 1.0, 0.94, 1.06)):
+        photo = (scene * gain).astype(np.uint8)
+        photo[5:35, x : x + 4] = 230  # the body, a bar that moves along the ramp
+        photos.append(photo)
+        covers.append(covered(photo.shape[:2], np.array([[x + 2.0, 5.0], [x + 2.0, 35.0]]), 4.0))
+    estimate = estimate_background(photos, covers).astype(int)
+    assert estimate.max() - estimate.min() <= 1, (estimate.min(), estimate.max())

@@ -378,15 +378,36 @@ def matched_exposure(background_bgr: np.ndarray, image_bgr: np.ndarray) -> np.nd
     >>> matched_exposure(bg, photo)[1, 1].tolist()
     [110, 100, 90]
     """
+    gain = exposure_gains(background_bgr, image_bgr)
+    if (gain == 1.0).all():
+        return background_bgr
+    return cv2.convertScaleAbs(background_bgr.astype(np.float32) * gain)
+
+
+def exposure_gains(
+    reference_bgr: np.ndarray, image_bgr: np.ndarray, where: np.ndarray | None = None
+) -> np.ndarray:
+    """Per colour channel, how much brighter ``image_bgr`` is exposed than ``reference_bgr`` (a
+    photo of the same scene): the median ratio over the pixels of both that are neither near
+    black nor saturated, most of them backdrop (float32, shape (3,); ones when too few pixels
+    are usable).  ``where`` (bool, the images' height and width) keeps only those pixels.
+
+    Examples
+    --------
+    >>> ref = np.full((20, 20, 3), 100, np.uint8)
+    >>> [round(float(g), 2) for g in exposure_gains(ref, (ref * [1.1, 1.0, 0.9]).astype(np.uint8))]
+    [1.1, 1.0, 0.9]
+    """
     step = max(1, int(np.sqrt(image_bgr.shape[0] * image_bgr.shape[1] / GAIN_PIXELS)))
     a = image_bgr[::step, ::step].reshape(-1, 3).astype(np.float32)
-    b = background_bgr[::step, ::step].reshape(-1, 3).astype(np.float32)
+    b = reference_bgr[::step, ::step].reshape(-1, 3).astype(np.float32)
     usable = ((a > GAIN_DARKEST) & (a < GAIN_BRIGHTEST) & (b > GAIN_DARKEST)
               & (b < GAIN_BRIGHTEST)).all(axis=1)
+    if where is not None:
+        usable &= where[::step, ::step].reshape(-1)
     if usable.sum() < 100:
-        return background_bgr
-    gain = np.median(a[usable] / b[usable], axis=0)
-    return cv2.convertScaleAbs(background_bgr.astype(np.float32) * gain.astype(np.float32))
+        return np.ones(3, np.float32)
+    return np.asarray(np.median(a[usable] / b[usable], axis=0), np.float32)
 
 
 #: a photo and its empty scene that differ by more than this noise (robust sigma of the colour

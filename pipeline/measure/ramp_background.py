@@ -6,7 +6,10 @@ away from it is the empty scene there; where the body stayed put (its base, by t
 photo is free of it and the plain median shows the body, which
 :func:`pipeline.measure.body.estimated_background_difference` recognises and leaves to the
 backdrop.  A translucent body on a backdrop of its own grey, whose faint parts the backdrop
-model misses, stands out against this estimate as against a photo of the empty scene.
+model misses, stands out against this estimate as against a photo of the empty scene.  A camera
+left on automatic exposes each photo and balances its colours a little differently; each photo is
+brought to the ramp's typical exposure first, or the median would join patches of different
+exposures.
 
 Examples
 --------
@@ -27,6 +30,8 @@ import warnings
 
 import cv2
 import numpy as np
+
+from pipeline.measure.body import exposure_gains
 
 #: a ramp of at least this many measured body photos gets its empty scene estimated
 RAMP_BACKGROUND_MIN_PHOTOS = 8
@@ -64,7 +69,13 @@ def covered(shape: tuple[int, int], centreline_px: np.ndarray, width_px: float) 
 def estimate_background(images: list[np.ndarray], covers: list[np.ndarray]) -> np.ndarray:
     """The empty scene (uint8, as ``images``): per pixel the median over the images whose body
     does not cover it (``covers``), over all of them where fewer than :data:`MIN_FREE_PHOTOS`
-    are free there."""
+    are free there; each image first scaled to the images' median exposure, per colour channel
+    (:func:`pipeline.measure.body.exposure_gains` over the pixels free of the body in it and in
+    the first image)."""
+    gains = np.stack(
+        [exposure_gains(images[0], im, ~(covers[0] | c)) for im, c in zip(images, covers)]
+    )
+    gains /= np.median(gains, axis=0)
     h = images[0].shape[0]
     out = np.empty(images[0].shape, np.uint8)
     # a band of rows at a time: the working copies stay near BAND_VALUES floats whatever the
@@ -72,6 +83,7 @@ def estimate_background(images: list[np.ndarray], covers: list[np.ndarray]) -> n
     rows = max(1, BAND_VALUES // max(1, len(images) * images[0][0].size))
     for top in range(0, h, rows):
         band = np.stack([im[top : top + rows] for im in images]).astype(np.float32)
+        band /= gains[:, None, None, :]
         cover = np.stack([c[top : top + rows] for c in covers])
         plain = np.median(band, axis=0)
         band[np.broadcast_to(cover[..., None], band.shape)] = np.nan
