@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -387,76 +386,6 @@ def aggregate_per_actuator(
     if out.empty:
         return pd.DataFrame(columns=list(PER_ACTUATOR_COLUMNS))
     return out[list(PER_ACTUATOR_COLUMNS)]
-
-
-def reason_kind(reason: str) -> str:
-    """A reason with its numbers replaced by ``#``, so similar reasons count together.
-
-    Examples
-    --------
-    >>> reason_kind(" line partly hidden: 65% of l0 visible")
-    'line partly hidden: #% of l0 visible'
-    >>> reason_kind("")
-    '(no reason given)'
-    """
-    # keeps names like l0
-    text = re.sub(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?", "#", reason.strip())
-    return text or "(no reason given)"
-
-
-def status_counts(angles: pd.DataFrame, max_kinds: int = 6) -> pd.DataFrame:
-    """Count rows per dataset (when present), material and status, with the reasons.
-
-    Parameters
-    ----------
-    angles : pandas.DataFrame
-        Rows shaped like angles.csv; ``dataset`` and ``reason`` columns are used when present.
-    max_kinds : int
-        Most frequent kinds of reason listed; the rest are summed into one entry.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per (dataset, material): ``images``, ``ok``, ``flagged``, ``failed`` and
-        ``reasons``: text ``"kind xN; ..."`` over non-ok rows, most frequent first, where a row's
-        reason is split at ``;`` and numbers are replaced by ``#`` (:func:`reason_kind`).
-    """
-    df = angles.copy()
-    if "dataset" not in df.columns:
-        df["dataset"] = ""
-    if "reason" not in df.columns:
-        df["reason"] = ""
-    rows = []
-    for (dataset, material), g in df.groupby(["dataset", "material"], sort=False):
-        bad = g[g["status"] != "ok"]
-        kinds = [
-            reason_kind(part)
-            for r in bad["reason"].fillna("").astype(str)
-            for part in (r.split(";") or [""])
-        ]
-        counts = pd.Series(kinds, dtype=str).value_counts(sort=False)
-        ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
-        if len(ordered) > max_kinds:
-            ordered = ordered[:max_kinds] + [
-                (
-                    f"{len(ordered) - max_kinds} other kind(s)",
-                    sum(c for _, c in ordered[max_kinds:]),
-                )
-            ]
-        rows.append(
-            {
-                "dataset": dataset,
-                "material": material,
-                "images": len(g),
-                "ok": int((g["status"] == "ok").sum()),
-                "flagged": int((g["status"] == "flagged").sum()),
-                "failed": int((g["status"] == "failed").sum()),
-                "reasons": "; ".join(f"{r} x{c}" for r, c in ordered),
-            }
-        )
-    return pd.DataFrame(
-        rows, columns=["dataset", "material", "images", "ok", "flagged", "failed", "reasons"]
-    )
 
 
 def actuator_keys(angles: pd.DataFrame) -> pd.Series:

@@ -15,7 +15,6 @@ from pipeline.aggregate import (
     pool_hysteresis,
     pressure_levels,
     read_angles,
-    status_counts,
 )
 from pipeline.cli import main
 from pipeline.errors import UserInputError
@@ -155,13 +154,6 @@ def test_binning_uses_measured_pressure():
         aggregate_hysteresis(angles, bin_kpa=0.0)
 
 
-def test_status_counts(crafted):
-    s = status_counts(crafted)
-    ds20 = s[s["material"] == "DS20"].iloc[0]
-    assert (ds20["images"], ds20["ok"], ds20["flagged"], ds20["failed"]) == (9, 6, 1, 2)
-    assert ds20["reasons"] == "no line x2; short line x1"
-
-
 def test_cli_roundtrip_and_bad_input(crafted, tmp_path, capsys):
     a = tmp_path / "angles.csv"
     crafted.to_csv(a, index=False)
@@ -194,27 +186,3 @@ def test_pooling_two_datasets_equals_aggregating_their_union(crafted):
     assert r["n_actuators"] == 4  # "first/1", "first/2", "second/1", "second/2"
     values = np.r_[200.0, 210.0, 220.0, 103.0, 108.0, 113.0]
     assert r["psi_sd_deg"] == pytest.approx(values.std(ddof=1))
-
-
-def test_reasons_grouped_by_kind():
-    rows = [
-        _row(np.nan, "failed", 0, "up", 1, i, reason=r)
-        for i, r in enumerate(
-            [
-                "line partly hidden: 65% of l0 visible; touches border",
-                "line partly hidden: 80% of l0 visible",
-                "",
-                "a",
-                "b",
-                "c",
-                "d",
-                "e",
-            ]
-        )
-    ]
-    s = status_counts(pd.DataFrame(rows, columns=COLUMNS), max_kinds=3).iloc[0]
-    assert s["failed"] == 8
-    assert (
-        s["reasons"]
-        == "line partly hidden: #% of l0 visible x2; (no reason given) x1; a x1; 5 other kind(s) x5"
-    )
