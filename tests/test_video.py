@@ -454,3 +454,40 @@ def test_the_preview_of_a_video_set_shows_its_first_most_bent_and_last_frames(vi
     _video(broken).write_bytes(b"not a video")
     path, tiles = write_preview(broken, tmp_path / "broken.png")
     assert tiles == 1 and cv2.imread(str(path)) is not None
+
+
+def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_measured(
+    tmp_path,
+):
+    # --shutter-s: a frame is exposed while the body moves (up to 20 deg a frame here), as a
+    # webcam's 1/30 s smears a step response at 15 fps; at rest it is the instantaneous frame
+    kw = {
+        "profile": PressureProfile("steps", max_kpa=160, step_kpa=160, hold_s=0.6),
+        "fps": 15,
+        "rest_s": 0.2,
+        "scene": "green_fibre",
+        "scene_overrides": {"width": 1280, "height": 720},
+        "seed": 3,
+    }
+    truth = render_video(tmp_path / "sharp", "DS20", **kw)
+    render_video(tmp_path / "smeared", "DS20", shutter_s=1 / 30, **kw)
+    name = "DS20_A1_t1_steps.avi"
+    assert (tmp_path / "sharp" / "truth.csv").read_bytes() == (
+        tmp_path / "smeared" / "truth.csv"
+    ).read_bytes()
+    sharp, smeared = (cv2.VideoCapture(str(tmp_path / d / name)) for d in ("sharp", "smeared"))
+    change = []
+    for _ in range(len(truth)):
+        a, b = sharp.read()[1].astype(int), smeared.read()[1].astype(int)
+        change.append(float(np.abs(a - b).mean()))
+    still = np.abs(np.gradient(truth["psi_image_deg"].to_numpy())) < 0.01
+    assert still.sum() >= 3 and max(np.array(change)[still]) == 0.0, change
+    assert max(change) > 0.3, change  # smeared (the body covers a few per cent of the frame)
+    m = measure_photoset(tmp_path / "smeared", jobs=2).merge(
+        truth, on=["image", "frame"], suffixes=("", "_true")
+    )
+    err = (m["psi_deg"] - m["psi_image_deg"]).abs()
+    ok = m["status"] == "ok"
+    assert ok.mean() >= 0.8 and err[ok].max() < 10.0, m[["psi_deg", "psi_image_deg", "status"]]
+    with pytest.raises(UserInputError, match="shutter_s"):
+        render_video(tmp_path / "x", "DS20", shutter_s=0.1, **kw)  # longer than a frame

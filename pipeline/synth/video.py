@@ -38,7 +38,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -206,6 +206,31 @@ def fit_scene(
     return scene, rotation
 
 
+#: a frame exposed over ``shutter_s`` is the mean of this many renders (odd: the middle one is
+#: the frame's own time)
+SHUTTER_SUBFRAMES = 5
+
+
+def _exposed(
+    middle: np.ndarray,
+    t_s: float,
+    shutter_s: float,
+    sim: pd.DataFrame,
+    render: Callable[[float], np.ndarray],
+) -> np.ndarray:
+    """The frame at ``t_s`` exposed over ``shutter_s``: the mean of ``middle`` (rendered at
+    ``t_s``) and the renders (``render(psi_deg)``, same seed: same noise) at the other
+    :data:`SHUTTER_SUBFRAMES` - 1 instants spread evenly over the exposure."""
+    offsets = shutter_s * ((np.arange(SHUTTER_SUBFRAMES) + 0.5) / SHUTTER_SUBFRAMES - 0.5)
+    total = np.zeros(middle.shape, np.float32)
+    for dt in offsets:
+        if dt == 0:
+            total += middle
+        else:
+            total += render(float(np.interp(t_s + dt, sim["time_s"], sim["psi_deg"])))
+    return np.clip(total / SHUTTER_SUBFRAMES + 0.5, 0, 255).astype(np.uint8)
+
+
 def render_video(
     out_dir: str | os.PathLike[str],
     material: str,
@@ -227,6 +252,7 @@ def render_video(
     psi_fn: PsiFunction | None = None,
     trial_actuator: TrialActuator | None = None,
     progress: bool | None = None,
+    shutter_s: float = 0.0,
 ) -> pd.DataFrame:
     """Render a video photo set of one actuator going through ``profile`` (see the module
     docstring).
@@ -263,6 +289,10 @@ def render_video(
         Use this actuator instead of drawing one (tests).
     progress : bool or None
         Progress bar (None: on a terminal only).
+    shutter_s : float
+        Exposure time of each frame (s; 0: instantaneous).  A moving actuator is smeared over
+        it: the frame is the mean of :data:`SHUTTER_SUBFRAMES` renders spread evenly over the
+        exposure, centred on the frame's time (its truth).
 
     Returns
     -------
@@ -279,6 +309,10 @@ def render_video(
         and clock_offset_s >= 0
     ):
         raise UserInputError("fps and log_hz must be positive, rest_s and clock_offset_s >= 0")
+    if not (math.isfinite(shutter_s) and 0 <= shutter_s <= 1 / fps):
+        raise UserInputError(
+            f"shutter_s = {shutter_s!r} must lie between 0 and one frame (1 / fps = {1 / fps:g} s)"
+        )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     dyn = dynamics or Dynamics()
@@ -322,7 +356,16 @@ def render_video(
                                 bulge=float(trial_actuator.bulge(psi[k])), backdrop=backdrop)
             seen[k] = r.psi_image_deg
             fixed_end = r.fixed_end_px
-            writer.write(r.image)
+            if shutter_s > 0:  # smeared over the exposure: the same seed, the same noise
+
+                def at(p: float, k: int = k) -> np.ndarray:
+                    return render_actuator(p, l0, sc, seed=child_seed(seed, mk, _FRAME, k),
+                                           bulge=float(trial_actuator.bulge(p)),
+                                           backdrop=backdrop).image
+
+                writer.write(_exposed(r.image, frame_t[k], shutter_s, sim, at))
+            else:
+                writer.write(r.image)
     finally:
         writer.release()
     os.replace(tmp, out / name)

@@ -77,6 +77,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="actuator lag behind its static angle, first order (s, default 0.4)",
     )
     parser.add_argument(
+        "--shutter-s",
+        type=float,
+        default=0.0,
+        help="exposure time of a frame (s, at most 1/fps; default 0: instantaneous): a moving "
+             "actuator is smeared over it, as a camera's 1/60 s smears a step response",
+    )
+    parser.add_argument(
         "--codec",
         choices=sorted(CODECS),
         default="mjpg",
@@ -140,6 +147,7 @@ def run(args: argparse.Namespace) -> int:
         l0_mm=args.l0_mm,
         actuator=args.actuator,
         trial=args.trial,
+        shutter_s=args.shutter_s,
     )
     dt = time.perf_counter() - t0
     print(
