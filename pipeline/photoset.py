@@ -968,9 +968,12 @@ def file_problems(
                 "no mm_per_px: psi will be the turning of the measured line, so a line cut short "
                 "by the clamp or the border reads low"
                 if any(r.target == "line" for r in unscaled)
-                else "no mm_per_px: a body is not checked against l0_mm, so one partly hidden or "
-                "cut short is not flagged for its length",
-                "with a ruler in view, measure the image scale (mm per pixel) and set "
+                else "no mm_per_px (optional for a body): a body's length is then checked "
+                "against the other photos of its ramp only, not against l0_mm",
+                "set mm_per_px if a ruler or a known length is in view (a body's width, in mm "
+                "over px); otherwise there is nothing to do"
+                if all(r.target == "body" for r in unscaled)
+                else "with a ruler in view, measure the image scale (mm per pixel) and set "
                 "mm_per_px; without one, a known length in the photo does (a body's width across "
                 "it, in mm over px), or leave it out (a reminder only)",
                 warning=True,

@@ -157,10 +157,15 @@ def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
     assert len(loaded.rows) == 8 and calls == {"yaml": 1, "csv": 1}
 
 
-@pytest.mark.parametrize(("target", "says"), [("line", "line cut short"), ("body", "l0_mm")])
-def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, target, says):
+@pytest.mark.parametrize(
+    ("target", "says", "fix"),
+    [("line", "line cut short", "a reminder only"), ("body", "optional for a body",
+                                                     "otherwise there is nothing to do")],
+)
+def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, target, says, fix):
     # a line's psi rests on its measured length without a scale; a body's tip angle does not, and
-    # only its length check is lost
+    # only its length check against l0 is lost (its ramp's other photos still check it): three
+    # customers with no ruler found the warning noise they could not act on
     from pipeline import photoset_init
 
     photoset_init.init_photoset(
@@ -171,7 +176,7 @@ def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, t
     (warning,) = [
         p for p in ps.validate_photoset(photo_folder, warnings=True) if "mm_per_px" in p.message
     ]
-    assert warning.warning and says in warning.message
+    assert warning.warning and says in warning.message and fix in warning.fix
 
 
 NO_SEALED_END = "no sealed_end_mm: the tip angle is read where the body's centre line stops"
