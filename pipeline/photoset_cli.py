@@ -181,6 +181,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     preview.add_argument(
         "--all", action="store_true", help="every photo, not only three of each ramp"
     )
+    preview.add_argument(
+        "--image", action="append", default=[], metavar="NAME",
+        help="only this photo, named as in manifest.csv (e.g. trial1/IMG_0017.JPG: a flagged "
+             "row's); repeatable",
+    )
     pick = sub.add_parser(
         "pick-color",
         help="print an HSV range (ready for photoset.yaml) for the colour around a pixel",
@@ -214,7 +219,7 @@ def run(args: argparse.Namespace) -> int:
         from pipeline.preview import write_preview
 
         out = args.out or f"{Path(args.folder).resolve().name}_preview.jpg"
-        path, n = write_preview(args.folder, out, every=args.all)
+        path, n = write_preview(args.folder, out, every=args.all, images=args.image)
         print(
             f"wrote {path}: {n} photo(s) or frame(s); green = ok, orange = flagged, tinted = what "
             "the settings select"

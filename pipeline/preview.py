@@ -15,6 +15,7 @@ measured there and the calibration's reprojection error. It is the measurement i
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
@@ -241,11 +242,22 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
     return panel
 
 
-def preview_rows(ps: PhotoSet, every: bool = False) -> list[int]:
+def preview_rows(
+    ps: PhotoSet, every: bool = False, images: Sequence[str] = ()
+) -> list[int]:
     """Positions (0-based) of the photos a preview shows: the first of every ramp, the one at its
     highest pressure (the most bent: on a ramp up and back down the first and last are both at
-    rest) and the last (or all)."""
+    rest) and the last (or all, or the ``images`` named, in their order)."""
     m = ps.manifest.reset_index(drop=True)
+    if images:
+        names = m["image"].astype(str).tolist()
+        missing = [name for name in images if name not in names]
+        if missing:
+            raise UserInputError(
+                f"--image {missing[0]}: no such photo in {ps.folder / 'manifest.csv'} (fix: give "
+                f"its name as in the manifest's image column, e.g. {names[0]})"
+            )
+        return [names.index(name) for name in images]
     if every:
         return list(range(len(m)))
     order = m.sort_values("step", kind="stable") if "step" in m.columns else m
@@ -319,8 +331,10 @@ def write_preview(
     *,
     method: str = "auto",
     every: bool = False,
+    images: Sequence[str] = (),
 ) -> tuple[Path, int]:
-    """Write the preview contact sheet of a photo set; return its path and the tile count.
+    """Write the preview contact sheet of a photo set (of the ``images`` named, when given);
+    return its path and the tile count.
 
     The sheet is a JPEG, or a PNG when ``out`` ends in ``.png``; another ending is refused before
     anything is measured.
@@ -333,8 +347,13 @@ def write_preview(
             "or .png)"
         )
     ps = load_photoset(folder)
+    if ps.is_video and images:
+        raise UserInputError(
+            f"--image {images[0]}: {ps.folder} is a video set, whose preview shows frames along "
+            "each video (fix: leave --image out)"
+        )
     tiles = video_tiles(ps, method) if ps.is_video else []
-    for i in [] if ps.is_video else preview_rows(ps, every):
+    for i in [] if ps.is_video else preview_rows(ps, every, images):
         row = ps.manifest.iloc[i]
         title = (
             f"{row['image']}  {row['material']} {row['actuator']} t{row['trial']}  "

@@ -661,3 +661,23 @@ def test_the_preview_shows_each_ramps_most_bent_photo_not_only_its_two_rests(pho
         ["1", 0.0], ["1", 20.0], ["1", 0.0], ["2", 0.0], ["2", 20.0]
     ]
     assert len(preview_rows(loaded, every=True)) == len(loaded.manifest) == 8
+
+
+def test_the_preview_shows_the_photos_named_and_refuses_a_name_not_in_the_manifest(
+    photo_folder, tmp_path_factory, capsys
+):
+    # a flagged row's reason says "check with photoset preview", whose sheet of three photos a
+    # ramp need not hold that row (customers 10 and 11): --image shows it
+    from pipeline.cli import main
+    from pipeline.preview import preview_rows
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    loaded = ps.load_photoset(photo_folder)
+    names = loaded.manifest["image"].tolist()
+    assert preview_rows(loaded, images=[names[3], names[1]]) == [3, 1]
+    out = tmp_path_factory.mktemp("sheet") / "one.png"
+    assert main(["photoset", "preview", str(photo_folder), "--image", names[3], "--out",
+                 str(out)]) == 0
+    assert "1 photo(s)" in capsys.readouterr().out and out.is_file()
+    with pytest.raises(UserInputError, match=r"--image IMG_9\.JPG: no such photo in .*manifest"):
+        preview_rows(loaded, images=["IMG_9.JPG"])
