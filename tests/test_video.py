@@ -459,7 +459,7 @@ def test_the_preview_of_a_video_set_shows_its_first_most_bent_and_last_frames(vi
 def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_measured(
     tmp_path,
 ):
-    # --shutter-s: a frame is exposed while the body moves (up to 20 deg a frame here), as a
+    # --shutter-s: a frame is exposed while the body moves (up to 45 deg a frame here), as a
     # webcam's 1/30 s smears a step response at 15 fps; at rest it is the instantaneous frame
     kw = {
         "profile": PressureProfile("steps", max_kpa=160, step_kpa=160, hold_s=0.6),
@@ -475,10 +475,10 @@ def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_
     assert (tmp_path / "sharp" / "truth.csv").read_bytes() == (
         tmp_path / "smeared" / "truth.csv"
     ).read_bytes()
-    sharp, smeared = (cv2.VideoCapture(str(tmp_path / d / name)) for d in ("sharp", "smeared"))
+    caps = [cv2.VideoCapture(str(tmp_path / d / name)) for d in ("sharp", "smeared")]
     change = []
     for _ in range(len(truth)):
-        a, b = sharp.read()[1].astype(int), smeared.read()[1].astype(int)
+        a, b = (cap.read()[1].astype(int) for cap in caps)
         change.append(float(np.abs(a - b).mean()))
     still = np.abs(np.gradient(truth["psi_image_deg"].to_numpy())) < 0.01
     assert still.sum() >= 3 and max(np.array(change)[still]) == 0.0, change
@@ -488,6 +488,13 @@ def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_
     )
     err = (m["psi_deg"] - m["psi_image_deg"]).abs()
     ok = m["status"] == "ok"
-    assert ok.mean() >= 0.8 and err[ok].max() < 10.0, m[["psi_deg", "psi_image_deg", "status"]]
+    assert ok[still].all() and err[ok].max() < 10.0, m[["psi_deg", "psi_image_deg", "status"]]
+    # a frame whose tip is a fan of its places over the exposure says so, and is flagged; the
+    # sharp video's frames never do (their free ends are at most 1.08 times the body's width)
+    smeared = m["reason"].fillna("").str.contains("smeared, the body moving")
+    assert smeared.sum() >= 5 and (m.loc[smeared, "status"] == "flagged").all(), m["reason"]
+    assert not smeared[still].any()
+    sharp_rows = measure_photoset(tmp_path / "sharp", jobs=2)
+    assert not sharp_rows["reason"].fillna("").str.contains("smeared").any()
     with pytest.raises(UserInputError, match="shutter_s"):
         render_video(tmp_path / "x", "DS20", shutter_s=0.1, **kw)  # longer than a frame

@@ -472,6 +472,7 @@ def measure_body(
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
         background_estimated=settings.background_estimated,
+        video_frame=settings.video_frame,
         missed_tip_deg=missed_tip_deg,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,

@@ -172,6 +172,11 @@ WIDTH_RATIO = 2.2
 RIDGE_TIP_DEG = 4.0
 #: body: a free end narrower than this fraction of the body's width has lost a side
 NARROW_FREE_END = 0.6
+#: body, a frame of a video: a free end wider than this times the body is smeared, the tip a fan
+#: of its places over the exposure.  Rendered step responses (DS20 on green, SS40 on grey, 850
+#: sharp frames) reach at most 1.08; with a shutter open a whole frame at 30 fps the frames more
+#: than 10 deg off reach 1.12 and more (one `ok` at 1.12, 23.5 deg off)
+SMEARED_FREE_END = 1.1
 #: body: where the free end is narrower than this fraction of the body's width (a faint side),
 #: its curvature says less of how far the uncovered tip turns, and a centre line stopping short
 #: of a tip that turns more than FAINT_TIP_TURN_DEG (deg) at that curvature is flagged (not
@@ -264,6 +269,7 @@ def assess_body(
     side_on_border: bool = False,
     tip_at_region_edge: bool = False,
     background_estimated: bool = False,
+    video_frame: bool = False,
     missed_tip_deg: float = 0.0,
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
@@ -283,7 +289,9 @@ def assess_body(
     :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
     from ``fixed_end`` (not when ``fixed_direction_deg`` is given, ``base_mismatch_deg`` not
     None: psi does not depend on it); the body closes on itself; or it is much shorter than
-    ``l0`` (partly hidden).  Notes (status stays ``ok``) say how psi was taken.
+    ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
+    :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
+    how psi was taken.
     """
     import numpy as np
 
@@ -363,6 +371,11 @@ def assess_body(
             f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: one side of "
             "it may not be selected "
             "(faint), which turns its direction; check with photoset preview"
+        )
+    if video_frame and free_end_width_ratio > SMEARED_FREE_END:
+        flags.append(
+            f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: smeared, "
+            "the body moving while the frame was exposed (a shorter shutter keeps it sharp)"
         )
     if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
         further = tip_turn_deg(ridge_tip_deg, missed_tip_deg) != ridge_tip_deg

@@ -158,6 +158,9 @@ class MeasureSettings:
         ``background_path`` is not a photo of the empty scene but an estimate of it from the
         other photos of the ramp (:mod:`pipeline.measure.ramp_background`): where it still shows
         the body, the backdrop decides.
+    video_frame : bool
+        A frame of a video, exposed while the actuator may move (set by the video measurement,
+        not a key): a free end wider than the body is then a smeared one.
     roi : Polygon or None
         Where the actuator can be (px); None: the whole photo.
     exclude : tuple of Polygon
@@ -185,6 +188,7 @@ class MeasureSettings:
     target: str = "line"
     background_path: str | None = None
     background_estimated: bool = False
+    video_frame: bool = False
     roi: Polygon | None = None
     exclude: tuple[Polygon, ...] = ()
     fixed_direction_deg: float | None = None

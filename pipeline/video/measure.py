@@ -14,6 +14,7 @@ at all and whose frame count is unknown gives one ``failed`` row with an empty `
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -61,7 +62,8 @@ def _tasks(
 ) -> list[tuple[int, FrameChunk]]:
     tasks = []
     for clip in clips:
-        settings = ps.rows[clip.position]
+        row = ps.rows[clip.position]
+        settings = None if row is None else dataclasses.replace(row, video_frame=True)
         reasons = [r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r]
         reason = "; ".join(reasons)
         n = clip.n_frames
