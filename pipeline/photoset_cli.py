@@ -380,7 +380,9 @@ def _pick(args: argparse.Namespace) -> int:
     share = float(color_mask(img, spec).mean())
     print(f'line_color: "{spec.text}"')
     print(f"# {spec.describe()}; selects {100 * share:.1f}% of {Path(args.image).name}"
-          + ("; that is a lot: pick on a purer spot or add an roi" if share > 0.3 else ""))
+          + ("; that is a lot: pick on a purer spot or add an roi, or, for a body the colour "
+             "of its backdrop, leave line_color out (target: body tells it from the backdrop)"
+             if share > 0.3 else ""))
     return 0
 
 

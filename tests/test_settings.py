@@ -6,6 +6,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -378,3 +379,18 @@ def test_a_number_written_with_a_decimal_comma_is_read_and_a_list_of_them_is_not
     assert (s.l0_mm, s.mm_per_px, s.sealed_end_mm) == (255.0, 0.3, 4.5)
     with pytest.raises(SettingsError, match="l0_mm = '1,2,3' must be a positive number"):
         resolve_settings(l0_mm="1,2,3")
+
+
+def test_pick_color_on_a_body_the_colour_of_its_backdrop_points_to_leaving_the_colour_out(
+    tmp_path, capsys
+):
+    # a translucent grey body on grey: every spot picked selects most of the photo, and "pick on
+    # a purer spot" was all it said (customer 13: there is none)
+    from pipeline.cli import main
+
+    img = np.full((60, 80, 3), 128, np.uint8)
+    img[25:35, 10:70] = 136  # the body, a shade lighter
+    cv2.imwrite(str(tmp_path / "grey.png"), img)
+    assert main(["photoset", "pick-color", str(tmp_path / "grey.png"), "--at", "40,30"]) == 0
+    out = capsys.readouterr().out
+    assert "that is a lot" in out and "leave line_color out" in out, out
