@@ -14,7 +14,6 @@ measured there and the calibration's reprojection error. It is the measurement i
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -31,7 +30,7 @@ from pipeline.measure.extract import line_mask, region_mask
 from pipeline.measure.overlay import draw_fixed_end, wrap_text
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
-from pipeline.video.clips import Clip, resolve_clips
+from pipeline.video.clips import Clip, frame_settings, resolve_clips
 from pipeline.video.reader import read_frames
 from pipeline.video.timeline import frame_conditions
 
@@ -296,12 +295,6 @@ def preview_frames(pressure_kpa: np.ndarray) -> list[int]:
     return list(dict.fromkeys((0, top, len(pressure_kpa) - 1)))
 
 
-def _frame_settings(ps: PhotoSet, clip: Clip) -> MeasureSettings | None:
-    """A video row's settings for its frames (``video_frame``: exposed while the body moves)."""
-    row = ps.rows[clip.position]
-    return None if row is None else dataclasses.replace(row, video_frame=True)
-
-
 def video_tiles(ps: PhotoSet, method: str = "auto") -> list[np.ndarray]:
     """The preview tiles of a video photo set: of every video its first frame, the one at the
     highest logged pressure (the most bent) and its last."""
@@ -326,7 +319,7 @@ def video_tiles(ps: PhotoSet, method: str = "auto") -> list[np.ndarray]:
                 f"  {pressure[k]:g} kPa" if np.isfinite(pressure[k]) else ""
             )
             tiles.append(
-                encoded_tile(data, f"{clip.video} frame {k}", _frame_settings(ps, clip),
+                encoded_tile(data, f"{clip.video} frame {k}", frame_settings(ps, clip),
                              method=method, title=title, reason=frame.reason)
             )
     return tiles

@@ -222,12 +222,12 @@ def _exposed(
     ``t_s``) and the renders (``render(psi_deg)``, same seed: same noise) at the other
     :data:`SHUTTER_SUBFRAMES` - 1 instants spread evenly over the exposure."""
     offsets = shutter_s * ((np.arange(SHUTTER_SUBFRAMES) + 0.5) / SHUTTER_SUBFRAMES - 0.5)
+    psi = np.interp(t_s + offsets, sim["time_s"], sim["psi_deg"])
+    if np.ptp(psi) == 0:  # at rest over the exposure: the frame itself, not five equal renders
+        return middle
     total = np.zeros(middle.shape, np.float32)
-    for dt in offsets:
-        if dt == 0:
-            total += middle
-        else:
-            total += render(float(np.interp(t_s + dt, sim["time_s"], sim["psi_deg"])))
+    for dt, p in zip(offsets, psi):
+        total += middle if dt == 0 else render(float(p))
     return np.clip(total / SHUTTER_SUBFRAMES + 0.5, 0, 255).astype(np.uint8)
 
 

@@ -10,13 +10,13 @@ video (``k / fps`` for AVI) ``+ clock_offset_s``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from pipeline.measure.settings import is_missing
+from pipeline.measure.settings import MeasureSettings, is_missing
 from pipeline.photoset import MANIFEST, PhotoSet, Problem, geometry_problems
 from pipeline.video.reader import VideoInfo, probe_video, read_frames
 from pipeline.video.timeline import (
@@ -153,6 +153,13 @@ def resolve_clips(ps: PhotoSet) -> tuple[Clip, ...]:
             Clip(i, int(row["manifest_line"]), video, info, log, times, offset, tuple(problems))
         )
     return tuple(clips)
+
+
+def frame_settings(ps: PhotoSet, clip: Clip) -> MeasureSettings | None:
+    """The settings a clip's frames are measured with: its manifest row's, marked
+    ``video_frame`` (exposed while the body may move); None where the row cannot be measured."""
+    row = ps.rows[clip.position]
+    return None if row is None else replace(row, video_frame=True)
 
 
 def span_problem(clip: Clip) -> str:

@@ -14,7 +14,6 @@ at all and whose frame count is unknown gives one ``failed`` row with an empty `
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 from pathlib import Path
 
@@ -24,7 +23,7 @@ import pandas as pd
 from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import VIDEO_OPTIONAL_COLUMNS, PhotoSet
 from pipeline.pool import map_photos
-from pipeline.video.clips import Clip, resolve_clips, span_problem
+from pipeline.video.clips import Clip, frame_settings, resolve_clips, span_problem
 from pipeline.video.timeline import frame_conditions, span_text
 from pipeline.video.worker import CHUNK_COLUMNS, CHUNK_FRAMES, FrameChunk, run_chunk
 
@@ -62,8 +61,7 @@ def _tasks(
 ) -> list[tuple[int, FrameChunk]]:
     tasks = []
     for clip in clips:
-        row = ps.rows[clip.position]
-        settings = None if row is None else dataclasses.replace(row, video_frame=True)
+        settings = frame_settings(ps, clip)
         reasons = [r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r]
         reason = "; ".join(reasons)
         n = clip.n_frames
