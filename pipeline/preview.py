@@ -27,7 +27,13 @@ from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
 from pipeline.measure.core import AngleResult, decode_for_work, load_background, measure_decoded
 from pipeline.measure.extract import line_mask, region_mask
-from pipeline.measure.overlay import draw_fixed_end, wrap_text
+from pipeline.measure.overlay import (
+    draw_direction,
+    draw_fixed_end,
+    draw_tip,
+    screen_directions,
+    wrap_text,
+)
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 from pipeline.video.clips import Clip, frame_settings, resolve_clips
@@ -153,6 +159,16 @@ def encoded_tile(
         )
     if settings.fixed_end_px is not None:
         draw_fixed_end(tint, np.asarray(settings.fixed_end_px) * kk, settings.fixed_direction_deg)
+    # what psi is measured between, as in the overlays (on screen: not for a calibrated photo)
+    base_deg, tip_deg = (
+        screen_directions(res, settings.sign, settings.fixed_direction_deg)
+        if settings.calibration is None
+        else (None, None)
+    )
+    if settings.fixed_direction_deg is None and base_deg is not None and len(res.centreline_px):
+        draw_direction(tint, res.centreline_px[0] * kk, base_deg)
+    if tip_deg is not None and res.tip_px is not None:
+        draw_tip(tint, np.asarray(res.tip_px) * kk, tip_deg)
     text = [
         title,
         f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",

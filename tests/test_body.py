@@ -942,3 +942,57 @@ def test_measure_says_which_method_auto_took_for_a_body(tmp_path, capsys):
     )
     assert main(["measure", str(tmp_path), "--out", str(tmp_path / "a.csv")]) == 0
     assert "method auto (rows say which it took: tangents) ->" in capsys.readouterr().out
+
+
+def _centre_point_back_from_face(psi, back_px, length=600.0, width=46.0):
+    """The point ``back_px`` back along the centre line from the end face of :func:`body_photo`'s
+    body (world frame: y up, fixed end at the origin)."""
+    k = np.deg2rad(psi) / length
+    stretch = 1.0 - k * width / 2  # the centre line's length per unit of the lower edge's
+    s = length - back_px / stretch
+    p = np.array([np.sin(k * s) / k, (1 - np.cos(k * s)) / k])
+    return p + np.array([-np.sin(k * s), np.cos(k * s)]) * width / 2
+
+
+@pytest.mark.parametrize("psi", [120.0, -200.0])
+def test_a_body_says_where_and_in_which_direction_its_tip_was_read(psi):
+    # the overlays draw psi's two directions: the base's and the tip's, from where the tip was
+    # read, so that a user sees psi as the turn between two lines (and a sealed_end_mm given too
+    # short as a tip read inside the cap)
+    from pipeline.measure.overlay import screen_directions
+
+    img, fe, _ = body_photo(psi, seed=3)
+
+    def on_screen(p):
+        return np.array([p[0], -p[1]]) + fe
+
+    cut = measure_image(img, settings_for(fe, free_end="bends"))
+    base, tip = screen_directions(cut, 1, None)
+    assert cut.status == "ok", cut.reason
+    assert base == pytest.approx(0.0, abs=2.5) and tip == pytest.approx(psi, abs=3.0)
+    face = on_screen(_centre_point_back_from_face(psi, 0.0))
+    assert np.hypot(*(np.asarray(cut.tip_px) - face)) < 6.0, (cut.tip_px, face)
+    # a sealed end of 20 mm at 0.5 mm per px: read 40 px back from the face
+    sealed = measure_image(img, settings_for(fe, sealed_end_mm=20.0, mm_per_px=0.5))
+    back = on_screen(_centre_point_back_from_face(psi, 40.0))
+    assert np.hypot(*(np.asarray(sealed.tip_px) - back)) < 6.0, (sealed.tip_px, back)
+    _, tip = screen_directions(sealed, 1, None)
+    assert tip is not None and tip - psi == pytest.approx(-40.0 / 600.0 * psi, abs=3.0)
+
+
+def test_the_overlay_draws_the_tip_direction_from_where_it_was_read(tmp_path):
+    from pipeline.measure.worker import write_overlay
+
+    img, fe, _ = body_photo(120.0, seed=3)
+    settings = settings_for(fe, free_end="bends")
+    res = measure_image(img, settings)
+    write_overlay(str(tmp_path / "o.jpg"), img, 1, res, "t", settings)
+    drawn = cv2.imread(str(tmp_path / "o.jpg")).astype(int)
+    k = drawn.shape[1] / img.shape[1]  # the overlay is reduced
+    band = drawn.shape[0] - round(img.shape[0] * k)  # the text above the photo
+    a = np.deg2rad(120.0)
+    for along in (15.0, 40.0):  # px of the overlay along the tip's line
+        x, y = np.asarray(res.tip_px) * k + along * np.array([np.cos(a), -np.sin(a)])
+        near = drawn[band + round(y) - 1 : band + round(y) + 2, round(x) - 1 : round(x) + 2]
+        blue = (near[..., 0] - near[..., 2] > 80) & (near[..., 0] - near[..., 1] > 40)
+        assert blue.any(), (x, y, near.tolist())

@@ -103,6 +103,11 @@ class AngleResult:
         ``fixed_direction_deg`` given psi is not measured from it, but it is still read where
         the body's start is seen (the ramp check compares the two).  NaN for a line, a body
         whose start is not seen with the direction given, or when failed.
+    tip_px : (float, float) or None
+        A body's point where its free end's tangent was read (x right, y down, original px):
+        the centre line's end, moved back along it or on along the tangent by what the tangent
+        was carried (to the tip's face, or back to where a sealed end starts); None for a line or
+        when failed.  The overlays draw the tip's direction from it.
     """
 
     psi_deg: float
@@ -117,6 +122,7 @@ class AngleResult:
     degree: int = 0
     length_px: float = float("nan")
     base_direction_deg: float = float("nan")
+    tip_px: tuple[float, float] | None = None
 
 
 def failed(method: str, reason: str) -> AngleResult:
@@ -487,12 +493,37 @@ def measure_body(
         est, line, quality, settings, used,
     )
     own_base_deg = float(np.rad2deg(sign * start))
-    if base is not None:  # the body's own, beside the one given: where its start is seen
-        seen = start_seen(body.start_gap_px, line.width_px)
-        return replace(measured, base_direction_deg=own_base_deg if seen else float("nan"))
     if est is not tip:
         return measured
-    return replace(measured, base_direction_deg=own_base_deg)
+    tip_px = read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))
+    if base is not None:  # the body's own, beside the one given: where its start is seen
+        seen = start_seen(body.start_gap_px, line.width_px)
+        return replace(
+            measured, base_direction_deg=own_base_deg if seen else float("nan"), tip_px=tip_px
+        )
+    return replace(measured, base_direction_deg=own_base_deg, tip_px=tip_px)
+
+
+def read_point_px(centreline_px: NDArray[np.float64], beyond_px: float) -> tuple[float, float]:
+    """The point ``beyond_px`` past a centre line's last point: back along the line when
+    negative, on along its last direction (over its last 10 px) when positive (image px).
+
+    Examples
+    --------
+    >>> line = np.c_[np.arange(0.0, 101.0), np.zeros(101)]
+    >>> read_point_px(line, -30.0), read_point_px(line, 12.0), read_point_px(line, -500.0)
+    ((70.0, 0.0), (112.0, 0.0), (0.0, 0.0))
+    """
+    pts = np.asarray(centreline_px, float)
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
+    if beyond_px <= 0:
+        at = max(s[-1] + beyond_px, 0.0)
+        return float(np.interp(at, s, pts[:, 0])), float(np.interp(at, s, pts[:, 1]))
+    back = np.array([np.interp(s[-1] - 10.0, s, pts[:, 0]), np.interp(s[-1] - 10.0, s, pts[:, 1])])
+    step = pts[-1] - back
+    unit = step / max(float(np.hypot(*step)), 1e-9)
+    x, y = pts[-1] + beyond_px * unit
+    return float(x), float(y)
 
 
 def carried_on_psi_deg(

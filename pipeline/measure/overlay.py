@@ -41,6 +41,8 @@ def overlay_lines(result: AngleResult, title: str, width_px: int, height_px: int
 #: the fixed end's mark and the clamp direction's line (BGR), and that line's length as a
 #: fraction of the picture's width (long enough to lay along the body's base)
 FIXED_END_BGR, DIRECTION_LENGTH_FRACTION = (255, 80, 0), 0.3
+#: the free end's direction line, as a fraction of the picture's width (to lay along the tip)
+TIP_LENGTH_FRACTION = 0.12
 
 
 def draw_fixed_end(
@@ -59,15 +61,57 @@ def draw_fixed_end(
 
 
 def draw_direction(
-    image_bgr: np.ndarray, from_xy: Sequence[float] | np.ndarray, direction_deg: float
+    image_bgr: np.ndarray,
+    from_xy: Sequence[float] | np.ndarray,
+    direction_deg: float,
+    length_fraction: float = DIRECTION_LENGTH_FRACTION,
 ) -> None:
     """A thin straight line from ``from_xy`` in ``direction_deg`` (counter-clockwise from +x on
-    screen), :data:`DIRECTION_LENGTH_FRACTION` of the picture's width long (in place)."""
+    screen), ``length_fraction`` of the picture's width long (in place)."""
     start = np.asarray(from_xy, dtype=float)
     a = np.deg2rad(direction_deg)
-    far = start + DIRECTION_LENGTH_FRACTION * image_bgr.shape[1] * np.array([np.cos(a), -np.sin(a)])
+    far = start + length_fraction * image_bgr.shape[1] * np.array([np.cos(a), -np.sin(a)])
     ends = np.round(np.array([start, far]) * 16).astype(int).tolist()  # 4 fractional bits
     cv2.line(image_bgr, ends[0], ends[1], FIXED_END_BGR, 1, cv2.LINE_AA, 4)
+
+
+def draw_tip(
+    image_bgr: np.ndarray, tip_xy: Sequence[float] | np.ndarray, direction_deg: float
+) -> None:
+    """Mark where the free end's tangent was read (a dot at ``tip_xy``, px of ``image_bgr``) and
+    the direction psi takes it as (a thin line, :data:`TIP_LENGTH_FRACTION` of the picture's
+    width, counter-clockwise from +x on screen), to lay along the tip (in place): psi is the
+    turn from the base's line to this one."""
+    centre = tuple(np.round(np.asarray(tip_xy, dtype=float)).astype(int).tolist())
+    cv2.circle(image_bgr, centre, 3, FIXED_END_BGR, -1, cv2.LINE_AA)
+    draw_direction(image_bgr, tip_xy, direction_deg, TIP_LENGTH_FRACTION)
+
+
+def screen_directions(
+    result: AngleResult, sign: float, fixed_direction_deg: float | None
+) -> tuple[float | None, float | None]:
+    """The two directions psi of a body is measured between, on screen (deg counter-clockwise
+    from +x): where it leaves the fixed end (the one given, else its own) and where its free end
+    points (that one turned by psi); None where not known.  Not for a calibrated photo, whose
+    directions are taken on the plane.
+
+    Examples
+    --------
+    >>> from pipeline.measure.core import AngleResult
+    >>> r = AngleResult(-90.0, 0.0, 0.0, "tangents", 0.0, "ok", "", np.zeros((2, 2)),
+    ...                 base_direction_deg=-30.0, tip_px=(5.0, 5.0))
+    >>> screen_directions(r, -1, None), screen_directions(r, 1, 10.0)
+    ((30.0, 120.0), (10.0, -80.0))
+    """
+    if fixed_direction_deg is not None:
+        base: float | None = fixed_direction_deg
+    elif np.isfinite(result.base_direction_deg):
+        base = sign * result.base_direction_deg
+    else:
+        base = None
+    if base is None or result.tip_px is None or not np.isfinite(result.psi_deg):
+        return base, None
+    return base, base + sign * result.psi_deg
 
 
 def draw_overlay(
@@ -79,6 +123,7 @@ def draw_overlay(
     fixed_end_px: Sequence[float] | None = None,
     fixed_direction_deg: float | None = None,
     base_direction_deg: float | None = None,
+    tip_direction_deg: float | None = None,
 ) -> np.ndarray:
     """The photo with the extracted centre line and the fixed end drawn on it, and psi written in
     a band above it (not over it: a tip near the photo's top edge stays in view).
@@ -100,6 +145,9 @@ def draw_overlay(
     base_direction_deg : float, optional
         Without one given, the body's own base direction psi was measured from (deg
         counter-clockwise from +x on screen), drawn from the line's start.
+    tip_direction_deg : float, optional
+        The free end's direction as psi takes it (the base's turned by psi; deg counter-clockwise
+        from +x on screen), drawn from where it was read (``result.tip_px``: :func:`draw_tip`).
 
     Returns
     -------
@@ -128,6 +176,8 @@ def draw_overlay(
     drawn_from = pts[0] if len(result.centreline_px) else None
     if fixed_direction_deg is None and base_direction_deg is not None and drawn_from is not None:
         draw_direction(out, drawn_from, base_direction_deg)
+    if tip_direction_deg is not None and result.tip_px is not None:
+        draw_tip(out, (np.asarray(result.tip_px) - (scale - 1) / 2) * k, tip_direction_deg)
     lines = overlay_lines(result, title, out.shape[1], out.shape[0])
     band = np.full((12 + LINE_PX * len(lines), out.shape[1], 3), BAND_BGR, np.uint8)
     band[-2:] = DIVIDER_BGR

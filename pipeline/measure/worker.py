@@ -84,12 +84,18 @@ def write_overlay(
 ) -> None:
     """Draw ``res`` on the work image ``img`` (reduced by ``factor``; grey or BGR), with the
     fixed end and clamp direction of ``settings`` as given, and write a JPEG."""
-    from pipeline.measure.overlay import draw_overlay
+    from pipeline.measure.overlay import draw_overlay, screen_directions
 
     base = img if img is not None else np.full((480, 640, 3), 90, np.uint8)
     if base.ndim == 2:
         base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
     given = settings if img is not None else None  # not on the blank stand-in
+    # on screen: not for a calibrated photo, whose directions are taken on the plane
+    base_deg, tip_deg = (
+        screen_directions(res, given.sign, given.fixed_direction_deg)
+        if given and given.calibration is None
+        else (None, None)
+    )
     out = draw_overlay(
         base,
         res,
@@ -97,11 +103,8 @@ def write_overlay(
         title=title,
         fixed_end_px=given.fixed_end_px if given else None,
         fixed_direction_deg=given.fixed_direction_deg if given else None,
-        base_direction_deg=(
-            given.sign * res.base_direction_deg  # on screen (not on a calibrated plane)
-            if given and given.calibration is None and np.isfinite(res.base_direction_deg)
-            else None
-        ),
+        base_direction_deg=base_deg,
+        tip_direction_deg=tip_deg,
     )
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # a photo in a subfolder of its set
     cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
