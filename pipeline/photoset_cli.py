@@ -170,8 +170,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "the highest-pressure and the last photo of every ramp",
         description="For the first, the highest-pressure and the last photo of every ramp: the "
                     "photo with the selection tinted, roi/exclude, "
-        "candidates, the chosen line or body centre line, the fixed end and psi, beside the "
-        "selection mask.",
+        "candidates, the chosen line or body centre line, the fixed end, the directions psi "
+        "is measured between and psi, beside the selection mask and (for a body) its free end "
+        "enlarged.",
     )
     preview.add_argument("folder", metavar="DIR", help="photo-set folder")
     preview.add_argument(

@@ -45,6 +45,8 @@ TILE_WIDTH_PX = 480
 TEXT_SCALE = 0.48
 REASON_LINES = 6
 _STATUS_BGR = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
+#: the free end's panel shows this many body widths across, and at least this many work px
+TIP_PANEL_WIDTHS, TIP_PANEL_MIN_PX = 5.0, 60.0
 
 
 def selection(
@@ -198,12 +200,67 @@ def encoded_tile(
         1,
         cv2.LINE_AA,
     )
-    rectified = rectified_panel(img, float(f), settings, res, (small.shape[1], small.shape[0]))
-    panels = np.hstack([tint, right] + ([] if rectified is None else [rectified]))
+    size = (small.shape[1], small.shape[0])
+    rectified = rectified_panel(img, float(f), settings, res, size)
+    tip = tip_panel(img, float(f), res, tip_deg, size) if tip_deg is not None else None
+    panels = np.hstack([tint, right] + [p for p in (tip, rectified) if p is not None])
     band = cv2.copyMakeBorder(
         band, 0, 0, 0, panels.shape[1] - band.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30)
     )
     return np.vstack([band, panels])
+
+
+def tip_panel(
+    img: np.ndarray,
+    scale: float,
+    res: AngleResult,
+    tip_direction_deg: float,
+    size: tuple[int, int],
+) -> np.ndarray | None:
+    """A body's free end enlarged: :data:`TIP_PANEL_WIDTHS` of its widths across, with its
+    centre line, the dot where its tangent was read and the direction psi takes it as (None
+    without a tip).  On a 12 MP photo the tile shows a sealed end as a few pixels; here one sees
+    whether the dot sits where the body stops bending, and the line lies along the tip.
+
+    Examples
+    --------
+    >>> from pipeline.measure.core import AngleResult
+    >>> img = np.full((300, 400, 3), 200, np.uint8)
+    >>> line = np.c_[np.linspace(50.0, 300.0, 50), np.full(50, 150.0)]
+    >>> res = AngleResult(0.0, 0.0, 0.0, "tangents", 0.0, "ok", "", line,
+    ...                   line_width_px=20.0, tip_px=(300.0, 150.0))
+    >>> panel = tip_panel(img, 1.0, res, 0.0, (480, 360))
+    >>> panel.shape, tuple(int(v) for v in panel[180, 240])  # the dot, in the middle
+    ((360, 480, 3), (255, 80, 0))
+    """
+    if res.tip_px is None or not np.isfinite(res.line_width_px):
+        return None
+    base = np.asarray(img if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), np.uint8)
+    centre = np.asarray(res.tip_px, float) / scale  # work px
+    across = max(TIP_PANEL_WIDTHS * res.line_width_px / scale, TIP_PANEL_MIN_PX)
+    zoom = size[0] / across
+    shift = np.array(size, float) / 2 - zoom * centre
+    to_panel = np.array([[zoom, 0.0, shift[0]], [0.0, zoom, shift[1]]])
+    panel = cv2.warpAffine(
+        base, to_panel, size, flags=cv2.INTER_LINEAR if zoom > 1 else cv2.INTER_AREA,
+        borderMode=cv2.BORDER_CONSTANT, borderValue=(30, 30, 30),
+    )
+    if len(res.centreline_px):
+        q = res.centreline_px / scale * zoom + shift
+        colour = _STATUS_BGR.get(res.status, (255, 255, 255))
+        cv2.polylines(panel, [np.round(q * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
+    draw_tip(panel, centre * zoom + shift, tip_direction_deg)
+    cv2.putText(
+        panel,
+        f"free end, {zoom * base.shape[1] / TILE_WIDTH_PX:.1f}x the photo beside",
+        (8, size[1] - 10),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.45,
+        (0, 200, 255),
+        1,
+        cv2.LINE_AA,
+    )
+    return panel
 
 
 def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, res: AngleResult,

@@ -996,3 +996,23 @@ def test_the_overlay_draws_the_tip_direction_from_where_it_was_read(tmp_path):
         near = drawn[band + round(y) - 1 : band + round(y) + 2, round(x) - 1 : round(x) + 2]
         blue = (near[..., 0] - near[..., 2] > 80) & (near[..., 0] - near[..., 1] > 40)
         assert blue.any(), (x, y, near.tolist())
+
+
+def test_the_preview_shows_a_bodys_free_end_enlarged(tmp_path):
+    # a sealed end on a 12 MP photo is a few pixels of the preview's tile: a third panel shows
+    # the free end enlarged, with the dot where its tangent was read in the middle
+    from pipeline.preview import TILE_WIDTH_PX, preview_tile
+
+    img, fe, _ = body_photo(150.0, seed=5)
+    cv2.imwrite(str(tmp_path / "b.jpg"), img)
+    settings = settings_for(fe, sealed_end_mm=20.0, mm_per_px=0.5)
+    tile = preview_tile(tmp_path / "b.jpg", settings, title="t")
+    assert tile.shape[1] == 3 * TILE_WIDTH_PX
+    panel = tile[-(TILE_WIDTH_PX * H // W) :, 2 * TILE_WIDTH_PX :].astype(int)
+    middle = panel[panel.shape[0] // 2 - 2 : panel.shape[0] // 2 + 3, TILE_WIDTH_PX // 2 - 2 :][
+        :, :5
+    ]
+    assert ((middle[..., 0] > 200) & (middle[..., 2] < 60)).any(), middle.tolist()  # the dot
+    # the body fills it: 5 of its widths across (46 px of 1280), not the whole photo
+    body = (np.abs(panel - np.array([90, 140, 200])).sum(axis=2) < 60).mean()
+    assert 0.1 < body < 0.6, body
