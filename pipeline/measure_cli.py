@@ -57,7 +57,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Measure the set, write angles.csv, print a one-line summary."""
-    from pipeline.photoset import newer_spreadsheet_problems
+    from pipeline.photoset import load_photoset, newer_spreadsheet_problems, sealed_end_problems
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
@@ -68,7 +68,9 @@ def run(args: argparse.Namespace) -> int:
         with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
             angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
-    for problem in newer_spreadsheet_problems(Path(args.photoset)):
+    doubts = newer_spreadsheet_problems(Path(args.photoset))
+    doubts += sealed_end_problems(load_photoset(args.photoset))
+    for problem in doubts:
         print(problem, file=sys.stderr)
     used = sorted(set(angles["method"].dropna().astype(str)) - {args.method})
     took = f" (rows say which it took: {', '.join(used)})" if used else ""

@@ -217,9 +217,10 @@ def run(args: argparse.Namespace) -> int:
     if args.photoset_command == "init":
         return _init(args)
     if args.photoset_command == "preview":
+        from pipeline.photoset import PREVIEW_SHEET_SUFFIX
         from pipeline.preview import write_preview
 
-        out = args.out or f"{Path(args.folder).resolve().name}_preview.jpg"
+        out = args.out or f"{Path(args.folder).resolve().name}{PREVIEW_SHEET_SUFFIX}.jpg"
         path, n = write_preview(args.folder, out, every=args.all, images=args.image)
         print(
             f"wrote {path}: {n} photo(s) or frame(s); green = ok, orange = flagged, tinted = what "
