@@ -29,8 +29,6 @@ from pipeline.video.worker import CHUNK_COLUMNS, CHUNK_FRAMES, FrameChunk, run_c
 
 #: overlays drawn per video (evenly spread frames; a video is never written out frame by frame)
 OVERLAYS_PER_VIDEO = 24
-#: angles.csv columns a video adds after the measurement columns
-FRAME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
 
 
 def frame_overlay_name(video: str, frame: int) -> str:

@@ -48,7 +48,6 @@ from pipeline.fileio import read_user_csv
 from pipeline.measure.settings import is_missing, user_floats
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
-OPTIONAL_LOG_COLUMNS: tuple[str, ...] = ("measured_kpa",)
 FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
 #: a reversal of the pressure trend counts once the pressure left its extreme by this much (kPa)
 TREND_DEADBAND_KPA = 1.0
