@@ -557,8 +557,9 @@ def test_the_march_stops_where_an_oblique_end_face_cuts_the_profile_short():
     face = np.array([[0, 40], [200, 40], [208, 60], [0, 60]], np.float32)  # 20 px wide
     cv2.fillPoly(soft, [np.round(face * 16).astype(np.int32)], 1.0, cv2.LINE_AA, 4)
     pts = np.c_[np.arange(20.0, 181.0), np.full(161, 50.0)]
-    out, _ = _march(soft, pts, np.full(len(pts), 20.0), 10.0, (20.0, 20.0))
+    out, _, capped = _march(soft, pts, np.full(len(pts), 20.0), 10.0, (20.0, 20.0))
     assert out[-1, 0] >= 196.0 and abs(out[-1, 1] - 50.0) <= 0.5, out[-5:]
+    assert not capped  # an end face, not a cap
 
 
 @pytest.mark.parametrize(
@@ -1016,3 +1017,35 @@ def test_the_preview_shows_a_bodys_free_end_enlarged(tmp_path):
     # the body fills it: 5 of its widths across (46 px of 1280), not the whole photo
     body = (np.abs(panel - np.array([90, 140, 200])).sum(axis=2) < 60).mean()
     assert 0.1 < body < 0.6, body
+
+
+def test_a_sealed_end_given_without_its_cap_is_not_carried_on_over_the_cap():
+    # the fibre-wound body's sealed end is 4 mm and its white cap 6 mm: given as 4 (the cap
+    # forgotten), the tip's tangent was carried on over the cap, which does not bend (psi 12 deg
+    # high, ok); the centre line stops where the body widens into the cap, and psi is not
+    # carried past it: as if no sealed end had been given.  Given cap included, it is right.
+    from pipeline.measure.body import extract_body
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("green_fibre", width=1600, height=1200)
+    r = render_actuator(215.0, 200.0, scene, seed=3)
+    img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+
+    def error(**kw):
+        settings = resolve_settings(l0_mm=200.0, target="body", fixed_end=list(r.fixed_end_px),
+                                    mm_per_px=scene.mm_per_px, **kw)
+        res = measure_image(img, settings)
+        assert res.status == "ok", res.reason
+        return res.psi_deg - r.psi_image_deg
+
+    forgotten, none = error(sealed_end_mm=scene.sealed_end_mm), error()
+    assert abs(forgotten - none) < 0.5 and abs(forgotten) < 8.0, (forgotten, none)
+    assert abs(error(sealed_end_mm=scene.sealed_end_mm + scene.tip_cap_mm)) < 3.0
+    # no cap where a body ends without one (the dots scene) or curls its tip by its own middle
+    settings = settings_for(r.fixed_end_px)
+    assert extract_body(img, settings, scale=1.0).tip_capped
+    dots = scene_from("grey_dots", width=1600, height=1200)
+    for psi in (215.0, -300.0):
+        plain = render_actuator(psi, 200.0, dots, seed=4)
+        bare = cv2.imdecode(np.frombuffer(plain.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+        assert not extract_body(bare, settings_for(plain.fixed_end_px), scale=1.0).tip_capped

@@ -92,6 +92,9 @@ class BodyExtraction:
         How far the tip's face (the body's last pixel on the centre line's course, cap included)
         lies beyond the centre line's free end (original px); computed only when
         ``sealed_end_mm`` is given (0 otherwise).
+    tip_capped : bool
+        The centre line stopped at the free end where the body goes on wider, centred on its
+        course: a rigid cap, over which the body does not bend.
     """
 
     line: LineExtraction
@@ -104,6 +107,7 @@ class BodyExtraction:
     ridge_tip_deg: float = 0.0
     free_end_width_ratio: float = 1.0
     tip_face_px: float = 0.0
+    tip_capped: bool = False
     side_on_border: bool = False
     tip_at_region_edge: bool = False
 
@@ -929,9 +933,39 @@ def _good_span(good: np.ndarray, run: int) -> tuple[int, int] | None:
     return first, last
 
 
+#: a cap ahead of the march: the body goes on wider for this many of its steps (all but one),
+#: its middle within this fraction of the width of the course (both sides overhang alike)
+CAP_PROBE_STEPS, CAP_OFF_COURSE = 5, 0.1
+
+
+def _cap_ahead(
+    soft: np.ndarray, cur: np.ndarray, course: np.ndarray, half: float, width: float
+) -> bool:
+    """Whether the selection ahead of ``cur`` along the unit ``course`` stays wider than
+    ``width`` for :data:`CAP_PROBE_STEPS` march steps, centred on the course: a rigid cap wider
+    than the body, not a dot, a blob or the body's own other limb beside its tip (one side), nor
+    a faint side showing at the end face for a step.
+
+    Examples
+    --------
+    >>> soft = np.zeros((40, 80), np.float32)
+    >>> soft[14:26, :50] = 1.0; soft[12:28, 50:60] = 1.0  # a body 12 px wide, a cap 16 px
+    >>> _cap_ahead(soft, np.array([49.0, 19.5]), np.array([1.0, 0.0]), 6.0, 13.8)
+    True
+    >>> soft[26:34, 50:60] = 1.0; soft[12:14, 50:60] = 0.0  # widening to one side only
+    >>> _cap_ahead(soft, np.array([49.0, 19.5]), np.array([1.0, 0.0]), 6.0, 13.8)
+    False
+    """
+    ahead = cur + np.outer(np.arange(1, CAP_PROBE_STEPS + 1) * MARCH_STEP_PX, course)
+    mid, wid, _ = _midpoints(soft, np.vstack([cur, ahead]), reach=3.0 * half + 4.0)
+    off = np.abs((mid[1:] - ahead) @ np.array([-course[1], course[0]]))
+    wider = np.isfinite(wid[1:]) & (wid[1:] > width) & (off < CAP_OFF_COURSE * width)
+    return bool(wider.sum() >= CAP_PROBE_STEPS - 1)
+
+
 def _march(
     soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, end_med: tuple[float, float]
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, bool]:
     """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
     edges": each new point is the middle of the profile across the body ahead, kept while the
     body's width there is within [MARCH_WIDTH_LOW, MARCH_WIDTH_HIGH] of its median near that end
@@ -941,7 +975,8 @@ def _march(
 
     The ridge path stops about a half-width short of each end (there the medial axis forks into
     the corners); marching recovers that part, so a tip that curls to its end is measured to its
-    end, and a straight sealed cap is followed to its end face.
+    end, and a straight sealed cap is followed to its end face.  Also returns whether the march
+    at the free end stopped at a cap (:func:`_cap_ahead`).
     """
     k = 6
     ends = []
@@ -949,6 +984,7 @@ def _march(
         line = pts if forward else pts[::-1]
         new: list[np.ndarray] = []
         new_w: list[float] = []
+        capped = False
         cur = line[-1]
         prev = line[max(len(line) - 1 - k, 0)]
         last_w = med
@@ -960,6 +996,9 @@ def _march(
             if not (
                 np.isfinite(wid[1]) and MARCH_WIDTH_LOW * med <= wid[1] <= MARCH_WIDTH_HIGH * med
             ):
+                capped = bool(np.isfinite(wid[1]) and wid[1] > MARCH_WIDTH_HIGH * med) and (
+                    _cap_ahead(soft, cur, t, half, MARCH_WIDTH_HIGH * med)
+                )
                 break
             step = mid[1]
             d = step - prev  # the course over the last few points, not one step's jitter
@@ -972,6 +1011,9 @@ def _march(
                 wid[1] > MARCH_SWING_WIDTH * med
                 or abs(wid[1] - last_w) > MARCH_WIDTH_STEP * med
             ):
+                capped = bool(wid[1] > MARCH_SWING_WIDTH * med) and (
+                    _cap_ahead(soft, cur, t, half, MARCH_WIDTH_HIGH * med)
+                )
                 break  # widening, or a width jump, swinging off the course: into a cap or across
                 # an end face
             last_w = float(wid[1])
@@ -979,11 +1021,11 @@ def _march(
             new_w.append(float(wid[1]))
             hist = np.vstack([line[-k:], np.array(new)])
             prev, cur = hist[max(len(hist) - 1 - k, 0)], step
-        ends.append((np.array(new).reshape(-1, 2), np.array(new_w)))
-    (head, head_w), (tail, tail_w) = ends
+        ends.append((np.array(new).reshape(-1, 2), np.array(new_w), capped))
+    (head, head_w, _), (tail, tail_w, tip_capped) = ends
     pts = np.vstack([head[::-1], pts, tail])
     widths = np.concatenate([head_w[::-1], widths, tail_w])
-    return pts, widths
+    return pts, widths, tip_capped
 
 
 def _follow_ridge(ridge: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray:
@@ -1391,7 +1433,7 @@ def extract_body(
         else (2.0 * half,) * 2
     )
     body_width = float(np.nanmedian(widths)) if np.isfinite(widths).any() else 2.0 * half
-    pts, widths = _march(soft, pts, widths, half, end_med)
+    pts, widths, tip_capped = _march(soft, pts, widths, half, end_med)
     along_ridge = _follow_ridge(ridge, pts, half)
     ridge_tip_deg = 0.0
     if len(along_ridge) > len(pts) and len(pts) >= 8:
@@ -1436,6 +1478,7 @@ def extract_body(
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,
+        tip_capped=tip_capped,
         tip_face_px=(
             0.0
             if settings.sealed_end_mm is None

@@ -410,6 +410,11 @@ def measure_body(
         )
         sealed_px = settings.sealed_end_mm / mm_per_work_px / per_image_px
         ends = _read_before_sealed_end(body.tip_face_px, ends, sealed_px, per_image_px)
+        if body.tip_capped:
+            # the centre line stopped at a cap, which does not bend: a sealed end given shorter
+            # than the cap (the cap forgotten) carried the tip's tangent on over it (|psi| 6-12
+            # deg high on rendered capped bodies at psi ~ 215 deg)
+            ends = (ends[0], min(ends[1], 0.0))
     # the part of the body past the centre line's end, less what is not bend (half a width of
     # cap, the stretch already carried on to a cut end, the sealed end), turned through at the
     # free end's curvature (image axes, deg)
