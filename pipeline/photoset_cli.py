@@ -171,7 +171,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         description="For the first, the highest-pressure and the last photo of every ramp: the "
                     "photo with the selection tinted, roi/exclude, "
         "candidates, the chosen line or body centre line, the fixed end, the directions psi "
-        "is measured between and psi, beside the selection mask and (for a body) its free end "
+        "is measured between and psi, beside the selection mask and (for a body) its two ends "
         "enlarged.",
     )
     preview.add_argument("folder", metavar="DIR", help="photo-set folder")

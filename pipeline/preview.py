@@ -45,8 +45,8 @@ TILE_WIDTH_PX = 480
 TEXT_SCALE = 0.48
 REASON_LINES = 6
 _STATUS_BGR = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
-#: the free end's panel shows this many body widths across, and at least this many work px
-TIP_PANEL_WIDTHS, TIP_PANEL_MIN_PX = 5.0, 60.0
+#: a body's ends are shown enlarged this many body widths across, and at least this many work px
+END_PANEL_WIDTHS, END_PANEL_MIN_PX = 5.0, 60.0
 
 
 def selection(
@@ -202,25 +202,36 @@ def encoded_tile(
     )
     size = (small.shape[1], small.shape[0])
     rectified = rectified_panel(img, float(f), settings, res, size)
-    tip = tip_panel(img, float(f), res, tip_deg, size) if tip_deg is not None else None
-    panels = np.hstack([tint, right] + [p for p in (tip, rectified) if p is not None])
+    ends = []
+    if tip_deg is not None and res.tip_px is not None and base_deg is not None:
+        fixed = settings.fixed_end_px or tuple(res.centreline_px[0])
+        ends = [
+            end_panel(img, float(f), res, fixed, base_deg, size, free_end=False),
+            end_panel(img, float(f), res, res.tip_px, tip_deg, size, free_end=True),
+        ]
+    panels = np.hstack([tint, right] + [p for p in (*ends, rectified) if p is not None])
     band = cv2.copyMakeBorder(
         band, 0, 0, 0, panels.shape[1] - band.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30)
     )
     return np.vstack([band, panels])
 
 
-def tip_panel(
+def end_panel(
     img: np.ndarray,
     scale: float,
     res: AngleResult,
-    tip_direction_deg: float,
+    at_px: tuple[float, float],
+    direction_deg: float,
     size: tuple[int, int],
+    *,
+    free_end: bool,
 ) -> np.ndarray | None:
-    """A body's free end enlarged: :data:`TIP_PANEL_WIDTHS` of its widths across, with its
-    centre line, the dot where its tangent was read and the direction psi takes it as (None
-    without a tip).  On a 12 MP photo the tile shows a sealed end as a few pixels; here one sees
-    whether the dot sits where the body stops bending, and the line lies along the tip.
+    """One end of a body enlarged about ``at_px`` (original px): :data:`END_PANEL_WIDTHS` of its
+    widths across, with its centre line and the direction psi is measured from there (None
+    without a width).  At the fixed end: its mark and the base's line (given, or the body's own),
+    which should lie along the body's base; at the free end: the dot where its tangent was read
+    and the direction psi takes it as, which should lie along the tip, the dot where the body
+    stops bending.  On a 12 MP photo the tile shows either as a few pixels.
 
     Examples
     --------
@@ -229,15 +240,15 @@ def tip_panel(
     >>> line = np.c_[np.linspace(50.0, 300.0, 50), np.full(50, 150.0)]
     >>> res = AngleResult(0.0, 0.0, 0.0, "tangents", 0.0, "ok", "", line,
     ...                   line_width_px=20.0, tip_px=(300.0, 150.0))
-    >>> panel = tip_panel(img, 1.0, res, 0.0, (480, 360))
+    >>> panel = end_panel(img, 1.0, res, res.tip_px, 0.0, (480, 360), free_end=True)
     >>> panel.shape, tuple(int(v) for v in panel[180, 240])  # the dot, in the middle
     ((360, 480, 3), (255, 80, 0))
     """
-    if res.tip_px is None or not np.isfinite(res.line_width_px):
+    if not np.isfinite(res.line_width_px):
         return None
     base = np.asarray(img if img.ndim == 3 else cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), np.uint8)
-    centre = np.asarray(res.tip_px, float) / scale  # work px
-    across = max(TIP_PANEL_WIDTHS * res.line_width_px / scale, TIP_PANEL_MIN_PX)
+    centre = np.asarray(at_px, float) / scale  # work px
+    across = max(END_PANEL_WIDTHS * res.line_width_px / scale, END_PANEL_MIN_PX)
     zoom = size[0] / across
     shift = np.array(size, float) / 2 - zoom * centre
     to_panel = np.array([[zoom, 0.0, shift[0]], [0.0, zoom, shift[1]]])
@@ -249,10 +260,14 @@ def tip_panel(
         q = res.centreline_px / scale * zoom + shift
         colour = _STATUS_BGR.get(res.status, (255, 255, 255))
         cv2.polylines(panel, [np.round(q * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
-    draw_tip(panel, centre * zoom + shift, tip_direction_deg)
+    if free_end:
+        draw_tip(panel, centre * zoom + shift, direction_deg)
+    else:
+        draw_fixed_end(panel, centre * zoom + shift, direction_deg)
     cv2.putText(
         panel,
-        f"free end, {zoom * base.shape[1] / TILE_WIDTH_PX:.1f}x the photo beside",
+        f"{'free' if free_end else 'fixed'} end, {zoom * base.shape[1] / TILE_WIDTH_PX:.1f}x "
+        "the photo",
         (8, size[1] - 10),
         cv2.FONT_HERSHEY_SIMPLEX,
         0.45,
@@ -454,12 +469,13 @@ def write_preview(
         )
         for t in tiles
     ]
+    per_row = 2 if width <= 3 * TILE_WIDTH_PX else 1  # a body's tiles, with both ends: one
     sheet = np.vstack(
         [
-            np.hstack(tiles[i : i + 2])
-            if i + 1 < len(tiles)
+            np.hstack(tiles[i : i + per_row])
+            if i + per_row <= len(tiles)
             else np.hstack([tiles[i], np.zeros_like(tiles[i])])
-            for i in range(0, len(tiles), 2)
+            for i in range(0, len(tiles), per_row)
         ]
     )
     params = [cv2.IMWRITE_JPEG_QUALITY, 88] if encoding == ".jpg" else []

@@ -999,24 +999,42 @@ def test_the_overlay_draws_the_tip_direction_from_where_it_was_read(tmp_path):
         assert blue.any(), (x, y, near.tolist())
 
 
-def test_the_preview_shows_a_bodys_free_end_enlarged(tmp_path):
-    # a sealed end on a 12 MP photo is a few pixels of the preview's tile: a third panel shows
-    # the free end enlarged, with the dot where its tangent was read in the middle
-    from pipeline.preview import TILE_WIDTH_PX, preview_tile
+def test_the_preview_shows_a_bodys_ends_enlarged(tmp_path):
+    # a sealed end or a clamp's direction on a 12 MP photo is a few pixels of the preview's
+    # tile: two more panels show the fixed end (its mark and the base's line) and the free end
+    # (the dot where its tangent was read) enlarged, each in the middle
+    from pipeline.preview import TILE_WIDTH_PX, preview_tile, write_preview
 
     img, fe, _ = body_photo(150.0, seed=5)
     cv2.imwrite(str(tmp_path / "b.jpg"), img)
     settings = settings_for(fe, sealed_end_mm=20.0, mm_per_px=0.5)
     tile = preview_tile(tmp_path / "b.jpg", settings, title="t")
-    assert tile.shape[1] == 3 * TILE_WIDTH_PX
-    panel = tile[-(TILE_WIDTH_PX * H // W) :, 2 * TILE_WIDTH_PX :].astype(int)
-    middle = panel[panel.shape[0] // 2 - 2 : panel.shape[0] // 2 + 3, TILE_WIDTH_PX // 2 - 2 :][
-        :, :5
-    ]
-    assert ((middle[..., 0] > 200) & (middle[..., 2] < 60)).any(), middle.tolist()  # the dot
-    # the body fills it: 5 of its widths across (46 px of 1280), not the whole photo
-    body = (np.abs(panel - np.array([90, 140, 200])).sum(axis=2) < 60).mean()
-    assert 0.1 < body < 0.6, body
+    assert tile.shape[1] == 4 * TILE_WIDTH_PX
+    height = TILE_WIDTH_PX * H // W
+    fixed, free = (tile[-height:, k * TILE_WIDTH_PX : (k + 1) * TILE_WIDTH_PX].astype(int)
+                   for k in (2, 3))
+
+    def blue(part):
+        return (part[..., 0] > 200) & (part[..., 2] < 60)
+
+    c = (height // 2, TILE_WIDTH_PX // 2)
+    assert blue(free[c[0] - 2 : c[0] + 3, c[1] - 2 : c[1] + 3]).any()  # the dot
+    # the mark, a ring about the fixed end, and the base's line from it along the body (+x)
+    assert blue(fixed[c[0] - 1 : c[0] + 2, c[1] - 8 : c[1] - 3]).any()
+    assert blue(fixed[c[0] - 1 : c[0] + 2, c[1] + 40 : c[1] + 60]).any()
+    # the body fills them: 5 of its widths across (46 px of 1280), not the whole photo
+    for panel in (fixed, free):
+        body = (np.abs(panel - np.array([90, 140, 200])).sum(axis=2) < 60).mean()
+        assert 0.1 < body < 0.7, body
+    # a sheet of such tiles has one to a row
+    (tmp_path / "manifest.csv").write_text(
+        "image,pressure_kpa,direction,material,actuator,trial\nb.jpg,0,up,DS20,A1,1\n"
+    )
+    (tmp_path / "photoset.yaml").write_text(
+        f"l0_mm: 180\ntarget: body\nfixed_end: [{fe[0]:.1f}, {fe[1]:.1f}]\n"
+    )
+    path, n = write_preview(tmp_path, tmp_path / "p.png")
+    assert n == 1 and cv2.imread(str(path)).shape[1] == 4 * TILE_WIDTH_PX
 
 
 def test_a_sealed_end_given_without_its_cap_is_not_carried_on_over_the_cap():
