@@ -868,11 +868,17 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
 def sealed_end_problems(ps: PhotoSet) -> list[Problem]:
     """A warning when a capped body's rows give no ``sealed_end_mm`` (``check`` lists it;
     ``measure`` prints it, as every row may still come out ``ok``)."""
-    if not any(
-        r is not None and r.target == "body" and r.free_end == "capped" and r.sealed_end_mm is None
+    lacking = [
+        r
         for r in ps.rows
-    ):
+        if r is not None
+        and r.target == "body"
+        and r.free_end == "capped"
+        and r.sealed_end_mm is None
+    ]
+    if not lacking:
         return []
+    no_scene = any(r.background_path is None for r in lacking)
     # measured on rendered bodies (python -m pipeline bench realscenes --sealed-end-mm 8; the
     # 12 MP set: python -m pipeline synth S --material DS30 --scene grey_dots --actuators 1
     # --trials 2 --step-kpa 20 --seed 141 --set sealed_end_mm=8 --set width=4000 --set height=3000)
@@ -883,8 +889,13 @@ def sealed_end_problems(ps: PhotoSet) -> list[Problem]:
             "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
             "runs on into a sealed end or cap; on rendered bodies one of 8-12 mm read |psi| "
             "above 150 deg 5-7 deg high at 1280x960, and 8.8 deg high (up to 12) on a 12 MP set "
-            "with an 8 mm one, every row ok (and without an empty scene, a doubtful body gets no "
-            "second look against its ramp's own photos)",
+            "with an 8 mm one, every row ok"
+            + (
+                " (and without an empty scene, a doubtful body gets no second look against its "
+                "ramp's own photos)"
+                if no_scene
+                else ""
+            ),
             "measure the actuator's end that does not bend (from where the chamber ends to the "
             "tip, cap included) and set sealed_end_mm",
             warning=True,

@@ -223,6 +223,25 @@ def test_check_warns_of_the_free_end_settings_a_set_lacks_or_does_not_use(
     assert said == warnings
 
 
+@pytest.mark.parametrize("empty_scene", [False, True])
+def test_the_sealed_end_warning_names_the_second_look_only_without_an_empty_scene(
+    photo_folder, empty_scene
+):
+    # customer 15 had an empty scene and was told what a set without one lacks
+    from pipeline import photoset_init
+
+    cv2.imwrite(str(photo_folder / "empty.png"), np.full((24, 32, 3), 200, np.uint8))
+    photoset_init.init_photoset(
+        photo_folder,
+        "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 210.0, "target": "body",
+                  **({"background": "empty.png"} if empty_scene else {})},
+    )
+    (warning,) = [p for p in ps.sealed_end_problems(ps.load_photoset(photo_folder))]
+    assert warning.message.startswith(NO_SEALED_END)
+    assert ("without an empty scene" in warning.message) is not empty_scene
+
+
 def test_check_refuses_roi_outside_the_photo_and_a_two_point_exclude(photo_folder):
     from pipeline import photoset_init
 

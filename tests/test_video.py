@@ -235,11 +235,24 @@ def test_a_video_of_a_body_without_a_line_is_a_body_set_and_measured_as_one(tmp_
     # ... unless the actuator's end that does not bend is given (4 mm sealed + 6 mm cap)
     raw = yaml.safe_load((folder / "photoset.yaml").read_text())
     (folder / "photoset.yaml").write_text(yaml.safe_dump({**raw, "sealed_end_mm": 10.0}))
-    m = measure_photoset(folder, jobs=1).merge(truth, on=["image", "frame"], suffixes=("", "_t"))
+    measured = measure_photoset(folder, jobs=1, overlays_dir=tmp_path / "ov")
+    m = measured.merge(truth, on=["image", "frame"], suffixes=("", "_t"))
     err = (m["psi_deg"] - m["psi_image_deg"]).abs()
     ok = m["status"] == "ok"
     assert ok.mean() >= 0.8 and err[ok & (m["psi_image_deg"].abs() >= 180)].max() < 5.0
     assert err[ok].max() < 6.5
+    # a frame's overlay draws what a photo's does: the fixed end as given and psi's two
+    # directions in blue (customer 15's had only the centre line: the frame's settings were not
+    # passed on)
+    drawn = [cv2.imread(str(p)) for p in sorted((tmp_path / "ov").glob("*_f*.jpg"))]
+    assert drawn
+    for img in drawn:
+        b, g, r = (img[..., i].astype(int) for i in range(3))
+        k = img.shape[1] / 1280  # the overlay is reduced, below a band of text
+        fx, fy = np.asarray(settings.fixed_end_px) * k + [0.0, img.shape[0] - 720 * k]
+        ys, xs = np.nonzero((b > 200) & (g < 120) & (r < 60))
+        away = np.hypot(xs - fx, ys - fy) > 15.0  # not the fixed end's mark
+        assert away.sum() > 10, away.sum()
 
 
 def test_h264_is_written_when_the_build_can_and_refused_by_name_when_not(tmp_path):

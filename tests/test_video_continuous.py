@@ -25,6 +25,28 @@ def _first_order(tau: float) -> np.ndarray:
     return 50.0 + 30.0 * (1 - np.exp(-(T - 1.0) / tau)) * (T >= 1.0)
 
 
+def test_a_step_is_from_the_level_held_before_it_and_its_way_is_its_own():
+    # customer 15: a 20 Hz log of setpoints and 30 fps frames; a frame between the two log lines
+    # across a jump read 13.3 kPa, which steps.csv gave as the level the step came from, and the
+    # step up to the top level was "down" (its hold's last frame already counted the fall)
+    from pipeline.video.timeline import PressureLog, frame_conditions
+
+    levels = [0, 40, 80, 40, 0]
+    t_log = np.arange(0.0, 7.5, 0.05)
+    log = PressureLog("log.csv", t_log, np.array([levels[min(int(t // 1.5), 4)] for t in t_log],
+                                                 float))
+    t = np.arange(0.0, 7.4, 1.0 / 30.0) + 0.02
+    frames = frame_conditions(log, t).assign(
+        image="v.avi", frame=np.arange(len(t)), time_s=t, psi_deg=100.0 - t, status="ok",
+        material="DS30",
+        actuator="A1", trial=1,
+    )
+    assert not frames["pressure_kpa"].isin(levels).all()  # frames between log lines
+    got, _ = steps(frames)
+    assert list(got["from_kpa"]) == [0, 40, 80, 40] and list(got["to_kpa"]) == [40, 80, 40, 0]
+    assert list(got["direction"]) == ["up", "up", "down", "down"]
+
+
 def test_first_order_step_gives_its_closed_form_times():
     r = step_response(T, _first_order(0.3), step_time_s=1.0, before_deg=50.0)
     assert r["rise_time_s"] == pytest.approx(0.3 * np.log(9), abs=0.01)

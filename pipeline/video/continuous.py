@@ -354,13 +354,26 @@ def steps(
                 noise=sd,
             )
             prev = ramp[ramp["time_s"] < t_step]
+            # the level held before the step, not the last frame's pressure: a frame between two
+            # log lines across the jump reads a level never set (13.3 kPa between 0 and 40)
+            level = ramp.loc[ramp["step"] == k - 1, "pressure_kpa"]
+            from_kpa = (
+                float(level.median()) if len(level)
+                else float(prev["pressure_kpa"].iloc[-1]) if len(prev) else math.nan
+            )
+            to_kpa = float(hold["pressure_kpa"].median())
             row = dict(
                 zip(RAMP_KEYS, key),
                 step=int(k),
                 time_s=t_step,
-                from_kpa=float(prev["pressure_kpa"].iloc[-1]) if len(prev) else math.nan,
-                to_kpa=float(hold["pressure_kpa"].median()),
-                direction=str(hold["direction"].iloc[-1]),
+                from_kpa=from_kpa,
+                to_kpa=to_kpa,
+                # the step's own way (its hold's last frame may already count the fall after a
+                # top level as down)
+                direction=(
+                    str(hold["direction"].iloc[-1]) if not math.isfinite(from_kpa)
+                    else "up" if to_kpa > from_kpa else "down"
+                ),
                 hold_s=float(hold["time_s"].iloc[-1] - t_step),
                 psi_before_deg=before,
                 psi_final_deg=r["final"],

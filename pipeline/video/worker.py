@@ -127,7 +127,7 @@ def run_chunk(chunk: FrameChunk) -> dict[str, list[Any]]:
                 )
         seconds = time.perf_counter() - t0
         if k in overlays:
-            write_overlay(overlays[k], img, f, res, f"{chunk.title} frame {k}")
+            write_overlay(overlays[k], img, f, res, f"{chunk.title} frame {k}", chunk.settings)
         fields = result_fields(res, seconds)
         out["frame"].append(k)
         out["pts_s"].append(frame.pts_s)
