@@ -264,15 +264,11 @@ def end_panel(
         draw_tip(panel, centre * zoom + shift, direction_deg)
     else:
         draw_fixed_end(panel, centre * zoom + shift, direction_deg)
+    label = f"{'free' if free_end else 'fixed'} end, {END_PANEL_WIDTHS:g} body widths across"
+    (w, h), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
+    cv2.rectangle(panel, (0, size[1] - h - 16), (w + 14, size[1]), (30, 30, 30), -1)
     cv2.putText(
-        panel,
-        f"{'free' if free_end else 'fixed'} end, {zoom * base.shape[1] / TILE_WIDTH_PX:.1f}x "
-        "the photo",
-        (8, size[1] - 10),
-        cv2.FONT_HERSHEY_SIMPLEX,
-        0.45,
-        (0, 200, 255),
-        1,
+        panel, label, (8, size[1] - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 200, 255), 1,
         cv2.LINE_AA,
     )
     return panel
