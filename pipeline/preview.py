@@ -161,12 +161,8 @@ def encoded_tile(
         )
     if settings.fixed_end_px is not None:
         draw_fixed_end(tint, np.asarray(settings.fixed_end_px) * kk, settings.fixed_direction_deg)
-    # what psi is measured between, as in the overlays (on screen: not for a calibrated photo)
-    base_deg, tip_deg = (
-        screen_directions(res, settings.sign, settings.fixed_direction_deg)
-        if settings.calibration is None
-        else (None, None)
-    )
+    # what psi is measured between, as in the overlays
+    base_deg, tip_deg = screen_directions(res, settings)
     if settings.fixed_direction_deg is None and base_deg is not None and len(res.centreline_px):
         draw_direction(tint, res.centreline_px[0] * kk, base_deg)
     if tip_deg is not None and res.tip_px is not None:

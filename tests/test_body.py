@@ -968,7 +968,7 @@ def test_a_body_says_where_and_in_which_direction_its_tip_was_read(psi):
         return np.array([p[0], -p[1]]) + fe
 
     cut = measure_image(img, settings_for(fe, free_end="bends"))
-    base, tip = screen_directions(cut, 1, None)
+    base, tip = screen_directions(cut, settings_for(fe))
     assert cut.status == "ok", cut.reason
     assert base == pytest.approx(0.0, abs=2.5) and tip == pytest.approx(psi, abs=3.0)
     face = on_screen(_centre_point_back_from_face(psi, 0.0))
@@ -977,7 +977,7 @@ def test_a_body_says_where_and_in_which_direction_its_tip_was_read(psi):
     sealed = measure_image(img, settings_for(fe, sealed_end_mm=20.0, mm_per_px=0.5))
     back = on_screen(_centre_point_back_from_face(psi, 40.0))
     assert np.hypot(*(np.asarray(sealed.tip_px) - back)) < 6.0, (sealed.tip_px, back)
-    _, tip = screen_directions(sealed, 1, None)
+    _, tip = screen_directions(sealed, settings_for(fe))
     assert tip is not None and tip - psi == pytest.approx(-40.0 / 600.0 * psi, abs=3.0)
 
 

@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from pipeline.measure.core import AngleResult
+from pipeline.measure.settings import MeasureSettings
 
 #: overlays are at most this wide (px); narrower photos are enlarged to it
 OVERLAY_WIDTH_PX, MIN_OVERLAY_WIDTH_PX = 640, 480
@@ -88,21 +89,27 @@ def draw_tip(
 
 
 def screen_directions(
-    result: AngleResult, sign: float, fixed_direction_deg: float | None
+    result: AngleResult, settings: MeasureSettings
 ) -> tuple[float | None, float | None]:
     """The two directions psi of a body is measured between, on screen (deg counter-clockwise
     from +x): where it leaves the fixed end (the one given, else its own) and where its free end
-    points (that one turned by psi); None where not known.  Not for a calibrated photo, whose
-    directions are taken on the plane.
+    points (that one turned by psi); None where not known, and both None for a calibrated photo,
+    whose directions are taken on the plane.
 
     Examples
     --------
     >>> from pipeline.measure.core import AngleResult
+    >>> from pipeline.measure.settings import resolve_settings
     >>> r = AngleResult(-90.0, 0.0, 0.0, "tangents", 0.0, "ok", "", np.zeros((2, 2)),
     ...                 base_direction_deg=-30.0, tip_px=(5.0, 5.0))
-    >>> screen_directions(r, -1, None), screen_directions(r, 1, 10.0)
+    >>> cw = resolve_settings(l0_mm=200, target="body", positive_turn="cw")
+    >>> given = resolve_settings(l0_mm=200, target="body", fixed_direction_deg=10.0)
+    >>> screen_directions(r, cw), screen_directions(r, given)
     ((30.0, 120.0), (10.0, -80.0))
     """
+    if settings.calibration is not None:
+        return None, None
+    sign, fixed_direction_deg = settings.sign, settings.fixed_direction_deg
     if fixed_direction_deg is not None:
         base: float | None = fixed_direction_deg
     elif np.isfinite(result.base_direction_deg):

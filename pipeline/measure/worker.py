@@ -90,12 +90,7 @@ def write_overlay(
     if base.ndim == 2:
         base = cv2.cvtColor(base, cv2.COLOR_GRAY2BGR)
     given = settings if img is not None else None  # not on the blank stand-in
-    # on screen: not for a calibrated photo, whose directions are taken on the plane
-    base_deg, tip_deg = (
-        screen_directions(res, given.sign, given.fixed_direction_deg)
-        if given and given.calibration is None
-        else (None, None)
-    )
+    base_deg, tip_deg = screen_directions(res, given) if given else (None, None)
     out = draw_overlay(
         base,
         res,
