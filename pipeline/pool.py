@@ -2,7 +2,8 @@
 
 Workers are started by a forkserver (never plain ``fork``: forking a process that runs OpenCV or
 BLAS threads can deadlock), which preloads the light worker modules once so each worker starts
-fast; each worker runs OpenCV on one thread (the pool is the parallelism).  Results come back in
+fast; each worker runs OpenCV and BLAS on one thread (the pool is the parallelism; see
+:mod:`pipeline.worker_env`).  Results come back in
 task order; a progress bar is shown on an interactive terminal only.
 """
 
@@ -64,8 +65,8 @@ def map_photos(
         return [func(t) for t in tqdm(tasks, **bar)]  # type: ignore[call-overload]
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-    if "forkserver" in methods and preload:
-        ctx.set_forkserver_preload(list(preload))
+    if "forkserver" in methods:
+        ctx.set_forkserver_preload(["pipeline.worker_env", *preload])
     chunk = max(1, len(tasks) // (4 * jobs))
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
         return list(tqdm(pool.map(func, tasks, chunksize=chunk), **bar))  # type: ignore[call-overload]
