@@ -159,7 +159,7 @@ def test_verdict_threshold_is_on_the_ci_upper_bound() -> None:
 
 
 def test_scaling_measures_both_job_counts_and_the_pool_start_up(tmp_path) -> None:
-    out = bench.scaling(2, seed=3, workdir=tmp_path, copies=2)
+    out = bench.scaling(2, seed=3, workdir=tmp_path, copies=2, size=(640, 480))
     assert set(out) == {"jobs=1", "jobs=2", "start-up, jobs=2"}
     assert all(np.isfinite(v) and v > 0 for v in out.values())
     angles = pd.read_csv(tmp_path / "set" / "manifest.csv")

@@ -449,15 +449,18 @@ def _scaling_set(folder: Path, renders: list, scene, copies: int) -> None:
     write_settings(folder, {"l0_mm": L0_MM, "mm_per_px": scene.mm_per_px})
 
 
-def scaling(n: int, seed: int, workdir: Path, copies: int = COPIES) -> dict[str, float]:
-    """Wall time (s) of measure_photoset with 1 and 2 workers on one synthetic 4000x3000 set.
+def scaling(
+    n: int, seed: int, workdir: Path, copies: int = COPIES, size: tuple[int, int] = (4000, 3000)
+) -> dict[str, float]:
+    """Wall time (s) of measure_photoset with 1 and 2 workers on one synthetic set of ``size``
+    (width, height; the bench's figure is at 4000x3000).
 
     Also ``"start-up, jobs=2"``: the same call on a 2-photo set, i.e. what starting the pool
     costs (forkserver preloading OpenCV/numpy/scipy), which small sets cannot amortise.
     """
     from pipeline.photoset_measure import measure_photoset
 
-    scene = scene_from("lab", width=4000, height=3000)
+    scene = scene_from("lab", width=size[0], height=size[1])
     renders = [render_actuator(float(psi), L0_MM, scene, seed=seed + i)
                for i, psi in enumerate(np.linspace(210, -220, n))]
     _scaling_set(workdir / "set", renders, scene, copies)
