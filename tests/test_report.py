@@ -829,3 +829,23 @@ def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_p
     assert sha256_measurements(d.angles_csv) != digest
     angles.drop(columns="seconds").to_csv(d.angles_csv, index=False)
     assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)
+
+
+def test_a_body_set_without_its_sealed_end_is_warned_in_the_report(tmp_path):
+    # measure prints the warning, but a Snakemake run keeps what measure prints in the job's
+    # log: the advisor's PDF showed every row ok with nothing said about |psi| reading high
+    d = make_dataset(tmp_path, "DS20", actuators=1, trials=1, overlays=False)
+    assert d.photoset_dir is not None
+    manifest = pd.read_csv(d.angles_csv)[
+        ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    ]
+    manifest.to_csv(d.photoset_dir / "manifest.csv", index=False)
+    settings = "l0_mm: 195\ntarget: body\nfixed_end: [40, 60]\n"
+    (d.photoset_dir / "photoset.yaml").write_text(settings)
+    out = tmp_path / "r.pdf"
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    assert [w for w in res.warnings if w.startswith("DS20: no sealed_end_mm")], res.warnings
+    assert "DS20: no sealed_end_mm" in " ".join(pdf_text(out, 0).split())
+    (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end_mm: 6\n")
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    assert not [w for w in res.warnings if "sealed_end_mm" in w], res.warnings

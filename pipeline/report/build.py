@@ -26,7 +26,7 @@ from pipeline import __version__
 from pipeline.fileio import atomic_write_bytes
 from pipeline.force import pages as force_pages
 from pipeline.layout.style import FOOTER_PT, material_colors, report_style
-from pipeline.report.data import ReportData, ReportInputs, load_report_data
+from pipeline.report.data import ReportData, ReportInputs, load_report_data, photoset_warnings
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
 from pipeline.report.provenance import provenance_pages
@@ -178,6 +178,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
+        warnings += photoset_warnings(d)
     body = (
         [overview_page(data)]
         + [material_page(data, m) for m in data.materials]

@@ -29,7 +29,7 @@ from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 from pipeline.force.pages import FILES as FORCE_FILES
-from pipeline.photoset import MANIFEST, SETTINGS, TRUTH
+from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, load_photoset, sealed_end_problems
 from pipeline.study.pages import TABLES as BENCH_TABLES
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
@@ -408,6 +408,23 @@ def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
     )
     first, last, where = dataset_dates(angles, folder)
     return DatasetInfo(dataset.name, source, first, last, where)
+
+
+def photoset_warnings(dataset: Dataset) -> list[str]:
+    """Settings of a dataset's photo set that leave its rows ``ok`` but doubtful, one line each.
+
+    ``measure`` prints them, but a Snakemake run keeps that in the job's log, so the report says
+    them too (only what the set's content decides, never file times: same inputs, same report).
+    A photo set that can no longer be read gives none (its rows were measured when it could).
+    """
+    folder = dataset.photoset_dir
+    if folder is None or not (folder / SETTINGS).is_file():
+        return []
+    try:
+        ps = load_photoset(folder)
+    except UserInputError:
+        return []
+    return [f"{dataset.name}: {p.message}; {p.fix}" for p in sealed_end_problems(ps)]
 
 
 def dataset_dates(
