@@ -293,18 +293,34 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
         return None, [
             Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")
         ]
-    problems = [
-        Problem(
-            name,
-            None,
-            f"unknown key {key!r} is ignored",
-            f"use only {', '.join(KEYS)}",
-            warning=True,
+    return {**SETTING_DEFAULTS, **raw}, unknown_key_problems(name, raw)
+
+
+def unknown_key_problems(path: str, settings: Mapping[str, Any]) -> list[Problem]:
+    """A warning for each key of ``photoset.yaml`` that is not one: it is ignored, so a typo
+    (``sealed_end: 8``) measures as if nothing were given, with the closest key as the fix.
+
+    Examples
+    --------
+    >>> [p.fix[:27] for p in unknown_key_problems("photoset.yaml", {"l0_mm": 1, "sealed_end": 8})]
+    ['did you mean sealed_end_mm?']
+    """
+    out = []
+    for key in settings:
+        if key in KEYS:
+            continue
+        close = difflib.get_close_matches(str(key), KEYS, n=1, cutoff=0.6)
+        keys = ", ".join(KEYS)
+        out.append(
+            Problem(
+                path,
+                None,
+                f"unknown key {key!r} is ignored",
+                f"did you mean {close[0]}? (the keys: {keys})" if close else f"use only {keys}",
+                warning=True,
+            )
         )
-        for key in raw
-        if key not in KEYS
-    ]
-    return {**SETTING_DEFAULTS, **raw}, problems
+    return out
 
 
 def read_settings(folder: str | os.PathLike[str]) -> dict[str, Any]:
@@ -863,6 +879,15 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
     except PhotoSetRefused as exc:
         return None, problems + [p for p in exc.problems if p not in problems]
     return ps, problems + list(ps.problems)
+
+
+def doubtful_settings(ps: PhotoSet) -> list[Problem]:
+    """Warnings about settings under which rows are still measured, and may come out ``ok``,
+    but doubtful: a key that is ignored (:func:`unknown_key_problems`) and a capped body without
+    ``sealed_end_mm`` (:func:`sealed_end_problems`).  ``check`` lists them among the rest;
+    ``measure`` prints them and the report lists them, as both decide from the set's content.
+    """
+    return unknown_key_problems(str(ps.folder / SETTINGS), ps.settings) + sealed_end_problems(ps)
 
 
 def sealed_end_problems(ps: PhotoSet) -> list[Problem]:

@@ -86,11 +86,14 @@ def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
     assert out.returncode == 0 and "no sealed_end_mm" not in out.stderr, out.stderr
     # without it, measure says so too: every row may still come out ok (customer 14's did, 8-14
-    # deg off, and only check had said it)
-    written.pop("sealed_end_mm")
+    # deg off, and only check had said it); a typo of its key is ignored, and measure said
+    # nothing of it, only check did
+    written["sealed_end"] = written.pop("sealed_end_mm")
     (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(written))
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
     assert out.returncode == 0 and "no sealed_end_mm" in out.stderr, out.stderr
+    assert "unknown key 'sealed_end' is ignored (fix: did you mean sealed_end_mm?" in out.stderr
+    written.pop("sealed_end")
     written["sealed_end_mm"] = 6.0
     # without the scale it is turned into pixels with the body's length against l0_mm +
     # sealed_end_mm: check accepts it (and warns of the missing scale, as for any body)

@@ -846,6 +846,11 @@ def test_a_body_set_without_its_sealed_end_is_warned_in_the_report(tmp_path):
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert [w for w in res.warnings if w.startswith("DS20: no sealed_end_mm")], res.warnings
     assert "DS20: no sealed_end_mm" in " ".join(pdf_text(out, 0).split())
+    # a typo of the key is said as such
+    (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end: 6\n")
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    assert [w for w in res.warnings if w.startswith("DS20: unknown key 'sealed_end' is ignored; "
+                                                    "did you mean sealed_end_mm?")], res.warnings
     (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end_mm: 6\n")
     res = build_report(ReportInputs(datasets=(d,)), out)
-    assert not [w for w in res.warnings if "sealed_end_mm" in w], res.warnings
+    assert not [w for w in res.warnings if "sealed_end" in w], res.warnings
