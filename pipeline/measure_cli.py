@@ -57,7 +57,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Measure the set, write angles.csv, print a one-line summary."""
-    from pipeline.photoset import doubtful_settings, load_photoset, newer_spreadsheet_problems
+    from pipeline.photoset import load_photoset, measurement_doubts, newer_spreadsheet_problems
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
             angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
     doubts = newer_spreadsheet_problems(Path(args.photoset))
-    doubts += doubtful_settings(load_photoset(args.photoset))
+    doubts += measurement_doubts(load_photoset(args.photoset))
     for problem in doubts:
         print(problem, file=sys.stderr)
     used = sorted(set(angles["method"].dropna().astype(str)) - {args.method})

@@ -881,13 +881,19 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
     return ps, problems + list(ps.problems)
 
 
-def doubtful_settings(ps: PhotoSet) -> list[Problem]:
-    """Warnings about settings under which rows are still measured, and may come out ``ok``,
-    but doubtful: a key that is ignored (:func:`unknown_key_problems`) and a capped body without
-    ``sealed_end_mm`` (:func:`sealed_end_problems`).  ``check`` lists them among the rest;
-    ``measure`` prints them and the report lists them, as both decide from the set's content.
+def measurement_doubts(ps: PhotoSet) -> list[Problem]:
+    """Warnings of ``check`` that hold whatever the rows measure: a key that is ignored
+    (:func:`unknown_key_problems`), photos of the folder left out of the manifest
+    (:func:`unlisted_problems`) and a capped body without ``sealed_end_mm``
+    (:func:`sealed_end_problems`).  ``measure`` prints them and the report lists them (a
+    Snakemake run keeps what ``measure`` prints in the job's log); each is decided by the set's
+    content, never by file times.
     """
-    return unknown_key_problems(str(ps.folder / SETTINGS), ps.settings) + sealed_end_problems(ps)
+    return (
+        unknown_key_problems(str(ps.folder / SETTINGS), ps.settings)
+        + ([] if ps.is_video else unlisted_problems(ps))
+        + sealed_end_problems(ps)
+    )
 
 
 def sealed_end_problems(ps: PhotoSet) -> list[Problem]:

@@ -831,7 +831,9 @@ def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_p
     assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)
 
 
-def test_a_body_set_without_its_sealed_end_is_warned_in_the_report(tmp_path):
+def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in_the_report(
+    tmp_path,
+):
     # measure prints the warning, but a Snakemake run keeps what measure prints in the job's
     # log: the advisor's PDF showed every row ok with nothing said about |psi| reading high
     d = make_dataset(tmp_path, "DS20", actuators=1, trials=1, overlays=False)
@@ -846,6 +848,13 @@ def test_a_body_set_without_its_sealed_end_is_warned_in_the_report(tmp_path):
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert [w for w in res.warnings if w.startswith("DS20: no sealed_end_mm")], res.warnings
     assert "DS20: no sealed_end_mm" in " ".join(pdf_text(out, 0).split())
+    # so is a photo left out of the manifest (it was never measured)
+    (d.photoset_dir / "DS20_late.jpg").write_bytes(b"")
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    assert [w for w in res.warnings if w.startswith(
+        "DS20: 1 photo in the folder is not in manifest.csv and will not be measured: "
+        "'DS20_late.jpg'")], res.warnings
+    (d.photoset_dir / "DS20_late.jpg").unlink()
     # a typo of the key is said as such
     (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end: 6\n")
     res = build_report(ReportInputs(datasets=(d,)), out)

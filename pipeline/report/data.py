@@ -29,7 +29,7 @@ from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 from pipeline.force.pages import FILES as FORCE_FILES
-from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, doubtful_settings, load_photoset
+from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, load_photoset, measurement_doubts
 from pipeline.study.pages import TABLES as BENCH_TABLES
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
@@ -411,8 +411,8 @@ def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
 
 
 def photoset_warnings(dataset: Dataset) -> list[str]:
-    """Settings of a dataset's photo set that leave its rows ``ok`` but doubtful, one line each
-    (:func:`pipeline.photoset.doubtful_settings`).
+    """What a dataset's photo set leaves doubtful or unmeasured whatever its rows say, one line
+    each (:func:`pipeline.photoset.measurement_doubts`).
 
     ``measure`` prints them, but a Snakemake run keeps that in the job's log, so the report says
     them too (only what the set's content decides, never file times: same inputs, same report).
@@ -425,7 +425,7 @@ def photoset_warnings(dataset: Dataset) -> list[str]:
         ps = load_photoset(folder)
     except UserInputError:
         return []
-    return [f"{dataset.name}: {p.message}; {p.fix}" for p in doubtful_settings(ps)]
+    return [f"{dataset.name}: {p.message}; {p.fix}" for p in measurement_doubts(ps)]
 
 
 def dataset_dates(
