@@ -1,4 +1,5 @@
-"""Names and numbers every stage agrees on (DESIGN.md): ramp directions, row statuses, vacuum."""
+"""Names and numbers every stage agrees on (DESIGN.md): ramp directions and keys, row statuses,
+vacuum."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ DIRECTION_WORDS: dict[str, str] = {
     "down": "down", "d": "down", "dn": "down", "dec": "down", "decreasing": "down",
     "deflating": "down", "unload": "down", "unloading": "down",
 }
+#: the manifest columns that name one ramp (one trial of one actuator of one material)
+RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
 #: measurement status of a row: a trusted number, a doubtful number, no number
 STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 #: rest bending angle psi0 of the paper's actuators (deg, DESIGN.md): the fallback where no material

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA, direction_name
+from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, RAMP_KEYS, VACUUM_KPA, direction_name
 from pipeline.errors import UserInputError
 from pipeline.fileio import (
     atomic_write_bytes,
@@ -662,13 +662,13 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                     "use 'up' (increasing pressure) or 'down' (decreasing)",
                 )
             )
-        for key in ("material", "actuator", "trial"):
+        for key in RAMP_KEYS:
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
     if "step" in df.columns:
         dup = df[
             df["step"].notna()
-            & df.duplicated(["material", "actuator", "trial", "step"], keep="first")
+            & df.duplicated([*RAMP_KEYS, "step"], keep="first")
         ]
         for _, row in dup.iterrows():
             out.append(
@@ -738,10 +738,10 @@ def _video_row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                         "it empty for 0",
                     )
                 )
-        for key in ("material", "actuator", "trial"):
+        for key in RAMP_KEYS:
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
-        material, actuator, trial = (str(df[k].iloc[i]) for k in ("material", "actuator", "trial"))
+        material, actuator, trial = (str(df[k].iloc[i]) for k in RAMP_KEYS)
         key3 = (material, actuator, trial)
         if key3 in ramps:
             out.append(

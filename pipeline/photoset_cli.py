@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pipeline import photoset, photoset_init
+from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.settings import POSITIVE_TURNS
 
@@ -287,7 +288,7 @@ def _calibrate(args: argparse.Namespace) -> int:
 
 
 def _init(args: argparse.Namespace) -> int:
-    defaults = {k: getattr(args, k) for k in ("material", "actuator", "trial") if getattr(args, k)}
+    defaults = {k: getattr(args, k) for k in RAMP_KEYS if getattr(args, k)}
     settings: dict[str, object] = {"l0_mm": args.l0_mm, "positive_turn": args.positive_turn}
     if args.mm_per_px is not None:  # without a ruler the key is left out, not written empty
         settings["mm_per_px"] = args.mm_per_px

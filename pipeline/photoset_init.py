@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import DIRECTION_WORDS
+from pipeline.constants import DIRECTION_WORDS, RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
@@ -250,7 +250,7 @@ def init_photoset(
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
-        df["step"] = df.groupby(["material", "actuator", "trial"], sort=False).cumcount()
+        df["step"] = df.groupby(list(RAMP_KEYS), sort=False).cumcount()
     write_manifest(folder, df)
     if not (folder / SETTINGS).exists():
         write_settings(folder, {"l0_mm": None, **dict(settings or {})})
@@ -374,7 +374,7 @@ def _ramp_keys(name: str, fields: Mapping[str, Any], defaults: Mapping[str, Any]
     """``material``, ``actuator`` and ``trial`` of a file from its name's ``fields``, else from
     ``defaults``."""
     row = {}
-    for key in ("material", "actuator", "trial"):
+    for key in RAMP_KEYS:
         row[key] = fields.get(key) or defaults.get(key)
         if row[key] is None:
             raise UserInputError(f"{name}: no {key} in the file name and no default; pass --{key}")
@@ -412,7 +412,7 @@ def _with_pressures(
     out = df.copy()
     out["pressure_kpa"] = np.nan
     for (material, actuator, trial), g in out.groupby(
-        ["material", "actuator", "trial"], sort=False
+        list(RAMP_KEYS), sort=False
     ):
         order = g.sort_values("step") if "step" in g.columns else g
         ramp = f"material {material}, actuator {actuator}, trial {trial}"
@@ -441,7 +441,7 @@ def _with_pressures(
 
 def _infer_directions(df: pd.DataFrame) -> pd.Series:
     out = pd.Series("up", index=df.index, dtype=object)
-    for _, g in df.groupby(["material", "actuator", "trial"], sort=False):
+    for _, g in df.groupby(list(RAMP_KEYS), sort=False):
         g = (
             g.sort_values("step")
             if "step" in df.columns

@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work
@@ -37,7 +38,7 @@ from pipeline.photoset import (
     photo_names,
 )
 from pipeline.pool import map_photos
-from pipeline.ramp_check import RAMP_KEYS, check_ramps
+from pipeline.ramp_check import check_ramps
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
@@ -369,7 +370,7 @@ def write_contact_sheets(angles: pd.DataFrame, overlays_dir: Path) -> list[Path]
 
     written = []
     for (material, actuator, trial), g in angles.groupby(
-        ["material", "actuator", "trial"], sort=False
+        list(RAMP_KEYS), sort=False
     ):
         if "frame" in g.columns:
             from pipeline.video.measure import frame_overlay_name

@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.body import body_mask
@@ -342,7 +343,7 @@ def preview_rows(
         return list(range(len(m)))
     order = m.sort_values("step", kind="stable") if "step" in m.columns else m
     rows: list[int] = []
-    for _, ramp in order.groupby(["material", "actuator", "trial"], sort=False):
+    for _, ramp in order.groupby(list(RAMP_KEYS), sort=False):
         pressure = pd.to_numeric(ramp["pressure_kpa"], errors="coerce")
         top = pressure.idxmax() if pressure.notna().any() else ramp.index[0]
         for ix in (ramp.index[0], top, ramp.index[-1]):
@@ -488,7 +489,7 @@ def empty_first_photos(folder: str | os.PathLike[str]) -> pd.DataFrame:
     out = []
     m = ps.manifest.reset_index(drop=True)
     order = m.sort_values("step", kind="stable") if "step" in m.columns else m
-    for _, ramp in order.groupby(["material", "actuator", "trial"], sort=False):
+    for _, ramp in order.groupby(list(RAMP_KEYS), sort=False):
         i = int(ramp.index[0])
         s = ps.rows[i]
         path = ps.image_path(str(m["image"].iloc[i]))

@@ -45,6 +45,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import RAMP_KEYS
 from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
@@ -55,7 +56,6 @@ END_STEPS = 4.0
 AGREE_DEG = 3.0
 #: measured length outside [LENGTH_LOW, LENGTH_HIGH] x the ramp's median -> partial line
 LENGTH_LOW, LENGTH_HIGH = 0.85, 1.15
-RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
 #: a ramp's bodies share one base direction when at least this many were measured ...
 BASE_MIN_PHOTOS = 5
 #: ... and their own base directions lie this close (deg, median absolute deviation)

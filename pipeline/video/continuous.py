@@ -58,6 +58,7 @@ from pipeline.aggregate import (
     measured_pressure,
     settled_frames,
 )
+from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.fileio import write_table
 
@@ -72,7 +73,6 @@ BEFORE_WINDOW_S = 0.5
 MIN_CHANGE_SD = 10.0
 CURVE_POINTS = 200
 TIMELINE_POINTS = 2000
-RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
 FILES: tuple[str, ...] = ("loops.csv", "cycles.csv", "steps.csv", "settling.csv", "timeline.csv")
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import RAMP_KEYS
 from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import VIDEO_OPTIONAL_COLUMNS, PhotoSet
 from pipeline.pool import map_photos
@@ -145,7 +146,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
         df.loc[outside, "reason"] = why
     df = pd.concat([df.reset_index(drop=True), cond.reset_index(drop=True)], axis=1)
     row = ps.manifest.iloc[clip.position]
-    for key in ("material", "actuator", "trial"):
+    for key in RAMP_KEYS:
         df[key] = row[key]
     settings = ps.rows[clip.position]
     df["l0_mm"] = np.nan if settings is None else settings.l0_mm

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from pipeline.constants import RAMP_KEYS
 from pipeline.layout.style import A4_PORTRAIT_IN, MIN_FONT_PT, footer_fraction, text_page
 
 #: step rows shown in the table (the rest are counted)
@@ -116,7 +117,7 @@ def figures(folder: Path) -> list[Figure]:
     )
     ax_t = fig.add_subplot(grid[0, :])
     ax_p = ax_t.twinx()
-    ramps = timeline.groupby(["material", "actuator", "trial"], sort=False)
+    ramps = timeline.groupby(list(RAMP_KEYS), sort=False)
     psi_floor = float(np.nanmin(timeline["psi_deg"])) if timeline["psi_deg"].notna().any() else 0.0
     for j, (_, r) in enumerate(ramps):
         ax_t.plot(
@@ -154,7 +155,7 @@ def figures(folder: Path) -> list[Figure]:
 
     ax_l = fig.add_subplot(grid[1, 0])
     for j, (key, g) in enumerate(
-        loops.groupby(["material", "actuator", "trial", "cycle"], sort=False)
+        loops.groupby([*RAMP_KEYS, "cycle"], sort=False)
     ):
         for direction, d in g.groupby("direction", sort=False):
             d = d[d["n"] > 0].sort_values("pressure_kpa")
@@ -176,7 +177,7 @@ def figures(folder: Path) -> list[Figure]:
     ax_s = fig.add_subplot(grid[1, 1])
     if len(settling):
         for (key, g), j in zip(
-            settling.groupby(["material", "actuator", "trial", "step"], sort=False), range(10**6)
+            settling.groupby([*RAMP_KEYS, "step"], sort=False), range(10**6)
         ):
             direction = steps.loc[steps["step"] == key[3], "direction"]
             up = not len(direction) or direction.iloc[0] == "up"
