@@ -181,12 +181,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="sheet to write, .jpg or .png (default: <DIR name>_preview.jpg in the current folder)",
     )
     preview.add_argument(
-        "--all", action="store_true", help="every photo, not only three of each ramp"
+        "--all", action="store_true",
+        help="every photo, not only three of each ramp (of a video set: the 24 frames of each "
+             "video that --overlays draws)",
     )
     preview.add_argument(
         "--image", action="append", default=[], metavar="NAME",
         help="only this photo, named as in manifest.csv (e.g. trial1/IMG_0017.JPG: a flagged "
              "row's); repeatable",
+    )
+    preview.add_argument(
+        "--frame", action="append", default=[], type=int, metavar="N",
+        help="of a video set: only frame N of each video, numbered as angles.csv's frame column "
+             "(from 0; a flagged frame's); repeatable. --all shows the 24 frames --overlays draws",
     )
     pick = sub.add_parser(
         "pick-color",
@@ -222,7 +229,9 @@ def run(args: argparse.Namespace) -> int:
         from pipeline.preview import write_preview
 
         out = args.out or f"{Path(args.folder).resolve().name}{PREVIEW_SHEET_SUFFIX}.jpg"
-        path, n = write_preview(args.folder, out, every=args.all, images=args.image)
+        path, n = write_preview(
+            args.folder, out, every=args.all, images=args.image, frames=args.frame
+        )
         print(
             f"wrote {path}: {n} photo(s) or frame(s); green = ok, orange = flagged, tinted = what "
             "the settings select"

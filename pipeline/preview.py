@@ -38,6 +38,7 @@ from pipeline.measure.overlay import (
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 from pipeline.video.clips import Clip, frame_settings, resolve_clips
+from pipeline.video.measure import spread_frames
 from pipeline.video.reader import read_frames
 from pipeline.video.timeline import frame_conditions
 
@@ -376,18 +377,44 @@ def preview_frames(pressure_kpa: np.ndarray) -> list[int]:
     return list(dict.fromkeys((0, top, len(pressure_kpa) - 1)))
 
 
-def video_tiles(ps: PhotoSet, method: str = "auto") -> list[np.ndarray]:
+def video_tiles(
+    ps: PhotoSet, method: str = "auto", *, frames: Sequence[int] = (), every: bool = False
+) -> list[np.ndarray]:
     """The preview tiles of a video photo set: of every video its first frame, the one at the
-    highest logged pressure (the most bent) and its last."""
+    highest logged pressure (the most bent) and its last; or the ``frames`` given (numbered as
+    ``angles.csv``'s ``frame``, from 0); or, with ``every``, the frames ``--overlays`` draws.
+
+    Raises
+    ------
+    UserInputError
+        A frame given that no video of the set holds, naming the videos' frame counts.
+    """
+    clips = resolve_clips(ps)
+    longest = max((c.n_frames for c in clips if c.info.opened), default=0)
+    beyond = [k for k in frames if not 0 <= k < longest]
+    if beyond:
+        raise UserInputError(
+            f"--frame {beyond[0]}: no video of {ps.folder} holds it ("
+            + ", ".join(f"{c.video} has {c.n_frames}" for c in clips)
+            + " frames; fix: give a frame from 0 to one less than its count, as angles.csv's "
+            "frame column numbers them)"
+        )
     tiles = []
-    for clip in resolve_clips(ps):
+    for clip in clips:
         if not clip.info.opened or not clip.n_frames:
             blank = np.empty(0, np.uint8)
             why = "; ".join(clip.problems) or "video holds no frame"
             tiles.append(encoded_tile(blank, clip.video, None, title=clip.video, reason=why))
             continue
         pressure = frame_pressures_kpa(clip)
-        for k in preview_frames(pressure):
+        picks = (
+            [k for k in dict.fromkeys(frames) if k < clip.n_frames]
+            if frames
+            else spread_frames(clip.n_frames)
+            if every
+            else preview_frames(pressure)
+        )
+        for k in picks:
             frame = next(read_frames(clip.info, k, 1))
             data = (
                 np.empty(0, np.uint8)
@@ -413,9 +440,10 @@ def write_preview(
     method: str = "auto",
     every: bool = False,
     images: Sequence[str] = (),
+    frames: Sequence[int] = (),
 ) -> tuple[Path, int]:
-    """Write the preview contact sheet of a photo set (of the ``images`` named, when given);
-    return its path and the tile count.
+    """Write the preview contact sheet of a photo set (of the ``images`` named, or of a video
+    set the ``frames``, when given); return its path and the tile count.
 
     The sheet is a JPEG, or a PNG when ``out`` ends in ``.png``; another ending is refused before
     anything is measured.
@@ -431,9 +459,14 @@ def write_preview(
     if ps.is_video and images:
         raise UserInputError(
             f"--image {images[0]}: {ps.folder} is a video set, whose preview shows frames along "
-            "each video (fix: leave --image out)"
+            f"each video (fix: name a frame with --frame N, N as in angles.csv's frame column)"
         )
-    tiles = video_tiles(ps, method) if ps.is_video else []
+    if frames and not ps.is_video:
+        raise UserInputError(
+            f"--frame {frames[0]}: {ps.folder} is a set of photos, not videos (fix: name a photo "
+            "with --image NAME)"
+        )
+    tiles = video_tiles(ps, method, frames=frames, every=every) if ps.is_video else []
     for i in [] if ps.is_video else preview_rows(ps, every, images):
         row = ps.manifest.iloc[i]
         title = (

@@ -681,3 +681,9 @@ def test_the_preview_shows_the_photos_named_and_refuses_a_name_not_in_the_manife
     assert "1 photo(s)" in capsys.readouterr().out and out.is_file()
     with pytest.raises(UserInputError, match=r"--image IMG_9\.JPG: no such photo in .*manifest"):
         preview_rows(loaded, images=["IMG_9.JPG"])
+    # --frame is a video set's
+    assert main(["photoset", "preview", str(photo_folder), "--frame", "3", "--out",
+                 str(out)]) == 2
+    assert "is a set of photos, not videos (fix: name a photo with --image NAME)" in (
+        capsys.readouterr().err
+    )

@@ -462,6 +462,17 @@ def test_the_preview_of_a_video_set_shows_its_first_most_bent_and_last_frames(vi
     pressure = frame_pressures_kpa(clip)
     first, top, last = preview_frames(pressure)
     assert (first, last) == (0, 134) and pressure[top] == 80.0
+    # a chosen frame (a flagged row's), or the frames the overlays draw (it showed the same
+    # three whatever was asked, and refused --image)
+    _, tiles = write_preview(video_set, tmp_path / "frames.png", frames=[7, 7, 100])
+    assert tiles == 2
+    _, tiles = write_preview(video_set, tmp_path / "all.png", every=True)
+    assert tiles == 24
+    with pytest.raises(UserInputError, match=r"--frame 135: no video of .* holds it \(.* has "
+                       r"135 frames; fix: give a frame from 0"):
+        write_preview(video_set, tmp_path / "x.png", frames=[135])
+    with pytest.raises(UserInputError, match="fix: name a frame with --frame N"):
+        write_preview(video_set, tmp_path / "x.png", images=["frame.jpg"])
     # a video that cannot be opened is one tile saying so, not a crash
     broken = _copy(video_set, tmp_path)
     _video(broken).write_bytes(b"not a video")

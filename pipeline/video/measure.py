@@ -32,6 +32,18 @@ from pipeline.video.worker import CHUNK_COLUMNS, CHUNK_FRAMES, FrameChunk, run_c
 OVERLAYS_PER_VIDEO = 24
 
 
+def spread_frames(n_frames: int, count: int = OVERLAYS_PER_VIDEO) -> list[int]:
+    """``count`` frames evenly spread over a video of ``n_frames`` (all of a shorter one; none of
+    an empty one): the frames drawn as overlays, and shown by ``photoset preview --all``.
+
+    Examples
+    --------
+    >>> spread_frames(100, 4), spread_frames(2), spread_frames(0)
+    ([0, 33, 66, 99], [0, 1], [])
+    """
+    return [int(k) for k in np.unique(np.round(np.linspace(0, n_frames - 1, min(count, n_frames))))]
+
+
 def frame_overlay_name(video: str, frame: int) -> str:
     """Overlay file of one frame, e.g. ``ramp_f000120.jpg``."""
     return f"{Path(video).stem}_f{int(frame):06d}.jpg"
@@ -64,10 +76,8 @@ def _tasks(
         reasons = [r for r in (ps.row_reason(clip.position), "; ".join(clip.problems)) if r]
         reason = "; ".join(reasons)
         n = clip.n_frames
-        # evenly spread frames (none of an empty clip)
-        picks = np.unique(np.round(np.linspace(0, n - 1, min(OVERLAYS_PER_VIDEO, n))).astype(int))
         overlays = (
-            {int(k): str(overlays_dir / frame_overlay_name(clip.video, int(k))) for k in picks}
+            {k: str(overlays_dir / frame_overlay_name(clip.video, k)) for k in spread_frames(n)}
             if overlays_dir
             else {}
         )
