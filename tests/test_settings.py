@@ -161,18 +161,21 @@ def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
 @pytest.mark.parametrize(
     ("target", "says", "fix"),
     [("line", "line cut short", "a reminder only"), ("body", "optional for a body",
-                                                     "otherwise there is nothing to do")],
+                                                     "otherwise there is nothing to do"),
+     ("body+sealed", "optional for a body", "with sealed_end_mm it places the sealed end")],
 )
 def test_the_warning_of_a_set_without_a_scale_says_what_it_costs(photo_folder, target, says, fix):
     # a line's psi rests on its measured length without a scale; a body's tip angle does not, and
     # only its length check against l0 is lost (its ramp's other photos still check it): three
-    # customers with no ruler found the warning noise they could not act on
+    # customers with no ruler found the warning noise they could not act on; with a sealed end
+    # the scale places it (customer 16 read "nothing to do", and its curled frames 2-4 deg high)
     from pipeline import photoset_init
 
+    sealed = {"sealed_end_mm": 10.0} if target.endswith("+sealed") else {}
     photoset_init.init_photoset(
         photo_folder,
         "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
-        settings={"l0_mm": 210.0, "target": target},
+        settings={"l0_mm": 210.0, "target": target.removesuffix("+sealed"), **sealed},
     )
     (warning,) = [
         p for p in ps.validate_photoset(photo_folder, warnings=True) if "mm_per_px" in p.message
