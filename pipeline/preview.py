@@ -327,9 +327,19 @@ def rectified_panel(img: np.ndarray, scale: float, settings: MeasureSettings, re
 def preview_rows(
     ps: PhotoSet, every: bool = False, images: Sequence[str] = ()
 ) -> list[int]:
-    """Positions (0-based) of the photos a preview shows: the first of every ramp, the one at its
-    highest pressure (the most bent: on a ramp up and back down the first and last are both at
-    rest) and the last (or all, or the ``images`` named, in their order)."""
+    """Positions (0-based) of the photos a preview shows: the first of every ramp, the last at
+    its highest pressure (the most bent: on a ramp up and back down the first and last are both
+    at rest; of a step response's frames, the settled one) and the last (or all, or the
+    ``images`` named, in their order).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> frames = pd.DataFrame({"pressure_kpa": [0, 0, 80, 80, 80, 0], "material": "DS20",
+    ...                        "actuator": "A1", "trial": 1, "step": range(6)})
+    >>> preview_rows(SimpleNamespace(manifest=frames))
+    [0, 4, 5]
+    """
     m = ps.manifest.reset_index(drop=True)
     if images:
         names = m["image"].astype(str).tolist()
@@ -346,7 +356,9 @@ def preview_rows(
     rows: list[int] = []
     for _, ramp in order.groupby(list(RAMP_KEYS), sort=False):
         pressure = pd.to_numeric(ramp["pressure_kpa"], errors="coerce")
-        top = pressure.idxmax() if pressure.notna().any() else ramp.index[0]
+        top = pressure[pressure == pressure.max()].index[-1] if pressure.notna().any() else (
+            ramp.index[0]
+        )
         for ix in (ramp.index[0], top, ramp.index[-1]):
             if int(ix) not in rows:
                 rows.append(int(ix))
