@@ -86,8 +86,10 @@ PRESSURE_UNITS_KPA: dict[str, float] = {f"pressure_{u}": f for u, f in KPA_PER_U
 #: manifest columns of a video photo set (one row per video; see :mod:`pipeline.video`)
 VIDEO_REQUIRED_COLUMNS: tuple[str, ...] = ("video", "pressure_log", "material", "actuator", "trial")
 #: ``clock_offset_s``: log time of video time 0 (s, default 0); ``frame_times``: a ``frame, time_s``
-#: CSV of the frames' timestamps on the video's clock (default: the container's presentation times)
-VIDEO_OPTIONAL_COLUMNS: tuple[str, ...] = ("clock_offset_s", "frame_times")
+#: CSV of the frames' timestamps on the video's clock (default: the container's presentation
+#: times); ``fps``: the frames' rate, frame k at k / fps (a frame sequence's, which has none, or a
+#: container's that is wrong)
+VIDEO_OPTIONAL_COLUMNS: tuple[str, ...] = ("clock_offset_s", "frame_times", "fps")
 #: folder-wide settings written by default (the other keys are optional, see KEYS)
 SETTING_DEFAULTS: dict[str, Any] = {
     "l0_mm": None,
@@ -332,8 +334,21 @@ def read_settings(folder: str | os.PathLike[str]) -> dict[str, Any]:
 
 
 def write_settings(folder: str | os.PathLike[str], settings: Mapping[str, Any]) -> None:
-    """Write ``photoset.yaml`` atomically (defaults filled in, keys in a stable order; a key with
-    no value is left out, but ``l0_mm``, which has to be set: ``l0_mm: null`` says so)."""
+    """Write ``photoset.yaml`` atomically (defaults filled in, keys in a stable order, one a
+    line; a key with no value is left out, but ``l0_mm``, which has to be set: ``l0_mm: null``
+    says so).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> write_settings(root, {"l0_mm": 255.0, "roi": [[1, 2], [3, 4]]})
+    >>> print((root / SETTINGS).read_text(), end="")
+    l0_mm: 255.0
+    fixed_end: auto
+    positive_turn: ccw
+    roi: [[1, 2], [3, 4]]
+    """
     data = {
         k: v
         for k, v in {**SETTING_DEFAULTS, **dict(settings)}.items()
@@ -341,8 +356,19 @@ def write_settings(folder: str | os.PathLike[str], settings: Mapping[str, Any]) 
     }
     if isinstance(data.get("fixed_end"), tuple):
         data["fixed_end"] = [float(x) for x in data["fixed_end"]]
-    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+    text = yaml.dump(data, Dumper=_SettingsDumper, sort_keys=False, default_flow_style=False)
     atomic_write_bytes(Path(folder) / SETTINGS, text.encode())
+
+
+class _SettingsDumper(yaml.SafeDumper):
+    """``photoset.yaml`` as a person writes it: one key a line, a point or a range on one line
+    (``fixed_end: [812.0, 455.0]``; PyYAML's flow style wrote a set without one as one
+    ``{l0_mm: 255.0, ...}`` line)."""
+
+
+_SettingsDumper.add_representer(
+    list, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v, flow_style=True)
+)
 
 
 def is_video_manifest(manifest: pd.DataFrame) -> bool:
@@ -738,6 +764,17 @@ def _video_row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                         "it empty for 0",
                     )
                 )
+        fps = df["fps"].iloc[i] if "fps" in df.columns else None
+        if not is_missing(fps) and not user_float(fps) > 0:
+            out.append(
+                Problem(
+                    mpath,
+                    line,
+                    f"fps {fps!r} is not a frame rate",
+                    "give the frames per second the video was recorded at, e.g. 30, or leave it "
+                    "empty for the video's own",
+                )
+            )
         for key in RAMP_KEYS:
             if is_missing(df[key].iloc[i]):
                 out.append(Problem(mpath, line, f"{key} is empty", f"fill in the {key}"))
@@ -884,7 +921,8 @@ def load_checked(folder: str | os.PathLike[str]) -> tuple[PhotoSet | None, list[
 def measurement_doubts(ps: PhotoSet) -> list[Problem]:
     """Warnings of ``check`` that hold whatever the rows measure: a key that is ignored
     (:func:`unknown_key_problems`), photos of the folder left out of the manifest
-    (:func:`unlisted_problems`) and a capped body without ``sealed_end_mm``
+    (:func:`unlisted_problems`), a video's frames set up as photos
+    (:func:`repeated_level_problems`) and a capped body without ``sealed_end_mm``
     (:func:`sealed_end_problems`).  ``measure`` prints them and the report lists them (a
     Snakemake run keeps what ``measure`` prints in the job's log); each is decided by the set's
     content, never by file times.
@@ -892,6 +930,7 @@ def measurement_doubts(ps: PhotoSet) -> list[Problem]:
     return (
         unknown_key_problems(str(ps.folder / SETTINGS), ps.settings)
         + ([] if ps.is_video else unlisted_problems(ps))
+        + repeated_level_problems(ps)
         + sealed_end_problems(ps)
     )
 
@@ -1021,7 +1060,7 @@ def file_problems(
         mpath, [(line, image) for line, image in images if int(line) not in own_fixed_end], sizes
     )
     if not ps.is_video:
-        problems += unlisted_problems(ps)
+        problems += unlisted_problems(ps) + repeated_level_problems(ps)
     problems += _calibration_problems(ps)
     problems += newer_spreadsheet_problems(ps.folder)
     unscaled = [
@@ -1120,6 +1159,50 @@ def unlisted_photos(folder: Path, listed: Iterable[str], subfolders: bool = True
         and not (
             Path(n).stem.endswith(PREVIEW_SHEET_SUFFIX)
             and Path(n).suffix.lower() in (".jpg", ".png")
+        )
+    ]
+
+
+#: this many photos of one ramp at one pressure and direction look like a video's frames
+FRAMES_AT_ONE_LEVEL = 5
+
+
+def repeated_level_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning when a ramp has :data:`FRAMES_AT_ONE_LEVEL` or more photos at one pressure and
+    direction: frames cut from a video (a step response) set up as photos, whose curves would
+    average each level's frames, those still moving towards it too.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> _ = (root / SETTINGS).write_text("l0_mm: 200\\n")
+    >>> rows = "".join(f"f_{k}.jpg,{40 * (k > 2)},up,DS20,A1,1\\n" for k in range(8))
+    >>> _ = (root / MANIFEST).write_text("image,pressure_kpa,direction,material,actuator,trial\\n"
+    ...                                  + rows)
+    >>> print(repeated_level_problems(load_photoset(root))[0].message[:64])
+    5 photos of ramp DS20 A1 1 are at 40 kPa up (frames of a video?)
+    """
+    m = ps.manifest
+    if ps.is_video or not {"pressure_kpa", "direction", *RAMP_KEYS} <= set(m.columns):
+        return []
+    counts = m.groupby([*RAMP_KEYS, "direction", "pressure_kpa"], sort=False).size()
+    many = counts[counts >= FRAMES_AT_ONE_LEVEL]
+    if many.empty:
+        return []
+    (material, actuator, trial, direction, pressure), n = next(iter(many.items()))
+    return [
+        Problem(
+            str(ps.folder / MANIFEST),
+            None,
+            f"{n} photos of ramp {material} {actuator} {trial} are at {pressure:g} kPa "
+            f"{direction} (frames of a video?)"
+            + (f", and {len(many) - 1} more such level(s)" if len(many) > 1 else "")
+            + ": the curves average each level's photos, those still moving towards it too",
+            "measure frames cut from a video as the video they are: a video row naming them "
+            "like frame_%04d.jpg, with fps (README, Videos); repeated photos of a settled "
+            "level are fine as they are",
+            warning=True,
         )
     ]
 

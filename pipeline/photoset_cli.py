@@ -60,7 +60,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="for videos: the pressure log (a CSV with time_s and pressure_kpa) in DIR; "
              "'{video}' in it stands for each video's name without its ending "
              "('{video}_pressure.csv'). Writes a video photo set, one manifest row per video "
-             "matching --pattern (e.g. 'GX*.MP4')",
+             "matching --pattern (e.g. 'GX*.MP4'), or one row of a frame sequence: --pattern "
+             "'frame_%%04d.jpg' names frame_0001.jpg, frame_0002.jpg, ... (with --fps)",
+    )
+    init.add_argument(
+        "--fps",
+        type=float,
+        metavar="F",
+        help="for videos: their frame rate, written as the manifest's fps (a frame sequence has "
+             "none of its own; a video's own is used without it)",
     )
     init.add_argument(
         "--clock-offset-s",
@@ -325,6 +333,7 @@ def _init(args: argparse.Namespace) -> int:
             args.pattern,
             args.pressure_log,
             clock_offset_s=args.clock_offset_s,
+            fps=args.fps,
             defaults=defaults,
             settings=settings,
             overwrite=args.overwrite,
@@ -332,8 +341,9 @@ def _init(args: argparse.Namespace) -> int:
         print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s)")
         _print_next(args, kept)
         return 0
-    if args.clock_offset_s is not None:
-        raise UserInputError("--clock-offset-s is for videos: give their --pressure-log too")
+    for option, value in (("--clock-offset-s", args.clock_offset_s), ("--fps", args.fps)):
+        if value is not None:
+            raise UserInputError(f"{option} is for videos: give their --pressure-log too")
     df = photoset_init.init_photoset(
         args.folder,
         args.pattern,

@@ -22,6 +22,7 @@ from pipeline.constants import DIRECTION_WORDS, RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
+from pipeline.video.reader import sequence_files
 
 #: file endings taken for videos (any OpenCV reads): a pattern matching only these needs
 #: ``--pressure-log``
@@ -263,12 +264,14 @@ def init_video_photoset(
     pressure_log: str,
     *,
     clock_offset_s: float | None = None,
+    fps: float | None = None,
     defaults: Mapping[str, Any] | None = None,
     settings: Mapping[str, Any] | None = None,
     overwrite: bool = False,
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` of a video photo set, one row per video matching
-    ``pattern`` (and ``photoset.yaml`` if absent).
+    ``pattern``, or one row of the frame sequence ``pattern`` names (``frame_%04d.jpg``), and
+    ``photoset.yaml`` if absent.
 
     Parameters
     ----------
@@ -282,6 +285,8 @@ def init_video_photoset(
         without its ending (``{video}_pressure.csv``).
     clock_offset_s : float, optional
         The log's time at each video's first frame (s), written as ``clock_offset_s``.
+    fps : float, optional
+        The frames' rate, written as ``fps`` (a frame sequence has none of its own).
     defaults, settings, overwrite
         As for :func:`init_photoset`.
 
@@ -311,7 +316,12 @@ def init_video_photoset(
     regex = pattern_to_regex(pattern, pressure_in_name=False)
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     rows = []
-    for name in _matching_videos(folder, pattern):
+    frames = sequence_files(folder / pattern)
+    if frames is None:
+        names = _matching_videos(folder, pattern)
+    else:  # a frame sequence is one video
+        names = [pattern] if frames else []
+    for name in names:
         m = regex.match(name)
         if not m:
             continue
@@ -325,11 +335,16 @@ def init_video_photoset(
         row |= _ramp_keys(name, m.groupdict(), defaults)
         if clock_offset_s is not None:
             row["clock_offset_s"] = clock_offset_s
+        if fps is not None:
+            row["fps"] = fps
         rows.append(row)
     if not rows:
         raise UserInputError(
-            f"no video in {folder} matches pattern {pattern!r} (videos end in "
-            f"{', '.join(VIDEO_SUFFIXES)})"
+            f"no file in {folder} is a frame of the sequence {pattern!r} (its number where the "
+            "pattern has %04d, or %d unpadded)"
+            if frames is not None
+            else f"no video in {folder} matches pattern {pattern!r} (videos end in "
+            f"{', '.join(VIDEO_SUFFIXES)}; a frame sequence is named like frame_%04d.jpg)"
         )
     df = pd.DataFrame(rows)
     write_manifest(folder, df)

@@ -522,3 +522,54 @@ def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_
     assert not sharp_rows["reason"].fillna("").str.contains("smeared").any()
     with pytest.raises(UserInputError, match="shutter_s"):
         render_video(tmp_path / "x", "DS20", shutter_s=0.1, **kw)  # longer than a frame
+
+
+def test_a_frame_sequence_is_measured_as_the_video_it_was_cut_from(video_set, measured, tmp_path):
+    # customer 16 had the frames ffmpeg cut from a step response (frame_%04d.jpg), not the
+    # video: it built a manifest of photos, frame by frame, and aggregate pooled every frame at
+    # a setpoint, those still moving too; named by ffmpeg's pattern it is the video again
+    from pipeline.cli import main
+
+    folder = _copy(video_set, tmp_path)
+    (clip,) = resolve_clips(photoset.load_photoset(folder))
+    (folder / "frames").mkdir()
+    for frame in read_frames(clip.info, 0, clip.n_frames):  # the MJPEG packets: the same bytes
+        (folder / "frames" / f"f_{frame.index + 1:04d}.jpg").write_bytes(frame.data.tobytes())
+    _video(folder).unlink()
+    (folder / "manifest.csv").unlink()
+    log = pd.read_csv(video_set / "manifest.csv")["pressure_log"].iloc[0]
+    assert main(["photoset", "init", str(folder), "--pattern", "frames/f_%04d.jpg",
+                 "--pressure-log", log, "--clock-offset-s", "0.7", "--fps", "10",
+                 "--material", "SS40", "--l0-mm", "200"]) == 0
+    assert pd.read_csv(folder / "manifest.csv")["video"].tolist() == ["frames/f_%04d.jpg"]
+    assert check_photoset(folder) == []
+    out = measure_photoset(folder, jobs=2)
+    pd.testing.assert_frame_equal(out[MEASURED], measured[MEASURED])
+    # a file missing from the sequence is that frame's failed row; the frames after it keep
+    # their numbers, times and angles
+    kept = (folder / "frames" / "f_0050.jpg").read_bytes()
+    (folder / "frames" / "f_0050.jpg").unlink()
+    gap = measure_photoset(folder, jobs=2)
+    assert gap.loc[49, "status"] == "failed"
+    assert gap.loc[49, "reason"] == "frame 49 of f_%04d.jpg is missing from the sequence"
+    pd.testing.assert_frame_equal(
+        gap.drop(index=49)[MEASURED], measured.drop(index=49)[MEASURED]
+    )
+    assert [p.message for p in check_photoset(folder)] == [
+        (
+            "1 of the 135 frames of sequence frames/f_%04d.jpg are missing (1) or cannot be "
+            "decoded: frame 49; they will be failed rows"
+        )
+    ]
+    (folder / "frames" / "f_0050.jpg").write_bytes(kept)
+    # without its rate a sequence has no times: refused, naming both ways to give them
+    manifest = pd.read_csv(folder / "manifest.csv")
+    manifest.drop(columns="fps").to_csv(folder / "manifest.csv", index=False)
+    said = [p.message for p in check_photoset(folder)]
+    assert [m for m in said if "does not say its frame rate; give its fps (a column of "
+            "manifest.csv)" in m], said
+    manifest.assign(fps="fast").to_csv(folder / "manifest.csv", index=False)
+    assert [p.message for p in check_photoset(folder)] == ["fps 'fast' is not a frame rate"]
+    manifest.assign(video="frames/g_%04d.jpg").to_csv(folder / "manifest.csv", index=False)
+    (problem,) = check_photoset(folder)
+    assert "no file of" in problem.message and "g_<number>.jpg" in problem.message

@@ -16,7 +16,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pipeline.measure.settings import MeasureSettings, is_missing
+from pipeline.measure.settings import MeasureSettings, is_missing, user_float
 from pipeline.photoset import MANIFEST, PhotoSet, Problem, geometry_problems
 from pipeline.video.reader import VideoInfo, probe_video, read_frames
 from pipeline.video.timeline import (
@@ -144,10 +144,16 @@ def resolve_clips(ps: PhotoSet) -> tuple[Clip, ...]:
             times, time_problems = read_frame_times(ps.image_path(str(row["frame_times"])))
             problems += time_problems
         offset = _offset(row["clock_offset_s"]) if "clock_offset_s" in m.columns else 0.0
-        if info.opened and times is None and not math.isfinite(info.fps):
+        fps_cell = row["fps"] if "fps" in m.columns else None  # one not a rate: a row problem
+        fps = user_float(fps_cell) if not is_missing(fps_cell) else 0.0
+        if info.opened and fps > 0:
+            info = replace(info, fps=fps)
+            if times is None:  # frame k at k / fps, whatever the container says
+                times = np.arange(info.frame_count) / fps
+        if info.opened and times is None and not math.isfinite(info.fps) and is_missing(fps_cell):
             problems.append(
-                f"video {video} does not say its frame rate; give a frame_times file (frame, "
-                "time_s)"
+                f"video {video} does not say its frame rate; give its fps (a column of "
+                "manifest.csv) or a frame_times file (frame, time_s)"
             )
         clips.append(
             Clip(i, int(row["manifest_line"]), video, info, log, times, offset, tuple(problems))
@@ -244,7 +250,9 @@ def clip_problems(
             out += geometry_problems(
                 mpath, clip.line, settings, (clip.info.width, clip.info.height)
             )
-        if decode:
+        if clip.info.files:
+            out += _sequence_problems(mpath, clip, decode)
+        elif decode:
             n = readable_frames(clip.info)
             if n < clip.n_frames:
                 out.append(
@@ -258,3 +266,27 @@ def clip_problems(
                     )
                 )
     return out
+
+
+def _sequence_problems(mpath: str, clip: Clip, decode: bool) -> list[Problem]:
+    """The frames of a frame sequence that are missing (a number skipped) or, with ``decode``,
+    cannot be decoded: one problem naming the first files, as each will be a failed row."""
+    bad = [
+        Path(f).name if f else f"frame {k}"
+        for k, f in enumerate(clip.info.files)
+        if not f or (decode and cv2.imread(f, cv2.IMREAD_REDUCED_GRAYSCALE_8) is None)
+    ]
+    missing = sum(1 for f in clip.info.files if not f)
+    if not bad:
+        return []
+    shown = ", ".join(bad[:3]) + (", ..." if len(bad) > 3 else "")
+    return [
+        Problem(
+            mpath,
+            clip.line,
+            f"{len(bad)} of the {clip.n_frames} frames of sequence {clip.video} "
+            + (f"are missing ({missing}) or cannot be decoded" if decode else "are missing")
+            + f": {shown}; they will be failed rows",
+            "copy the frames again from where they were cut, or accept the failed frames",
+        )
+    ]

@@ -25,6 +25,7 @@ from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import VIDEO_OPTIONAL_COLUMNS, PhotoSet
 from pipeline.pool import map_photos
 from pipeline.video.clips import Clip, frame_settings, resolve_clips, span_problem
+from pipeline.video.reader import SEQUENCE_NUMBER
 from pipeline.video.timeline import frame_conditions, span_text
 from pipeline.video.worker import CHUNK_COLUMNS, CHUNK_FRAMES, FrameChunk, run_chunk
 
@@ -45,8 +46,16 @@ def spread_frames(n_frames: int, count: int = OVERLAYS_PER_VIDEO) -> list[int]:
 
 
 def frame_overlay_name(video: str, frame: int) -> str:
-    """Overlay file of one frame, e.g. ``ramp_f000120.jpg``."""
-    return f"{Path(video).stem}_f{int(frame):06d}.jpg"
+    """Overlay file of one frame, e.g. ``ramp_f000120.jpg`` (a frame sequence's without its
+    number's pattern: ``frame_%04d.jpg`` -> ``frame_f000120.jpg``).
+
+    Examples
+    --------
+    >>> frame_overlay_name("trial1/ramp.avi", 120), frame_overlay_name("frame_%04d.jpg", 7)
+    ('ramp_f000120.jpg', 'frame_f000007.jpg')
+    """
+    stem = SEQUENCE_NUMBER.sub("", Path(video).stem).rstrip("_-. ") or "frame"
+    return f"{stem}_f{int(frame):06d}.jpg"
 
 
 def chunk_ranges(

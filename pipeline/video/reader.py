@@ -7,6 +7,12 @@ it decodes a photo, directly at reduced size and in grey for a black line
 decode.  Any other codec OpenCV's FFmpeg can read (MPEG-4, H.264 where the build has a decoder)
 is read as decoded frames.
 
+A *frame sequence* (the files ``ffmpeg -i video.mp4 frame_%04d.jpg`` writes, or a high-speed
+camera's export) is read as a video named by that pattern, ``frame_%04d.jpg``: frame ``k`` is the
+``k``-th number from the lowest one present, and its file's bytes are its packet, decoded like a
+photo.  A number missing between the lowest and the highest is an unreadable frame, never a
+shift of the ones after it.  A sequence has no frame rate of its own (``fps`` NaN).
+
 Seeking: a chunk of frames starts with a seek, checked against the frame's presentation time
 (``k / fps``); where the container cannot seek (a truncated AVI has lost its index and OpenCV
 then returns frame 0 whatever is asked) the reader skips packets from the start instead, so a
@@ -30,6 +36,7 @@ Examples
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,6 +75,8 @@ class VideoInfo:
         A seek lands on the frame asked for (checked in the middle of the video).
     problem : str
         Why the video cannot be read ('' when it can).
+    files : tuple of str
+        Of a frame sequence: frame k's file ('' where its number is missing); empty for a video.
     """
 
     path: str
@@ -80,6 +89,7 @@ class VideoInfo:
     packets: bool = False
     seekable: bool = False
     problem: str = ""
+    files: tuple[str, ...] = ()
 
     @property
     def frame_period_s(self) -> float:
@@ -128,12 +138,82 @@ def _lands_on(cap: cv2.VideoCapture, index: int, fps: float) -> bool:
     return bool(ok) and abs(_pts_s(cap) - index / fps) <= 0.5 / fps
 
 
+#: the frame number in a frame sequence's name, as ffmpeg writes it: %d, or %0Nd zero-padded
+SEQUENCE_NUMBER = re.compile(r"%(0\d+)?d")
+
+
+def sequence_files(path: str | Path) -> tuple[str, ...] | None:
+    """The files of the frame sequence ``path`` names (``frames/frame_%04d.jpg``), frame k at
+    k places from the lowest number present ('' where a number is missing); None when ``path``
+    names no sequence.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("f_0001.jpg", "f_0002.jpg", "f_0004.jpg", "f_00003.jpg", "f_2.jpg"):
+    ...     _ = (root / name).write_bytes(b"x")
+    >>> [Path(f).name if f else "" for f in sequence_files(root / "f_%04d.jpg")]
+    ['f_0001.jpg', 'f_0002.jpg', '', 'f_0004.jpg']
+    >>> sequence_files(root / "f_0001.jpg") is None, sequence_files(root / "g_%d.png")
+    (True, ())
+    """
+    path = Path(path)
+    found = list(SEQUENCE_NUMBER.finditer(path.name))
+    if len(found) != 1:
+        return None
+    m = found[0]
+    width = int(m.group(1)) if m.group(1) else 1
+    name = re.compile(
+        re.escape(path.name[: m.start()]) + rf"(\d{{{width},}})" + re.escape(path.name[m.end():])
+    )
+    numbers: dict[int, str] = {}
+    if path.parent.is_dir():
+        for entry in path.parent.iterdir():
+            hit = name.fullmatch(entry.name)
+            # zero-padded to its width (%04d: 9999 is followed by 10000; 00003 is not its 3)
+            digits = hit.group(1) if hit else ""
+            if hit and entry.is_file() and (
+                not m.group(1) or len(digits) == width or digits[0] != "0"
+            ):
+                numbers[int(digits)] = str(entry)
+    if not numbers:
+        return ()
+    lo, hi = min(numbers), max(numbers)
+    return tuple(numbers.get(n, "") for n in range(lo, hi + 1))
+
+
+def _probe_sequence(path: str, files: tuple[str, ...]) -> VideoInfo:
+    """A frame sequence described as a video: its frames are its files, packets of one image
+    each; seekable; no frame rate."""
+    name = Path(path).name
+    if not files:
+        return VideoInfo(
+            path,
+            False,
+            problem=f"video {name}: no file of {Path(path).parent} is named like it (a frame "
+            f"sequence, {SEQUENCE_NUMBER.sub('<number>', name)})",
+        )
+    first = cv2.imread(files[0]) if files[0] else None
+    if first is None:
+        return VideoInfo(
+            path, False, problem=f"video {name}: its first frame {Path(files[0]).name} cannot be "
+            "decoded"
+        )
+    height, width = first.shape[:2]
+    return VideoInfo(path, True, len(files), math.nan, width, height, "", True, True, "", files)
+
+
 def probe_video(path: str | Path) -> VideoInfo:
-    """Open ``path`` and describe it (frame count, rate, size, codec, packet reading, seeking).
+    """Open ``path`` and describe it (frame count, rate, size, codec, packet reading, seeking);
+    a frame sequence's name (``frame_%04d.jpg``) describes its files.
 
     Never raises: a file OpenCV cannot open gives ``opened=False`` and the reason.
     """
     path = str(path)
+    files = sequence_files(path)
+    if files is not None:
+        return _probe_sequence(path, files)
     if not Path(path).is_file():
         return VideoInfo(path, False, problem=f"video {Path(path).name} does not exist")
     cap = _open(path, packets=False)
@@ -196,6 +276,9 @@ def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Fram
         for k in range(first, end if end is not None else first):
             yield Frame(k, math.nan, None, info.problem)
         return
+    if info.files:
+        yield from _sequence_frames(info, first, len(info.files) if end is None else end)
+        return
     cap = _open(info.path, info.packets)
     try:
         k = first
@@ -239,3 +322,15 @@ def read_frames(info: VideoInfo, first: int, count: int | None) -> Iterator[Fram
             k += 1
     finally:
         cap.release()
+
+
+def _sequence_frames(info: VideoInfo, first: int, end: int) -> Iterator[Frame]:
+    """Frames ``first .. end - 1`` of a frame sequence: each file's bytes, or the reason."""
+    for k in range(first, end):
+        file = info.files[k] if k < len(info.files) else ""
+        data = np.fromfile(file, np.uint8) if file else np.empty(0, np.uint8)
+        if data.size:
+            yield Frame(k, math.nan, data)
+            continue
+        why = "is empty" if file else "is missing from the sequence"
+        yield Frame(k, math.nan, None, f"frame {k} of {Path(info.path).name} {why}")
