@@ -167,12 +167,71 @@ def measure_photoset(
     drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
         out = check_ramps(out)
+    if not ps.is_video:
+        out = note_uneven_light(ps, out)
     if "calibration_px" in out.columns:
         out = flag_doubtful_calibration(out)
     if odir is not None:
         if not ps.is_video:
             note_changed_statuses(out, drawn, odir)
         write_contact_sheets(out, odir)
+    return out
+
+
+#: a body told from the backdrop whose light falls off by more than this across its photo
+#: (:func:`pipeline.measure.body.light_falloff`; rendered lamp-lit scenes 0.2-0.45) ...
+UNEVEN_LIGHT_FALLOFF = 0.5
+#: ... is told so when it is flagged or failed, with the fix
+NOTE_UNEVEN_LIGHT = "the backdrop's light falls off by"
+
+
+def note_uneven_light(ps: PhotoSet, angles: pd.DataFrame) -> pd.DataFrame:
+    """Say in the reason of each flagged or failed body told from the backdrop (no empty scene,
+    no colour) whose ramp's first such photo shows light that falls off by more than
+    :data:`UNEVEN_LIGHT_FALLOFF` that it does, and the fix: a photo of the empty scene.
+
+    Without one the body's faint parts are lost where the photo is darker, and the other reasons
+    (a rival selection by the clamp, a gap) point at ``roi`` or ``exclude`` instead (a rendered
+    12 MP translucent ramp darkened to 0.6 at a corner: all 44 flagged, none within 10 deg; with
+    its empty scene all within 5).
+    """
+    out = angles.copy()
+    bad = (out["status"] != "ok").to_numpy()
+    told_by_backdrop = np.array(
+        [r is not None and r.target == "body" and r.color is None and r.background_path is None
+         for r in ps.rows]
+    )
+    if not (bad & told_by_backdrop).any() or not set(RAMP_KEYS) <= set(out.columns):
+        return out
+    from pipeline.measure.body import light_falloff
+    from pipeline.measure.extract import region_mask
+
+    for _, ramp in out.groupby(list(RAMP_KEYS), sort=False):
+        rows = [i for i in ramp.index if told_by_backdrop[i]]
+        if not rows or not bad[rows].any():
+            continue
+        first = ps.rows[rows[0]]
+        assert first is not None
+        try:
+            data = np.fromfile(ps.image_path(str(out.at[rows[0], "image"])), np.uint8)
+        except OSError:  # its row says so already
+            continue
+        img, scale = decode_for_work(data, grey=False) if data.size else (None, 1)
+        if img is None:
+            continue
+        region = region_mask(img.shape, first.roi, first.exclude, scale)
+        falloff = light_falloff(img, np.ones(img.shape[:2], np.uint8) if region is None else region)
+        if falloff <= UNEVEN_LIGHT_FALLOFF:
+            continue
+        note = (
+            f"{NOTE_UNEVEN_LIGHT} {100 * falloff:.0f} % across the photo (one lamp to a side?): "
+            "without the empty scene the body's faint parts are lost where it is darker; take a "
+            "photo of the empty scene and name it as background in photoset.yaml"
+        )
+        for i in rows:
+            if bad[i]:
+                reason = str(out.at[i, "reason"]) if isinstance(out.at[i, "reason"], str) else ""
+                out.at[i, "reason"] = f"{reason}; {note}" if reason else note
     return out
 
 

@@ -1069,3 +1069,45 @@ def test_a_sealed_end_given_without_its_cap_is_not_carried_on_over_the_cap():
         plain = render_actuator(psi, 200.0, dots, seed=4)
         bare = cv2.imdecode(np.frombuffer(plain.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
         assert not extract_body(bare, settings_for(plain.fixed_end_px), scale=1.0).tip_capped
+
+
+def test_a_body_lost_to_light_that_falls_off_says_so_and_names_the_empty_scene(tmp_path):
+    # a translucent body on grey, no empty scene, the photo darkened to 0.6 of its middle at one
+    # corner (a lamp to a side): the body's faint parts are lost where it is darker and every
+    # photo is flagged, for a rival selection by the clamp or a gap, whose fixes (roi, exclude)
+    # do not help; the reason now says what does (with the empty scene: all within 5 deg)
+    from pipeline.measure.body import light_falloff
+    from pipeline.photoset_measure import UNEVEN_LIGHT_FALLOFF, measure_photoset
+    from pipeline.synth.photoset_writer import render_photoset
+
+    folder = tmp_path / "s"
+    render_photoset(folder, "DS30", actuators=1, trials=1, seed=17, scene="grey_dots_clear",
+                    step_kpa=50, max_kpa=200, scene_overrides={"width": 1280, "height": 960})
+    first = folder / "DS30_A1_t1_s000_up_0kPa.jpg"
+    allowed = np.ones((960, 1280), np.uint8)
+    assert light_falloff(cv2.imread(str(first)), allowed) < UNEVEN_LIGHT_FALLOFF  # as rendered
+    y, x = np.mgrid[0:960, 0:1280].astype(np.float32)
+    gain = (1 - 0.15 * (((x - 640) / 640) ** 2 + ((y - 480) / 480) ** 2)) * (0.85 + 0.3 * x / 1280)
+    for photo in folder.glob("DS30_*.jpg"):
+        img = cv2.imread(str(photo)).astype(np.float32) * gain[..., None]
+        cv2.imwrite(str(photo), np.clip(img, 0, 255).astype(np.uint8))
+    assert light_falloff(cv2.imread(str(first)), allowed) > UNEVEN_LIGHT_FALLOFF
+    settings = (folder / "photoset.yaml").read_text()
+    (folder / "photoset.yaml").write_text(
+        "".join(line for line in settings.splitlines(True) if "background" not in line)
+        + "sealed_end_mm: 10\n"
+    )
+    out = measure_photoset(folder)
+    assert (out["status"] != "ok").all()
+    assert out["reason"].str.contains(
+        "the backdrop's light falls off by 6[0-9] % across the photo .*take a photo of the empty "
+        "scene and name it as background in photoset.yaml"
+    ).all(), out["reason"].tolist()
+    # with the empty scene (darkened alike) the same photos are measured, and nothing is said
+    (folder / "photoset.yaml").write_text(settings + "sealed_end_mm: 10\n")
+    empty = folder / "background.jpg"
+    img = cv2.imread(str(empty)).astype(np.float32) * gain[..., None]
+    cv2.imwrite(str(empty), np.clip(img, 0, 255).astype(np.uint8))
+    seen = measure_photoset(folder)
+    assert (seen["status"] == "ok").sum() >= 7
+    assert not seen["reason"].fillna("").str.contains("light falls off").any()

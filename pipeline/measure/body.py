@@ -241,8 +241,51 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     sigma : float
         Robust spread of the difference over backdrop pixels.
     """
-    h, w = allowed.shape
     lab = _lab(image_bgr)
+    model, centres, order, ring, grid = _main_backdrop(lab, allowed)
+    diff = lab_distance(lab, model)
+    others = [centres[c] for c in order[1:]]
+    gy, gx = np.nonzero((allowed > 0) & grid)
+    lab_grid = lab[gy, gx]
+    region_px = lab_grid[:: max(1, len(lab_grid) // KMEANS_PIXELS)]
+    if len(region_px) >= 3:
+        glabels, gcentres = kmeans3(region_px)
+        gshare = np.bincount(glabels, minlength=3) / len(glabels)
+        others += [gcentres[c] for c in range(3) if gshare[c] >= DOMINANT_FRACTION]
+    for centre in others:
+        diff = np.minimum(diff, lab_distance(lab, centre))
+    vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
+    med = float(np.median(vals))
+    sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
+    return diff, sigma
+
+
+def light_falloff(image_bgr: np.ndarray, allowed: np.ndarray) -> float:
+    """How far the backdrop's light falls off across the allowed region: the spread (2nd to 98th
+    percentile) of its fitted lightness over the median (rendered lamp-lit scenes 0.2-0.45; one
+    darkened to 0.6 of the middle at a corner, 0.66).
+
+    Examples
+    --------
+    >>> even = np.full((60, 80, 3), 150, np.uint8)
+    >>> ramp = (even * np.linspace(0.5, 1.0, 80)[None, :, None]).astype(np.uint8)
+    >>> allowed = np.ones((60, 80), np.uint8)
+    >>> round(light_falloff(even, allowed), 2), light_falloff(ramp, allowed) > 0.5
+    (0.0, True)
+    """
+    model = _main_backdrop(_lab(image_bgr), allowed)[0]
+    light = model[:, :, 0][allowed > 0] / LIGHTNESS_WEIGHT
+    lo, mid, hi = (float(v) for v in np.percentile(light, [2, 50, 98]))
+    return (hi - lo) / mid if mid > 1.0 else 0.0
+
+
+def _main_backdrop(
+    lab: np.ndarray, allowed: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, list[int], np.ndarray, np.ndarray]:
+    """The backdrop's main colour as a smooth field over the image (H, W, 3 Lab, lightness
+    weighted), the colour groups of the region's border and those that are backdrop (most common
+    first), the border ring and the sparse grid the fits use."""
+    h, w = allowed.shape
     ring = _ring(allowed)
     step = max(1, int(np.sqrt(max(h * w, 1) / FIT_PIXELS)))  # the fits use a sparse grid of pixels
     grid = np.zeros((h, w), bool)
@@ -284,19 +327,7 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     model = cv2.resize(coarse, (cx.shape[1] * 8, cy.shape[0] * 8), interpolation=cv2.INTER_LINEAR)[
         :h, :w
     ]
-    diff = lab_distance(lab, model)
-    others = [centres[c] for c in order[1:]]
-    region_px = lab_grid[:: max(1, len(lab_grid) // KMEANS_PIXELS)]
-    if len(region_px) >= 3:
-        glabels, gcentres = kmeans3(region_px)
-        gshare = np.bincount(glabels, minlength=3) / len(glabels)
-        others += [gcentres[c] for c in range(3) if gshare[c] >= DOMINANT_FRACTION]
-    for centre in others:
-        diff = np.minimum(diff, lab_distance(lab, centre))
-    vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
-    med = float(np.median(vals))
-    sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
-    return diff, sigma
+    return model, centres, order, ring, grid
 
 
 #: where the ramp's estimate of the empty scene differs from the backdrop by at least this
