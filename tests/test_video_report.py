@@ -48,6 +48,15 @@ def test_a_folder_without_tables_gives_no_page_and_a_strip_needs_overlays(measur
     assert write_strip(measured, tmp_path / "no-overlays", tmp_path) is None
     write_continuous(measured.assign(psi_deg=np.nan, status="failed"), tmp_path / "all_failed")
     assert len(figures(tmp_path / "all_failed")) == 1  # every frame failed: the page still says so
+    # every frame flagged (a whole set measured without its fixed end): the plot was empty and
+    # the step table said "too few frames around the step", never why
+    from pipeline.report.textcheck import drawn_texts
+
+    write_continuous(measured.assign(status="flagged"), tmp_path / "all_flagged")
+    with report_style():
+        (fig,) = figures(tmp_path / "all_flagged")
+        said = [t.text for t in drawn_texts(fig)]
+    assert [t for t in said if t.startswith("no frame is ok: 135 flagged, 0 failed")], said
 
 
 def test_video_pages_have_no_overlaps_no_small_fonts_nothing_on_the_footer(measured, tmp_path):

@@ -428,7 +428,8 @@ def steps(
 def timeline(
     angles: pd.DataFrame, *, include_flagged: bool = False, points: int = TIMELINE_POINTS
 ) -> pd.DataFrame:
-    """psi and pressure against time, medians of at most ``points`` equal time bins per ramp."""
+    """psi and pressure against time, medians of at most ``points`` equal time bins per ramp,
+    with the failed and flagged frames each bin holds (``n_failed``, ``n_flagged``)."""
     df = _frames(angles, include_flagged)
     out = []
     for key, ramp in df.groupby(list(RAMP_KEYS), sort=False):
@@ -448,11 +449,16 @@ def timeline(
             .agg(agg)
             .rename(columns={"_psi": "psi_deg", "_pressure": "measured_pressure_kpa"})
         )
-        g["n_failed"] = ramp.groupby("_b")["status"].apply(lambda s: int((s == "failed").sum()))
+        status = ramp.groupby("_b")["status"]
+        g["n_failed"] = status.apply(lambda s: int((s == "failed").sum()))
+        g["n_flagged"] = status.apply(lambda s: int((s == "flagged").sum()))
         for k, v in zip(RAMP_KEYS, key):
             g.insert(0, k, v)
         out.append(g.reset_index(drop=True))
-    cols = [*RAMP_KEYS, "time_s", "psi_deg", "pressure_kpa", "measured_pressure_kpa", "n_failed"]
+    cols = [
+        *RAMP_KEYS, "time_s", "psi_deg", "pressure_kpa", "measured_pressure_kpa", "n_failed",
+        "n_flagged",
+    ]
     return pd.concat(out, ignore_index=True)[cols] if out else pd.DataFrame(columns=cols)
 
 

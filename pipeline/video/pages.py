@@ -142,6 +142,14 @@ def figures(folder: Path) -> list[Figure]:
                 lw=0.6,
                 label="measured" if j == 0 else None,
             )
+    if not timeline["psi_deg"].notna().any():  # nothing drawn: say why
+        flagged = int(timeline["n_flagged"].sum()) if "n_flagged" in timeline.columns else 0
+        ax_t.text(
+            0.5, 0.5,
+            f"no frame is ok: {flagged} flagged, {int(timeline['n_failed'].sum())} failed "
+            "(the reasons: page 1's data quality and angles.csv)",
+            transform=ax_t.transAxes, ha="center", va="center", fontsize=8.5, color="#b00000",
+        )
     ax_t.set_xlabel("time on the pressure log's clock (s)")
     ax_t.set_ylabel("psi (deg)")
     ax_p.set_ylabel("pressure (kPa)")
