@@ -731,7 +731,9 @@ def test_a_long_sealed_end_read_where_the_bending_stops_when_its_length_is_given
     over = unknown["error_deg"] * np.sign(unknown["psi_true_deg"])
     assert over[big].median() > 4.0
     assert (given["status"] == "ok").all(), given["reason"].tolist()
-    assert given["error_deg"].abs().max() < 5.5 and given["error_deg"].abs().median() < 2.0
+    # the tangent is fitted over the part that bends, up to where it stops: over a window
+    # reaching into the straight sealed end it read up to 4.9 deg low (customer 17: 5.0)
+    assert given["error_deg"].abs().max() < 2.5 and given["error_deg"].abs().median() < 2.0
     # without mm_per_px it is turned into pixels with the body's length against l0_mm +
     # sealed_end_mm (it was refused: "needs the image scale")
     unscaled = _long_sealed_end_cases(True, scale=False)

@@ -508,7 +508,11 @@ def _end_angle(
     s_mid: np.ndarray, theta: np.ndarray, at: float, window: float, from_start: bool
 ) -> tuple[float, float]:
     """Tangent angle at arc length ``at`` from a fit over the first/last ``window``; and its RMS."""
-    sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
+    if not from_start and at < s_mid[-1]:  # read inside the line (before a sealed end): the
+        # window ends there, over the part that bends only
+        sel = (s_mid >= at - window) & (s_mid <= at)
+    else:
+        sel = s_mid <= s_mid[0] + window if from_start else s_mid >= s_mid[-1] - window
     if sel.sum() < 3:
         sel = np.zeros_like(sel)
         sel[:3] = bool(from_start)
@@ -551,6 +555,16 @@ def end_tangents(
     >>> a, b, _ = end_tangents(pts)
     >>> print(round(float(np.rad2deg(b - a)), 2))
     300.0
+
+    Read inside the line (a negative free end: where a straight sealed end begins), the window
+    ends there, so the straight part does not pull the tangent back (it read 196.0 here; a 10 mm
+    sealed end at 12 MP read |psi| near 200 deg up to 5 deg low):
+
+    >>> arc = np.c_[np.sin(t), 1 - np.cos(t)][:334] * 100.0  # 200.2 deg
+    >>> sealed = arc[-1] + np.outer(np.linspace(0.5, 30.0, 60), [np.cos(t[333]), np.sin(t[333])])
+    >>> a, b, _ = end_tangents(np.r_[arc, sealed], ends_px=(0.0, -30.0))
+    >>> print(round(float(np.rad2deg(b - a)), 1))
+    200.2
     """
     if window_fraction is None:
         window_fraction = TANGENT_WINDOW_FRACTION
