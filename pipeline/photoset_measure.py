@@ -192,7 +192,7 @@ def note_uneven_light(ps: PhotoSet, angles: pd.DataFrame) -> pd.DataFrame:
 
     Without one the body's faint parts are lost where the photo is darker, and the other reasons
     (a rival selection by the clamp, a gap) point at ``roi`` or ``exclude`` instead (a rendered
-    12 MP translucent ramp darkened to 0.6 at a corner: all 44 flagged, none within 10 deg; with
+    12 MP translucent ramp darkened to 0.6 at a corner: all 44 flagged, 3 within 10 deg; with
     its empty scene all within 5).
     """
     out = angles.copy()
