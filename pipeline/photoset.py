@@ -927,9 +927,14 @@ def measurement_doubts(ps: PhotoSet) -> list[Problem]:
     Snakemake run keeps what ``measure`` prints in the job's log); each is decided by the set's
     content, never by file times.
     """
+    return unknown_key_problems(str(ps.folder / SETTINGS), ps.settings) + set_doubts(ps)
+
+
+def set_doubts(ps: PhotoSet) -> list[Problem]:
+    """:func:`measurement_doubts` but the ignored keys, which ``check`` has from reading
+    ``photoset.yaml``: the one list both ``check`` and ``measure`` take these from."""
     return (
-        unknown_key_problems(str(ps.folder / SETTINGS), ps.settings)
-        + ([] if ps.is_video else unlisted_problems(ps))
+        ([] if ps.is_video else unlisted_problems(ps))
         + repeated_level_problems(ps)
         + sealed_end_problems(ps)
     )
@@ -1059,8 +1064,6 @@ def file_problems(
     problems += size_problems(
         mpath, [(line, image) for line, image in images if int(line) not in own_fixed_end], sizes
     )
-    if not ps.is_video:
-        problems += unlisted_problems(ps) + repeated_level_problems(ps)
     problems += _calibration_problems(ps)
     problems += newer_spreadsheet_problems(ps.folder)
     unscaled = [
@@ -1108,7 +1111,7 @@ def file_problems(
                 warning=True,
             )
         )
-    problems += sealed_end_problems(ps)
+    problems += set_doubts(ps)
     unused = sorted({
         r.method
         for r in ps.rows
