@@ -353,7 +353,10 @@ def assess_body(
             "preview"
         )
     if line.branched_fraction > 0.05:
-        flags.append("body closes on itself")
+        flags.append(
+            "body closes on itself: where its two ends touch, an exclude box over the gap "
+            "between them opens the ring (photoset preview shows the outlines)"
+        )
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
     if line.gap_bridged:
