@@ -52,7 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "180 and back down to 0); every actuator and trial has as many photos, in file-name "
              "order (numbers as numbers) or by {step}.  Repeat it as TRIAL=SPEC (or "
              "ACTUATOR/TRIAL=SPEC) for ramps of their own: --pressures-kpa 1=0:160:20 "
-             "--pressures-kpa 2=0:180:20",
+             "--pressures-kpa 2=0:180:20; without {trial} in the pattern (ramps taken one after "
+             "another into one folder) the trials take the photos in that order",
     )
     init.add_argument(
         "--pressure-log",
@@ -361,6 +362,8 @@ def _init(args: argparse.Namespace) -> int:
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
         "down)"
     )
+    for line in photoset_init.ramp_lines(df):
+        print(f"  {line}")
     left = photoset.unlisted_photos(Path(args.folder), df["image"], "/" in args.pattern)
     if left:
         print(

@@ -161,7 +161,11 @@ def init_photoset(
     Fields missing from the pattern come from ``defaults`` (``material``, ``actuator``,
     ``trial``).  When the pattern has no ``{direction}``, it is inferred per actuator and trial
     from the order of the photos (by ``step`` if present, else by file name): ``up`` until the
-    highest pressure, ``down`` after it.
+    highest pressure, ``down`` after it.  Photos of several ramps taken one after another in one
+    folder (no ``{trial}`` in the pattern) are split into trials: by the trials' own
+    ``pressures_kpa``, given in the order they were taken, whose photo counts add up to the
+    folder's; or, with one list for them all, wherever the pressure has come back down to the
+    lowest of its ramp and rises again (:func:`ramp_starts`).
 
     Parameters
     ----------
@@ -241,13 +245,17 @@ def init_photoset(
             )
         )
     df = pd.DataFrame(rows)
+    trials_in_names = "trial" in regex.groupindex
     if pressures_kpa is not None:
         df = _with_pressures(
             df,
             {k: tuple(v) for k, v in pressures_kpa.items()}
             if isinstance(pressures_kpa, Mapping)
             else {None: tuple(pressures_kpa)},
+            trials_in_order=not trials_in_names,
         )
+        if not trials_in_names and "direction" not in df.columns:
+            df = _split_ramps(df)
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
@@ -420,10 +428,18 @@ def pressure_specs(specs: Sequence[str]) -> dict[str | None, tuple[float, ...]]:
 
 
 def _with_pressures(
-    df: pd.DataFrame, pressures_kpa: Mapping[str | None, tuple[float, ...]]
+    df: pd.DataFrame,
+    pressures_kpa: Mapping[str | None, tuple[float, ...]],
+    *,
+    trials_in_order: bool = False,
 ) -> pd.DataFrame:
     """``df`` with each ramp's photos given its pressures in order (by step, else by name):
-    those of its ``actuator/trial``, else of its trial, else those for every ramp (key None)."""
+    those of its ``actuator/trial``, else of its trial, else those for every ramp (key None).
+
+    With ``trials_in_order`` (the file names hold no trial), a group whose photo count is the sum
+    of the trials' own specs (two or more, keyed ``trial`` or ``actuator/trial``) is split in
+    photo order: the first spec's trial takes the first photos, and so on.
+    """
     out = df.copy()
     out["pressure_kpa"] = np.nan
     for (material, actuator, trial), g in out.groupby(
@@ -431,6 +447,29 @@ def _with_pressures(
     ):
         order = g.sort_values("step") if "step" in g.columns else g
         ramp = f"material {material}, actuator {actuator}, trial {trial}"
+        own = [
+            (key.rpartition("/")[2], values)
+            for key, values in pressures_kpa.items()
+            if key is not None and key.rpartition("/")[0] in ("", str(actuator))
+        ]
+        if trials_in_order and len(own) > 1 and len(order) == sum(len(v) for _, v in own):
+            start = 0  # ramps taken one after another: the first trial's photos come first
+            for label, values in own:
+                rows = order.index[start : start + len(values)]
+                out.loc[rows, "pressure_kpa"] = values
+                out.loc[rows, "trial"] = label
+                start += len(values)
+            continue
+        if trials_in_order and len(own) > 1:
+            counts = ", ".join(f"{label}: {len(v)}" for label, v in own)
+            raise UserInputError(
+                f"material {material}, actuator {actuator}: {len(order)} photo(s) "
+                f"({order['image'].iloc[0]} ... "
+                f"{order['image'].iloc[-1]}) but the trials' --pressures-kpa give "
+                f"{sum(len(v) for _, v in own)} pressures ({counts}); taken one after another "
+                "in one folder, the trials' photos must add up to its photos: a photo missing, "
+                "deleted or extra (move it out), or a spec that is not the ramp's"
+            )
         key = next(
             (k for k in (f"{actuator}/{trial}", str(trial), None) if k in pressures_kpa), "none"
         )
@@ -448,10 +487,86 @@ def _with_pressures(
                 + ("" if key is None else f"{key}=... ")
                 + f"gives {len(pressures)} pressures; give one pressure per photo of a ramp (a "
                 "missing or extra photo: add or move it; a trial of its own length: "
-                f"--pressures-kpa {trial}=SPEC; or write the manifest by hand)"
+                f"--pressures-kpa {trial}=SPEC"
+                + (
+                    "; trials taken one after another in this folder: each trial's spec, in the "
+                    "order they were taken (--pressures-kpa 1=0:180:20 --pressures-kpa "
+                    f"2=0:200:20), whose photos add up to its {len(order)}"
+                    if trials_in_order
+                    else ""
+                )
+                + "; or write the manifest by hand)"
             )
         out.loc[order.index, "pressure_kpa"] = pressures
     return out
+
+
+def ramp_starts(pressures_kpa: Sequence[float]) -> list[int]:
+    """Where each ramp begins in the pressures of ramps taken one after another.
+
+    A new ramp begins where the pressure, having come back down to the lowest of its ramp so far,
+    rises again; a pressure repeated at that bottom (the last photo of one ramp, the first of the
+    next) begins the new ramp. A hold or a repeated photo on the way (two photos at 180, or at
+    140 going down) and a minor loop that turns back up above the ramp's start do not.
+
+    Examples
+    --------
+    >>> ramp_starts([0, 20, 40, 20, 0, 0, 30, 60, 30, 0])
+    [0, 5]
+    >>> ramp_starts([0, 20, 0, 20, 0])  # no photo repeated at the bottom
+    [0, 3]
+    >>> ramp_starts([0, 40, 80, 40, 60, 80, 40, 0, 0, 0])  # a minor loop, zeros at the end
+    [0]
+    """
+    p = [float(v) for v in pressures_kpa]
+    starts, fell = [0], False
+    for i in range(1, len(p)):
+        if p[i] < p[i - 1]:
+            fell = True
+        elif p[i] > p[i - 1] and fell and p[i - 1] <= min(p[starts[-1] : i]):
+            repeated = i - 2 >= starts[-1] and p[i - 2] == p[i - 1]
+            starts.append(i - 1 if repeated else i)
+            fell = False
+    return starts
+
+
+def _split_ramps(df: pd.DataFrame) -> pd.DataFrame:
+    """Each ramp of a group holding several (:func:`ramp_starts`, photo order) as a trial of its
+    own: labels counted on from the group's (``1`` -> ``1``, ``2``, ...; ``x`` -> ``x-1``, ...)."""
+    out = df.copy()
+    for (_, _, trial), g in df.groupby(list(RAMP_KEYS), sort=False):
+        order = g.sort_values("step") if "step" in g.columns else g
+        starts = ramp_starts(order["pressure_kpa"].tolist())
+        if len(starts) == 1:
+            continue
+        for k, (a, b) in enumerate(zip(starts, [*starts[1:], len(order)], strict=True)):
+            label = str(int(trial) + k) if str(trial).isdigit() else f"{trial}-{k + 1}"
+            out.loc[order.index[a:b], "trial"] = label
+    return out
+
+
+def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
+    r"""One line per ramp of a new manifest, in photo order, for the user to check the split.
+
+    Examples
+    --------
+    >>> m = pd.DataFrame({"image": [f"IMG_{i}.JPG" for i in range(1, 7)], "material": "DS20",
+    ...                   "actuator": "A1", "trial": ["1"] * 3 + ["2"] * 3,
+    ...                   "pressure_kpa": [0.0, 20.0, 0.0, 0.0, 40.0, 0.0]})
+    >>> print("\n".join(ramp_lines(m)))
+    A1 trial 1: IMG_1.JPG ... IMG_3.JPG, 3 photos, 0 -> 20 -> 0 kPa
+    A1 trial 2: IMG_4.JPG ... IMG_6.JPG, 3 photos, 0 -> 40 -> 0 kPa
+    """
+    lines = []
+    for (_, actuator, trial), g in manifest.groupby(list(RAMP_KEYS), sort=False):
+        p = g["pressure_kpa"].to_numpy(float)
+        lines.append(
+            f"{actuator} trial {trial}: {g['image'].iloc[0]} ... {g['image'].iloc[-1]}, {len(g)} "
+            f"photos, {p[0]:g} -> {p.max():g} -> {p[-1]:g} kPa"
+        )
+    if len(lines) > limit:
+        lines = [*lines[: limit - 1], f"... and {len(lines) - limit + 1} more ramps"]
+    return lines
 
 
 def _infer_directions(df: pd.DataFrame) -> pd.Series:

@@ -496,6 +496,43 @@ def test_trials_of_their_own_length_take_their_own_pressures(tmp_path):
         photoset_init.pressure_specs(["1=0:40:20", "1=0:60:20"])
 
 
+def test_ramps_taken_one_after_another_in_one_folder_are_split_into_trials(tmp_path):
+    # customer 18: a phone's IMG_5201 ... IMG_5243 in one folder, ramp 1 to 180 kPa (19 photos),
+    # three deleted, ramp 2 to 200 (21). Each trial's spec was refused ('trial 1 has 40 photos'),
+    # and one 40-value list for both wrote 30 up and 10 down in one trial; now either splits them
+    names = [f"IMG_{n}.JPG" for n in [*range(5201, 5220), *range(5223, 5244)]]
+    for name in names:
+        (tmp_path / name).write_bytes(b"")
+    want = {
+        "1": list(photoset_init.ramp_pressures("0:180:20")),
+        "2": list(photoset_init.ramp_pressures("0:200:20")),
+    }
+    base = [sys.executable, "-m", "pipeline", "photoset", "init", str(tmp_path), "--pattern",
+            "IMG_*.JPG", "--material", "DS20", "--overwrite"]
+    for specs in (
+        ["--pressures-kpa", "1=0:180:20", "--pressures-kpa", "2=0:200:20"],
+        ["--pressures-kpa", ",".join(f"{v:g}" for v in want["1"] + want["2"])],
+    ):
+        out = subprocess.run(base + specs, capture_output=True, text=True, check=False)
+        assert out.returncode == 0, out.stderr
+        assert "A1 trial 2: IMG_5223.JPG ... IMG_5243.JPG, 21 photos, 0 -> 200 -> 0 kPa" in (
+            out.stdout
+        )
+        m = ps.read_manifest(tmp_path)
+        assert m.groupby("trial")["pressure_kpa"].apply(list).to_dict() == want
+        assert m.groupby("trial")["direction"].apply(list).to_dict() == {
+            "1": ["up"] * 10 + ["down"] * 9, "2": ["up"] * 11 + ["down"] * 10
+        }
+        assert m.groupby("trial")["step"].max().to_dict() == {"1": 18, "2": 20}
+    # trials' specs that do not add up name the counts, not 'trial 1 has 40 photos'
+    out = subprocess.run(base + ["--pressures-kpa", "1=0:180:20", "--pressures-kpa", "2=0:180:20"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 2 and "give 38 pressures (1: 19, 2: 19)" in out.stderr, out.stderr
+    # the photo repeated at the bottom begins the next ramp; a hold at the top splits nothing
+    assert photoset_init.ramp_starts([0, 50, 0, 0, 50, 0]) == [0, 3]
+    assert photoset_init.ramp_starts([0, 50, 50, 0, 0]) == [0]
+
+
 def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_ignored(photo_folder):
     # the manifest edited in Excel and saved as manifest.xlsx: manifest.csv, unchanged, was read
     # as it was with no word; a 'Manifest.csv' was only 'missing'
