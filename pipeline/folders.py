@@ -115,6 +115,29 @@ def folder_files(folder: str | os.PathLike[str]) -> list[Path]:
     return sorted(out)
 
 
+def folder_sha256(folder: str | os.PathLike[str]) -> tuple[str, int]:
+    """SHA-256 over every file of ``folder`` (each file's content hash, size and path relative to
+    it, as :func:`update_folder_digest` lists them, so the two agree for a folder that names no file
+    outside it), and the number of files.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "a.jpg").write_bytes(b"one")
+    >>> digest, n = folder_sha256(d)
+    >>> n, digest == update_folder_digest(d, d / ".state" / "a.sha256").read_text().split()[0]
+    (1, True)
+    """
+    folder = Path(folder)
+    files = folder_files(folder) if folder.is_dir() else []
+    text = "".join(
+        f"{_sha256(p)}  {p.stat().st_size:>12d}  {p.relative_to(folder).as_posix()}\n"
+        for p in files
+    )
+    return hashlib.sha256(text.encode()).hexdigest(), len(files)
+
+
 def update_folder_digest(
     folder: str | os.PathLike[str],
     digest_file: str | os.PathLike[str],

@@ -831,6 +831,22 @@ def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_p
     assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)
 
 
+def test_the_provenance_page_covers_every_photo_not_only_the_manifest(tmp_path):
+    # customer 19: the page said photos were 'covered by the sha256 of their photo set's
+    # manifest.csv and photoset.yaml', which a photo replaced under the same name leaves alone;
+    # the photo set's folder now has one sha256 over every file in it
+    d = make_dataset(tmp_path, "SS40", overlays=False, trials=1)
+    first = {f.role: f.sha256 for f in load_report_data(ReportInputs(datasets=(d,))).files}
+    role = next(r for r in first if r.startswith("SS40: every file of the photo set"))
+    photo = sorted(d.photoset_dir.glob("*.jpg"))[3]
+    photo.write_bytes(photo.read_bytes()[:-10] + bytes(10))  # edited in place, same name
+    again = {f.role: f.sha256 for f in load_report_data(ReportInputs(datasets=(d,))).files}
+    assert again[role] != first[role]
+    assert {r: h for r, h in again.items() if r != role} == {
+        r: h for r, h in first.items() if r != role
+    }
+
+
 def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in_the_report(
     tmp_path,
 ):

@@ -319,6 +319,23 @@ def _every_stage_config(checkout: Path) -> dict:
     }
 
 
+def test_the_readmes_report_of_your_photos_alone_plans_nothing_synthetic(repo, tmp_path):
+    # customer 19 added a set beside the shipped entries and got a 16-page PDF of which most was
+    # the sample, synthetic materials, synthetic force sets, the paper's grasp example and the
+    # bench; the README's config for a report of your photos alone (tested as written there)
+    # plans the user's set and the report only
+    readme = (repo / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"report of your photos alone.*?```yaml\n(.*?)```", readme, re.DOTALL)
+    assert block is not None
+    (tmp_path / "config.yaml").write_text(block[1])
+    shutil.copytree(repo / "sample_images", tmp_path / "my_photos")
+    out = _snakemake(tmp_path, repo, "-n", "--cores", "2")
+    assert out.returncode == 0, out.stderr[-3000:]
+    planned = _planned_jobs(out.stdout)
+    assert planned["measure"] == 1 and planned["report"] == 1, planned
+    assert not [j for j in planned if "synth" in j or "bench" in j or "force" in j], planned
+
+
 @pytest.mark.parametrize("checkout", ["as shipped", "after the README's add-a-dataset step"])
 def test_lint_and_dry_run_plan_every_stage(checkout, repo, tmp_path):
     src = repo if checkout == "as shipped" else _users_checkout(repo, tmp_path / "user")

@@ -28,6 +28,7 @@ from pipeline.aggregate import (
 from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
+from pipeline.folders import folder_sha256
 from pipeline.force.pages import FILES as FORCE_FILES
 from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, load_photoset, measurement_doubts
 from pipeline.study.pages import TABLES as BENCH_TABLES
@@ -308,9 +309,11 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
 
 
 def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
-    """Every file the report reads, with its sha256 (photos are covered by their manifests; angles
-    tables are hashed without their run-time column, :func:`sha256_measurements`)."""
+    """Every file the report reads, with its sha256 (angles tables without their run-time column,
+    :func:`sha256_measurements`), and each photo set's folder, photos and all, with one sha256
+    over every file in it (:func:`pipeline.folders.folder_sha256`)."""
     files: list[tuple[str, Path]] = []
+    folders: list[InputFile] = []
     for d in inputs.datasets:
         files.append((f"{d.name}: angles", d.angles_csv))
         if d.photoset_dir is not None:
@@ -319,6 +322,12 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
                 for n in (MANIFEST, SETTINGS)
                 if (d.photoset_dir / n).is_file()
             ]
+            if d.photoset_dir.is_dir():
+                digest, n = folder_sha256(d.photoset_dir)
+                folders.append(
+                    InputFile(f"{d.name}: every file of the photo set ({n})", str(d.photoset_dir),
+                              digest)
+                )
     files += [("hysteresis", p) for p in inputs.hysteresis]
     files += [("comparison", p) for p in inputs.rms]
     files += [("model curve", p) for p in inputs.model_curves]
@@ -336,7 +345,7 @@ def input_files(inputs: ReportInputs) -> tuple[InputFile, ...]:
             role, str(p), sha256_measurements(p) if role.endswith(": angles") else sha256_file(p)
         )
         for role, p in files
-    )
+    ) + tuple(folders)
 
 
 def mixed_materials(
@@ -363,6 +372,21 @@ def mixed_materials(
         synthetic = tuple(n for n in names if kind.get(n) == "synthetic")
         if real and synthetic:
             out[str(material)] = (real, synthetic)
+    return out
+
+
+def material_sources(data: ReportData) -> dict[str, str]:
+    """Per material: ``synthetic``, ``real``, ``real + synthetic`` or ``unknown``."""
+    by_dataset = {d.name: d.source for d in data.datasets}
+    out = {}
+    for m in data.materials:
+        names = sorted(
+            data.angles.loc[data.angles["material"].astype(str) == m, "dataset"]
+            .astype(str)
+            .unique()
+        )
+        kinds = sorted({by_dataset[n] for n in names if n in by_dataset})
+        out[m] = " + ".join(kinds) if kinds else "unknown"
     return out
 
 

@@ -157,8 +157,9 @@ def model_provenance_page(data: ReportData) -> Figure | None:
             "data."
         ),
         (
-            "k_P fitted is the one number fitted to these data (least squares on the angles, "
-            "bootstrap over actuators): it is a fit, not an agreement."
+            "k_P fitted is the one number fitted to these data (least squares on the angles at "
+            "rising pressure, the model's loading branch; bootstrap over actuators): it is a fit, "
+            "not an agreement."
         ),
         "Constants of the model fitted to the paper's own numbers: " + ("; ".join(fit) or NA) + ".",
         (

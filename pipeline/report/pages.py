@@ -28,7 +28,13 @@ from pipeline.layout.style import (
     page,
 )
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
-from pipeline.report.data import ReportData, comparisons, mixed_sources_note, rms_row
+from pipeline.report.data import (
+    ReportData,
+    comparisons,
+    material_sources,
+    mixed_sources_note,
+    rms_row,
+)
 from pipeline.report.model_page import comparison_note
 from pipeline.report.strip import Strip, build_strip, strip_image
 
@@ -221,7 +227,7 @@ def metric_table(
             fmt(g("paper_range_kpa"), 0),
         ),
         ("Hysteresis width, max |ψ_up - ψ_down| (deg)", "", "", width, NA),
-        ("k_P fitted to these photos [95 % CI] (-)", "", "", k_ci, fmt(g("k_p_paper"), 1)),
+        ("k_P fitted to the rising leg [95 % CI] (-)", "", "", k_ci, fmt(g("k_p_paper"), 1)),
     )
     return Table(
         columns=(
@@ -359,7 +365,14 @@ def material_page(data: ReportData, material: str) -> Figure:
     )
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)
-    fig.suptitle(f"{material}: bending angle versus pressure", color=color, fontweight="bold")
+    source = material_sources(data)[material]
+    kind = {
+        "synthetic": " (synthetic photos, rendered from the model)",
+        "real + synthetic": " (real and synthetic photos)",
+    }.get(source, "")
+    fig.suptitle(
+        f"{material}: bending angle versus pressure{kind}", color=color, fontweight="bold"
+    )
     top, bottom = fig.subfigures(2, 1, squeeze=False, height_ratios=[1.45, 1.0])[:, 0]
     plot_hysteresis(
         top.subplots(),
@@ -390,8 +403,9 @@ def comparison_notes(data: ReportData) -> list[str]:
             "mean curve, or not reported by the paper."
         ),
         (
-            "k_P is fitted to this run's photos (bootstrap interval over actuators): a fitted "
-            "value, so its closeness to the paper's k_P is not evidence for the model."
+            "k_P is fitted to this run's photos at rising pressure, the model's loading branch "
+            "(bootstrap interval over actuators; n/a with one): a fitted value, so its closeness "
+            "to the paper's k_P is not evidence for the model."
         ),
     ]
     note = comparison_note(data)

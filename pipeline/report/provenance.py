@@ -55,8 +55,9 @@ def provenance_pages(
     flow.text(
         "The same inputs give the same PDF, byte for byte: nothing on any page comes from the "
         "clock or the "
-        "machine.  Photos are covered by the sha256 of their photo set's manifest.csv and "
-        "photoset.yaml.",
+        "machine.  Each photo set's folder (its photos, manifest.csv, photoset.yaml and any other "
+        "file in it) has one sha256 over every file's path, size and sha256: a photo replaced or "
+        "edited changes it.",
         size=8.0,
         color="0.25",
     )

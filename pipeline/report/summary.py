@@ -18,7 +18,13 @@ from matplotlib.figure import Figure
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 from pipeline.report.calibration import calibration_lines
-from pipeline.report.data import ReportData, comparisons, mixed_sources_note, rms_row
+from pipeline.report.data import (
+    ReportData,
+    comparisons,
+    material_sources,
+    mixed_sources_note,
+    rms_row,
+)
 from pipeline.report.reasons import top_reasons
 
 #: least height (pt) worth giving the overview plot on page 1
@@ -27,21 +33,6 @@ MIN_PLOT_PT = 170.0
 MAX_PLOT_PT = 250.0
 #: warnings printed on page 1 (all of them are on the provenance page)
 MAX_WARNINGS = 8
-
-
-def material_sources(data: ReportData) -> dict[str, str]:
-    """Per material: ``synthetic``, ``real``, ``real + synthetic`` or ``unknown``."""
-    by_dataset = {d.name: d.source for d in data.datasets}
-    out = {}
-    for m in data.materials:
-        names = sorted(
-            data.angles.loc[data.angles["material"].astype(str) == m, "dataset"]
-            .astype(str)
-            .unique()
-        )
-        kinds = sorted({by_dataset[n] for n in names if n in by_dataset})
-        out[m] = " + ".join(kinds) if kinds else "unknown"
-    return out
 
 
 def date_line(data: ReportData) -> str:
@@ -101,11 +92,10 @@ def results_table(data: ReportData) -> Table:
          "= 0: where the "
         "mean curve crosses ψ = 0 (linear between levels).  RMS: the model (loading branch) "
         "against the mean "
-        "curve at the measured levels, both directions.  k_P: fitted to this run's photos (both "
-        "directions), "
-        "95 % bootstrap interval over actuators; a fitted value, so its closeness to the paper's "
-        "k_P "
-        "tests nothing."),
+        "curve at the measured levels, both directions (as the paper's RMS).  k_P: fitted to this "
+        "run's photos at rising pressure (the model's loading branch; the falling leg's "
+        "hysteresis would pull it low), 95 % bootstrap interval over actuators (n/a: one "
+        "actuator); a fitted value, so its closeness to the paper's k_P tests nothing."),
     ]
     notes += missing_notes(data)
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
