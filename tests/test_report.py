@@ -607,6 +607,17 @@ def test_dates_come_from_timestamps_or_exif_never_the_clock(tmp_path):
 
 
 @ON_THE_DEFAULT_REPORT
+def test_a_material_page_of_synthetic_photos_says_so_in_its_title(pages):
+    # customer 19 read the DS30, SS40 and SS50 pages as materials the lab had measured
+    titles = {
+        label: next((t.text for t in texts if "bending angle versus pressure" in t.text), "")
+        for label, texts in pages
+        if label.startswith("material ")
+    }
+    assert titles["material DS30"].endswith("(synthetic photos, rendered from the model)")
+    assert titles["material DS20"].endswith("(real and synthetic photos)"), titles
+
+
 def test_missing_values_read_na_on_the_comparison_page(pages):
     comparison = dict(pages)["comparison"]
     # SS50: table cells and the two bars of P at psi = 0
