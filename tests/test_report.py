@@ -842,6 +842,20 @@ def test_a_re_measured_set_that_differs_only_in_timings_gives_the_same_pdf(tmp_p
     assert sha256_measurements(d.angles_csv) == sha256_file(d.angles_csv)
 
 
+def test_page_one_says_when_psi_0_is_crossed_across_a_jump_the_steps_do_not_resolve(tmp_path):
+    # customer 19: P at psi = 0 read 58 kPa, a straight line between 40 kPa (+128 deg) and 60 kPa
+    # (-18 deg) across the actuator's snap-through, and nothing said so
+    coarse = make_dataset(tmp_path, "DS20", name="coarse", step=40.0, actuators=1, trials=1,
+                          photos=False, overlays=False)
+    fine = make_dataset(tmp_path, "SS40", name="fine", actuators=1, trials=1, photos=False,
+                        overlays=False)
+    with report_style():
+        made, _ = report_figures(load_report_data(ReportInputs(datasets=(coarse, fine))))
+    text = " ".join(t.text for t in drawn_texts(made[0]))
+    assert "coarse: ψ = 0 is crossed between 40 and 80 kPa rising" in text, text
+    assert "fine:" not in text
+
+
 def test_the_provenance_page_covers_every_photo_not_only_the_manifest(tmp_path):
     # customer 19: the page said photos were 'covered by the sha256 of their photo set's
     # manifest.csv and photoset.yaml', which a photo replaced under the same name leaves alone;

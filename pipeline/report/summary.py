@@ -9,17 +9,22 @@ synthetic, the warnings, and where each part of the report is.  Hashes are on th
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
+import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from pipeline.aggregate import aggregate_hysteresis
+from pipeline.compare import branch
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import (
     ReportData,
+    aggregate_options,
     comparisons,
     material_sources,
     mixed_sources_note,
@@ -98,6 +103,7 @@ def results_table(data: ReportData) -> Table:
         "actuator); a fitted value, so its closeness to the paper's k_P tests nothing."),
     ]
     notes += missing_notes(data)
+    notes += coarse_crossing_notes(data.angles, aggregate_options(data.inputs.config))
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
         notes.append(
@@ -131,6 +137,65 @@ def results_table(data: ReportData) -> Table:
         row_colors=tuple(row_colors),
         size=8.0,
     )
+
+
+#: mean psi of two adjacent pressure levels differing by more than this (deg) across psi = 0: the
+#: P at psi = 0 interpolated between them is a straight line across a jump the steps do not resolve
+COARSE_CROSSING_DEG = 90.0
+
+
+def coarse_crossing_notes(
+    angles: pd.DataFrame, options: Mapping[str, Any] | None = None
+) -> list[str]:
+    r"""Per dataset, where psi = 0 is crossed between two adjacent levels whose mean psi differ by
+    more than :data:`COARSE_CROSSING_DEG`: the interpolated P at psi = 0 is then a straight line
+    across a jump (an actuator snapping through), uncertain by up to the step.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        angles rows of every dataset, with ``dataset``.
+    options : mapping, optional
+        ``aggregate_hysteresis`` options (the run's ``bin_kpa``, ``include_flagged``).
+
+    Examples
+    --------
+    >>> rows = [("up", 0, 210.0), ("up", 20, 190.0), ("up", 40, 128.0), ("up", 60, -18.0)]
+    >>> angles = pd.DataFrame([{"dataset": "lab", "image": f"{p}.jpg", "material": "DS20",
+    ...     "direction": d, "pressure_kpa": p, "psi_deg": s, "status": "ok", "actuator": "A1",
+    ...     "trial": 1} for d, p, s in rows])
+    >>> (note,) = coarse_crossing_notes(angles)
+    >>> print(note.replace(", where", ",\nwhere").replace(": its", ":\nits"))
+    lab: ψ = 0 is crossed between 40 and 60 kPa rising,
+    where the mean ψ jumps from +128 to -18 deg:
+    its P at ψ = 0 is a straight line across that jump (take smaller pressure steps there)
+    """
+    out = []
+    for name, g in angles.groupby("dataset", sort=True):
+        h = aggregate_hysteresis(g, **(options or {}))
+        parts = []
+        for material in sorted(h["material"].astype(str).unique()):
+            for direction, word in (("up", "rising"), ("down", "falling")):
+                p, psi = branch(h[h["material"].astype(str) == material], direction)
+                keep = np.isfinite(psi)
+                p, psi = p[keep], psi[keep]
+                for i in range(len(psi) - 1):
+                    if psi[i] * psi[i + 1] < 0.0:
+                        if abs(psi[i] - psi[i + 1]) > COARSE_CROSSING_DEG:
+                            parts.append(
+                                f"between {p[i]:g} and {p[i + 1]:g} kPa {word}, where the mean ψ "
+                                f"jumps from {psi[i]:+.0f} to {psi[i + 1]:+.0f} deg"
+                            )
+                        break
+        if parts:
+            out.append(
+                f"{name}: ψ = 0 is crossed "
+                + " and ".join(parts)
+                + (": its P at ψ = 0 is a straight line across that jump" if len(parts) == 1
+                   else ": its P at ψ = 0 values are straight lines across those jumps")
+                + " (take smaller pressure steps there)"
+            )
+    return out
 
 
 def missing_notes(data: ReportData) -> list[str]:
