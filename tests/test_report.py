@@ -355,7 +355,12 @@ def make_default(tmp: Path) -> tuple[ReportInputs, Path, Path]:
     ]
     hyst, rms = pipeline_tables(tmp, datasets)
     config = tmp / "config.yaml"
-    config.write_text("datasets: []\n")
+    config.write_text(  # as the shipped config: synthetic force sets and the paper's grasp log
+        "datasets: []\nforce:\n  datasets:\n"
+        "    - {name: force_DS20, source: synthetic, material: DS20}\n"
+        "    - {name: force_SS40, source: synthetic, material: SS40}\n"
+        f"  grasp_log: {EXAMPLE_LOG}\n"
+    )
     inputs = ReportInputs(
         datasets=tuple(datasets),
         hysteresis=tuple(hyst),
@@ -618,6 +623,21 @@ def test_a_material_page_of_synthetic_photos_says_so_in_its_title(pages):
     assert titles["material DS20"].endswith("(real and synthetic photos)"), titles
 
 
+@ON_THE_DEFAULT_REPORT
+def test_the_force_pages_say_which_materials_were_rendered_and_that_the_grasp_log_is_an_example(
+    default,
+):
+    # customer 19 read the synthetic blocked-force sets and the paper's grasp example as results
+    with report_style():
+        made = {f.get_label(): f for f in report_figures(load_report_data(default[0]))[0]}
+    note = "synthetic (rendered by the virtual rig, not measured): DS20, SS40"
+    assert made["force"].axes[0].get_title().endswith(note)
+    table = " ".join(t.text for t in drawn_texts(made["eccentricity"]))
+    assert note.replace(" ", "") in table.replace(" ", ""), table
+    assert "the paper's example, transcribed from its text" in made["grasp"].get_suptitle()
+
+
+@ON_THE_DEFAULT_REPORT
 def test_missing_values_read_na_on_the_comparison_page(pages):
     comparison = dict(pages)["comparison"]
     # SS50: table cells and the two bars of P at psi = 0

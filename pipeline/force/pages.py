@@ -19,7 +19,7 @@ own pages (:func:`pipeline.layout.style.material_colors`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import cv2
@@ -53,7 +53,13 @@ def _read(force_dir: Path, name: str) -> pd.DataFrame | None:
     )
 
 
-def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[Figure]:
+def figures(
+    force_dir: Path,
+    colors: Mapping[str, Color] | None = None,
+    *,
+    synthetic: Sequence[str] = (),
+    grasp_example: bool = False,
+) -> list[Figure]:
     """Report pages for the files present in ``force_dir`` (see module docstring).
 
     Parameters
@@ -63,6 +69,11 @@ def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[
     colors : mapping, optional
         Colour of each material (the report passes its own); others get
         :func:`~pipeline.layout.style.material_colors`.
+    synthetic : sequence of str
+        Materials whose blocked-force photos were rendered, not taken: the force and
+        eccentricity pages say so.
+    grasp_example : bool
+        The grasp log is the paper's example (the shipped ``grasp_example.csv``): its page says so.
 
     Returns
     -------
@@ -81,18 +92,34 @@ def figures(force_dir: Path, colors: Mapping[str, Color] | None = None) -> list[
     )
     palette = {**material_colors(sorted(set(found) | set(colors or {}))), **dict(colors or {})}
     out: list[Figure] = []
+    note = synthetic_note(synthetic)
     if tables[FORCE_SUMMARY] is not None:
-        out.append(force_figure(tables[FORCE_SUMMARY], palette))
+        out.append(force_figure(tables[FORCE_SUMMARY], palette, note=note))
     summary = tables[ECCENTRICITY_SUMMARY]
     if summary is not None and len(summary):
-        out.append(eccentricity_figure(summary, palette, base=force_dir))
+        out.append(eccentricity_figure(summary, palette, base=force_dir, note=note))
     if tables[GRASP_SUMMARY] is not None:
-        out.append(grasp_figure(tables[GRASP_SUMMARY], palette))
+        out.append(grasp_figure(tables[GRASP_SUMMARY], palette, example=grasp_example))
     return out
 
 
+def synthetic_note(materials: Sequence[str]) -> str:
+    """The line a force page carries when some of its materials' photos were rendered.
+
+    >>> synthetic_note(["SS40", "DS20"])
+    'synthetic (rendered by the virtual rig, not measured): DS20, SS40'
+    >>> synthetic_note([])
+    ''
+    """
+    return (
+        f"synthetic (rendered by the virtual rig, not measured): {', '.join(sorted(materials))}"
+        if materials
+        else ""
+    )
+
+
 @report_style()
-def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color]) -> Figure:
+def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color], note: str = "") -> Figure:
     """Fig. 7A-style page: blocked force (N) against pressure (kPa), mean +- 1 sd per material,
     and below it the mean eccentricity against pressure where measured."""
     fig = page(label="force")
@@ -126,6 +153,7 @@ def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color]) -> Figure:
         "shaded; "
         f"largest sd {fmt(sd_max, 3)} N"
         + (", so the shading hides behind the lines" if hidden else "")
+        + (f"\n{note}" if note else "")
     )
     ax.legend(loc="upper left", frameon=False)
     if has_e:
@@ -155,7 +183,7 @@ def force_figure(summary: pd.DataFrame, colors: Mapping[str, Color]) -> Figure:
     return fig
 
 
-def eccentricity_table(summary: pd.DataFrame) -> Table:
+def eccentricity_table(summary: pd.DataFrame, note: str = "") -> Table:
     """e at the maximum pressure per material, typeset."""
     rows = tuple(
         (
@@ -180,18 +208,18 @@ def eccentricity_table(summary: pd.DataFrame) -> Table:
             Column("force (N)"),
         ),
         rows=rows,
-        title="Eccentricity at the maximum pressure (cf. Fig. 7B)",
+        title="Eccentricity at the maximum pressure (cf. Fig. 7B)" + (f"; {note}" if note else ""),
         size=8.0,
     )
 
 
 @report_style()
 def eccentricity_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = None, *,
-                        base: Path | None = None) -> Figure:
+                        base: Path | None = None, note: str = "") -> Figure:
     """Fig. 7B-style page: table of e at the maximum pressure per material and, when the photo
     is reachable, a representative photo with the fitted ellipse (yellow dashed) drawn on it."""
     palette = {**material_colors(sorted(summary["material"].astype(str))), **dict(colors or {})}
-    table = eccentricity_table(summary)
+    table = eccentricity_table(summary, note)
     width = PAGE_W_PT - 2 * MARGIN_PT
     top = 36.0 + table_height_pt(table, width) + 10.0
     fig = page(label="eccentricity", top_pt=top)
@@ -278,7 +306,9 @@ def grasp_table(summary: pd.DataFrame) -> Table:
 
 
 @report_style()
-def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = None) -> Figure:
+def grasp_figure(
+    summary: pd.DataFrame, colors: Mapping[str, Color] | None = None, *, example: bool = False
+) -> Figure:
     """Fig. 8B-style page: heaviest mass held (g) against pressure (kPa), one line per material.
 
     One panel per (side, object diameter), all on the same axes ranges so panels compare at a
@@ -291,6 +321,8 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
         Output of :func:`pipeline.force.grasp.heaviest_held`.
     colors : mapping, optional
         Colour of each material.
+    example : bool
+        The log is the paper's example: the title says so.
 
     Returns
     -------
@@ -305,7 +337,14 @@ def grasp_figure(summary: pd.DataFrame, colors: Mapping[str, Color] | None = Non
     width = PAGE_W_PT - 2 * MARGIN_PT
     table_h = table_height_pt(table, width) + 10.0
     fig = page(label="grasp", bottom_pt=table_h)
-    fig.suptitle("Grasp log: heaviest mass held against pressure (cf. Fig. 8B)")
+    fig.suptitle(
+        "Grasp log: heaviest mass held against pressure (cf. Fig. 8B)"
+        + (
+            "\nthe paper's example, transcribed from its text (config force.grasp_log: your own)"
+            if example
+            else ""
+        )
+    )
     if not groups:
         ax = fig.subplots()
         ax.text(0.5, 0.5, "grasp log has no rows", ha="center", va="center", transform=ax.transAxes)

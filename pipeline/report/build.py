@@ -26,7 +26,13 @@ from pipeline import __version__
 from pipeline.fileio import atomic_write_bytes
 from pipeline.force import pages as force_pages
 from pipeline.layout.style import FOOTER_PT, material_colors, report_style
-from pipeline.report.data import ReportData, ReportInputs, load_report_data, photoset_warnings
+from pipeline.report.data import (
+    ReportData,
+    ReportInputs,
+    force_inputs,
+    load_report_data,
+    photoset_warnings,
+)
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
 from pipeline.report.provenance import provenance_pages
@@ -143,9 +149,19 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     infos: list[str] = []
     extra: list[Figure] = []
     colors = material_colors(data.materials)
+    synthetic_force, grasp_example = force_inputs(data.inputs.config)
     sources = [
         ("--bench-dir", data.inputs.bench_dir, study_pages.figures),
-        ("--force-dir", data.inputs.force_dir, lambda d: force_pages.figures(d, colors=colors)),
+        (
+            "--force-dir",
+            data.inputs.force_dir,
+            lambda d: force_pages.figures(
+                d,
+                colors=colors,
+                synthetic=synthetic_force,
+                grasp_example=grasp_example,
+            ),
+        ),
     ]
     # a page per video dataset
     sources += [("--video-dirs", d, video_pages.figures) for d in data.inputs.video_dirs]

@@ -29,6 +29,7 @@ from pipeline.compare import check_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 from pipeline.folders import folder_sha256
+from pipeline.force.grasp import EXAMPLE_LOG as GRASP_EXAMPLE
 from pipeline.force.pages import FILES as FORCE_FILES
 from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, load_photoset, measurement_doubts
 from pipeline.study.pages import TABLES as BENCH_TABLES
@@ -402,6 +403,33 @@ def mixed_sources_note(data: ReportData, material: str) -> str:
         f"only; the synthetic ones ({', '.join(synthetic)}) are left out of them.  The tables "
         "compare each with the model on its own."
     )
+
+
+def force_inputs(config_path: Path | None) -> tuple[tuple[str, ...], bool]:
+    """From the run's (resolved) config: the materials of its synthetic blocked-force sets, and
+    whether its grasp log is the paper's example (the shipped file's bytes), so that the force
+    pages can say what was not measured; nothing without a readable config."""
+    import yaml
+
+    try:
+        cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) if config_path else {}
+    except (OSError, yaml.YAMLError):
+        return (), False
+    force = (cfg.get("force") or {}) if isinstance(cfg, dict) else {}
+    synthetic = sorted(
+        {
+            str(d["material"])
+            for d in force.get("datasets") or []
+            if isinstance(d, dict) and d.get("source") == "synthetic" and d.get("material")
+        }
+    )
+    log = force.get("grasp_log")
+    example = (
+        isinstance(log, str)
+        and Path(log).is_file()
+        and Path(log).read_bytes() == GRASP_EXAMPLE.read_bytes()
+    )
+    return tuple(synthetic), example
 
 
 def aggregate_options(config_path: Path | None) -> dict[str, Any]:
