@@ -139,6 +139,7 @@ RMS_COLUMNS: tuple[str, ...] = (
     "p_zero_down_kpa",
     "p_minus_psi0_up_kpa",
     "p_minus_psi0_down_kpa",
+    "model_p_zero_kpa",
     "psi0_deg",
     "range_deg",
     "psi_max_deg",
@@ -243,6 +244,27 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
             t = d[i] / (d[i] - d[i + 1])
             return float(p[i] + t * (p[i + 1] - p[i]))
     return math.nan
+
+
+#: pressures (kPa) the model's own psi = 0 is looked for over: past the paper's 674 kPa for SS50
+MODEL_CROSSING_GRID_KPA = np.arange(0.0, 1000.5, 0.5)
+
+
+def model_crossing_kpa(
+    model_psi: Callable[[str, np.ndarray], np.ndarray], material: str, level_deg: float
+) -> float:
+    """Pressure (kPa) at which the model's loading branch reaches ``level_deg``: its prediction
+    of P at psi = 0, nothing fitted (NaN when it does not within
+    :data:`MODEL_CROSSING_GRID_KPA`).
+
+    Examples
+    --------
+    >>> round(model_crossing_kpa(lambda m, p: 210.0 - 3.0 * np.asarray(p), "x", 0.0), 1)
+    70.0
+    """
+    grid = MODEL_CROSSING_GRID_KPA
+    psi = np.asarray(model_psi(material, grid), dtype=float).reshape(grid.shape)
+    return crossing_kpa(grid, psi, level_deg)
 
 
 def branch(hyst_material: pd.DataFrame, direction: str) -> tuple[np.ndarray, np.ndarray]:
@@ -414,6 +436,7 @@ def compare_material(
         out["rms_deg"], _, out["n_model_nan"] = rms_deg(meas, model)
         out["rms_up_deg"] = rms_deg(meas[up], model[up])[0]
         out["rms_down_deg"] = rms_deg(meas[~up], model[~up])[0]
+        out["model_p_zero_kpa"] = model_crossing_kpa(model_psi, material, 0.0)
     for direction in DIRECTIONS:
         p_b, s_b = branch(h, direction)
         out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0)

@@ -85,6 +85,7 @@ def results_table(data: ReportData) -> Table:
                 fmt(g("paper_range_deg"), 0),
                 fmt(g("p_zero_up_kpa"), 0),
                 fmt(g("p_zero_down_kpa"), 0),
+                fmt(g("model_p_zero_kpa"), 0),
                 fmt(g("paper_p_zero_kpa"), 0),
                 fmt(g("rms_deg"), 1),
                 fmt(g("paper_rms_deg"), 1),
@@ -95,8 +96,9 @@ def results_table(data: ReportData) -> Table:
     notes = [
         ("Range: the range of motion, largest minus smallest mean ψ over both directions.  P at ψ "
          "= 0: where the "
-        "mean curve crosses ψ = 0 (linear between levels).  RMS: the model (loading branch) "
-        "against the mean "
+        "mean curve crosses ψ = 0 (linear between levels); model: where the model's loading "
+        "branch does (predicted: the paper's k_P, nothing fitted).  RMS: the model (loading "
+        "branch) against the mean "
         "curve at the measured levels, both directions (as the paper's RMS).  k_P: fitted to this "
         "run's photos at rising pressure (the model's loading branch; the falling leg's "
         "hysteresis would pull it low), 95 % bootstrap interval over actuators (n/a: one "
@@ -118,6 +120,7 @@ def results_table(data: ReportData) -> Table:
             Column("paper"),
             Column("rising"),
             Column("falling"),
+            Column("model"),
             Column("paper"),
             Column("run"),
             Column("paper"),
@@ -127,7 +130,7 @@ def results_table(data: ReportData) -> Table:
         groups=(
             ("", 2),
             ("Range (deg)", 2),
-            ("P at ψ = 0 (kPa)", 3),
+            ("P at ψ = 0 (kPa)", 4),
             ("RMS (deg)", 2),
             ("k_P (-)", 2),
         ),
