@@ -256,6 +256,8 @@ def test_cli_with_the_real_model(tmp_path, capsys):
     assert out["k_p_ci_low"] <= out["k_p_fit"] <= out["k_p_ci_high"]
     assert abs(out["k_p_fit"] - 2.2) < 0.1
     assert out["p_zero_up_kpa"] == pytest.approx(crossing_kpa(p, truth, 0.0), abs=3.0)
+    # the model's own crossing, on its fine grid: where the noiseless truth crosses
+    assert out["model_p_zero_kpa"] == pytest.approx(crossing_kpa(p, truth, 0.0), abs=1.0)
     assert main(["compare", str(tmp_path / "missing.csv"), "--out", str(rms)]) == 2
     # another reading of the model reaches the comparison: the printed Jacobian (jacobian=none)
     # is about 15 % softer, so data drawn from the default model need a larger k_P
