@@ -925,3 +925,17 @@ def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in
     (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end_mm: 6\n")
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert not [w for w in res.warnings if "sealed_end" in w], res.warnings
+
+
+def test_a_title_of_several_lines_is_among_the_drawn_texts():
+    # matplotlib draws each line of a text of several lines without naming the Text: the
+    # overlap and font-size checks never saw such titles (the force page's three-line one)
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(4, 3))
+    ax = fig.subplots()
+    ax.set_title("first line\nsecond line")
+    ax.set_xlabel("one line")
+    texts = {t.text for t in drawn_texts(fig)}
+    plt.close(fig)
+    assert {"first line\nsecond line", "one line"} <= texts

@@ -9,7 +9,10 @@ in the footer band.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import matplotlib as mpl
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
@@ -47,11 +50,37 @@ class _RecordingRenderer(RendererAgg):
     def __init__(self, width: float, height: float, dpi: float) -> None:
         super().__init__(width, height, dpi)
         self.drawn: dict[int, Text] = {}
+        self.current: Text | None = None  # the Text being drawn (see _recording)
 
     def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):  # type: ignore[no-untyped-def]
         if mtext is not None and s.strip():
             self.drawn[id(mtext)] = mtext
+        elif self.current is not None and s.strip():
+            # a text of several lines draws each without naming itself (mtext is None)
+            self.drawn[id(self.current)] = self.current
         return super().draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+
+
+@contextlib.contextmanager
+def _naming_texts(renderer: _RecordingRenderer) -> Iterator[None]:
+    """While drawing, ``renderer.current`` is the Text being drawn: matplotlib draws each line of
+    a text of several lines without naming the Text, which would leave such titles unchecked."""
+    original = Text.draw
+
+    def draw(self: Text, r: Any, *args: Any, **kwargs: Any) -> Any:
+        if r is not renderer:
+            return original(self, r, *args, **kwargs)
+        outer, renderer.current = renderer.current, self
+        try:
+            return original(self, r, *args, **kwargs)
+        finally:
+            renderer.current = outer
+
+    Text.draw = draw  # type: ignore[method-assign,assignment]
+    try:
+        yield
+    finally:
+        Text.draw = original  # type: ignore[method-assign]
 
 
 def drawn_texts(fig: Figure, dpi: float = 100.0) -> list[DrawnText]:
@@ -78,7 +107,8 @@ def drawn_texts(fig: Figure, dpi: float = 100.0) -> list[DrawnText]:
         with mpl.rc_context({"text.hinting": "no_hinting"}):
             w, h = fig.get_size_inches() * dpi
             renderer = _RecordingRenderer(int(w), int(h), dpi)
-            fig.draw(renderer)
+            with _naming_texts(renderer):
+                fig.draw(renderer)
             scale = 72.0 / dpi
             out = []
             for t in renderer.drawn.values():
