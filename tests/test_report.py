@@ -622,6 +622,14 @@ def test_a_material_page_of_synthetic_photos_says_so_in_its_title(pages):
     }
     assert titles["material DS30"].endswith("(synthetic photos, rendered from the model)")
     assert titles["material DS20"].endswith("(real and synthetic photos)"), titles
+    # and what its mean and sd are over: customer 19's one actuator read 'over actuators'
+    spread = {
+        label: next(t.text for t in texts if t.text.startswith("Mean ± 1 sd over"))
+        for label, texts in pages
+        if label.startswith("material ")
+    }
+    assert spread["material DS30"].startswith("Mean ± 1 sd over 3 actuators, 6 ramps (as Fig. 6)")
+    assert spread["material DS20"].startswith("Mean ± 1 sd over the 2 ramps of one actuator")
 
 
 @ON_THE_DEFAULT_REPORT

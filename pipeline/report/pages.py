@@ -251,6 +251,16 @@ def metric_table(
     )
 
 
+def spread_of(data: ReportData, material: str) -> str:
+    """What a material's mean and sd are over, in words: ``"3 actuators, 18 ramps"``, or ``"the
+    2 ramps of one actuator"`` (the plotted photos: a lab's own beside synthetic ones)."""
+    per = data.per_actuator[data.per_actuator["material"] == material]
+    n_act = int(per["actuator"].nunique())
+    n_ramps = int(per.groupby("actuator")["n_trials"].max().sum()) if len(per) else 0
+    ramps = f"{n_ramps} ramp{'s' if n_ramps != 1 else ''}"
+    return f"the {ramps} of one actuator" if n_act == 1 else f"{n_act} actuators, {ramps}"
+
+
 def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -> None:
     """Mean psi of each actuator (over its trials): solid increasing, dashed decreasing pressure."""
     per = data.per_actuator[data.per_actuator["material"] == material]
@@ -379,7 +389,7 @@ def material_page(data: ReportData, material: str) -> Figure:
         data,
         material,
         color,
-        title="Mean ± 1 sd over actuators and trials (as Fig. 6); dashed: analytical model",
+        title=f"Mean ± 1 sd over {spread_of(data, material)} (as Fig. 6); dashed: analytical model",
     )
     plot_per_actuator(bottom.subplots(), data, material, color)
     flow = Flow(fig, top_pt=72.0 * fig.get_figheight() - (22.0 + table_h + STRIP_BAND_PT + 6.0))
