@@ -23,6 +23,7 @@ from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
 from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
 from pipeline.video.reader import sequence_files
+from pipeline.video.timeline import read_pressure_log
 
 #: file endings taken for videos (any OpenCV reads): a pattern matching only these needs
 #: ``--pressure-log``
@@ -306,15 +307,16 @@ def init_video_photoset(
     Raises
     ------
     UserInputError
-        If no video matches, a video's log is missing, a field has no default, or a manifest
-        exists.
+        If no video matches, a video's log is missing or cannot be read
+        (:func:`pipeline.video.timeline.read_pressure_log`), a field has no default, or a
+        manifest exists.
 
     Examples
     --------
     >>> import tempfile
     >>> root = Path(tempfile.mkdtemp())
-    >>> for name in ("GX010071.MP4", "GX010071_log.csv"):
-    ...     _ = (root / name).write_bytes(b"")
+    >>> _ = (root / "GX010071.MP4").write_bytes(b"")
+    >>> _ = (root / "GX010071_log.csv").write_text("t (s),Setpoint (kPa)\\n0,0\\n9,80\\n")
     >>> init_video_photoset(root, "GX*.MP4", "{video}_log.csv", clock_offset_s=0.5,
     ...                     defaults={"material": "DS20"}).to_dict("records")
     [{'video': 'GX010071.MP4', 'pressure_log': 'GX010071_log.csv', 'material': 'DS20', \
@@ -339,6 +341,9 @@ def init_video_photoset(
                 f"{name}: its pressure log {log} is not in {folder}; put the log (a CSV with "
                 "time_s and pressure_kpa) beside the video and give its name with --pressure-log"
             )
+        _, problems = read_pressure_log(folder / log)
+        if problems:  # said now, not first by check
+            raise UserInputError(f"{name}: " + "; ".join(problems))
         row: dict[str, Any] = {"video": name, "pressure_log": log}
         row |= _ramp_keys(name, m.groupdict(), defaults)
         if clock_offset_s is not None:

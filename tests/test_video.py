@@ -323,6 +323,32 @@ def test_pressure_log_problems_name_the_line(tmp_path):
     assert "below absolute vacuum" in read_pressure_log(path)[1][0]
 
 
+def test_a_loggers_own_header_with_units_is_read_and_init_says_when_a_log_cannot_be(tmp_path):
+    # customer 20: a regulator's log headed 't (s), setpoint (kPa), sensor (kPa)' was accepted by
+    # init and refused by check ('lacks column(s)', fix: 'fix the file named'); the user renamed
+    # a copy by hand. Its own names with units are read; a header without units still is not
+    # (1.2 may be kPa or bar), and init says so at once, naming the video
+    from pipeline.errors import UserInputError
+    from pipeline.photoset_init import init_video_photoset
+
+    path = tmp_path / "log.csv"
+    path.write_text("t (s),setpoint (kPa),sensor (kPa)\n0,0,0.1\n0.05,12.5,11.9\n")
+    log, problems = read_pressure_log(path)
+    assert problems == [] and log is not None
+    assert log.pressure_kpa.tolist() == [0.0, 12.5] and log.measured_kpa.tolist() == [0.1, 11.9]
+    path.write_text("Time [ms],P set (bar)\n0,0\n500,0.8\n")
+    log, problems = read_pressure_log(path)
+    assert problems == [] and log.time_s.tolist() == [0.0, 0.5]
+    assert log.pressure_kpa.tolist() == [0.0, 80.0]
+    path.write_text("time,setpoint\n0,0\n1,10\n")
+    (problem,) = read_pressure_log(path)[1]
+    assert "'Setpoint (kPa)'" in problem
+    (tmp_path / "ramp.avi").write_bytes(b"")
+    with pytest.raises(UserInputError, match=r"ramp.avi: pressure log log.csv lacks column"):
+        init_video_photoset(tmp_path, "*.avi", "log.csv", defaults={"material": "DS20"})
+    assert not (tmp_path / "manifest.csv").exists()
+
+
 def test_a_pressure_log_saved_by_a_european_spreadsheet_is_read(tmp_path):
     # a logger's export opened and saved in Excel where the decimal mark is a comma: ';' between
     # the fields, '0,05' for 0.05 s; it was 'lacks column(s) [time_s, pressure_kpa]'

@@ -220,7 +220,12 @@ def clip_problems(
             fix = (
                 "copy the file into the photo-set folder or fix its name in manifest.csv"
                 if "does not exist" in message
-                else "fix the file named (see message)"
+                else "give the log a header line naming time_s and pressure_kpa (or the "
+                "logger's own names with their unit in brackets: 't (s)', 'Setpoint (kPa)')"
+                if "lacks column" in message
+                else "save the log as a CSV file (comma, semicolon or tab between the fields)"
+                if "cannot be parsed" in message
+                else "correct the file and line the message names"
             )
             out.append(Problem(mpath, clip.line, message, fix))
         span = span_problem(clip)

@@ -44,10 +44,19 @@ import numpy as np
 import pandas as pd
 
 from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA
-from pipeline.fileio import read_user_csv
+from pipeline.fileio import plain_name, read_user_csv
 from pipeline.measure.settings import is_missing, user_floats
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
+#: the words a regulator's or logger's own header uses for the log's columns (any case, a unit in
+#: brackets: "t (s)", "Setpoint [bar]", "Sensor (kPa)"), by the column each stands for
+LOG_WORDS: dict[str, tuple[str, ...]] = {
+    "time": ("time", "t", "elapsed", "timestamp"),
+    "pressure": ("pressure", "setpoint", "set_pressure", "set", "command", "target", "p_set"),
+    "measured": ("measured", "sensor", "readback", "read_back", "actual", "feedback", "p_meas"),
+}
+#: seconds per unit of a time column
+SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "ms": 1e-3, "min": 60.0}
 FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
 #: a reversal of the pressure trend counts once the pressure left its extreme by this much (kPa)
 TREND_DEADBAND_KPA = 1.0
@@ -71,6 +80,63 @@ class PressureLog:
     def span_s(self) -> tuple[float, float]:
         """First and last logged time (s)."""
         return float(self.time_s[0]), float(self.time_s[-1])
+
+
+def log_header_names(columns: list[str]) -> dict[str, str]:
+    """The log's own names (``time_s``, ``pressure_kpa``, ``measured_kpa``, or a pressure in
+    another unit, ``pressure_bar``) for a header a regulator or logger wrote its own way; each only
+    where one column alone can be meant and the log does not name it already.
+
+    Examples
+    --------
+    >>> log_header_names(["t (s)", "setpoint (kPa)", "sensor (kPa)"])
+    {'t (s)': 'time_s', 'setpoint (kPa)': 'pressure_kpa', 'sensor (kPa)': 'measured_kpa'}
+    >>> log_header_names(["Time [ms]", "P set (bar)", "Sensor (kPa)"])
+    {'Time [ms]': 'time_ms', 'P set (bar)': 'pressure_bar', 'Sensor (kPa)': 'measured_kpa'}
+    >>> log_header_names(["time", "setpoint"])  # no unit: none is guessed
+    {}
+    >>> log_header_names(["time_s", "pressure_kpa"])
+    {}
+    """
+    plain = {c: plain_name(str(c)) for c in columns}
+    units = {
+        "time": tuple(SECONDS_PER_UNIT),
+        "pressure": ("kpa", *KPA_PER_UNIT),
+        "measured": ("kpa", *KPA_PER_UNIT),
+    }
+    canonical = {f"{role}_{unit}" for role, us in units.items() for unit in us}
+    out = {  # "Time [ms]", "Pressure (bar)": the log's own names written another way
+        c: p for c, p in plain.items() if p in canonical and p != c and p not in columns
+    }
+    taken = set(plain.values())
+    for role in ("time", "pressure", "measured"):
+        if any(p.startswith(f"{role}_") and p.split("_", 1)[1] in units[role] for p in taken):
+            continue  # named already
+        matches = []
+        for column, p in plain.items():
+            if column in out:
+                continue
+            for word in LOG_WORDS[role]:  # the unit must be written: 1.2 is kPa or bar
+                unit = p[len(word) + 1:] if p.startswith(f"{word}_") else None
+                if unit in units[role]:
+                    matches.append((column, unit))
+                    break
+        if len(matches) == 1:
+            column, unit = matches[0]
+            out[column] = f"{role}_{unit}"
+            taken.add(out[column])
+    return out
+
+
+def _in_seconds(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with ``time_s`` from a time in ms or min (``time_ms``, ``time_min``)."""
+    out = df.copy()
+    units = [u for u in SECONDS_PER_UNIT if u != "s" and f"time_{u}" in out.columns]
+    if "time_s" not in out.columns and len(units) == 1:
+        written = out[f"time_{units[0]}"]
+        values = user_floats(written) * SECONDS_PER_UNIT[units[0]]
+        out["time_s"] = [float(v) if np.isfinite(v) else w for v, w in zip(values, written)]
+    return out
 
 
 def _in_kpa(df: pd.DataFrame) -> pd.DataFrame:
@@ -131,7 +197,7 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         df = read_user_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
-    df = _in_kpa(df)
+    df = _in_kpa(_in_seconds(df.rename(columns=log_header_names(list(df.columns)))))
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
         header = list(map(str, df.columns))
@@ -139,7 +205,9 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
             (
                 f"pressure log {name} lacks column(s) {missing} (its header is {header}); it "
                 "needs time_s (s) and pressure_kpa (kPa; or pressure_bar, pressure_mbar, "
-                "pressure_psi or pressure_mpa), optionally measured_kpa (or measured_bar, ...)"
+                "pressure_psi or pressure_mpa), optionally measured_kpa (or measured_bar, ...); "
+                "a logger's own names are read with their unit in brackets ('t (s)', "
+                "'Setpoint (kPa)', 'Sensor [bar]')"
             )
         ]
     if len(df) < 2:
