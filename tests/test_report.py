@@ -39,7 +39,7 @@ from pipeline.report.data import (
 )
 from pipeline.report.reasons import top_reasons, words
 from pipeline.report.summary import date_line
-from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
+from pipeline.report.textcheck import FOOTER_GID, drawn_texts, outside_page, overlapping_texts
 from pipeline.study import analysis
 
 #: rough p(psi=0) per material, only to make curves of the right shape
@@ -444,6 +444,7 @@ def test_no_labels_overlap_no_small_fonts_nothing_on_the_footer(pages):
     for label, texts in pages:
         assert len(texts) > 10, label
         assert overlapping_texts(texts) == [], label
+        assert outside_page(texts) == [], label
         assert [(t.text, t.size_pt) for t in texts if t.size_pt < MIN_FONT_PT] == [], label
         assert [
             t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5

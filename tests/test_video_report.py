@@ -61,7 +61,7 @@ def test_a_folder_without_tables_gives_no_page_and_a_strip_needs_overlays(measur
 
 def test_video_pages_have_no_overlaps_no_small_fonts_nothing_on_the_footer(measured, tmp_path):
     from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT
-    from pipeline.report.textcheck import FOOTER_GID, drawn_texts, overlapping_texts
+    from pipeline.report.textcheck import FOOTER_GID, drawn_texts, outside_page, overlapping_texts
 
     write_continuous(measured, tmp_path / "continuous" / "steps")
     with report_style():
@@ -71,6 +71,7 @@ def test_video_pages_have_no_overlaps_no_small_fonts_nothing_on_the_footer(measu
             texts = drawn_texts(fig)
             assert len(texts) > 5
             assert overlapping_texts(texts) == []
+            assert outside_page(texts) == []  # customer 20: the pressure axis's ticks were cut
             assert [(t.text, t.size_pt) for t in texts if t.size_pt < MIN_FONT_PT] == []
             on_footer = [
                 t.text for t in texts if t.gid != FOOTER_GID and t.box.y0 < FOOTER_PT - 0.5

@@ -75,8 +75,8 @@ def provenance_pages(
     while True:
         table = Table(
             columns=(
-                Column("Input", "left"),
-                Column("File", "left", wrap_pt=150.0),
+                Column("Input", "left", wrap_pt=100.0),
+                Column("File", "left", wrap_pt=110.0),
                 Column("sha256", "left", family=MONO),
             ),
             rows=rows,

@@ -36,12 +36,15 @@ class DrawnText:
     box : Bbox
         Extent in points from the page's bottom-left corner.
     gid : str or None
+    page_pt : (float, float)
+        The page's width and height in points.
     """
 
     text: str
     size_pt: float
     box: Bbox
     gid: str | None
+    page_pt: tuple[float, float] = (0.0, 0.0)
 
 
 class _RecordingRenderer(RendererAgg):
@@ -119,12 +122,25 @@ def drawn_texts(fig: Figure, dpi: float = 100.0) -> list[DrawnText]:
                         float(t.get_fontsize()),
                         Bbox.from_extents(b.x0 * scale, b.y0 * scale, b.x1 * scale, b.y1 * scale),
                         t.get_gid(),
+                        (72.0 * fig.get_figwidth(), 72.0 * fig.get_figheight()),
                     )
                 )
             return out
     finally:
         fig.dpi = saved_dpi
         fig.set_canvas(saved_canvas)
+
+
+def outside_page(texts: list[DrawnText], tolerance_pt: float = 0.5) -> list[str]:
+    """The texts that run past an edge of their page (cut off in the PDF)."""
+    return [
+        t.text
+        for t in texts
+        if t.box.x0 < -tolerance_pt
+        or t.box.y0 < -tolerance_pt
+        or t.box.x1 > t.page_pt[0] + tolerance_pt
+        or t.box.y1 > t.page_pt[1] + tolerance_pt
+    ]
 
 
 def overlapping_texts(texts: list[DrawnText], tolerance_pt: float = 0.5) -> list[tuple[str, str]]:

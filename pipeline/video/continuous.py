@@ -110,12 +110,28 @@ def _legs(ramp: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rate(time_s: np.ndarray, pressure: np.ndarray) -> float:
-    """Mean rate of a leg (kPa/s): its pressure range over its duration (NaN when too short)."""
+    """Mean rate of a leg (kPa/s): its pressure range over the time the pressure moves (a rest at
+    either end, the video before the ramp starts, is not counted); NaN when too short.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 22.0, 0.5)   # 1.5 s at rest, then 8 kPa/s to 160 kPa
+    >>> round(_rate(t, np.clip((t - 1.5) * 8.0, 0.0, 160.0)), 2)
+    8.0
+    """
     ok = np.isfinite(time_s) & np.isfinite(pressure)
     t, p = time_s[ok], pressure[ok]
     if len(t) < 3 or t[-1] <= t[0]:
         return math.nan
-    return float((p.max() - p.min()) / (t[-1] - t[0]))
+    span = float(p.max() - p.min())
+    tol = 1e-6 * span  # a setpoint rests exactly; a noisy read-back is timed end to end
+    moving = np.flatnonzero(np.abs(p - p[0]) > tol)
+    settled = np.flatnonzero(np.abs(p - p[-1]) > tol)
+    if span == 0.0 or not len(moving):
+        return 0.0 if span == 0.0 else math.nan
+    i0 = max(int(moving[0]) - 1, 0)  # the last sample of the rest before the pressure moved
+    i1 = min(int(settled[-1]) + 1, len(t) - 1)  # the first of the rest after it
+    return float(span / (t[i1] - t[i0])) if t[i1] > t[i0] else math.nan
 
 
 def loops(

@@ -89,6 +89,47 @@ def _fmt(value: object, digits: int = 2) -> str:
     return "n/a" if not np.isfinite(v) else f"{v:.{digits}f}"
 
 
+def cycle_summary(cycles: pd.DataFrame, *, stepped: bool) -> str:
+    r"""The line under the loops: each cycle's rates and loop width, and, for a continuous ramp
+    (no steps), that its loop holds the actuator's lag as well as its hysteresis.
+
+    Examples
+    --------
+    >>> c = pd.DataFrame([{"material": "DS30", "actuator": "A1", "trial": 1, "cycle": 1,
+    ...     "rate_up_kpa_s": 8.0, "rate_down_kpa_s": 8.0, "width_mean_deg": 45.7,
+    ...     "width_max_deg": 105.8, "width_max_at_kpa": 105.0, "area_deg_kpa": 7524.0}])
+    >>> import textwrap
+    >>> print(textwrap.fill(cycle_summary(c, stepped=False), 90))
+    DS30 A1 t1 cycle 1: rising 8.0 kPa/s, falling 8.0 kPa/s, loop width mean 45.7 deg (largest
+    105.8 deg at 105 kPa), area 7524 deg kPa.  On a continuous ramp the loop holds the
+    actuator's lag behind the pressure as well as its hysteresis; a stepped profile with holds
+    (the step table) tells the two apart.
+    >>> cycle_summary(c, stepped=True)[:54]
+    'DS30 A1 t1 cycle 1: in steps, loop width mean 45.7 deg'
+    """
+    text = "; ".join(
+        f"{_label(c)} cycle {int(c['cycle'])}: "
+        + (
+            "in steps"  # a mean rate of instant steps and holds would mean little
+            if stepped
+            else f"rising {_fmt(c['rate_up_kpa_s'], 1)} kPa/s, falling "
+            f"{_fmt(c['rate_down_kpa_s'], 1)} kPa/s"
+        )
+        + ", loop width mean "
+        f"{_fmt(c['width_mean_deg'], 1)} deg "
+        f"(largest {_fmt(c['width_max_deg'], 1)} deg at {_fmt(c['width_max_at_kpa'], 0)} kPa), "
+        f"area {_fmt(c['area_deg_kpa'], 0)} deg kPa"
+        for _, c in cycles.iterrows()
+    )
+    if not stepped:  # customer 20 read a ramp's loop as the material's hysteresis alone
+        text += (
+            ".  On a continuous ramp the loop holds the actuator's lag behind the pressure as "
+            "well as its hysteresis; a stepped profile with holds (the step table) tells the two "
+            "apart."
+        )
+    return text
+
+
 def figures(folder: Path) -> list[Figure]:
     """One page for the video dataset whose continuous tables are in ``folder`` (none if empty)."""
     folder = Path(folder)
@@ -115,7 +156,8 @@ def figures(folder: Path) -> list[Figure]:
         top=0.93,
         bottom=footer_fraction(A4_PORTRAIT_IN) + 0.03,
     )
-    ax_t = fig.add_subplot(grid[0, :])
+    # the time plot leaves room on its right for the pressure axis's ticks and label
+    ax_t = fig.add_subplot(grid[0, :].subgridspec(1, 2, width_ratios=[0.91, 0.09], wspace=0)[0, 0])
     ax_p = ax_t.twinx()
     ramps = timeline.groupby(list(RAMP_KEYS), sort=False)
     psi_floor = float(np.nanmin(timeline["psi_deg"])) if timeline["psi_deg"].notna().any() else 0.0
@@ -157,7 +199,7 @@ def figures(folder: Path) -> list[Figure]:
     lines = ax_t.get_legend_handles_labels()
     more = ax_p.get_legend_handles_labels()
     ax_t.legend(
-        lines[0] + more[0], lines[1] + more[1], loc="upper right", fontsize=MIN_FONT_PT, ncol=2
+        lines[0] + more[0], lines[1] + more[1], loc="best", fontsize=MIN_FONT_PT, ncol=2
     )
     ax_t.set_title("Every frame measured (medians of short time bins)", fontsize=9)
 
@@ -214,17 +256,10 @@ def figures(folder: Path) -> list[Figure]:
     ax_c = fig.add_subplot(grid[2, :])
     ax_c.axis("off")
     if len(cycles):
-        text = "; ".join(
-            f"{_label(c)} cycle {int(c['cycle'])}: rising {_fmt(c['rate_up_kpa_s'], 1)} kPa/s, "
-            "falling "
-            f"{_fmt(c['rate_down_kpa_s'], 1)} kPa/s, loop width mean "
-            f"{_fmt(c['width_mean_deg'], 1)} deg "
-            f"(largest {_fmt(c['width_max_deg'], 1)} deg at {_fmt(c['width_max_at_kpa'], 0)} kPa), "
-            "area "
-            f"{_fmt(c['area_deg_kpa'], 0)} deg kPa"
-            for _, c in cycles.iterrows()
+        ax_c.text(
+            0.0, 1.0, cycle_summary(cycles, stepped=bool(len(steps))), va="top", fontsize=7,
+            wrap=True, transform=ax_c.transAxes,
         )
-        ax_c.text(0.0, 1.0, text, va="top", fontsize=7, wrap=True, transform=ax_c.transAxes)
 
     ax_tab = fig.add_subplot(grid[3, :])
     ax_tab.axis("off")
