@@ -948,3 +948,24 @@ def test_a_title_of_several_lines_is_among_the_drawn_texts():
     texts = {t.text for t in drawn_texts(fig)}
     plt.close(fig)
     assert {"first line\nsecond line", "one line"} <= texts
+
+
+def test_a_strip_of_video_frames_says_frames_of_the_video_and_rounds_their_pressures():
+    # customer 20: 'files ramp.avi to ramp.avi', 'Photos across one ramp' and '21.3333 kPa'
+    from pipeline.layout.style import text_page
+    from pipeline.layout.typeset import Flow
+    from pipeline.report.pages import draw_strip
+    from pipeline.report.strip import Strip, StripPhoto
+
+    thumb = np.full((60, 80, 3), 200, np.uint8)
+    photos = tuple(
+        StripPhoto(thumb, p, 100.0 - p, "ok", "overlay") for p in (0.0, 21.333333, 42.666667)
+    )
+    strip = Strip("DS30", "ramp", "A1", "1", "up", photos, images=("ramp.avi",) * 3)
+    with report_style():
+        fig = text_page(label="strip")
+        draw_strip(fig, Flow(fig, top_pt=36.0), strip)
+        texts = [t.text for t in drawn_texts(fig)]
+    caption = " ".join(t for t in texts if "across one ramp" in t)
+    assert caption.startswith("Frames across one ramp") and "frames of ramp.avi;" in caption
+    assert {"0 kPa", "21.3 kPa", "42.7 kPa"} <= set(texts), texts

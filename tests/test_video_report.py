@@ -36,6 +36,11 @@ def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
     assert with_video.pages == len(plain) + 2
     pages = _text(tmp_path / "video.pdf")
     assert "0 photos, 135 video frames" in pages[0]  # not "135 photos"
+    # the contents name the video pages (customer 20 found them missing), at the first one
+    first = 1 + next(i for i, p in enumerate(pages) if "Video dataset" in p)
+    assert f"p. {first} One page per video: every frame, loops, steps" in " ".join(
+        pages[0].split()
+    )
     video_pages = [p for p in pages if "Video dataset" in p]
     assert len(video_pages) == 2 and "Video dataset steps_a" in video_pages[0]
     for text in video_pages:

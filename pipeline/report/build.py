@@ -55,6 +55,7 @@ CONTENTS: dict[str, str] = {
     "force": "Blocked force and eccentricity (Fig. 7A)",
     "eccentricity": "Eccentricity at the highest pressure (Fig. 7B)",
     "grasp": "Grasping: heaviest mass held (Fig. 8B)",
+    "video": "One page per video: every frame, loops, steps",
     "provenance": "Provenance: software, config, sha256 of inputs",
 }
 

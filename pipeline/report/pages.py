@@ -303,11 +303,18 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
         )
         return
     direction = "increasing" if strip.direction == "up" else "decreasing"
-    names = f"{strip.images[0]} to {strip.images[-1]}" if len(strip.images) > 1 else strip.images[0]
+    video = len(set(strip.images)) == 1 and len(strip.photos) > 1  # frames of one video
+    names = (
+        f"frames of {strip.images[0]}"
+        if video
+        else f"files {strip.images[0]} to {strip.images[-1]}"
+        if len(strip.images) > 1
+        else f"file {strip.images[0]}"
+    )
     flow.text(
-        f"Photos across one ramp (as Fig. 5): actuator {strip.actuator_label}, trial "
-        f"{strip.trial}, "
-        f"{direction} pressure; files {names}; {strip.note}.",
+        f"{'Frames' if video else 'Photos'} across one ramp (as Fig. 5): actuator "
+        f"{strip.actuator_label}, trial {strip.trial}, {direction} pressure; {names}; "
+        f"{strip.note}.",
         size=7.5,
     )
     flow.space(2.0)
@@ -325,7 +332,7 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
         fig.text(
             x,
             top,
-            f"{photo.pressure_kpa:g} kPa",
+            f"{round(photo.pressure_kpa, 1):g} kPa",  # a frame's is interpolated: 21.3, not 21.3333
             transform=flow.transform,
             fontsize=7.5,
             ha="center",
