@@ -378,7 +378,8 @@ def assess_body(
     if video_frame and free_end_width_ratio > SMEARED_FREE_END:
         flags.append(
             f"the free end is {100 * free_end_width_ratio:.0f}% as wide as the body: smeared, "
-            "the body moving while the frame was exposed (a shorter shutter keeps it sharp)"
+            "the body moving while the frame was exposed (a shorter shutter keeps it sharp), or "
+            "wider at its tip than along it (a dot or a highlight there, in a slow frame)"
         )
     if abs(ridge_tip_deg) > RIDGE_TIP_DEG:
         further = tip_turn_deg(ridge_tip_deg, missed_tip_deg) != ridge_tip_deg

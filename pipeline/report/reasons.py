@@ -72,7 +72,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^the body starts \d+ px from fixed_end", "body starts away from fixed_end"),
     (r"^the body leaves the fixed end [-+\d]+ deg off its ramp's direction",
      "body leaves the clamp off its ramp's direction"),
-    (r"^the free end is \d+% as wide as the body: smeared", "smeared by motion (video frame)"),
+    (r"^the free end is \d+% as wide as the body: smeared",
+     "free end wider than the body (motion smear?)"),
 )
 #: how the parts of a cause that follow a ``;`` inside it begin (a fix, a carried-on figure, a
 #: bracket's second half), and the ramp check's note of the base psi is taken from: not causes
