@@ -599,3 +599,18 @@ def test_a_frame_sequence_is_measured_as_the_video_it_was_cut_from(video_set, me
     manifest.assign(video="frames/g_%04d.jpg").to_csv(folder / "manifest.csv", index=False)
     (problem,) = check_photoset(folder)
     assert "no file of" in problem.message and "g_<number>.jpg" in problem.message
+
+
+def test_a_videos_timestamp_column_dates_its_frames_for_the_report(video_set, tmp_path):
+    # customer 20: 'Photos taken: no date in the inputs' for a video, whose manifest had no place
+    # for one in the README; a timestamp column is carried to every frame and dates the set
+    from pipeline.report.data import dataset_dates
+
+    folder = tmp_path / "steps"
+    shutil.copytree(video_set, folder)
+    manifest = pd.read_csv(folder / "manifest.csv")
+    manifest.assign(timestamp="2026-12-04 10:15").to_csv(folder / "manifest.csv", index=False)
+    angles = measure_photoset(folder, jobs=1)
+    assert (angles["timestamp"] == "2026-12-04 10:15").all()
+    first, last, _where = dataset_dates(angles, folder)
+    assert first == last == "2026-12-04"
