@@ -50,6 +50,9 @@ from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIV
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
+#: a video's frames, a fraction of a second apart, allow less: this many times the ramp's own
+#: frame-to-frame noise (robust, from its second differences), but at least VIDEO_SLACK_MIN_DEG
+VIDEO_SLACK_NOISE, VIDEO_SLACK_MIN_DEG = 6.0, 4.0
 #: an end photo of a leg may lie this many neighbouring steps beyond its neighbour
 END_STEPS = 4.0
 #: a cosmetically flagged photo within this of its ramp's prediction (deg) is trusted again
@@ -191,12 +194,38 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
                         f"line length {100 * length / med:.0f}% of its ramp's median: part of it "
                         "may be missing or extra",
                     )
+        slack = video_slack_deg(measured) if "frame" in measured.columns else SLACK_DEG
         legs = (measured["direction"] != measured["direction"].shift()).cumsum()
         for number, leg in measured.groupby(legs, sort=False):
             others = measured[(legs != number) & (measured["status"] == "ok")]
-            _check_leg(leg, position, status, reason, _same_pressure(leg, others))
+            _check_leg(leg, position, status, reason, _same_pressure(leg, others), slack)
     out["status"], out["reason"] = status, reason
     return out
+
+
+def video_slack_deg(frames: pd.DataFrame) -> float:
+    """How far outside its neighbours' range a video's frame may read before it breaks its ramp:
+    :data:`VIDEO_SLACK_NOISE` times the frames' own noise (from the second differences of the
+    ``ok`` frames' psi in time order, robust to the steps), at least :data:`VIDEO_SLACK_MIN_DEG`,
+    at most :data:`SLACK_DEG`.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.arange(600) / 15.0                      # 40 s at 15 fps, 0.7 deg of noise
+    >>> psi = 200.0 - 8.0 * t + rng.normal(0.0, 0.7, t.size)
+    >>> frames = pd.DataFrame({"psi_deg": psi, "status": "ok", "time_s": t})
+    >>> round(video_slack_deg(frames), 1)
+    4.2
+    """
+    ok = frames[frames["status"] == "ok"]
+    psi = ok.sort_values("time_s")["psi_deg"].to_numpy(float) if "time_s" in ok else np.array([])
+    psi = psi[np.isfinite(psi)]
+    if len(psi) < 10:
+        return SLACK_DEG
+    d2 = psi[2:] - 2.0 * psi[1:-1] + psi[:-2]
+    noise = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
+    return float(np.clip(VIDEO_SLACK_NOISE * noise, VIDEO_SLACK_MIN_DEG, SLACK_DEG))
 
 
 def _wrap_deg(angle: np.ndarray) -> np.ndarray:
@@ -463,9 +492,10 @@ def _check_leg(
     status: np.ndarray,
     reason: np.ndarray,
     same_pressure: list[np.ndarray],
+    slack: float = SLACK_DEG,
 ) -> None:
-    """Flag the leg's outliers one at a time (worst first, then check again without it);
-    re-trust."""
+    """Flag the leg's outliers, more than ``slack`` (deg) outside their neighbours' range, one at
+    a time (worst first, then check again without it); re-trust."""
     keep = list(range(len(leg)))
     psi_all = leg["psi_deg"].to_numpy(float)
     doubtful = (leg["status"] != "ok").to_numpy()  # flagged on its own, before the ramp
@@ -482,7 +512,7 @@ def _check_leg(
                 off, lo, hi = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
             else:
                 off, lo, hi = _allowed_in_leg(psi, i, same_pressure[keep[i]])
-            if off > SLACK_DEG:
+            if off > slack:
                 breaking.append((off, i, lo, hi))
         if not breaking:
             break

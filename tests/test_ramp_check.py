@@ -310,3 +310,25 @@ def test_two_doubtful_photos_read_wrong_alike_do_not_outvote_a_right_one_between
     assert out.loc[2, "status"] == "ok", out[["psi_deg", "status", "reason"]]
     assert (out.loc[[0, 1, 5, 6, 7], "status"] == "ok").all()
     assert (out.loc[[3, 4], "status"] == "flagged").all()
+
+
+def test_a_video_frame_off_its_neighbours_by_a_few_degrees_breaks_its_ramp():
+    # customer 20: two frames of a 15 fps ramp read 6.6 and 6.8 deg off, ok, where neighbouring
+    # frames differ by 0.7 deg of noise; a photo ramp's 12 deg slack let them through. A video's
+    # slack is 6 times its own frame noise (at least 4 deg); photos keep theirs
+    rng = np.random.default_rng(3)
+    t = np.arange(300) / 15.0
+    psi = 200.0 - 15.0 * t + rng.normal(0.0, 0.7, t.size)
+    psi[150] += 6.5
+    frames = pd.DataFrame(
+        {
+            "image": "ramp.avi", "frame": range(t.size), "time_s": t, "psi_deg": psi,
+            "status": "ok", "reason": "", "pressure_kpa": 8.0 * t, "direction": "up",
+            "material": "DS20", "actuator": "A1", "trial": "1", "length_px": 900.0,
+        }
+    )
+    checked = check_ramps(frames)
+    broken = checked["reason"].str.startswith("breaks its ramp")
+    assert broken.tolist() == [k == 150 for k in range(t.size)], checked[broken]
+    as_photos = check_ramps(frames.drop(columns="frame"))
+    assert (as_photos["status"] == "ok").all()
