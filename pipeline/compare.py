@@ -140,6 +140,7 @@ RMS_COLUMNS: tuple[str, ...] = (
     "p_minus_psi0_up_kpa",
     "p_minus_psi0_down_kpa",
     "model_p_zero_kpa",
+    "model_p_minus_psi0_kpa",
     "psi0_deg",
     "range_deg",
     "psi_max_deg",
@@ -437,6 +438,7 @@ def compare_material(
         out["rms_up_deg"] = rms_deg(meas[up], model[up])[0]
         out["rms_down_deg"] = rms_deg(meas[~up], model[~up])[0]
         out["model_p_zero_kpa"] = model_crossing_kpa(model_psi, material, 0.0)
+        out["model_p_minus_psi0_kpa"] = model_crossing_kpa(model_psi, material, -psi0_deg)
     for direction in DIRECTIONS:
         p_b, s_b = branch(h, direction)
         out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0)

@@ -969,3 +969,16 @@ def test_a_strip_of_video_frames_says_frames_of_the_video_and_rounds_their_press
     caption = " ".join(t for t in texts if "across one ramp" in t)
     assert caption.startswith("Frames across one ramp") and "frames of ramp.avi;" in caption
     assert {"0 kPa", "21.3 kPa", "42.7 kPa"} <= set(texts), texts
+
+
+def test_a_materials_table_sets_the_models_predicted_crossings_beside_the_run_and_the_paper():
+    # customer 19's advisor had the run's P at psi = 0 beside the paper's measurement only
+    from pipeline.report.pages import metric_table
+
+    row = {"p_zero_up_kpa": 57.5, "p_zero_down_kpa": 38.0, "model_p_zero_kpa": 54.18,
+           "model_p_minus_psi0_kpa": 103.4, "paper_p_zero_kpa": 65.0}
+    table = metric_table(row)
+    cells = {r[0]: r[1:] for r in table.rows}
+    assert cells["P at ψ = 0 (kPa)"] == ("58", "38", "", "54", "65"), cells
+    assert cells["P at ψ = -ψ0 (kPa)"][3] == "103"
+    assert any("predicted, nothing fitted" in n for n in table.notes)

@@ -202,6 +202,7 @@ def metric_table(
             fmt(g("rms_up_deg"), 1),
             fmt(g("rms_down_deg"), 1),
             fmt(g("rms_deg"), 1),
+            "",
             fmt(g("paper_rms_deg"), 1),
         ),
         (
@@ -209,6 +210,7 @@ def metric_table(
             fmt(g("p_zero_up_kpa"), 0),
             fmt(g("p_zero_down_kpa"), 0),
             "",
+            fmt(g("model_p_zero_kpa"), 0),
             fmt(g("paper_p_zero_kpa"), 0),
         ),
         (
@@ -216,18 +218,23 @@ def metric_table(
             fmt(g("p_minus_psi0_up_kpa"), 0),
             fmt(g("p_minus_psi0_down_kpa"), 0),
             "",
+            fmt(g("model_p_minus_psi0_kpa"), 0),
             NA,
         ),
-        ("Range of motion (deg)", "", "", fmt(g("range_deg"), 0), fmt(g("paper_range_deg"), 0)),
+        (
+            "Range of motion (deg)", "", "", fmt(g("range_deg"), 0), "",
+            fmt(g("paper_range_deg"), 0),
+        ),
         (
             "... over a pressure span of (kPa)",
             "",
             "",
             fmt(g("range_kpa"), 0),
+            "",
             fmt(g("paper_range_kpa"), 0),
         ),
-        ("Hysteresis width, max |ψ_up - ψ_down| (deg)", "", "", width, NA),
-        ("k_P fitted to the rising leg [95 % CI] (-)", "", "", k_ci, fmt(g("k_p_paper"), 1)),
+        ("Hysteresis width, max |ψ_up - ψ_down| (deg)", "", "", width, "", NA),
+        ("k_P fitted to the rising leg [95 % CI] (-)", "", "", k_ci, "", fmt(g("k_p_paper"), 1)),
     )
     return Table(
         columns=(
@@ -235,6 +242,7 @@ def metric_table(
             Column("increasing P"),
             Column("decreasing P"),
             Column("both"),
+            Column("model"),
             Column("paper"),
         ),
         rows=rows,
@@ -242,9 +250,10 @@ def metric_table(
         size=8.0,
         notes=(
             (
-                "paper n/a: the paper reports no such value.  k_P is fitted, not predicted: the "
-                "paper's "
-                "value stands beside it for reference only."
+                "model: where the model's loading branch (the paper's k_P, this l0) reaches the "
+                "angle, predicted, nothing fitted.  paper n/a: the paper reports no such value.  "
+                "k_P is fitted, not predicted: the paper's value stands beside it for reference "
+                "only."
             ),
             *extra_notes,
         ),
