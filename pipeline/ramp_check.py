@@ -42,6 +42,8 @@ True
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pandas as pd
 
@@ -50,8 +52,8 @@ from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIV
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
-#: a video's frames, a fraction of a second apart, allow less: this many times the ramp's own
-#: frame-to-frame noise (robust, from its second differences), but at least VIDEO_SLACK_MIN_DEG
+#: a video's frame breaks its ramp when it stands off its neighbouring frames by this many times
+#: the frames' own noise, and at least VIDEO_SLACK_MIN_DEG (deg): :func:`video_spikes`
 VIDEO_SLACK_NOISE, VIDEO_SLACK_MIN_DEG = 6.0, 4.0
 #: an end photo of a leg may lie this many neighbouring steps beyond its neighbour
 END_STEPS = 4.0
@@ -194,38 +196,73 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
                         f"line length {100 * length / med:.0f}% of its ramp's median: part of it "
                         "may be missing or extra",
                     )
-        slack = video_slack_deg(measured) if "frame" in measured.columns else SLACK_DEG
+        if "frame" in measured.columns and "time_s" in measured.columns:
+            for ix, expected in video_spikes(measured):
+                k = position[ix]
+                status[k] = "flagged"
+                reason[k] = _join(
+                    f"breaks its ramp: psi {float(out.at[ix, 'psi_deg']):+.0f} deg where the "
+                    f"frames before and after it lead to {expected:+.0f}",
+                    reason[k],
+                )
         legs = (measured["direction"] != measured["direction"].shift()).cumsum()
         for number, leg in measured.groupby(legs, sort=False):
             others = measured[(legs != number) & (measured["status"] == "ok")]
-            _check_leg(leg, position, status, reason, _same_pressure(leg, others), slack)
+            _check_leg(leg, position, status, reason, _same_pressure(leg, others))
     out["status"], out["reason"] = status, reason
     return out
 
 
-def video_slack_deg(frames: pd.DataFrame) -> float:
-    """How far outside its neighbours' range a video's frame may read before it breaks its ramp:
-    :data:`VIDEO_SLACK_NOISE` times the frames' own noise (from the second differences of the
-    ``ok`` frames' psi in time order, robust to the steps), at least :data:`VIDEO_SLACK_MIN_DEG`,
-    at most :data:`SLACK_DEG`.
+def video_spikes(frames: pd.DataFrame) -> list[tuple[Any, float]]:
+    """The ``ok`` frames of one video ramp that stand off their neighbours: (index, the psi the
+    neighbouring frames lead to), worst first.
+
+    A frame is a spike when it lies both outside the range of the frames just before and after
+    it and off the parabola in time through the two ``ok`` frames on each side, each by more than
+    :data:`VIDEO_SLACK_NOISE` times the frames' own noise (robust, from their second differences)
+    and at least :data:`VIDEO_SLACK_MIN_DEG`.  A step's onset lies within its neighbours' range,
+    an overshoot's peak close to their parabola, so neither is one.  The worst spike is taken
+    out and the rest judged again without it.
 
     Examples
     --------
     >>> rng = np.random.default_rng(0)
-    >>> t = np.arange(600) / 15.0                      # 40 s at 15 fps, 0.7 deg of noise
-    >>> psi = 200.0 - 8.0 * t + rng.normal(0.0, 0.7, t.size)
+    >>> t = np.arange(300) / 15.0                  # 20 s at 15 fps, 0.7 deg of noise: a step
+    >>> psi = np.where(t < 10, 200.0, 200.0 - 150.0 * (1 - np.exp(-(t - 10) / 0.4)))
+    >>> psi = psi + 8.0 * np.exp(-(t - 11) / 0.5) * np.sin(2 * np.pi * (t - 11) / 0.5) * (t > 11)
+    >>> psi = psi + rng.normal(0.0, 0.7, t.size)   # ... ringing after it
+    >>> psi[60] += 6.0                             # and one frame read 6 deg off
     >>> frames = pd.DataFrame({"psi_deg": psi, "status": "ok", "time_s": t})
-    >>> round(video_slack_deg(frames), 1)
-    4.2
+    >>> [(int(i), round(p)) for i, p in video_spikes(frames)]
+    [(60, 199)]
     """
-    ok = frames[frames["status"] == "ok"]
-    psi = ok.sort_values("time_s")["psi_deg"].to_numpy(float) if "time_s" in ok else np.array([])
-    psi = psi[np.isfinite(psi)]
+    ok = frames[(frames["status"] == "ok") & np.isfinite(frames["psi_deg"].to_numpy(float))]
+    ok = ok.sort_values("time_s")
+    index = list(ok.index)
+    t, psi = ok["time_s"].to_numpy(float), ok["psi_deg"].to_numpy(float)
     if len(psi) < 10:
-        return SLACK_DEG
+        return []
     d2 = psi[2:] - 2.0 * psi[1:-1] + psi[:-2]
     noise = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
-    return float(np.clip(VIDEO_SLACK_NOISE * noise, VIDEO_SLACK_MIN_DEG, SLACK_DEG))
+    limit = max(VIDEO_SLACK_MIN_DEG, VIDEO_SLACK_NOISE * noise)
+    out: list[tuple[Any, float]] = []
+    while len(psi) >= 5:
+        off = np.zeros(len(psi))
+        expected = np.full(len(psi), np.nan)
+        for i in range(2, len(psi) - 2):
+            lo, hi = sorted((psi[i - 1], psi[i + 1]))
+            if max(lo - psi[i], psi[i] - hi) <= limit:
+                continue
+            near = [i - 2, i - 1, i + 1, i + 2]
+            expected[i] = np.polyfit(t[near] - t[i], psi[near], 2)[-1]
+            off[i] = abs(psi[i] - expected[i])
+        worst = int(np.argmax(off))
+        if off[worst] <= limit:
+            break
+        out.append((index[worst], float(expected[worst])))
+        del index[worst]
+        t, psi = np.delete(t, worst), np.delete(psi, worst)
+    return out
 
 
 def _wrap_deg(angle: np.ndarray) -> np.ndarray:
@@ -492,10 +529,9 @@ def _check_leg(
     status: np.ndarray,
     reason: np.ndarray,
     same_pressure: list[np.ndarray],
-    slack: float = SLACK_DEG,
 ) -> None:
-    """Flag the leg's outliers, more than ``slack`` (deg) outside their neighbours' range, one at
-    a time (worst first, then check again without it); re-trust."""
+    """Flag the leg's outliers one at a time (worst first, then check again without it);
+    re-trust."""
     keep = list(range(len(leg)))
     psi_all = leg["psi_deg"].to_numpy(float)
     doubtful = (leg["status"] != "ok").to_numpy()  # flagged on its own, before the ramp
@@ -512,7 +548,7 @@ def _check_leg(
                 off, lo, hi = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
             else:
                 off, lo, hi = _allowed_in_leg(psi, i, same_pressure[keep[i]])
-            if off > slack:
+            if off > SLACK_DEG:
                 breaking.append((off, i, lo, hi))
         if not breaking:
             break
