@@ -483,3 +483,27 @@ def test_every_failure_of_a_run_has_its_status_and_exit_code(exc, status):
     got, message = failure_status(exc)
     assert got == status and message
     assert got in EXIT_CODES
+
+
+def test_a_resume_with_another_ramp_is_refused_before_the_port_is_opened(tmp_path):
+    # customer 21 resumed a set begun at 10 kPa steps with --step-kpa 20: it was accepted and
+    # trial 1 became 0, 10, ..., 90, then 200 kPa, one trial of two ramps (only the ramp check
+    # of measure caught it). Now the recorded steps are checked against the command's ramp
+    rows = [
+        {"image": f"DS20_A1_t1_s{k:03d}_up_{p}kPa.jpg", "pressure_kpa": p, "direction": "up",
+         "material": "DS20", "actuator": "A1", "trial": 1, "step": k}
+        for k, p in enumerate((0, 10, 20))
+    ]
+    pd.DataFrame(rows).to_csv(tmp_path / "manifest.csv", index=False)
+    for r in rows:
+        (tmp_path / r["image"]).write_bytes(b"x")
+    base = [sys.executable, "-m", "pipeline", "acquire", "--camera", "synthetic", "--material",
+            "DS20", "--actuator", "A1", "--trials", "1", "--out", str(tmp_path)]
+    # no --port: refused for the ramp before the missing port is even noticed
+    out = subprocess.run(base + ["--step-kpa", "20"], capture_output=True, text=True, check=False)
+    assert out.returncode == 2, out.stderr
+    assert "trial 1's step 1 was taken at 10 kPa up, where this ramp has 20 kPa up" in out.stderr
+    assert "--port" not in out.stderr
+    out = subprocess.run(base + ["--step-kpa", "10", "--dry-run"], capture_output=True, text=True,
+                         check=False)
+    assert out.returncode == 0 and "3 recorded, resume at step 3 (30 kPa up)" in out.stdout

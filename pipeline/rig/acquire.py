@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 import numpy as np
 from tqdm import tqdm
 
+from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.settings import MeasureSettings, SettingsError, resolve_settings
 from pipeline.photoset import MANIFEST, append_manifest_rows, write_manifest, write_settings
@@ -186,7 +187,15 @@ def trial_plans(cfg: SessionConfig) -> list[tuple[int, list[session.StepPlan], s
     for trial in range(1, cfg.trials + 1):
         rows = rec[rec["trial_n"] == trial]
         peak = session.known_peak(rows, len(up))
-        out.append((trial, session.trial_sequence(trial, up, peak), set(rows["step_n"].tolist())))
+        seq = session.trial_sequence(trial, up, peak)
+        mismatch = session.recorded_mismatch(rows, seq)
+        if mismatch:
+            raise UserInputError(
+                f"{cfg.out_dir / MANIFEST}: trial {trial}'s {mismatch} (--step-kpa "
+                f"{cfg.step_kpa:g}, --max-kpa {cfg.max_kpa:g}); resume with the ramp the set was "
+                "started with, or give a new --out folder for this one"
+            )
+        out.append((trial, seq, set(rows["step_n"].tolist())))
     return out
 
 

@@ -24,6 +24,7 @@ from pipeline.rig.acquire import (
     describe_plan,
     psi0_stop_criterion,
     run_session,
+    trial_plans,
 )
 
 
@@ -303,6 +304,7 @@ def run(args: argparse.Namespace) -> int:
         else (synthetic and args.mode == "bending")
     )
     stop_at_psi0 = bool(wants_stop)
+    trial_plans(cfg)  # a folder begun with another ramp is refused before any port is opened
     if args.dry_run:
         print(
             describe_plan(

@@ -125,6 +125,35 @@ def known_peak(rows: pd.DataFrame, n_levels: int) -> int | None:
     return int(min(down.min() - 1, n_levels - 1))
 
 
+def recorded_mismatch(rows: pd.DataFrame, sequence: list[StepPlan]) -> str | None:
+    """How the recorded rows of a trial disagree with the planned ``sequence`` (a resume with
+    another ``--step-kpa`` or ``--max-kpa`` would mix two ramps in one trial), or ``None``.
+
+    Examples
+    --------
+    >>> seq = trial_sequence(1, [0.0, 10.0, 20.0])
+    >>> rows = pd.DataFrame({"step_n": [0, 1], "pressure_kpa": ["0", "20"],
+    ...                      "direction": ["up", "up"]})
+    >>> recorded_mismatch(rows, seq)
+    'step 1 was taken at 20 kPa up, where this ramp has 10 kPa up'
+    >>> recorded_mismatch(rows.iloc[:1], seq) is None
+    True
+    """
+    planned = {p.step: p for p in sequence}
+    for _, row in rows.sort_values("step_n").iterrows():
+        plan = planned.get(int(row["step_n"]))
+        try:
+            kpa = float(row["pressure_kpa"])
+        except (TypeError, ValueError):
+            continue  # a hand-edited cell: the photo set's own check names it
+        taken = f"step {int(row['step_n'])} was taken at {kpa:g} kPa {row['direction']}"
+        if plan is None:
+            return f"{taken}, past the end of this ramp"
+        if abs(plan.pressure_kpa - kpa) > 1e-6 or plan.direction != row["direction"]:
+            return f"{taken}, where this ramp has {plan.pressure_kpa:g} kPa {plan.direction}"
+    return None
+
+
 def first_missing(sequence: list[StepPlan], recorded: set[int]) -> int | None:
     """Index in ``sequence`` of the first step not recorded, or ``None`` when the trial is
     complete."""
