@@ -41,6 +41,8 @@ def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
     assert f"p. {first} One page per video: every frame, loops, steps" in " ".join(
         pages[0].split()
     )
+    # the provenance page says what those pages are in words, not '--video-dirs' (customer 20)
+    assert "1 page(s) of a video dataset from" in " ".join(pages[-1].split())
     video_pages = [p for p in pages if "Video dataset" in p]
     assert len(video_pages) == 2 and "Video dataset steps_a" in video_pages[0]
     for text in video_pages:

@@ -60,6 +60,14 @@ CONTENTS: dict[str, str] = {
 }
 
 
+#: what the pages from each folder option are, in words, for the provenance page
+SOURCE_WORDS: dict[str, str] = {
+    "--bench-dir": "the angle-method benchmark",
+    "--force-dir": "blocked force and grasping",
+    "--video-dirs": "a video dataset",
+}
+
+
 @dataclass(frozen=True)
 class ReportResult:
     """What was written, and how long each part took (wall seconds; they never reach the PDF)."""
@@ -174,7 +182,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
             continue
         figs = build(folder)
         extra += figs
-        infos.append(f"{len(figs)} page(s) from {name} {folder}")
+        infos.append(f"{len(figs)} page(s) of {SOURCE_WORDS[name]} from {folder}")
     if data.inputs.model_curves:
         for m in data.materials:
             if not (data.model_curves["material"].astype(str) == m).any():
