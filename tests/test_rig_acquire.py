@@ -123,7 +123,8 @@ def test_full_short_ramp(tmp_path, photo):
         assert done.returncode == 0, done.stderr
         assert emu.setpoint_kpa == 0.0
         sets = [line for line in emu.stats.received if line.startswith("SET")]
-    assert "acquired 14 photo(s)" in done.stdout
+    assert (done.stdout + done.stderr).count("14 photo(s)") == 1  # said once, not again by the CLI
+    assert "acquire: done: 14 photo(s) taken, 0 already recorded" in done.stderr
     df = assert_consistent(out)
     assert len(df) == 14
     assert list(df["direction"]) == ["up"] * 4 + ["down"] * 3 + ["up"] * 4 + ["down"] * 3
@@ -154,7 +155,7 @@ def test_estop_mid_ramp_vents_keeps_data_then_resumes(tmp_path, photo):
         emu.release_estop()
         resumed = run(acquire_cmd(str(link), out, photo))
         assert resumed.returncode == 0, resumed.stderr
-    assert "acquired 10 photo(s) (4 already recorded)" in resumed.stdout
+    assert "acquire: done: 10 photo(s) taken, 4 already recorded" in resumed.stderr
     assert len(assert_consistent(out)) == 14
 
 
@@ -178,7 +179,8 @@ def test_dropped_connection_then_rerun_resumes_without_duplicates(tmp_path, phot
         second = run(acquire_cmd(str(link), out, photo))
         assert second.returncode == 0, second.stderr
         resumed_sets = [c for c in emu.stats.received[received_before:] if c.startswith("SET")]
-    assert f"acquired {14 - n_kept} photo(s) ({n_kept} already recorded)" in second.stdout
+    said = f"acquire: done: {14 - n_kept} photo(s) taken, {n_kept} already recorded"
+    assert said in second.stderr
     df = assert_consistent(out)
     assert len(df) == 14
     for image, stamp in stamps.items():  # recorded rows untouched
@@ -425,7 +427,7 @@ def test_synthetic_ramp_stops_when_psi_reaches_minus_psi0(tmp_path):
     with Emulator(seed=2) as emu:
         done = run(synthetic_cmd(emu.port, out, "--stop-at-psi0", step=20, top=260), timeout=120)
     assert done.returncode == 0, done.stderr
-    assert "(6 already recorded)" in done.stdout
+    assert "6 already recorded" in done.stderr
     ps = load_photoset(out)
     df = ps.manifest
     up, down = df[df["direction"] == "up"], df[df["direction"] == "down"]

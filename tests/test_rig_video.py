@@ -69,7 +69,7 @@ def test_a_continuous_ramp_is_recorded_as_a_video_photo_set_and_resumed(tmp_path
         assert max(sets) == 40.0 and len(set(sets)) > 10  # ramped continuously, not in a few steps
         again = run(video_cmd(emu.port, out, trials=2))  # trial 1 is kept, trial 2 recorded
         assert again.returncode == 0, again.stderr
-    assert "1 trial(s) already recorded" in again.stdout
+    assert "1 trial(s) already recorded" in again.stderr
     assert check_photoset(out) == []
     m = pd.read_csv(out / "manifest.csv")
     assert list(m["trial"]) == [1, 2] and (m["clock_offset_s"] == 0).all()

@@ -374,12 +374,7 @@ def _acquire(
             driver.close()
     finally:
         camera.close()
-    if result.status == "done":
-        print(
-            f"acquired {result.photos_taken} photo(s) ({result.steps_skipped} already recorded) "
-            f"into {args.out}"
-        )
-    return result.exit_code
+    return result.exit_code  # the session has said what it did ("acquire: done: ...")
 
 
 def _acquire_video(args: argparse.Namespace, settings: dict[str, Any]) -> int:
@@ -454,9 +449,4 @@ def _acquire_video(args: argparse.Namespace, settings: dict[str, Any]) -> int:
             driver.close()
     finally:
         recorder.close()
-    if result.status == "done":
-        print(
-            f"acquired {result.photos_taken} frame(s) ({result.steps_skipped} trial(s) already "
-            f"recorded) into {args.out}"
-        )
-    return result.exit_code
+    return result.exit_code  # the session has said what it did ("acquire: done: ...")
