@@ -302,6 +302,7 @@ def test_dry_run_prints_plan_and_resume_point(tmp_path, photo, capsys):
     code, text, _ = main_inprocess(acquire_cmd("", out, photo, "--dry-run"), capsys)
     assert code == 0
     assert "up 0 50 100 120" in text and "trial 2: 7 steps, 0 recorded, start at step 0" in text
+    assert "synthetic camera" not in text  # a real camera's photos keep the settings listed
     assert not out.exists()
     with Emulator(faults=Faults(drop_after=16)) as emu:
         assert run(acquire_cmd(emu.port, out, photo)).returncode == 4
@@ -509,3 +510,5 @@ def test_a_resume_with_another_ramp_is_refused_before_the_port_is_opened(tmp_pat
     out = subprocess.run(base + ["--step-kpa", "10", "--dry-run"], capture_output=True, text=True,
                          check=False)
     assert out.returncode == 0 and "3 recorded, resume at step 3 (30 kPa up)" in out.stdout
+    # the plan says where the photo set's fixed end comes from (not the 'auto' it lists)
+    assert "the synthetic camera writes its own scene's fixed_end" in out.stdout

@@ -215,7 +215,13 @@ def describe_plan(
         f"  settle {cfg.settle_s:g} s per step"
         + (f"; {cfg.force_samples} load-cell samples per step" if cfg.mode == "blocked" else "")
         + ("; up leg stops early when measured psi <= -psi0" if stop_at_psi0 else ""),
-        "  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items()),
+        "  photoset.yaml: " + ", ".join(f"{k}={v}" for k, v in cfg.settings.items())
+        + (
+            "; the synthetic camera writes its own scene's fixed_end, mm_per_px and line_color "
+            "over these"
+            if camera_spec.strip().startswith("synthetic")
+            else ""
+        ),
     ]
     todo = 0
     for trial, seq, recorded in trial_plans(cfg):
