@@ -255,6 +255,32 @@ def test_dots_are_drawn_where_the_truth_puts_them():
     assert to_line.max() * 0.45 < 1.0
 
 
+@pytest.mark.parametrize("layout,from_line_half_widths", [("edges", 0.55), ("outline", 1.0)])
+def test_dots_of_an_edge_layout_lie_off_the_centre_line_and_outline_ones_stand_out_of_the_body(
+    layout, from_line_half_widths
+):
+    kw = {"tilt_deg": 0.0, "shadow": 0.0, "dot_layout": layout, "dot_diameter_mm": 6.0}
+    scene, r, _ = render_with_empty("grey_dots", 140.0, **kw)
+    half_px = 0.5 * scene.body_width_mm / VIEW["mm_per_px"]
+    gaps = r.dots_px[:, None, :] - r.centreline_px[None, :, :]
+    nearest = np.argmin(np.hypot(*gaps.transpose(2, 0, 1)), axis=1)
+    outward = r.dots_px - r.centreline_px[nearest]
+    from_line = np.hypot(*outward.T)
+    assert np.allclose(from_line / half_px, from_line_half_widths, atol=0.15)
+    # the dots alternate sides
+    side = np.sign(np.cross(np.gradient(r.centreline_px, axis=0)[nearest], outward))
+    assert set(side[::2]) != set(side[1::2]) and len(set(side[::2])) == 1
+    # a white marker's outer rim: on the body (edges) or on the backdrop past its edge (outline)
+    rim = r.dots_px + outward / from_line[:, None] * 0.4 * scene.dot_diameter_mm / VIEW["mm_per_px"]
+    rim_from_line = np.hypot(*(rim - r.centreline_px[nearest]).T) / half_px
+    px = np.round(rim).astype(int)
+    assert r.image[px[:, 1], px[:, 0]].min(axis=1).min() > 180
+    if layout == "outline":
+        assert rim_from_line.min() > 1.1
+    else:
+        assert rim_from_line.max() < 1.0
+
+
 @pytest.mark.parametrize("preset,texture", [("green_fibre", "fibre"), ("dark_translucent", "ribs")])
 def test_texture_repeats_along_the_body_at_its_pitch(preset, texture):
     def spectrum(**kw):

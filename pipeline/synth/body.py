@@ -50,8 +50,9 @@ CAP_OVERHANG = 0.08
 #: soft shadow: offset and blur (mm)
 SHADOW_OFFSET_MM = 2.5
 SHADOW_BLUR_MM = 2.0
-#: dots: how far from the centre line the ``edges`` layout puts them (fraction of the half-width)
-DOT_EDGE_V = 0.55
+#: dots: how far from the centre line the ``edges`` and ``outline`` layouts put them (fraction of
+#: the half-width)
+DOT_EDGE_V = {"edges": 0.55, "outline": 1.0}
 _TABLE = 256
 
 
@@ -104,8 +105,8 @@ def make_body_style(scene: SceneParams, rng: np.random.Generator) -> BodyStyle:
     if n:
         u = np.linspace(0.12, 0.94, n) + rng.uniform(-0.25, 0.25, n) * (0.82 / max(n, 1))
         v = rng.uniform(-0.08, 0.08, n)
-        if scene.dot_layout == "edges":
-            v += DOT_EDGE_V * np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
+        if scene.dot_layout in DOT_EDGE_V:
+            v += DOT_EDGE_V[scene.dot_layout] * np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
     else:
         u = v = np.zeros(0)
     return BodyStyle(

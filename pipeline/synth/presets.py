@@ -64,7 +64,7 @@ SHAPES: tuple[str, ...] = ("model", "arc", "distal", "chambers")
 TEXTURES: tuple[str, ...] = ("none", "fibre", "ribs")
 CLAMP_STYLES: tuple[str, ...] = ("block", "white", "plate")
 DOT_COLORS: tuple[str, ...] = ("white", "dark")
-DOT_LAYOUTS: tuple[str, ...] = ("centre", "edges")
+DOT_LAYOUTS: tuple[str, ...] = ("centre", "edges", "outline")
 #: knobs that are colours (three integers 0-255, B, G, R, or a name of NAMED_BGR)
 COLOR_KEYS: tuple[str, ...] = ("table_bgr", "body_bgr", "texture_bgr", "tip_cap_bgr")
 
@@ -166,7 +166,9 @@ class SceneParams:
     dot_diameter_mm : float
         Dot diameter (mm).
     dot_layout : str
-        ``centre`` (on the body's centre line) or ``edges`` (alternating near the two faces).
+        ``centre`` (on the body's centre line), ``edges`` (alternating near the two faces) or
+        ``outline`` (alternating on the two edges, each standing half out of the body's outline:
+        markers stuck along its top and bottom faces).
     tip_cap_mm : float
         Length of a rigid end block at the free end (mm, 0 = none); it is a little wider than
         the body and coloured ``tip_cap_bgr``.
