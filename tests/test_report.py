@@ -766,6 +766,24 @@ def test_the_summary_says_which_model_readings_were_used(tmp_path):
         load_report_data(ReportInputs(datasets=(d,), config=config))
 
 
+def test_the_report_reads_its_config_once(tmp_path, monkeypatch):
+    d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
+    config = tmp_path / "config.yaml"
+    config.write_text("aggregate: {bin_kpa: 5}\nforce: {datasets: [], grasp_log: null}\n")
+    reads = []
+    read_text = Path.read_text
+
+    def counted(self, *args, **kwargs):
+        if Path(self) == config:
+            reads.append(self)
+        return read_text(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "read_text", counted)
+    build_report(ReportInputs(datasets=(d,), config=config), tmp_path / "r.pdf")
+    # the aggregate options, the force pages' inputs and the model's readings all come from it
+    assert len(reads) == 1
+
+
 def test_one_material_without_optional_tables(tmp_path):
     d = make_dataset(tmp_path, "SS40", photos=False, overlays=False, trials=1)
     out = tmp_path / "r.pdf"

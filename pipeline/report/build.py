@@ -158,7 +158,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     infos: list[str] = []
     extra: list[Figure] = []
     colors = material_colors(data.materials)
-    synthetic_force, grasp_example = force_inputs(data.inputs.config)
+    synthetic_force, grasp_example = force_inputs(data.run_config)
     sources = [
         ("--bench-dir", data.inputs.bench_dir, study_pages.figures),
         (

@@ -134,6 +134,9 @@ class ReportData:
         Source and dates of each dataset, in input order.
     notes : list of str
         Things the reader should know (e.g. hysteresis recomputed from angles).
+    run_config : dict
+        The run's resolved config (``--config``), read once (:func:`read_run_config`); empty
+        without one.
     """
 
     inputs: ReportInputs
@@ -145,6 +148,7 @@ class ReportData:
     files: tuple[InputFile, ...]
     datasets: tuple[DatasetInfo, ...]
     notes: list[str] = field(default_factory=list)
+    run_config: dict[str, Any] = field(default_factory=dict)
 
     @property
     def materials(self) -> list[str]:
@@ -248,11 +252,12 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
             "hysteresis recomputed from the angles (setpoint levels, ok rows only): no "
             "--hysteresis given"
         )
+    run_config = read_run_config(inputs.config)
     infos = tuple(dataset_info(d, angles[angles["dataset"] == d.name]) for d in inputs.datasets)
     plotted = angles
     pooled = mixed_materials(angles, infos)
     if pooled:  # real beside synthetic photos of one material: its plots show the real ones
-        options = aggregate_options(inputs.config)
+        options = aggregate_options(run_config)
         left_out = [
             str(d) in pooled.get(str(m), ((), ()))[1]
             for m, d in zip(angles["material"], angles["dataset"], strict=True)
@@ -295,7 +300,7 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
     if not inputs.model_curves:
         notes.append("no --model-curves given: plots show the measurements only")
     if inputs.config is not None:
-        notes.append(model_readings_note(inputs.config))
+        notes.append(model_readings_note(run_config))
     return ReportData(
         inputs=inputs,
         angles=angles,
@@ -306,6 +311,7 @@ def load_report_data(inputs: ReportInputs) -> ReportData:
         files=input_files(inputs),
         notes=notes,
         datasets=infos,
+        run_config=run_config,
     )
 
 
@@ -405,17 +411,32 @@ def mixed_sources_note(data: ReportData, material: str) -> str:
     )
 
 
-def force_inputs(config_path: Path | None) -> tuple[tuple[str, ...], bool]:
-    """From the run's (resolved) config: the materials of its synthetic blocked-force sets, and
-    whether its grasp log is the paper's example (the shipped file's bytes), so that the force
-    pages can say what was not measured; nothing without a readable config."""
+def read_run_config(config_path: Path | None) -> dict[str, Any]:
+    """The run's resolved config (``--config``) as a mapping, read once; empty without one.
+
+    Raises
+    ------
+    UserInputError
+        If the file cannot be read as YAML.
+    """
     import yaml
 
+    if config_path is None:
+        return {}
     try:
-        cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) if config_path else {}
-    except (OSError, yaml.YAMLError):
-        return (), False
-    force = (cfg.get("force") or {}) if isinstance(cfg, dict) else {}
+        cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
+    except (OSError, yaml.YAMLError) as exc:
+        raise UserInputError(
+            f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config"
+        ) from None
+    return cfg if isinstance(cfg, dict) else {}
+
+
+def force_inputs(run_config: dict[str, Any]) -> tuple[tuple[str, ...], bool]:
+    """From the run's (resolved) config: the materials of its synthetic blocked-force sets, and
+    whether its grasp log is the paper's example (the shipped file's bytes), so that the force
+    pages can say what was not measured; nothing without a config."""
+    force = run_config.get("force") or {}
     synthetic = sorted(
         {
             str(d["material"])
@@ -432,18 +453,10 @@ def force_inputs(config_path: Path | None) -> tuple[tuple[str, ...], bool]:
     return tuple(synthetic), example
 
 
-def aggregate_options(config_path: Path | None) -> dict[str, Any]:
+def aggregate_options(run_config: dict[str, Any]) -> dict[str, Any]:
     """``bin_kpa`` and ``include_flagged`` of the run's ``aggregate`` settings (the resolved
     config), as ``aggregate`` used them; the defaults without a config."""
-    import yaml
-
-    cfg: Any = {}
-    if config_path is not None:
-        try:
-            cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
-        except (OSError, yaml.YAMLError):
-            cfg = {}  # model_readings_note reports an unreadable config
-    agg = (cfg.get("aggregate") or {}) if isinstance(cfg, dict) else {}
+    agg = run_config.get("aggregate") or {}
     return {
         "bin_kpa": agg.get("bin_kpa"),
         "include_flagged": bool(agg.get("include_flagged", False)),
@@ -551,23 +564,10 @@ def exif_date(path: Path) -> str | None:
     return date if pd.notna(pd.to_datetime(date, errors="coerce", format="%Y-%m-%d")) else None
 
 
-def model_readings_note(config_path: Path) -> str:
-    """One line saying which readings of the paper's model the run used (config ``model.readings``).
-
-    Raises
-    ------
-    UserInputError
-        If the config file cannot be read as YAML.
-    """
-    import yaml
-
-    try:
-        cfg = yaml.safe_load(Path(config_path).read_text(encoding="utf-8")) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        raise UserInputError(
-            f"--config {config_path}: cannot read it as YAML ({exc}); pass the resolved config"
-        ) from None
-    readings = ((cfg.get("model") or {}) if isinstance(cfg, dict) else {}).get("readings") or {}
+def model_readings_note(run_config: dict[str, Any]) -> str:
+    """One line saying which readings of the paper's model the run used (config
+    ``model.readings``)."""
+    readings = (run_config.get("model") or {}).get("readings") or {}
     if not readings:
         return (
             "model: the paper's Eqs. 1-13 with the default readings (docs/model.md: derived, no "

@@ -105,7 +105,7 @@ def results_table(data: ReportData) -> Table:
         "actuator); a fitted value, so its closeness to the paper's k_P tests nothing."),
     ]
     notes += missing_notes(data)
-    notes += coarse_crossing_notes(data.angles, aggregate_options(data.inputs.config))
+    notes += coarse_crossing_notes(data.angles, aggregate_options(data.run_config))
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
         notes.append(
