@@ -61,15 +61,16 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
+    ps = load_photoset(args.photoset)
     kw = {"method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check}
     if args.overlays is None:
-        angles = measure_photoset(args.photoset, **kw)
+        angles = measure_photoset(ps, **kw)
     else:  # the overlay folder appears only when complete
         with staged_folder(args.overlays, marker="contact_*.jpg") as overlays:
-            angles = measure_photoset(args.photoset, overlays_dir=overlays, **kw)
+            angles = measure_photoset(ps, overlays_dir=overlays, **kw)
     write_angles(angles, args.out)
     doubts = newer_spreadsheet_problems(Path(args.photoset))
-    doubts += measurement_doubts(load_photoset(args.photoset))
+    doubts += measurement_doubts(ps)
     for problem in doubts:
         print(problem, file=sys.stderr)
     used = sorted(set(angles["method"].dropna().astype(str)) - {args.method})

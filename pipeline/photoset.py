@@ -381,18 +381,24 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
     photos; in ``photoset.yaml`` or a ``manifest.csv`` column), resolved, inside the folder or
     not. Read leniently: a set whose files cannot be parsed names nothing here."""
     folder = Path(folder)
-    values: list[Any] = []
     try:
         raw = yaml.safe_load(read_user_text(folder / SETTINGS)) or {}
     except (OSError, yaml.YAMLError):
         raw = {}
-    if isinstance(raw, dict):
-        values += [raw.get("background"), raw.get("calibration")]
     try:
         manifest = read_user_csv(folder / MANIFEST, dtype=str)
         manifest = manifest.rename(columns=header_names(manifest.columns))  # 'Background'
     except (OSError, ValueError, pd.errors.ParserError):
         manifest = pd.DataFrame()
+    return files_named_in(folder, raw, manifest)
+
+
+def files_named_in(folder: Path, settings: Any, manifest: pd.DataFrame) -> frozenset[Path]:
+    """:func:`named_files` of settings and a manifest already read (``settings`` as in
+    ``photoset.yaml``, the manifest with its columns' canonical names)."""
+    values: list[Any] = []
+    if isinstance(settings, dict):
+        values += [settings.get("background"), settings.get("calibration")]
     for column in ("background", "calibration"):
         if column in manifest.columns:
             values += manifest[column].dropna().unique().tolist()
@@ -1140,10 +1146,16 @@ def file_problems(
 PREVIEW_SHEET_SUFFIX = "_preview"
 
 
-def unlisted_photos(folder: Path, listed: Iterable[str], subfolders: bool = True) -> list[str]:
+def unlisted_photos(
+    folder: Path,
+    listed: Iterable[str],
+    subfolders: bool = True,
+    named: frozenset[Path] | None = None,
+) -> list[str]:
     """The photos of ``folder`` (:func:`photo_names`) that are neither ``listed`` (the manifest's
-    images) nor files the set's settings name (:func:`named_files`: the empty scene, calibration
-    boards), nor a preview sheet (``*_preview.jpg``/``.png`` not listed).
+    images) nor files the set's settings name (``named``, else read with :func:`named_files`:
+    the empty scene, calibration boards), nor a preview sheet (``*_preview.jpg``/``.png`` not
+    listed).
 
     Examples
     --------
@@ -1154,7 +1166,9 @@ def unlisted_photos(folder: Path, listed: Iterable[str], subfolders: bool = True
     >>> unlisted_photos(root, ["a.jpg"])
     ['b.jpg']
     """
-    taken = {(folder / name).resolve() for name in listed} | named_files(folder)
+    taken = {(folder / name).resolve() for name in listed} | (
+        named_files(folder) if named is None else named
+    )
     return [
         n
         for n in photo_names(folder, subfolders)
@@ -1228,7 +1242,9 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     1 photo in the folder is not in manifest.csv and will not be measured: 'a_10kpa.jpg'
     """
     left = unlisted_photos(
-        ps.folder, [str(i) for i in ps.manifest["image"] if not is_missing(i)]
+        ps.folder,
+        [str(i) for i in ps.manifest["image"] if not is_missing(i)],
+        named=files_named_in(ps.folder, ps.settings, ps.manifest),
     )
     if not left:
         return []

@@ -107,7 +107,7 @@ def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
 
 
 def measure_photoset(
-    folder: str | os.PathLike[str],
+    folder: str | os.PathLike[str] | PhotoSet,
     *,
     method: str = DEFAULT_METHOD,
     jobs: int = 1,
@@ -119,8 +119,9 @@ def measure_photoset(
 
     Parameters
     ----------
-    folder : path
-        Photo-set folder (manifest.csv + photoset.yaml + images).
+    folder : path or PhotoSet
+        Photo-set folder (manifest.csv + photoset.yaml + images), or one already loaded
+        (:func:`pipeline.photoset.load_photoset`).
     method : str
         Estimator, a key of :data:`pipeline.measure.METHODS`.
     jobs : int
@@ -154,7 +155,7 @@ def measure_photoset(
         raise UserInputError(f"--method {method!r} is unknown; use one of {sorted(METHODS)}")
     if jobs < 1:
         raise UserInputError(f"--jobs {jobs} must be at least 1")
-    ps = load_photoset(folder)
+    ps = folder if isinstance(folder, PhotoSet) else load_photoset(folder)
     odir = None if overlays_dir is None else Path(overlays_dir)
     if odir is not None:
         odir.mkdir(parents=True, exist_ok=True)

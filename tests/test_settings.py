@@ -156,6 +156,12 @@ def test_load_photoset_reads_each_file_once(photo_folder, monkeypatch):
     monkeypatch.setattr(ps.pd, "read_csv", count_csv)
     loaded = ps.load_photoset(photo_folder)
     assert len(loaded.rows) == 8 and calls == {"yaml": 1, "csv": 1}
+    # the measure command loads the set once, for measuring and for its closing doubts
+    from pipeline.cli import main
+
+    calls.update(yaml=0, csv=0)
+    assert main(["measure", str(photo_folder), "--out", str(photo_folder / "a.csv")]) == 0
+    assert calls == {"yaml": 1, "csv": 1}
 
 
 @pytest.mark.parametrize(
