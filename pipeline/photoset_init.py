@@ -21,7 +21,15 @@ import pandas as pd
 from pipeline.constants import DIRECTION_WORDS, RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
-from pipeline.photoset import MANIFEST, SETTINGS, photo_names, write_manifest, write_settings
+from pipeline.photoset import (
+    MANIFEST,
+    SETTINGS,
+    files_named_in,
+    named_files,
+    photo_names,
+    write_manifest,
+    write_settings,
+)
 from pipeline.video.reader import sequence_files
 from pipeline.video.timeline import read_pressure_log
 
@@ -165,8 +173,11 @@ def init_photoset(
     highest pressure, ``down`` after it.  Photos of several ramps taken one after another in one
     folder (no ``{trial}`` in the pattern) are split into trials: by the trials' own
     ``pressures_kpa``, given in the order they were taken, whose photo counts add up to the
-    folder's; or, with one list for them all, wherever the pressure has come back down to the
-    lowest of its ramp and rises again (:func:`ramp_starts`).
+    folder's (keyed ``actuator/trial`` over several actuators, with no ``{actuator}`` in the
+    pattern either: each actuator's ramps too); or, with one list for them all, wherever the
+    pressure has come back down to the lowest of its ramp and rises again
+    (:func:`ramp_starts`).  A photo the settings name (``background``, a calibration board) is
+    not one of a ramp.
 
     Parameters
     ----------
@@ -206,8 +217,12 @@ def init_photoset(
         )
     regex = pattern_to_regex(pattern, pressure_in_name=pressures_kpa is None)
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
+    # the empty scene and calibration boards the settings name are no photos of a ramp
+    named = files_named_in(folder, dict(settings or {}), pd.DataFrame()) | named_files(folder)
     rows, unmatched = [], []
     for name in sorted(photo_names(folder, subfolders="/" in pattern), key=natural_key):
+        if (folder / name).resolve() in named:
+            continue
         m = regex.match(name)
         if not m:
             unmatched.append(name)
@@ -254,6 +269,7 @@ def init_photoset(
             if isinstance(pressures_kpa, Mapping)
             else {None: tuple(pressures_kpa)},
             trials_in_order=not trials_in_names,
+            actuators_in_order="actuator" not in regex.groupindex,
         )
         if not trials_in_names and "direction" not in df.columns:
             df = _split_ramps(df)
@@ -437,13 +453,16 @@ def _with_pressures(
     pressures_kpa: Mapping[str | None, tuple[float, ...]],
     *,
     trials_in_order: bool = False,
+    actuators_in_order: bool = False,
 ) -> pd.DataFrame:
     """``df`` with each ramp's photos given its pressures in order (by step, else by name):
     those of its ``actuator/trial``, else of its trial, else those for every ramp (key None).
 
     With ``trials_in_order`` (the file names hold no trial), a group whose photo count is the sum
     of the trials' own specs (two or more, keyed ``trial`` or ``actuator/trial``) is split in
-    photo order: the first spec's trial takes the first photos, and so on.
+    photo order: the first spec's trial takes the first photos, and so on.  With
+    ``actuators_in_order`` too (nor the actuator) and specs naming several actuators, every
+    spec's ramp is taken in that order, its actuator with it.
     """
     out = df.copy()
     out["pressure_kpa"] = np.nan
@@ -452,28 +471,42 @@ def _with_pressures(
     ):
         order = g.sort_values("step") if "step" in g.columns else g
         ramp = f"material {material}, actuator {actuator}, trial {trial}"
-        own = [
-            (key.rpartition("/")[2], values)
+        keyed = [
+            (key.rpartition("/")[0] or str(actuator), key.rpartition("/")[2], values)
             for key, values in pressures_kpa.items()
-            if key is not None and key.rpartition("/")[0] in ("", str(actuator))
+            if key is not None
         ]
-        if trials_in_order and len(own) > 1 and len(order) == sum(len(v) for _, v in own):
-            start = 0  # ramps taken one after another: the first trial's photos come first
-            for label, values in own:
+        # the actuators, too, one after another in one folder (no actuator in the names): every
+        # ramp's spec in the order given; else this actuator's
+        own = (
+            keyed
+            if actuators_in_order and len({a for a, _, _ in keyed}) > 1
+            else [k for k in keyed if k[0] == str(actuator)]
+        )
+        if trials_in_order and len(own) > 1 and len(order) == sum(len(v) for _, _, v in own):
+            start = 0  # ramps taken one after another: the first ramp's photos come first
+            for ramp_actuator, label, values in own:
                 rows = order.index[start : start + len(values)]
                 out.loc[rows, "pressure_kpa"] = values
+                out.loc[rows, "actuator"] = ramp_actuator
                 out.loc[rows, "trial"] = label
                 start += len(values)
             continue
         if trials_in_order and len(own) > 1:
-            counts = ", ".join(f"{label}: {len(v)}" for label, v in own)
+            several = len({a for a, _, _ in own}) > 1
+            counts = ", ".join(
+                f"{a + '/' if several else ''}{label}: {len(v)}" for a, label, v in own
+            )
             raise UserInputError(
-                f"material {material}, actuator {actuator}: {len(order)} photo(s) "
-                f"({order['image'].iloc[0]} ... "
-                f"{order['image'].iloc[-1]}) but the trials' --pressures-kpa give "
-                f"{sum(len(v) for _, v in own)} pressures ({counts}); taken one after another "
-                "in one folder, the trials' photos must add up to its photos: a photo missing, "
-                "deleted or extra (move it out), or a spec that is not the ramp's"
+                f"material {material}"
+                + ("" if several else f", actuator {actuator}")
+                + f": {len(order)} photo(s) ({order['image'].iloc[0]} ... "
+                f"{order['image'].iloc[-1]}) but the "
+                + ("ramps'" if several else "trials'")
+                + f" --pressures-kpa give {sum(len(v) for _, _, v in own)} pressures ({counts}); "
+                "taken one after another in one folder, the ramps' photos must add up to its "
+                "photos: a photo missing, deleted or extra (move it out), or a spec that is not "
+                "the ramp's"
             )
         key = next(
             (k for k in (f"{actuator}/{trial}", str(trial), None) if k in pressures_kpa), "none"

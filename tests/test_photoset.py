@@ -533,6 +533,38 @@ def test_ramps_taken_one_after_another_in_one_folder_are_split_into_trials(tmp_p
     assert photoset_init.ramp_starts([0, 50, 50, 0, 0]) == [0]
 
 
+def test_two_actuators_ramps_and_the_empty_scene_in_one_camera_folder_are_told_apart(tmp_path):
+    # customer 22: IMG_1001 ... IMG_1078, actuator A1's two ramps then A2's (21 and 19 photos),
+    # and IMG_1079 the empty rig. The A2/... specs were silently dropped ('78 photos but the
+    # trials' --pressures-kpa give 38 pressures (1: 19, 2: 19)'), and the empty scene, named
+    # by --background, was counted as a ramp's photo
+    for n in range(1001, 1080):
+        (tmp_path / f"IMG_{n}.JPG").write_bytes(b"")
+    specs = {"A1/1": "0:180:20", "A1/2": "0:180:20", "A2/1": "0:200:20", "A2/2": "0:180:20"}
+    base = [sys.executable, "-m", "pipeline", "photoset", "init", str(tmp_path), "--pattern",
+            "IMG_*.JPG", "--material", "DS30", "--target", "body", "--l0-mm", "255",
+            "--background", "IMG_1079.JPG"]
+    for key, spec in specs.items():
+        base += ["--pressures-kpa", f"{key}={spec}"]
+    out = subprocess.run(base, capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr
+    m = ps.read_manifest(tmp_path)
+    assert "IMG_1079.JPG" not in set(m["image"]) and len(m) == 78
+    got = m.groupby(["actuator", "trial"], sort=False)["pressure_kpa"].apply(list).to_dict()
+    assert got == {
+        tuple(k.split("/")): list(photoset_init.ramp_pressures(v)) for k, v in specs.items()
+    }
+    assert m.loc[m["image"] == "IMG_1039.JPG", ["actuator", "trial", "step"]].values.tolist() == [
+        ["A2", "1", 0]
+    ]
+    assert "A2 trial 1: IMG_1039.JPG ... IMG_1059.JPG, 21 photos" in out.stdout
+    # the ramps' specs that do not add up name each ramp's count
+    out = subprocess.run(base[:-2] + ["--pressures-kpa", "A2/2=0:160:20", "--overwrite"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 2, out.stderr
+    assert "give 76 pressures (A1/1: 19, A1/2: 19, A2/1: 21, A2/2: 17)" in out.stderr
+
+
 def test_a_manifest_kept_in_a_spreadsheets_own_format_is_named_not_silently_ignored(photo_folder):
     # the manifest edited in Excel and saved as manifest.xlsx: manifest.csv, unchanged, was read
     # as it was with no word; a 'Manifest.csv' was only 'missing'
