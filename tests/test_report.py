@@ -937,6 +937,11 @@ def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert [w for w in res.warnings if w.startswith("DS20: no sealed_end_mm")], res.warnings
     assert "DS20: no sealed_end_mm" in " ".join(pdf_text(out, 0).split())
+    # the provenance page says how the set was measured (customer 22's advisor could not tell:
+    # target, sealed end, empty scene, fixed end were nowhere in the PDF)
+    last = " ".join(pdf_text(out, res.pages - 1).split())
+    assert "How each photo set was measured" in last
+    assert "l0_mm 195, fixed_end [40, 60], positive_turn ccw, target body" in last, last
     # so is a photo left out of the manifest (it was never measured)
     (d.photoset_dir / "DS20_late.jpg").write_bytes(b"")
     res = build_report(ReportInputs(datasets=(d,)), out)

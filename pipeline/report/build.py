@@ -31,7 +31,6 @@ from pipeline.report.data import (
     ReportInputs,
     force_inputs,
     load_report_data,
-    photoset_warnings,
 )
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
@@ -203,7 +202,8 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         for label, folder in (("--photosets", d.photoset_dir), ("--overlays", d.overlays_dir)):
             if folder is not None and not folder.is_dir():
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
-        warnings += photoset_warnings(d)
+    for info in data.datasets:
+        warnings += info.doubts
     body = (
         [overview_page(data)]
         + [material_page(data, m) for m in data.materials]

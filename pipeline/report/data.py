@@ -11,7 +11,7 @@ import csv
 import hashlib
 import io
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,7 +31,15 @@ from pipeline.fileio import read_table
 from pipeline.folders import folder_sha256
 from pipeline.force.grasp import EXAMPLE_LOG as GRASP_EXAMPLE
 from pipeline.force.pages import FILES as FORCE_FILES
-from pipeline.photoset import MANIFEST, SETTINGS, TRUTH, load_photoset, measurement_doubts
+from pipeline.measure.settings import OVERRIDE_COLUMNS
+from pipeline.photoset import (
+    MANIFEST,
+    SETTINGS,
+    TRUTH,
+    PhotoSet,
+    load_photoset,
+    measurement_doubts,
+)
 from pipeline.study.pages import TABLES as BENCH_TABLES
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
@@ -101,6 +109,13 @@ class DatasetInfo:
     date_source : str
         Where the dates come from (``"timestamps"``, ``"EXIF"`` or ``""``); without dates, why
         the timestamps could not be read as dates, or ``""``.
+    settings : str
+        How its photos were measured: the photo set's settings (``photoset.yaml`` with its
+        defaults, those with a value) and the manifest's per-row setting columns, in words;
+        ``""`` without a readable photo set.
+    doubts : tuple of str
+        What its photo set leaves doubtful or unmeasured whatever its rows say
+        (:func:`photoset_doubts`).
     """
 
     name: str
@@ -108,6 +123,8 @@ class DatasetInfo:
     first_date: str | None
     last_date: str | None
     date_source: str
+    settings: str = ""
+    doubts: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -472,25 +489,50 @@ def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
         else ("synthetic" if (folder / TRUTH).is_file() else "real")
     )
     first, last, where = dataset_dates(angles, folder)
-    return DatasetInfo(dataset.name, source, first, last, where)
+    ps = None
+    if folder is not None and (folder / SETTINGS).is_file():
+        try:
+            ps = load_photoset(folder)
+        except UserInputError:
+            ps = None  # its rows were measured when it could be read
+    return DatasetInfo(
+        dataset.name,
+        source,
+        first,
+        last,
+        where,
+        settings="" if ps is None else settings_words(ps.settings, ps.manifest),
+        doubts=() if ps is None else photoset_doubts(dataset.name, ps),
+    )
 
 
-def photoset_warnings(dataset: Dataset) -> list[str]:
+def settings_words(settings: Mapping[str, Any], manifest: pd.DataFrame) -> str:
+    """How a photo set was measured, in one line: its settings that have a value, then the
+    manifest's per-row setting columns and how many rows give one.
+
+    Examples
+    --------
+    >>> m = pd.DataFrame({"image": ["a.jpg", "b.jpg"], "exclude": [None, "[[1, 2, 3, 4]]"]})
+    >>> settings_words({"l0_mm": 30, "mm_per_px": None, "target": "body"}, m)
+    'l0_mm 30, target body; per row: exclude (1 row)'
+    """
+    given = [f"{k} {v}" for k, v in settings.items() if v is not None and v != ""]
+    per_row = [
+        f"{c} ({n} row{'s' if n != 1 else ''})"
+        for c in OVERRIDE_COLUMNS
+        if c in manifest.columns and (n := int(manifest[c].notna().sum()))
+    ]
+    return ", ".join(given) + (f"; per row: {', '.join(per_row)}" if per_row else "")
+
+
+def photoset_doubts(name: str, ps: PhotoSet) -> tuple[str, ...]:
     """What a dataset's photo set leaves doubtful or unmeasured whatever its rows say, one line
     each (:func:`pipeline.photoset.measurement_doubts`).
 
     ``measure`` prints them, but a Snakemake run keeps that in the job's log, so the report says
     them too (only what the set's content decides, never file times: same inputs, same report).
-    A photo set that can no longer be read gives none (its rows were measured when it could).
     """
-    folder = dataset.photoset_dir
-    if folder is None or not (folder / SETTINGS).is_file():
-        return []
-    try:
-        ps = load_photoset(folder)
-    except UserInputError:
-        return []
-    return [f"{dataset.name}: {p.message}; {p.fix}" for p in measurement_doubts(ps)]
+    return tuple(f"{name}: {p.message}; {p.fix}" for p in measurement_doubts(ps))
 
 
 def dataset_dates(

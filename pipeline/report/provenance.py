@@ -70,24 +70,48 @@ def provenance_pages(
             f"Camera calibration: {line}", size=8.0, color="#b00000" if style == "w" else "0.25"
         )
     flow.space(4.0)
-    rows = tuple((f.role, f.path, f.sha256) for f in data.files)
     pages = [fig]
-    while True:
-        table = Table(
-            columns=(
+    # how the angles were taken (the advisor's first question of a photo set), then the inputs
+    measured = tuple((d.name, d.settings) for d in data.datasets if d.settings)
+    tables = (
+        (
+            (Column("Dataset", "left", wrap_pt=100.0), Column("Settings", "left", wrap_pt=380.0)),
+            measured,
+            (
+                "How each photo set was measured (photoset.yaml with its defaults; the "
+                "manifest's per-row settings)"
+            ),
+        ),
+        (
+            (
                 Column("Input", "left", wrap_pt=100.0),
                 Column("File", "left", wrap_pt=110.0),
                 Column("sha256", "left", family=MONO),
             ),
-            rows=rows,
-            title="Input files" + ("" if len(pages) == 1 else " (continued)"),
-            size=7.0,
-        )
-        k = rows_that_fit(table, flow.width, flow.remaining_pt)
-        flow.table(dataclasses.replace(table, rows=rows[:k]))
-        rows = rows[k:]
-        if not rows:
-            return pages
-        fig = text_page(label="provenance (continued)")
-        flow = Flow(fig, top_pt=36.0)
-        pages.append(fig)
+            tuple((f.role, f.path, f.sha256) for f in data.files),
+            "Input files",
+        ),
+    )
+    fresh = False  # a page with nothing on it yet
+    for columns, rows, title in tables:
+        first = True
+        while rows:
+            table = Table(
+                columns=columns,
+                rows=rows,
+                title=title + ("" if first else " (continued)"),
+                size=7.0,
+            )
+            k = rows_that_fit(table, flow.width, flow.remaining_pt)
+            if k == 0 and fresh:
+                raise ValueError(f"a row of {title!r} does not fit on a page")
+            if k:
+                flow.table(dataclasses.replace(table, rows=rows[:k]))
+                flow.space(4.0)
+                rows, first, fresh = rows[k:], False, False
+            if rows:
+                fig = text_page(label="provenance (continued)")
+                flow = Flow(fig, top_pt=36.0)
+                pages.append(fig)
+                fresh = True
+    return pages
