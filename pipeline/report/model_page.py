@@ -163,7 +163,8 @@ def model_provenance_page(data: ReportData) -> Figure | None:
         ),
         "Constants of the model fitted to the paper's own numbers: " + ("; ".join(fit) or NA) + ".",
         (
-            "l0: 'photo set' is the marked length the photos were measured with (angles.csv); "
+            "l0: 'photo set' is the l0_mm the photos were measured with (angles.csv: a drawn "
+            "line's marked length, or a body's length that bends); "
             "'materials file' is the model's default, the one parameter the paper's two model "
             "results fix (docs/model.md); 'dataset's materials file' is the l0 of the dataset's "
             "own materials file (config datasets[].materials_file)."
