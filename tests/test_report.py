@@ -1005,3 +1005,25 @@ def test_a_materials_table_sets_the_models_predicted_crossings_beside_the_run_an
     assert cells["P at ψ = 0 (kPa)"] == ("58", "38", "", "54", "65"), cells
     assert cells["P at ψ = -ψ0 (kPa)"][3] == "103"
     assert any("predicted, nothing fitted" in n for n in table.notes)
+
+
+def test_a_level_one_photo_alone_reached_is_drawn_hollow_and_said(tmp_path):
+    # customer 22: only one ramp went to 200 kPa; its single photo was plotted as a mean point,
+    # unsaid, and the page's range rested on it
+    d = make_dataset(tmp_path, "DS20", actuators=2, trials=1, photos=False, overlays=False)
+    angles = pd.read_csv(d.angles_csv)
+    top = angles["pressure_kpa"].max()
+    keep = ~((angles["pressure_kpa"] == top) & (angles["actuator"] == "A2"))
+    angles[keep].to_csv(d.angles_csv, index=False)
+    data = load_report_data(ReportInputs(datasets=(d,)))
+    with report_style():
+        made, _ = report_figures(data)
+    page = next(f for f in made if f.get_label() == "material DS20")
+    text = " ".join(t.text for t in drawn_texts(page))
+    said = " ".join(text.split())
+    assert "Hollow points: one photo alone at " in said and f" {top:g} kPa rising" in said
+    hollow = [
+        line for ax in page.axes for line in ax.get_lines()
+        if line.get_markerfacecolor() == "white" and len(line.get_xdata())
+    ]
+    assert hollow and top in {float(x) for line in hollow for x in line.get_xdata()}

@@ -115,6 +115,10 @@ def plot_hysteresis(
             p, m - sd, m + sd, color=col, alpha=alpha, linewidth=0, label=f"± 1 sd, {label}"
         )
         ax.plot(p, m, color=col, marker="o", markersize=2.5, label=f"mean, {label}")
+        one = b["n"].to_numpy(float) == 1 if "n" in b.columns else np.zeros(len(b), bool)
+        if one.any():  # a level only one photo reached: a value, not a mean (hollow)
+            ax.plot(p[one], m[one], linestyle="none", marker="o", markersize=3.5,
+                    markerfacecolor="white", markeredgecolor=col, markeredgewidth=0.8)
     for label, mp, ms, style in model_lines(data, material, p_max * 1.02):
         ax.plot(mp, ms, linestyle=style, color="0.15", linewidth=1.2, label=label)
     ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=0)
@@ -371,6 +375,33 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
     flow.y = top + caption + height
 
 
+def single_photo_note(data: ReportData, material: str) -> str:
+    """A sentence naming the levels of ``material`` that one photo alone reached (``n`` = 1 in
+    the hysteresis table: drawn hollow, a value with no spread), else ``""``.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> h = pd.DataFrame({"material": "DS30", "direction": ["up", "up", "up", "down"],
+    ...                   "pressure_kpa": [160.0, 180.0, 200.0, 180.0], "n": [1, 4, 1, 1]})
+    >>> single_photo_note(SimpleNamespace(hysteresis=h), "DS30")
+    'Hollow points: one photo alone at 160 and 200 kPa rising, 180 kPa falling (n = 1, no spread).'
+    """
+    h = data.hysteresis[data.hysteresis["material"].astype(str) == material]
+    if "n" not in h.columns:
+        return ""
+    said = []
+    for direction, word in (("up", "rising"), ("down", "falling")):
+        levels = sorted(h.loc[(h["n"] == 1) & (h["direction"] == direction), "pressure_kpa"])
+        if levels:
+            listed = [f"{p:g}" for p in levels]
+            head = ", ".join(listed[:-1]) + " and " if len(listed) > 1 else ""
+            said.append(f"{head}{listed[-1]} kPa {word}")
+    if not said:
+        return ""
+    return f"Hollow points: one photo alone at {', '.join(said)} (n = 1, no spread)."
+
+
 def material_page(data: ReportData, material: str) -> Figure:
     """One material: Fig. 6 plot, per-actuator curves, comparison table, Fig. 5-style photo
     strip."""
@@ -387,7 +418,8 @@ def material_page(data: ReportData, material: str) -> Figure:
         extra_notes=tuple(
             f"Also compared: {o} (all comparisons: the model-curve page)." for o in others
         )
-        + tuple(n for n in (mixed_sources_note(data, material),) if n),
+        + tuple(n for n in (mixed_sources_note(data, material), single_photo_note(data, material))
+                if n),
     )
     table_h = table_height_pt(table, 595.0 - 84.0)
     fig = page(label=f"material {material}", bottom_pt=table_h + STRIP_BAND_PT + 12.0)

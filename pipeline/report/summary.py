@@ -102,7 +102,8 @@ def results_table(data: ReportData) -> Table:
         "curve at the measured levels, both directions (as the paper's RMS).  k_P: fitted to this "
         "run's photos at rising pressure (the model's loading branch; the falling leg's "
         "hysteresis would pull it low), 95 % bootstrap interval over actuators (n/a for a "
-        "material with one actuator); a fitted value, so its closeness to the paper's k_P tests nothing."),
+        "material with one actuator); a fitted value, so its closeness to the paper's k_P "
+        "tests nothing."),
     ]
     notes += missing_notes(data)
     notes += coarse_crossing_notes(data.angles, aggregate_options(data.run_config))
