@@ -136,7 +136,7 @@ def test_a_preview_name_that_is_no_image_format_is_refused(tmp_path):
     assert not (tmp_path / "sheet.gif").exists()
 
 
-def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
+def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped(tmp_path):
     # the dev strips are 200 px wide: their overlays were 200 px with one 90-character reason
     # line running off the photo; now enlarged, with the reason wrapped in a band of at most
     # 30 % of the photo (the report's strip crops that band off)
@@ -170,6 +170,14 @@ def test_an_overlay_of_a_small_photo_is_enlarged_and_shows_its_reason_wrapped():
     noted = note_final_status(out, "flagged", "breaks its ramp", "")
     assert noted.shape[0] > out.shape[0] and (noted[: out.shape[0]] == out).all()
     assert crop_banner(noted).shape[0] == photo_h
+    # the report's photo strip shows the photo alone, its bands cut before it is made small
+    # (customer 22's strip kept a sliver of one band or the other on 4 of 6 tiles)
+    from pipeline.report.strip import load_thumbnail
+
+    path = tmp_path / "overlay.jpg"
+    cv2.imwrite(str(path), noted)
+    thumb = load_thumbnail(path, banner=True)
+    assert thumb is not None and thumb.shape[0] == round(photo_h * thumb.shape[1] / 640)
     assert " ".join(lines[2:]).startswith(res.reason.split(";")[0])
     assert final_status_text("flagged", "breaks its ramp; x", "x") == (
         "then flagged: also breaks its ramp"

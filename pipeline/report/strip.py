@@ -133,9 +133,9 @@ def load_thumbnail(
     bgr = read_image(path)
     if bgr is None:
         return None
-    bgr = _narrowed(bgr, max_width_px)
-    if banner:
+    if banner:  # at full size: narrowed, the 2-px line between band and photo blurs away
         bgr = crop_banner(bgr)
+    bgr = _narrowed(bgr, max_width_px)
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
 
 
