@@ -26,7 +26,7 @@ from pipeline.cli import main
 from pipeline.errors import UserInputError
 from pipeline.force.aggregate_force import eccentricity_at_max_pressure, force_vs_pressure
 from pipeline.force.grasp import EXAMPLE_LOG, heaviest_held, read_grasp_log
-from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, report_style
+from pipeline.layout.style import FOOTER_PT, MIN_FONT_PT, material_colors, report_style
 from pipeline.layout.typeset import NA, fmt
 from pipeline.measure.overlay import BAND_BGR, DIVIDER_BGR
 from pipeline.report.build import build_report, report_figures
@@ -1027,3 +1027,18 @@ def test_a_level_one_photo_alone_reached_is_drawn_hollow_and_said(tmp_path):
         if line.get_markerfacecolor() == "white" and len(line.get_xdata())
     ]
     assert hollow and top in {float(x) for line in hollow for x in line.get_xdata()}
+
+
+def test_each_actuator_of_a_material_has_its_own_colour(tmp_path):
+    # customer 22: A1 and A2 were both the material's orange, told apart by markers only, and
+    # the one's falling curve hid the other's
+    d = make_dataset(tmp_path, "DS30", actuators=3, trials=1, photos=False, overlays=False)
+    data = load_report_data(ReportInputs(datasets=(d,)))
+    with report_style():
+        made, _ = report_figures(data)
+    page = next(f for f in made if f.get_label() == "material DS30")
+    ax = next(a for a in page.axes if a.get_title().startswith("Per actuator"))
+    rising = {line.get_label(): line.get_color() for line in ax.get_lines()
+              if line.get_linestyle() == "-" and line.get_label() in ("A1", "A2", "A3")}
+    assert len(rising) == 3 and len({tuple(c) for c in rising.values()}) == 3
+    assert tuple(rising["A1"]) == material_colors(["DS30"])["DS30"]  # the first: the page's own

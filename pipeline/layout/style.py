@@ -140,6 +140,12 @@ def material_colors(materials: Sequence[str]) -> dict[str, Color]:
     return out
 
 
+def actuator_colors() -> list[Color]:
+    """Colours that tell the actuators of one material apart: the paper's four materials', then
+    the others' (no grey: the model's lines are grey)."""
+    return [to_rgb(c) for c in (*MATERIAL_COLORS.values(), *_OTHER_COLORS) if c != "#7f7f7f"]
+
+
 def lighter(color: Color, amount: float = 0.55) -> Color:
     """Blend ``color`` with white (``amount`` = share of white)."""
     r, g, b = color

@@ -22,6 +22,7 @@ from pipeline.layout.style import (
     P_LABEL,
     PSI_LABEL,
     Color,
+    actuator_colors,
     footer_fraction,
     lighter,
     material_colors,
@@ -278,7 +279,11 @@ def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -
     """Mean psi of each actuator (over its trials): solid increasing, dashed decreasing pressure."""
     per = data.per_actuator[data.per_actuator["material"] == material]
     markers = "os^vD<>ph*"
+    # each actuator its own colour (one colour for all, told apart by markers only, hid an
+    # actuator's curve under another's: customer 22); the material's own for the first
+    palette = [color, *[c for c in actuator_colors() if c != color]]
     for i, (actuator, g) in enumerate(per.groupby("actuator", sort=True)):
+        own = palette[i % len(palette)]
         for direction, ls in (("up", "-"), ("down", "--")):
             b = g[g["direction"] == direction].sort_values("pressure_kpa")
             if b.empty:
@@ -290,7 +295,7 @@ def plot_per_actuator(ax: Axes, data: ReportData, material: str, color: Color) -
                 marker=markers[i % len(markers)],
                 markersize=2.5,
                 linewidth=0.9,
-                color=color if direction == "up" else lighter(color, 0.4),
+                color=own if direction == "up" else lighter(own, 0.4),
                 label=f"{actuator}" if direction == "up" else None,
             )
     ax.axhline(0.0, color="0.5", linewidth=0.6, zorder=0)
