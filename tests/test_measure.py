@@ -474,3 +474,23 @@ def test_photoset_check_takes_a_phone_photo_as_it_is_seen(tmp_path):
     )
     write_settings(tmp_path, {"l0_mm": 210, "fixed_end": [250, 380], "roi": [10, 300, 290, 390]})
     assert [str(p) for p in check_photoset(tmp_path)] == []
+
+
+def test_a_contact_sheet_keeps_each_overlays_aspect_and_fills_its_rows(tmp_path: Path) -> None:
+    # customer 22: 19 overlays on 6 columns left a third of the sheet black, and an overlay with
+    # a band below its photo was squeezed to the others' height (its photo's angles distorted)
+    from pipeline.measure.overlay import contact_sheet
+
+    paths = []
+    for k in range(19):
+        img = np.full((480 + (40 if k == 1 else 0), 640, 3), 200, np.uint8)
+        cv2.circle(img, (320, 240), 100, (0, 0, 0), -1)
+        paths.append(tmp_path / f"o{k}.png")
+        cv2.imwrite(str(paths[-1]), img)
+    sheet = contact_sheet(paths)
+    assert sheet.shape[1] == 1920  # 4 columns of 480 px: one empty tile, not five
+    tile = sheet[: round(520 * 480 / 640), 480:960]  # the taller overlay, row 1 column 2
+    dark = np.argwhere(tile.max(axis=2) < 60)
+    height, width = np.ptp(dark, axis=0) + 1
+    assert abs(height - width) <= 2  # its circle is still round
+    assert sheet.shape[0] == round(520 * 480 / 640) + 4 * round(480 * 480 / 640)  # padded rows

@@ -294,22 +294,55 @@ def wrap_text(text: str, width_px: int, scale: float, max_lines: int) -> list[st
     return lines
 
 
+#: a ramp's contact sheet is this wide; its columns are chosen to leave the fewest empty tiles
+SHEET_WIDTH_PX = 1920
+SHEET_COLUMNS = (4, 5, 6)
+
+
+def sheet_columns(n: int, choices: Sequence[int] = SHEET_COLUMNS) -> int:
+    """Columns of a sheet of ``n`` tiles: of ``choices``, the one leaving the fewest empty tiles
+    in its last row (the fewer columns, and so the larger tiles, on a tie); ``n`` itself when
+    fewer.
+
+    Examples
+    --------
+    >>> [sheet_columns(n) for n in (3, 17, 19, 24, 40)]
+    [3, 6, 4, 4, 4]
+    """
+    if n <= min(choices):
+        return max(n, 1)
+    return min(choices, key=lambda c: (-n % c, c))
+
+
 def contact_sheet(
-    paths: Sequence[Path], *, columns: int = 6, tile_width_px: int = 320
+    paths: Sequence[Path], *, columns: int | None = None, tile_width_px: int | None = None
 ) -> np.ndarray:
-    """Tile overlay images (in the given order) into one sheet; unreadable tiles stay grey."""
+    """Tile overlay images (in the given order) into one sheet; unreadable tiles stay grey.
+
+    Each tile keeps its overlay's aspect (one with a band below the photo is taller, padded
+    under the others in its row, never squeezed); ``columns`` defaults to
+    :func:`sheet_columns` and the tiles to :data:`SHEET_WIDTH_PX` across.
+    """
     if not paths:
         raise ValueError("no overlays for a contact sheet")
+    columns = columns or sheet_columns(len(paths))
+    width = tile_width_px or SHEET_WIDTH_PX // columns
     images = [cv2.imread(str(p)) for p in paths]
-    h_ref = next(
-        (t.shape[0] * tile_width_px // t.shape[1] for t in images if t is not None),
-        tile_width_px * 3 // 4,
-    )
-    grey = np.full((h_ref, tile_width_px, 3), 128, np.uint8)
     tiles: list[np.ndarray] = [
-        grey if t is None else cv2.resize(t, (tile_width_px, h_ref), interpolation=cv2.INTER_AREA)
+        np.full((width * 3 // 4, width, 3), 128, np.uint8)
+        if t is None
+        else cv2.resize(
+            t, (width, max(1, round(t.shape[0] * width / t.shape[1]))),
+            interpolation=cv2.INTER_AREA,
+        )
         for t in images
     ]
-    rows = int(np.ceil(len(tiles) / columns))
-    tiles += [np.zeros_like(grey)] * (rows * columns - len(tiles))
-    return np.vstack([np.hstack(tiles[r * columns : (r + 1) * columns]) for r in range(rows)])
+    rows = []
+    for r in range(0, len(tiles), columns):
+        row = tiles[r : r + columns]
+        row += [np.zeros_like(row[0][:1])] * (columns - len(row))
+        h = max(t.shape[0] for t in row)
+        rows.append(
+            np.hstack([np.vstack([t, np.zeros((h - t.shape[0], width, 3), np.uint8)]) for t in row])
+        )
+    return np.vstack(rows)
