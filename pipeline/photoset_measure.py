@@ -27,8 +27,9 @@ from pipeline.measure.ramp_background import (
     RAMP_BACKGROUND_MIN_PHOTOS,
     covered,
     estimate_background,
+    estimates_background,
 )
-from pipeline.measure.settings import OVERRIDE_COLUMNS, MeasureSettings
+from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task, run_task
 from pipeline.photoset import (
     PhotoSet,
@@ -290,22 +291,6 @@ def _measure_photos(
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
     return pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
         drop=True
-    )
-
-
-def estimates_background(settings: MeasureSettings | None) -> bool:
-    """Whether a row's body may be measured again against its ramp's estimate of the empty
-    scene: a body told from the backdrop (no colour) without a photo of the empty scene, whose
-    free end is known (``sealed_end_mm`` given, or ``free_end: bends``).  A tip seen whole
-    against the estimate but read over its sealed end swung (up to 16 deg on rendered
-    translucent ramps), so without that length the backdrop alone decides, as before.
-    """
-    return (
-        settings is not None
-        and settings.target == "body"
-        and settings.color is None
-        and settings.background_path is None
-        and (settings.sealed_end_mm is not None or settings.free_end == "bends")
     )
 
 

@@ -35,6 +35,7 @@ from pipeline.measure.overlay import (
     screen_directions,
     wrap_text,
 )
+from pipeline.measure.ramp_background import estimates_background
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 from pipeline.video.clips import Clip, frame_settings, resolve_clips
@@ -90,6 +91,17 @@ def preview_tile(
     """The preview of one photo: annotated photo beside its selection mask (BGR)."""
     data = np.fromfile(str(path), dtype=np.uint8) if Path(path).is_file() else np.empty(0, np.uint8)
     return encoded_tile(data, Path(path).name, settings, method=method, title=title, reason=reason)
+
+
+def tile_reason(res: AngleResult, settings: MeasureSettings | None) -> str:
+    """A tile's reason; a doubtful body that ``measure`` looks at again against its ramp's own
+    photos (the second look, :func:`~pipeline.measure.ramp_background.estimates_background`) is
+    shown as its first look saw it, and says so (a customer saw flagged tiles whose rows
+    ``measure`` then wrote ``ok``)."""
+    again = res.status != "ok" and estimates_background(settings)
+    return ("first look, measure looks again against its ramp's photos: " if again else "") + (
+        res.reason
+    )
 
 
 def encoded_tile(
@@ -172,7 +184,7 @@ def encoded_tile(
     text = [
         title,
         f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",
-        *wrap_text(res.reason, 2 * tint.shape[1] - 16, TEXT_SCALE, REASON_LINES),
+        *wrap_text(tile_reason(res, settings), 2 * tint.shape[1] - 16, TEXT_SCALE, REASON_LINES),
     ]
     # the words in a band above the photo and its mask: the whole reason, none of the photo hidden
     band = np.full((12 + 20 * len(text), 2 * tint.shape[1], 3), 30, np.uint8)

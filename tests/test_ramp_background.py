@@ -10,8 +10,9 @@ import pandas as pd
 import pytest
 
 from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
+from pipeline.measure.ramp_background import estimates_background
 from pipeline.measure.settings import resolve_settings
-from pipeline.photoset_measure import estimates_background, measure_photoset
+from pipeline.photoset_measure import measure_photoset
 
 
 def _without_background(folder, extra: str = "") -> None:
@@ -104,3 +105,28 @@ def test_each_photo_is_brought_to_the_ramps_exposure_before_the_median():
         covers.append(covered(photo.shape[:2], np.array([[x + 2.0, 5.0], [x + 2.0, 35.0]]), 4.0))
     estimate = estimate_background(photos, covers).astype(int)
     assert estimate.max() - estimate.min() <= 1, (estimate.min(), estimate.max())
+
+
+def test_the_preview_says_a_doubtful_first_look_is_looked_at_again(translucent_ramp):
+    # customer 23: preview tiles flagged 'the centre line stops 77 px short' whose rows measure
+    # then wrote ok, with nothing on the tile to say why
+    import cv2
+
+    from pipeline.measure import measure_image
+    from pipeline.photoset import load_photoset
+    from pipeline.preview import tile_reason
+
+    ps = load_photoset(translucent_ramp)
+    looks = [
+        (measure_image(cv2.imread(str(translucent_ramp / name)), settings), settings)
+        for name, settings in zip(ps.manifest["image"], ps.rows, strict=True)
+    ]
+    doubtful = [(r, s) for r, s in looks if r.status != "ok"]
+    assert doubtful and all(
+        tile_reason(r, s).startswith("first look, measure looks again against its ramp's photos")
+        for r, s in doubtful
+    )
+    assert all(tile_reason(r, s) == r.reason for r, s in looks if r.status == "ok")
+    # an empty scene given: no second look, nothing said
+    given = dataclasses.replace(doubtful[0][1], background_path="/x/empty.jpg")
+    assert tile_reason(doubtful[0][0], given) == doubtful[0][0].reason

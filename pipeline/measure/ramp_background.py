@@ -32,6 +32,7 @@ import cv2
 import numpy as np
 
 from pipeline.measure.body import exposure_gains
+from pipeline.measure.settings import MeasureSettings
 
 #: a ramp of at least this many measured body photos gets its empty scene estimated
 RAMP_BACKGROUND_MIN_PHOTOS = 8
@@ -93,3 +94,19 @@ def estimate_background(images: list[np.ndarray], covers: list[np.ndarray]) -> n
         free = (~cover).sum(axis=0)[..., None] >= MIN_FREE_PHOTOS
         out[top : top + rows] = np.clip(np.round(np.where(free, masked, plain)), 0, 255)
     return out
+
+
+def estimates_background(settings: MeasureSettings | None) -> bool:
+    """Whether a row's body may be measured again against its ramp's estimate of the empty
+    scene: a body told from the backdrop (no colour) without a photo of the empty scene, whose
+    free end is known (``sealed_end_mm`` given, or ``free_end: bends``).  A tip seen whole
+    against the estimate but read over its sealed end swung (up to 16 deg on rendered
+    translucent ramps), so without that length the backdrop alone decides, as before.
+    """
+    return (
+        settings is not None
+        and settings.target == "body"
+        and settings.color is None
+        and settings.background_path is None
+        and (settings.sealed_end_mm is not None or settings.free_end == "bends")
+    )
