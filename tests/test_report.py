@@ -942,6 +942,10 @@ def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in
     last = " ".join(pdf_text(out, res.pages - 1).split())
     assert "How each photo set was measured" in last
     assert "l0_mm 195, fixed_end [40, 60], positive_turn ccw, target body" in last, last
+    # and what was not given, what was done without it, and the method the rows name
+    # (customer 24's advisor found only the keys typed)
+    assert "not given: mm_per_px (no scale), fixed_direction_deg (the base direction read" in last
+    assert "method: paper (" in last
     # so is a photo left out of the manifest (it was never measured)
     (d.photoset_dir / "DS20_late.jpg").write_bytes(b"")
     res = build_report(ReportInputs(datasets=(d,)), out)

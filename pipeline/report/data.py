@@ -31,6 +31,7 @@ from pipeline.fileio import read_table
 from pipeline.folders import folder_sha256
 from pipeline.force.grasp import EXAMPLE_LOG as GRASP_EXAMPLE
 from pipeline.force.pages import FILES as FORCE_FILES
+from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
 from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import (
     MANIFEST,
@@ -501,20 +502,47 @@ def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
         first,
         last,
         where,
-        settings="" if ps is None else settings_words(ps.settings, ps.manifest),
+        settings="" if ps is None else settings_words(ps.settings, ps.manifest, angles),
         doubts=() if ps is None else photoset_doubts(dataset.name, ps),
     )
 
 
-def settings_words(settings: Mapping[str, Any], manifest: pd.DataFrame) -> str:
-    """How a photo set was measured, in one line: its settings that have a value, then the
-    manifest's per-row setting columns and how many rows give one.
+#: a body's settings that, not given, leave something to the measurement, and what it does
+NOT_GIVEN_WORDS: dict[str, str] = {
+    "mm_per_px": "no scale",
+    "fixed_direction_deg": "the base direction read from the photos, each ramp's median",
+    "background": "no empty scene",
+    "sealed_end_mm": "the tip read where the centre line stops",
+}
+
+
+def settings_words(
+    settings: Mapping[str, Any], manifest: pd.DataFrame, angles: pd.DataFrame | None = None
+) -> str:
+    r"""How a photo set was measured, in one line: its settings that have a value, the manifest's
+    per-row setting columns (how many rows give one), for a body the settings not given (and
+    what was done without them), and from its ``angles`` the method each row took and how many
+    rows were measured again against their ramp's own photos (the second look).
 
     Examples
     --------
     >>> m = pd.DataFrame({"image": ["a.jpg", "b.jpg"], "exclude": [None, "[[1, 2, 3, 4]]"]})
-    >>> settings_words({"l0_mm": 30, "mm_per_px": None, "target": "body"}, m)
-    'l0_mm 30, target body; per row: exclude (1 row)'
+    >>> settings_words({"l0_mm": 30, "mm_per_px": None, "target": "line"}, m)
+    'l0_mm 30, target line; per row: exclude (1 row)'
+    >>> a = pd.DataFrame({"method": ["tangents"] * 2, "reason": ["", "measured against the "
+    ...                   "empty scene estimated from its ramp's photos (the first look ...)"]})
+    >>> words = settings_words({"l0_mm": 30, "target": "body", "sealed_end_mm": 4}, m, a)
+    >>> print(*words.replace(", ", ",\n  ").split("; "), sep="\n")
+    l0_mm 30,
+      target body,
+      sealed_end_mm 4
+    per row: exclude (1 row)
+    not given: mm_per_px (no scale),
+      fixed_direction_deg (the base direction read from the photos,
+      each ramp's median),
+      background (no empty scene)
+    method: tangents (2 rows)
+    1 row measured again (the second look) against the empty scene estimated from its ramp's photos
     """
     given = [f"{k} {v}" for k, v in settings.items() if v is not None and v != ""]
     per_row = [
@@ -522,7 +550,32 @@ def settings_words(settings: Mapping[str, Any], manifest: pd.DataFrame) -> str:
         for c in OVERRIDE_COLUMNS
         if c in manifest.columns and (n := int(manifest[c].notna().sum()))
     ]
-    return ", ".join(given) + (f"; per row: {', '.join(per_row)}" if per_row else "")
+    parts = [", ".join(given)] + ([f"per row: {', '.join(per_row)}"] if per_row else [])
+    if settings.get("target") == "body":
+        missing = [
+            f"{k} ({why})"
+            for k, why in NOT_GIVEN_WORDS.items()
+            if settings.get(k) in (None, "")
+            and not (k in manifest.columns and manifest[k].notna().any())
+        ]
+        parts += [f"not given: {', '.join(missing)}"] if missing else []
+    if angles is not None and len(angles):
+        counts = angles["method"].dropna().astype(str).value_counts()
+        if len(counts):
+            parts.append(
+                "method: "
+                + ", ".join(f"{m} ({n} row{'s' if n != 1 else ''})" for m, n in counts.items())
+            )
+        again = int(
+            angles["reason"].fillna("").astype(str).str.contains(NOTE_RAMP_BACKGROUND,
+                                                                 regex=False).sum()
+        )
+        if again:
+            parts.append(
+                f"{again} row{'s' if again != 1 else ''} measured again (the second look)"
+                + NOTE_RAMP_BACKGROUND.removeprefix("measured")
+            )
+    return "; ".join(parts)
 
 
 def photoset_doubts(name: str, ps: PhotoSet) -> tuple[str, ...]:

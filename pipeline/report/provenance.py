@@ -78,8 +78,8 @@ def provenance_pages(
             (Column("Dataset", "left", wrap_pt=100.0), Column("Settings", "left", wrap_pt=380.0)),
             measured,
             (
-                "How each photo set was measured (photoset.yaml with its defaults; the "
-                "manifest's per-row settings)"
+                "How each photo set was measured (photoset.yaml; the manifest's per-row "
+                "settings; for a body what was not given; the method angles.csv names)"
             ),
         ),
         (
