@@ -785,6 +785,27 @@ def test_a_shadow_beside_the_body_is_left_out_but_a_neutral_grey_body_is_kept():
     assert mask[40:60, 40:260].all()
 
 
+def test_a_shadow_is_left_out_against_the_empty_scene_estimated_from_the_ramp(tmp_path):
+    # the second look measures a doubtful body against the empty scene estimated from its
+    # ramp's photos; the body's shadow was kept there (customer 23's opaque body curled to
+    # +213 deg read 6.8 deg high, ok), so it is told from the body as against an empty-scene
+    # photo, where the estimate shows the backdrop
+    import dataclasses
+
+    import cv2
+
+    from pipeline.measure.body import body_mask
+
+    photo, empty = _band_photo((60, 60, 200), shadow_bgr=(150, 150, 150))
+    estimate = tmp_path / "estimate.png"
+    cv2.imwrite(str(estimate), empty)
+    settings = dataclasses.replace(
+        settings_for((30.0, 50.0)), background_path=str(estimate), background_estimated=True
+    )
+    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    assert mask[40:60, 40:260].all() and not mask[62:75, 40:260].any()
+
+
 def test_the_realscenes_bench_gives_each_analogue_its_empty_scene_when_asked():
     # --background: the translucent body on grey is found whole against its empty scene (without
     # it 2 of these 4 photos are flagged, up to 10.6 deg off)

@@ -567,16 +567,22 @@ def body_mask(
     if settings.color is not None:
         mask &= color_mask(image_bgr, settings.color)
     if settings.color is None or background_bgr is not None:
+        shade = None  # the body's shadow on the empty scene: it differs from it too
         if background_bgr is not None and settings.background_estimated:
             assert settings.background_path is not None
             like = estimate_looks_like_backdrop(
                 settings.background_path, (h, w), settings.roi, settings.exclude, scale
             )
             diff, sigma = estimated_background_difference(image_bgr, background_bgr, allowed, like)
-            background_bgr = None  # an estimate: no shadow to tell from the body
+            # where the estimate is the backdrop (elsewhere it shows the body itself): left in,
+            # the shadow widened the body on one side and |psi| near 215 deg read 5-9 deg high
+            shade = shadow_mask(image_bgr, matched_exposure(background_bgr, image_bgr)) & (
+                like > 0
+            )
         elif background_bgr is not None:
             background_bgr = matched_exposure(background_bgr, image_bgr)
             diff, sigma = background_difference(image_bgr, background_bgr)
+            shade = shadow_mask(image_bgr, background_bgr)
         else:
             diff, sigma = backdrop_difference(exposed(image_bgr, allowed), allowed)
         # any clear difference is body: a translucent body differs faintly (splitting the
@@ -584,10 +590,8 @@ def body_mask(
         thr = _threshold(sigma)
         low = max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE)
         differs = _hysteresis(diff, thr, low)
-        if background_bgr is not None:  # the body's shadow differs from the empty scene too
-            lit = _hysteresis(
-                np.where(shadow_mask(image_bgr, background_bgr), 0.0, diff), thr, low
-            )
+        if shade is not None:
+            lit = _hysteresis(np.where(shade, 0.0, diff), thr, low)
             if lit.sum() >= SHADOW_KEEP * differs.sum():
                 differs = lit
         mask &= differs
