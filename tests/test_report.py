@@ -789,9 +789,13 @@ def test_one_material_without_optional_tables(tmp_path):
     out = tmp_path / "r.pdf"
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert res.materials == ("SS40",)
-    # summary, overview, SS40, comparison, provenance (no rms.csv: no model-curve page)
-    assert res.pages == 5
+    # summary, overview, SS40, provenance: no rms.csv and no model curve, so no comparison with
+    # the model and no model-curve page (customer 24's lab materials, unknown to the model, got
+    # both pages empty, and captions promising a dashed model line)
+    assert res.pages == 4
     text = " ".join(pdf_text(out, 0).split())
+    assert "No model comparison: none of this run's materials (SS40) has a model curve" in text
+    assert "analytical model" not in " ".join(pdf_text(out, 2).split())
     assert "SS40 unknown" in text  # no photo-set folder: neither real nor synthetic can be told
     assert "SS40: no row in --rms" in text
 

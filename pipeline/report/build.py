@@ -31,6 +31,7 @@ from pipeline.report.data import (
     ReportInputs,
     force_inputs,
     load_report_data,
+    modelled_materials,
 )
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
@@ -207,9 +208,10 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     body = (
         [overview_page(data)]
         + [material_page(data, m) for m in data.materials]
-        + [comparison_page(data)]
+        + ([comparison_page(data)] if modelled_materials(data) else [])
     )
-    body += [f for f in [model_provenance_page(data)] if f is not None]  # which l0, what was fitted
+    if modelled_materials(data):  # which l0, what was fitted
+        body += [f for f in [model_provenance_page(data)] if f is not None]
     body += extra + provenance_pages(data, __version__, infos, warnings)
     return [summary_page(data, __version__, warnings, contents(body))] + body, warnings
 

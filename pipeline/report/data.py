@@ -676,6 +676,16 @@ def model_readings_note(run_config: dict[str, Any]) -> str:
     )
 
 
+def modelled_materials(data: ReportData) -> list[str]:
+    """The run's materials compared with the model: a model curve, or an RMS against it (the
+    others have no dashed line, RMS or fitted k_P: the model has no such material, or neither
+    was given)."""
+    have = set(data.model_curves["material"].astype(str))
+    if "rms_deg" in data.rms.columns:  # compared with the model (its curve maybe not given)
+        have |= set(data.rms.loc[data.rms["rms_deg"].notna(), "material"].astype(str))
+    return [m for m in data.materials if m in have]
+
+
 def rms_row(data: ReportData, material: str) -> dict[str, float]:
     """rms.csv row of a material as a dict (empty when absent).
 

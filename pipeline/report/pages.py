@@ -34,6 +34,7 @@ from pipeline.report.data import (
     comparisons,
     material_sources,
     mixed_sources_note,
+    modelled_materials,
     rms_row,
 )
 from pipeline.report.model_page import comparison_note
@@ -135,25 +136,24 @@ def plot_hysteresis(
         ax.legend(loc="best", frameon=False)
 
 
-def legend_proxies() -> tuple[list[Artist], list[str]]:
-    """Neutral legend entries for the hysteresis plots of every material."""
+def legend_proxies(model: bool = True) -> tuple[list[Artist], list[str]]:
+    """Neutral legend entries for the hysteresis plots of every material (the model's dashed
+    line only where ``model``: some material has one)."""
     dark, light = (0.3, 0.3, 0.3), lighter((0.3, 0.3, 0.3))
-    return (
-        [
-            Line2D([], [], color=dark, marker="o", markersize=2.5),
-            Patch(color=dark, alpha=0.35, linewidth=0),
-            Line2D([], [], color=light, marker="o", markersize=2.5),
-            Patch(color=light, alpha=0.35, linewidth=0),
-            Line2D([], [], color="0.15", linestyle="--", linewidth=1.2),
-        ],
-        [
-            "mean, increasing P",
-            "± 1 sd, increasing P",
-            "mean, decreasing P",
-            "± 1 sd, decreasing P",
-            "analytical model",
-        ],
-    )
+    handles: list[Artist] = [
+        Line2D([], [], color=dark, marker="o", markersize=2.5),
+        Patch(color=dark, alpha=0.35, linewidth=0),
+        Line2D([], [], color=light, marker="o", markersize=2.5),
+        Patch(color=light, alpha=0.35, linewidth=0),
+    ]
+    labels = ["mean, increasing P", "± 1 sd, increasing P", "mean, decreasing P",
+              "± 1 sd, decreasing P"]
+    if model:
+        handles.append(Line2D([], [], color="0.15", linestyle="--", linewidth=1.2))
+        labels.append("analytical model")
+    return handles, labels
+
+
 
 
 def overview_page(data: ReportData) -> Figure:
@@ -170,7 +170,7 @@ def overview_page(data: ReportData) -> Figure:
         plot_hysteresis(ax, data, m, colors[m], legend=False)
     for ax in list(axes.flat)[len(materials) :]:
         ax.set_axis_off()
-    handles, labels = legend_proxies()
+    handles, labels = legend_proxies(model=bool(modelled_materials(data)))
     fig.legend(
         handles,
         labels,
@@ -442,7 +442,8 @@ def material_page(data: ReportData, material: str) -> Figure:
         data,
         material,
         color,
-        title=f"Mean ± 1 sd over {spread_of(data, material)} (as Fig. 6); dashed: analytical model",
+        title=f"Mean ± 1 sd over {spread_of(data, material)} (as Fig. 6)"
+        + ("; dashed: analytical model" if material in modelled_materials(data) else ""),
     )
     plot_per_actuator(bottom.subplots(), data, material, color)
     flow = Flow(fig, top_pt=72.0 * fig.get_figheight() - (22.0 + table_h + STRIP_BAND_PT + 6.0))

@@ -28,6 +28,7 @@ from pipeline.report.data import (
     comparisons,
     material_sources,
     mixed_sources_note,
+    modelled_materials,
     rms_row,
 )
 from pipeline.report.reasons import top_reasons
@@ -105,6 +106,15 @@ def results_table(data: ReportData) -> Table:
         "material with one actuator); a fitted value, so its closeness to the paper's k_P "
         "tests nothing."),
     ]
+    if data.materials and not modelled_materials(data):
+        notes.append(
+            "No model comparison: none of this run's materials ("
+            + ", ".join(data.materials)
+            + ") has a model curve or an RMS against the model, so nothing was predicted or "
+            "fitted, and the comparison and model-curve pages are left out (a material the "
+            "model does not have: add it to a materials file named in config.yaml, "
+            "model.materials_file)."
+        )
     notes += missing_notes(data)
     notes += coarse_crossing_notes(data.angles, aggregate_options(data.run_config))
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
