@@ -1050,3 +1050,20 @@ def test_each_actuator_of_a_material_has_its_own_colour(tmp_path):
               if line.get_linestyle() == "-" and line.get_label() in ("A1", "A2", "A3")}
     assert len(rising) == 3 and len({tuple(c) for c in rising.values()}) == 3
     assert tuple(rising["A1"]) == material_colors(["DS30"])["DS30"]  # the first: the page's own
+
+
+def test_page_1_names_the_few_photos_it_counts_as_flagged_or_failed(tmp_path):
+    # customer 24: 'hook at an end of the centre line (1)' and no word of which photo
+    d = make_dataset(tmp_path, "DS20", actuators=1, trials=1, photos=False, overlays=False)
+    angles = pd.read_csv(d.angles_csv)
+    angles["status"], angles["reason"] = "ok", ""
+    angles.loc[3, ["status", "reason"]] = ["flagged", "the free end's direction is uncertain"]
+    angles.to_csv(d.angles_csv, index=False)
+    out = tmp_path / "r.pdf"
+    build_report(ReportInputs(datasets=(d,)), out)
+    text = " ".join(pdf_text(out, 0).split())
+    assert f"(1): {angles.loc[3, 'image']}" in text
+    angles.loc[:7, ["status", "reason"]] = ["flagged", "the free end's direction is uncertain"]
+    angles.to_csv(d.angles_csv, index=False)
+    build_report(ReportInputs(datasets=(d,)), out)
+    assert angles.loc[3, "image"] not in " ".join(pdf_text(out, 0).split())  # many: counted
