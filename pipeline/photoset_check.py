@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import os
 
-from pipeline.photoset import Problem, file_problems, load_checked
+from pipeline.model.materials import load_materials
+from pipeline.photoset import MANIFEST, PhotoSet, Problem, file_problems, load_checked
 from pipeline.video.clips import clip_problems
 
 
@@ -35,4 +36,26 @@ def check_photoset(
         if ps.is_video:
             problems += clip_problems(ps, decode=decode_images, require_files=require_images)
         problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
+        problems += material_problems(ps)
     return [p for p in problems if warnings or not p.warning]
+
+
+def material_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning for each material of the set that the model's packaged materials file does not
+    have: the report then compares it with the model only when a materials file named in the
+    run's config has it (customer 24 learnt it from the finished PDF)."""
+    known = load_materials()
+    materials = ps.manifest["material"].dropna().astype(str)
+    out = []
+    for m in sorted(set(materials) - set(known)):
+        line = ps.manifest.loc[materials[materials == m].index[0], "manifest_line"]
+        out.append(Problem(
+            str(ps.folder / MANIFEST),
+            int(line),
+            f"material {m} is not one of the model's materials ({', '.join(sorted(known))}): "
+            "its angles are measured and reported, but not compared with the model",
+            f"to compare, add {m} (its Ogden terms, k_P and geometry) to a materials file named "
+            "in config.yaml (model.materials_file); else nothing to do",
+            warning=True,
+        ))
+    return out

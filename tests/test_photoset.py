@@ -756,3 +756,20 @@ def test_the_preview_shows_the_photos_named_and_refuses_a_name_not_in_the_manife
     assert "is a set of photos, not videos (fix: name a photo with --image NAME)" in (
         capsys.readouterr().err
     )
+
+
+def test_check_warns_of_a_material_the_model_does_not_have(photo_folder):
+    # customer 24 named the materials as the lab does (softA, stiffB) and learnt only from the
+    # finished PDF that nothing was compared with the model
+    from pipeline.photoset_check import check_photoset
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    assert not [p for p in check_photoset(photo_folder, warnings=True) if "material" in p.message]
+    m = ps.read_manifest(photo_folder).drop(columns="manifest_line")
+    m.loc[m.index[2:], "material"] = "softA"
+    m.to_csv(photo_folder / ps.MANIFEST, index=False)
+    (warning,) = [p for p in check_photoset(photo_folder, warnings=True) if "softA" in p.message]
+    assert warning.warning and warning.line == 4 and "not compared with the model" in (
+        warning.message
+    )
+    assert "model.materials_file" in warning.fix
