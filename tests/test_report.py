@@ -10,6 +10,7 @@ synthetic, dates from the inputs, n/a for missing values, identical bytes for id
 from __future__ import annotations
 
 import dataclasses
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -1067,3 +1068,14 @@ def test_page_1_names_the_few_photos_it_counts_as_flagged_or_failed(tmp_path):
     angles.to_csv(d.angles_csv, index=False)
     build_report(ReportInputs(datasets=(d,)), out)
     assert angles.loc[3, "image"] not in " ".join(pdf_text(out, 0).split())  # many: counted
+
+
+@ON_THE_DEFAULT_REPORT
+def test_a_material_pages_table_says_what_psi0_and_each_n_a_are(pages):
+    # customer 24: 'P at psi = -psi0' with psi0 defined nowhere on the page, and 'n/a' both for
+    # 'not reached' and for 'the paper gives none'
+    for label, texts in pages:
+        if label.startswith("material "):
+            said = " ".join(" ".join(t.text for t in texts).split())
+            assert re.search(r"ψ0 = 2\d\d\.\d°, the rest angle \(the model's;", said), label
+            assert "another n/a: not reached within the run's pressures" in said, label

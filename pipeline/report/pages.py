@@ -256,9 +256,16 @@ def metric_table(
         notes=(
             (
                 "model: where the model's loading branch (the paper's k_P, this l0) reaches the "
-                "angle, predicted, nothing fitted.  paper n/a: the paper reports no such value.  "
-                "k_P is fitted, not predicted: the paper's value stands beside it for reference "
-                "only."
+                "angle, predicted, nothing fitted.  paper n/a: the paper reports no such value; "
+                "another n/a: not reached within the run's pressures (or no model).  "
+                + (
+                    f"ψ0 = {fmt(g('psi0_deg'), 1)}°, the rest angle (the model's; for a "
+                    "material it does not have, the mean ψ at the lowest rising pressure).  "
+                    if fmt(g("psi0_deg"), 1) != NA
+                    else ""
+                )
+                + "k_P is fitted, not predicted: the paper's value stands beside it for "
+                "reference only."
             ),
             *extra_notes,
         ),
