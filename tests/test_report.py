@@ -1036,6 +1036,22 @@ def test_a_level_one_photo_alone_reached_is_drawn_hollow_and_said(tmp_path):
         if line.get_markerfacecolor() == "white" and len(line.get_xdata())
     ]
     assert hollow and top in {float(x) for line in hollow for x in line.get_xdata()}
+    overview = next(f for f in made if f.get_label() == "overview")
+    assert "hollow points: one photo alone (n = 1)" in " ".join(
+        t.text for t in drawn_texts(overview)
+    )
+
+
+def test_the_overview_draws_every_material_on_one_psi_scale(tmp_path):
+    # customer 24: side by side on scales of their own, a material bending 60 deg looked like one
+    # bending 450
+    a = make_dataset(tmp_path, "DS20", actuators=1, trials=1, photos=False, overlays=False)
+    b = make_dataset(tmp_path, "SS50", actuators=1, trials=1, photos=False, overlays=False)
+    with report_style():
+        made, _ = report_figures(load_report_data(ReportInputs(datasets=(a, b))))
+    overview = next(f for f in made if f.get_label() == "overview")
+    limits = {ax.get_ylim() for ax in overview.axes if ax.get_title()}
+    assert len(limits) == 1
 
 
 def test_each_actuator_of_a_material_has_its_own_colour(tmp_path):

@@ -165,9 +165,13 @@ def overview_page(data: ReportData) -> Figure:
     nrows = math.ceil(n / ncols)
     fig = page(label="overview", bottom_pt=LEGEND_BAND_PT)
     fig.suptitle("Bending angle versus input pressure (as Fig. 6 of the paper)")
-    axes = fig.subplots(nrows, ncols, squeeze=False)
+    # one psi scale for all (panels each on their own made a small range look like a large one:
+    # customer 24)
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharey=True)
     for ax, m in zip(axes.flat, materials, strict=False):
         plot_hysteresis(ax, data, m, colors[m], legend=False)
+    for ax in axes[:, 1:].flat:
+        ax.set_ylabel("")  # the first column's says it
     for ax in list(axes.flat)[len(materials) :]:
         ax.set_axis_off()
     handles, labels = legend_proxies(model=bool(modelled_materials(data)))
@@ -179,7 +183,12 @@ def overview_page(data: ReportData) -> Figure:
         ncols=3,
         frameon=False,
         title="Each panel in its material's colour; shading: ± 1 standard deviation over actuators "
-        "and trials",
+        "and trials"
+        + (
+            "; hollow points: one photo alone (n = 1)"
+            if "n" in data.hysteresis.columns and (data.hysteresis["n"] == 1).any()
+            else ""
+        ),
     )
     return fig
 
