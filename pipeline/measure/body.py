@@ -366,8 +366,9 @@ def estimate_looks_like_backdrop(
 def estimated_background_difference(
     image_bgr: np.ndarray, estimate_bgr: np.ndarray, allowed: np.ndarray, backdrop_like: np.ndarray
 ) -> tuple[np.ndarray, float]:
-    """Difference of each pixel from the empty scene estimated from the ramp's photos, joined
-    with its difference from the backdrop (:func:`backdrop_difference`), and that noise.
+    """Difference of each pixel from the empty scene estimated from the ramp's photos (already
+    at the photo's exposure, :func:`matched_exposure`), joined with its difference from the
+    backdrop (:func:`backdrop_difference`), and that noise.
 
     Both differences are scaled so that their selection thresholds (``NOISE_SIGMAS`` times each
     one's noise, at least ``MIN_DIFFERENCE``) meet at ``MIN_DIFFERENCE``, and the larger counts.
@@ -382,9 +383,7 @@ def estimated_background_difference(
         The noise that puts the threshold at ``MIN_DIFFERENCE``.
     """
     from_backdrop, s_backdrop = backdrop_difference(exposed(image_bgr, allowed), allowed)
-    from_estimate, s_estimate = background_difference(
-        image_bgr, matched_exposure(estimate_bgr, image_bgr)
-    )
+    from_estimate, s_estimate = background_difference(image_bgr, estimate_bgr)
     joined = np.maximum(
         np.where(backdrop_like > 0, from_estimate / _threshold(s_estimate), 0.0),
         from_backdrop / _threshold(s_backdrop),
@@ -573,12 +572,11 @@ def body_mask(
             like = estimate_looks_like_backdrop(
                 settings.background_path, (h, w), settings.roi, settings.exclude, scale
             )
-            diff, sigma = estimated_background_difference(image_bgr, background_bgr, allowed, like)
+            estimate = matched_exposure(background_bgr, image_bgr)
+            diff, sigma = estimated_background_difference(image_bgr, estimate, allowed, like)
             # where the estimate is the backdrop (elsewhere it shows the body itself): left in,
             # the shadow widened the body on one side and |psi| near 215 deg read 5-9 deg high
-            shade = shadow_mask(image_bgr, matched_exposure(background_bgr, image_bgr)) & (
-                like > 0
-            )
+            shade = shadow_mask(image_bgr, estimate) & (like > 0)
         elif background_bgr is not None:
             background_bgr = matched_exposure(background_bgr, image_bgr)
             diff, sigma = background_difference(image_bgr, background_bgr)

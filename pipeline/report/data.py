@@ -111,9 +111,8 @@ class DatasetInfo:
         Where the dates come from (``"timestamps"``, ``"EXIF"`` or ``""``); without dates, why
         the timestamps could not be read as dates, or ``""``.
     settings : str
-        How its photos were measured: the photo set's settings (``photoset.yaml`` with its
-        defaults, those with a value) and the manifest's per-row setting columns, in words;
-        ``""`` without a readable photo set.
+        How its photos were measured, in words (:func:`settings_words`); ``""`` without a
+        readable photo set.
     doubts : tuple of str
         What its photo set leaves doubtful or unmeasured whatever its rows say
         (:func:`photoset_doubts`).

@@ -154,8 +154,6 @@ def legend_proxies(model: bool = True) -> tuple[list[Artist], list[str]]:
     return handles, labels
 
 
-
-
 def overview_page(data: ReportData) -> Figure:
     """All materials side by side, as the paper's Fig. 6 (one legend for all panels)."""
     materials = data.materials
