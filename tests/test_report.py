@@ -533,6 +533,10 @@ def test_page_one_quality_reasons_in_words_sources_and_dates(default):
         assert " ".join(counts) in text, d.name
     total = len(angles)
     assert f"all {total} {(angles['status'] == 'ok').sum()}" in text
+    # how well: these sets' truth.csv holds no psi_image_deg, so the trials' scatter, each
+    # dataset's own figure (customer 24: the PDF said how many were flagged, not how good)
+    assert "|ψ error| (deg)" in text and "blind to an error every photo shares" in text
+    assert text.count("between trials") == len(inputs.datasets)
     assert "synthetic: the photos were rendered from this model" in text
     # 'sample' (real) and 'DS20' (synthetic) are both DS20: its plots show the real one, and say so
     assert (

@@ -41,6 +41,7 @@ from pipeline.photoset import (
     load_photoset,
     measurement_doubts,
 )
+from pipeline.report.accuracy import NO_ACCURACY, AngleAccuracy, angle_accuracy
 from pipeline.study.pages import TABLES as BENCH_TABLES
 
 #: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
@@ -116,6 +117,8 @@ class DatasetInfo:
     doubts : tuple of str
         What its photo set leaves doubtful or unmeasured whatever its rows say
         (:func:`photoset_doubts`).
+    accuracy : AngleAccuracy
+        How well its angles were measured (:func:`pipeline.report.accuracy.angle_accuracy`).
     """
 
     name: str
@@ -125,6 +128,7 @@ class DatasetInfo:
     date_source: str
     settings: str = ""
     doubts: tuple[str, ...] = ()
+    accuracy: AngleAccuracy = NO_ACCURACY
 
 
 @dataclass(frozen=True)
@@ -503,7 +507,17 @@ def dataset_info(dataset: Dataset, angles: pd.DataFrame) -> DatasetInfo:
         where,
         settings="" if ps is None else settings_words(ps.settings, ps.manifest, angles),
         doubts=() if ps is None else photoset_doubts(dataset.name, ps),
+        accuracy=angle_accuracy(angles, _truth(folder) if source == "synthetic" else None),
     )
+
+
+def _truth(folder: Path | None) -> pd.DataFrame | None:
+    """The renderer's truth.csv of a photo set, or None when it cannot be read."""
+    assert folder is not None  # a synthetic set's folder
+    try:
+        return read_table(folder / TRUTH, "the renderer's truth.csv")
+    except UserInputError:
+        return None
 
 
 #: a body's settings that, not given, leave something to the measurement, and what it does

@@ -21,6 +21,7 @@ from pipeline.aggregate import aggregate_hysteresis
 from pipeline.compare import branch
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
+from pipeline.report.accuracy import ACCURACY_NOTE
 from pipeline.report.calibration import calibration_lines
 from pipeline.report.data import (
     ReportData,
@@ -271,7 +272,17 @@ def quality_table(
         doubted = a.loc[status != "ok", "image"].astype(str).tolist()
         if 0 < len(doubted) <= NAMED_PHOTOS:  # few enough to look at (its overlay, the preview)
             why += f": {', '.join(doubted)}"
-        rows.append((info.name, info.source, materials, dates, *(str(int(v)) for v in c), why))
+        rows.append(
+            (
+                info.name,
+                info.source,
+                materials,
+                dates,
+                *(str(int(v)) for v in c),
+                info.accuracy.cell(),
+                why,
+            )
+        )
     dated = any(d.first_date for d in data.datasets)
 
     def table(kept: list[int]) -> Table:
@@ -286,11 +297,12 @@ def quality_table(
                     "",
                     "",
                     *(str(int(v)) for v in other),
+                    "",
                     "fewest flagged/failed",
                 )
             )
         total = sum(counts, np.zeros(4, dtype=int))
-        body.append(("all", "", "", "", *(str(int(v)) for v in total), ""))
+        body.append(("all", "", "", "", *(str(int(v)) for v in total), "", ""))
         columns: tuple[Column, ...] = (
             Column("Dataset", "left"),
             Column("Data", "left"),
@@ -300,7 +312,8 @@ def quality_table(
             Column("ok"),
             Column("flagged"),
             Column("failed"),
-            Column("Top reasons (photos)", "left", wrap_pt=200.0),
+            Column("|ψ error| (deg)", "left", wrap_pt=80.0),
+            Column("Top reasons (photos)", "left", wrap_pt=150.0),
         )
         if not dated:  # the date line above says so once
             columns = columns[:3] + columns[4:]
@@ -313,6 +326,7 @@ def quality_table(
                 ("Flagged and failed photos are left out of the curves and fits; the reasons are "
                  "counted once "
                 "per photo.  Data: synthetic = the photo set holds the renderer's truth.csv."),
+                ACCURACY_NOTE,
             ),
             size=8.0,
         )
