@@ -45,23 +45,24 @@ class AngleAccuracy:
     off: int = 0
 
     def cell(self) -> str:
-        """The figure in a table cell.
+        r"""The figure in a table cell: median / 95th percentile, and on a second line what they
+        are against.
 
         Examples
         --------
         >>> AngleAccuracy("truth", 40, 0.31, 1.24, 1).cell()
-        '0.31, 95 % ≤ 1.2 vs truth; 1 ok > 5°'
+        '0.31 / 1.2\ntruth, 1 ok > 5°'
+        >>> AngleAccuracy("truth", 40, 0.31, 1.24, 0).cell()
+        '0.31 / 1.2\ntruth'
         >>> AngleAccuracy("trials", 12, 0.8, 2.14).cell()
-        '0.80, 95 % ≤ 2.1 between trials'
+        '0.80 / 2.1\ntrials'
         >>> AngleAccuracy("none", 0).cell()
         'n/a (one trial)'
         """
         if self.basis == "none":
             return "n/a (one trial)"
-        figure = f"{self.median_deg:.2f}, 95 % ≤ {self.p95_deg:.1f}"
-        if self.basis == "trials":
-            return f"{figure} between trials"
-        return f"{figure} vs truth; {self.off} ok > {OFF_DEG:g}°"
+        figure = f"{self.median_deg:.2f} / {self.p95_deg:.1f}\n{self.basis}"
+        return f"{figure}, {self.off} ok > {OFF_DEG:g}°" if self.off else figure
 
 
 #: no figure: no truth and one trial per actuator (or no ok photo)
@@ -169,10 +170,9 @@ def angle_accuracy(angles: pd.DataFrame, truth: pd.DataFrame | None) -> AngleAcc
 
 #: the quality table's note on its error column
 ACCURACY_NOTE = (
-    "|ψ error|: median and 95th percentile (deg) over the ok photos, against the renderer's "
-    "truth.csv where the photo set has one (with the count of ok photos more than "
-    f"{OFF_DEG:g}° off); else how far two trials of one actuator at the same pressure and "
-    "direction differ: the rig's and the measurement's scatter together, blind to an error "
-    "every photo shares (a base direction read off: give fixed_direction_deg or an empty-scene "
-    "photo to rule it out)."
+    "|ψ error|: median / 95th percentile (deg) over the ok photos: against the renderer's "
+    f"truth.csv (with the ok photos more than {OFF_DEG:g}° off, if any); else how far two trials "
+    "of one actuator at one pressure and direction differ, the rig's and the measurement's "
+    "scatter, blind to an error every photo shares (a base direction read off: give "
+    "fixed_direction_deg or an empty-scene photo)."
 )

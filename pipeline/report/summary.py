@@ -76,19 +76,19 @@ def results_table(data: ReportData) -> Table:
     for m, label, row in comparisons(data):
         g = row.get
         ci = f"{fmt(g('k_p_fit'), 2)} [{fmt(g('k_p_ci_low'), 2)}, {fmt(g('k_p_ci_high'), 2)}]"
-        # one comparison: the material's datasets; several (one per l0): the photos of this one
-        source = sources[m] if label == m else str(g("data_source", NA)).replace("measured", "real")
         row_colors.append(colors[m])
+        # real or synthetic: the quality table's, per dataset (a column of it here made the
+        # 13-column table wrap its labels)
         rows.append(
             (
                 label,
-                source,
                 fmt(g("range_deg"), 0),
                 fmt(g("paper_range_deg"), 0),
                 fmt(g("p_zero_up_kpa"), 0),
                 fmt(g("p_zero_down_kpa"), 0),
                 fmt(g("model_p_zero_kpa"), 0),
                 fmt(g("paper_p_zero_kpa"), 0),
+                fmt(g("rms_up_deg"), 1),
                 fmt(g("rms_deg"), 1),
                 fmt(g("paper_rms_deg"), 1),
                 ci if fmt(g("k_p_fit"), 2) != NA else NA,
@@ -101,7 +101,9 @@ def results_table(data: ReportData) -> Table:
         "mean curve crosses ψ = 0 (linear between levels); model: where the model's loading "
         "branch does (predicted: the paper's k_P, nothing fitted).  RMS: the model (loading "
         "branch) against the mean "
-        "curve at the measured levels, both directions (as the paper's RMS).  k_P: fitted to this "
+        "curve at the measured levels: over the rising leg, which the loading branch models, and "
+        "over both directions as the paper's RMS (the falling leg's hysteresis, not modelled, "
+        "makes it larger).  k_P: fitted to this "
         "run's photos at rising pressure (the model's loading branch; the falling leg's "
         "hysteresis would pull it low), 95 % bootstrap interval over actuators (n/a for a "
         "material with one actuator); a fitted value, so its closeness to the paper's k_P "
@@ -127,23 +129,23 @@ def results_table(data: ReportData) -> Table:
     return Table(
         columns=(
             Column("Material", "left"),
-            Column("Data", "left"),
             Column("run"),
             Column("paper"),
             Column("rising"),
             Column("falling"),
             Column("model"),
             Column("paper"),
-            Column("run"),
+            Column("rising"),
+            Column("both"),
             Column("paper"),
             Column("fitted [95 % CI]"),
             Column("paper"),
         ),
         groups=(
-            ("", 2),
+            ("", 1),
             ("Range (deg)", 2),
             ("P at ψ = 0 (kPa)", 4),
-            ("RMS (deg)", 2),
+            ("RMS (deg)", 3),
             ("k_P (-)", 2),
         ),
         rows=tuple(rows),
@@ -312,8 +314,8 @@ def quality_table(
             Column("ok"),
             Column("flagged"),
             Column("failed"),
-            Column("|ψ error| (deg)", "left", wrap_pt=80.0),
-            Column("Top reasons (photos)", "left", wrap_pt=150.0),
+            Column("|ψ error| (deg)\nmedian / 95 %", "left"),
+            Column("Top reasons (photos)", "left", wrap_pt=200.0),
         )
         if not dated:  # the date line above says so once
             columns = columns[:3] + columns[4:]
