@@ -172,7 +172,9 @@ def test_a_side_along_the_image_border_is_measured_from_the_other_edge(scene, i)
     )
     img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
     res = measure_image(img, settings_for(r.fixed_end_px))
-    assert "a side runs along the image border" in res.reason
+    if scene != "green_fibre":  # its side stays inside: its shadow, selected with it until
+        # shadows were left out without an empty scene, ran out of the photo (2.4 -> 0.2 deg)
+        assert "a side runs along the image border" in res.reason
     assert res.status == "ok", res.reason
     assert res.psi_deg == pytest.approx(r.psi_image_deg, abs=2.5)
 
@@ -256,20 +258,29 @@ def test_a_free_end_with_one_side_lost_is_flagged():
     assert "free end" in res.reason, res.reason
 
 
-def test_a_hook_where_the_body_meets_the_clamp_is_flagged_not_an_ok_psi():
-    # silicone with dots on grey, saved again at JPEG quality 40: the selection runs into the
-    # plate's edge at the clamp and the centre line's first pixels hook towards it; a fit over
-    # the usual end window smooths the hook into the base tangent (it was ok at 16 deg off), a
-    # fit over half that window turns 13 deg
+@pytest.mark.parametrize("body", ["pink", "grey"])
+def test_a_hook_where_the_body_meets_the_clamp_is_flagged_not_an_ok_psi(body):
+    # silicone with dots on grey, saved again at JPEG quality 40: the selection ran into the
+    # body's shadow and the plate's edge at the clamp and the centre line's first pixels hooked
+    # towards them; a fit over the usual end window smoothed the hook into the base tangent (ok
+    # at 16 deg off), a fit over half that window turns 13 deg: flagged.  The pink body's shadow
+    # is now left out without an empty scene (backdrop_shadows), and it reads right; a grey
+    # body's cannot be told from it (its shaded side looks like a shadow too), and the check
+    # still flags its hook
     from pipeline.synth import render_actuator, scene_from
 
     psi = float(np.linspace(215.0, -220.0, 12)[6])
-    r = render_actuator(psi, 270.0, scene_from("grey_dots", width=1280, height=960), seed=36)
+    colour = {"pink": {}, "grey": {"body_bgr": (150, 150, 150)}}[body]
+    scene = scene_from("grey_dots", width=1280, height=960, **colour)
+    r = render_actuator(psi, 270.0, scene, seed=36)
     img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
     _ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 40])
     res = measure_image(cv2.imdecode(buf, cv2.IMREAD_COLOR), settings_for(r.fixed_end_px))
-    assert abs(res.psi_deg - r.psi_image_deg) > 10.0  # still wrong: the check is what changed
-    assert res.status == "flagged" and "the fixed end's direction turns" in res.reason
+    if body == "pink":
+        assert res.status == "ok" and abs(res.psi_deg - r.psi_image_deg) < 5.0, res.reason
+    else:
+        assert abs(res.psi_deg - r.psi_image_deg) > 10.0
+        assert res.status == "flagged" and "the fixed end's direction turns" in res.reason
 
 
 def _paint_gap(img, psi, gap_px, at=0.6, length=600.0, width=46.0, backdrop=(190, 196, 200)):
@@ -875,10 +886,13 @@ def test_a_ramps_bodies_are_measured_from_its_one_base_direction(tmp_path):
         if ramp_check:
             assert got.groupby("trial")["base_direction_deg"].nunique().eq(1).all()  # one clamp
             assert got["reason"].str.contains("deg against its ramp's base direction").any()
-            faint_tip = got["reason"].str.contains("a faint tip?", regex=False)
-            assert ((got["status"] == "ok") | faint_tip).all(), got["reason"].tolist()
-            assert faint_tip.sum() <= 2, got.loc[faint_tip, "reason"].tolist()
-    assert scores[False] >= 3 and scores[True] < scores[False], scores
+            short = got["reason"].str.contains("short of the body's free end", regex=False)
+            assert ((got["status"] == "ok") | short).all(), got["reason"].tolist()
+            assert short.sum() <= 2, got.loc[short, "reason"].tolist()
+    # since the body's shadow is left out without an empty scene (backdrop_shadows) its bases
+    # agree by themselves: 3 -> 1 wrong `ok` row before the check, 2 -> 1 after it; the one
+    # left is off at its free end, which the check cannot mend
+    assert scores[True] <= scores[False] <= 1, scores
 
 
 def test_a_camera_turned_mid_ramp_is_not_measured_from_the_ramps_first_direction(tmp_path):

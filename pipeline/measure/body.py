@@ -216,8 +216,10 @@ def exposed(image_bgr: np.ndarray, allowed: np.ndarray) -> np.ndarray:
     return cv2.convertScaleAbs(image_bgr, alpha=gain)
 
 
-def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, float]:
-    """Colour distance of each pixel from the backdrop, and the backdrop's noise.
+def backdrop_difference(
+    image_bgr: np.ndarray, allowed: np.ndarray
+) -> tuple[np.ndarray, float, tuple[np.ndarray, ...]]:
+    """Colour distance of each pixel from the backdrop, the backdrop's noise and its colours.
 
     The colours along the border of the allowed region are the backdrop's: they are grouped
     (k-means, 3 groups) and every group seen on at least :data:`BACKDROP_CLASS_FRACTION` of the
@@ -240,6 +242,9 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
         Colour distance (Lab, lightness weighted).
     sigma : float
         Robust spread of the difference over backdrop pixels.
+    backdrop_lab : tuple of ndarray
+        The backdrop's colours (Lab, lightness weighted): the main one's smooth field (H, W, 3),
+        then the others (3,) (:func:`backdrop_shadows`).
     """
     lab = _lab(image_bgr)
     model, centres, order, ring, grid = _main_backdrop(lab, allowed)
@@ -257,7 +262,64 @@ def backdrop_difference(image_bgr: np.ndarray, allowed: np.ndarray) -> tuple[np.
     vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
     med = float(np.median(vals))
     sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
-    return diff, sigma
+    return diff, sigma, (model, *others)
+
+
+def _bgr_of(lab: np.ndarray) -> np.ndarray:
+    """Lightness-weighted Lab colours (..., 3) as uint8 BGR (N, 1, 3): an image for OpenCV."""
+    unweighted = np.asarray(lab, np.float32).reshape(-1, 1, 3) / [LIGHTNESS_WEIGHT, 1.0, 1.0]
+    return cv2.cvtColor(np.clip(unweighted, 0, 255).astype(np.uint8), cv2.COLOR_LAB2BGR)
+
+
+def backdrop_shadows(
+    image_bgr: np.ndarray,
+    backdrop_lab: tuple[np.ndarray, ...],
+    where: np.ndarray,
+    clear: np.ndarray,
+) -> tuple[np.ndarray, float]:
+    """Where (among ``where``) the photo is one of the backdrop's colours in shadow, and how
+    coloured the clear differences (``clear``, a subset of ``where``) outside it are.
+
+    The body's shadow without an empty scene: a pixel that is one of the backdrop's colours
+    (:func:`backdrop_difference`) darker by one factor in every channel, no darker than
+    :data:`SHADOW_DARKEST_NO_BACKGROUND` (:func:`shadow_mask`).  Only ``where`` is looked at (the
+    pixels that differ at all: a tenth of the photo, not all of it).
+
+    Returns
+    -------
+    shade : ndarray (H, W) bool
+    chroma : float
+        Median distance (Lab a, b; 8-bit units) of the pixels of ``clear`` not in shadow from the
+        backdrop colour nearest each: a neutral body on a neutral backdrop has ~0, and its
+        shaded side looks like a shadow (:data:`BODY_CHROMA`).  (The faint differences of
+        ``where`` are mostly the backdrop's own texture and neutral.)
+
+    Examples
+    --------
+    >>> grey = np.full((1, 4, 3), 128, np.uint8)
+    >>> photo = grey.copy(); photo[0, 1] = (60, 60, 200); photo[0, 2] = (90, 90, 90)
+    >>> where = np.array([[0, 1, 1, 0]], bool)
+    >>> shade, chroma = backdrop_shadows(photo, (_lab(grey),), where, where)
+    >>> shade.tolist(), chroma > BODY_CHROMA
+    ([[False, False, True, False]], True)
+    """
+    ys, xs = np.nonzero(where)
+    shade = np.zeros(where.shape, bool)
+    if not len(ys):
+        return shade, 0.0
+    px = image_bgr[ys, xs].reshape(-1, 1, 3)
+    hit = np.zeros(len(ys), bool)
+    chroma = np.full(len(ys), np.inf, np.float32)
+    ab = cv2.cvtColor(px, cv2.COLOR_BGR2LAB).reshape(-1, 3)[:, 1:].astype(np.float32)
+    main, *others = backdrop_lab
+    for ref in [main[ys, xs], *(np.broadcast_to(c, (len(ys), 3)) for c in others)]:
+        ref_bgr = _bgr_of(ref)
+        hit |= shadow_mask(px, ref_bgr, darkest=SHADOW_DARKEST_NO_BACKGROUND).ravel()
+        ref_ab = np.asarray(ref, np.float32)[:, 1:]
+        chroma = np.minimum(chroma, np.hypot(*(ab - ref_ab).T))
+    shade[ys, xs] = hit
+    body = chroma[~hit & clear[ys, xs]]
+    return shade, float(np.median(body)) if len(body) else 0.0
 
 
 def light_falloff(image_bgr: np.ndarray, allowed: np.ndarray) -> float:
@@ -341,6 +403,11 @@ def _threshold(sigma: float) -> float:
     return max(NOISE_SIGMAS * sigma, MIN_DIFFERENCE)
 
 
+def _weak_threshold(sigma: float) -> float:
+    """The threshold of a faint difference next to a clear one (:func:`_hysteresis`)."""
+    return max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE)
+
+
 @functools.lru_cache(maxsize=4)
 def estimate_looks_like_backdrop(
     path: str, shape: tuple[int, int], roi: Polygon | None, exclude: tuple[Polygon, ...],
@@ -356,7 +423,7 @@ def estimate_looks_like_backdrop(
     estimate = cv2.resize(read, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
     region = region_mask((*shape, 3), roi, exclude, scale)
     allowed = np.ones(shape, np.uint8) if region is None else region
-    shows_body, sigma = backdrop_difference(exposed(estimate, allowed), allowed)
+    shows_body, sigma, _ = backdrop_difference(exposed(estimate, allowed), allowed)
     return cv2.erode(
         (shows_body < ESTIMATE_SHOWS_BODY * _threshold(sigma)).astype(np.uint8),
         np.ones((5, 5), np.uint8),
@@ -382,7 +449,7 @@ def estimated_background_difference(
     sigma : float
         The noise that puts the threshold at ``MIN_DIFFERENCE``.
     """
-    from_backdrop, s_backdrop = backdrop_difference(exposed(image_bgr, allowed), allowed)
+    from_backdrop, s_backdrop, _ = backdrop_difference(exposed(image_bgr, allowed), allowed)
     from_estimate, s_estimate = background_difference(image_bgr, estimate_bgr)
     joined = np.maximum(
         np.where(backdrop_like > 0, from_estimate / _threshold(s_estimate), 0.0),
@@ -478,16 +545,23 @@ def background_difference(
 #: the three ratios), between these factors, is a shadow the body casts, not the body
 SHADOW_RATIO_SPREAD = 0.12
 SHADOW_DARKEST, SHADOW_LIGHTEST = 0.3, 0.97
+#: ... and without an empty scene, against the backdrop's own colour, no darker than this: a
+#: grey clamp a third as bright as the backdrop is not the body's shadow (taken for one, the
+#: clamp left the selection and the base was read from what remained, 5-12 deg off)
+SHADOW_DARKEST_NO_BACKGROUND = 0.5
 #: ... unless leaving the shadows out would lose this share of the selection (a neutral grey body
 #: darker than a neutral backdrop looks like a shadow; it is then all kept)
 SHADOW_KEEP = 0.5
 
 
-def shadow_mask(image_bgr: np.ndarray, background_bgr: np.ndarray) -> np.ndarray:
+def shadow_mask(
+    image_bgr: np.ndarray, background_bgr: np.ndarray, darkest: float = SHADOW_DARKEST
+) -> np.ndarray:
     """Where the photo is the empty scene in shadow: darker by one factor in every channel.
 
     A shadow dims the backdrop and keeps its colour; the body, even translucent, changes the
-    colour (a red body on green) or brightens it.  On rendered ramp sets with a background photo
+    colour (a red body on green) or brightens it.  ``darkest``: the darkest shadow, as a fraction
+    of the empty scene's brightness.  On rendered ramp sets with a background photo
     the body's shadow was selected with it, widening the body on one side and round its tip
     (|psi| > 150 deg read 5-14 deg high, all ``ok``).
 
@@ -503,7 +577,12 @@ def shadow_mask(image_bgr: np.ndarray, background_bgr: np.ndarray) -> np.ndarray
     b, g, r = cv2.split(ratio)  # per channel with OpenCV: the mask took 16 ms on a 1280x960
     mean = (b + g + r) / np.float32(3.0)  # photo, 34 with numpy's reductions over the last axis
     spread = cv2.max(cv2.max(b, g), r) - cv2.min(cv2.min(b, g), r)
-    return (mean > SHADOW_DARKEST) & (mean < SHADOW_LIGHTEST) & (spread < SHADOW_RATIO_SPREAD)
+    return (mean > darkest) & (mean < SHADOW_LIGHTEST) & (spread < SHADOW_RATIO_SPREAD)
+
+
+#: a body is told from its shadow without an empty scene only when its colour differs from the
+#: backdrop's by at least this chroma (Lab a, b: 8-bit units) over most of it
+BODY_CHROMA = 8.0
 
 
 def _hysteresis(diff: np.ndarray, high: float, low: float) -> np.ndarray:
@@ -582,11 +661,19 @@ def body_mask(
             diff, sigma = background_difference(image_bgr, background_bgr)
             shade = shadow_mask(image_bgr, background_bgr)
         else:
-            diff, sigma = backdrop_difference(exposed(image_bgr, allowed), allowed)
+            seen = exposed(image_bgr, allowed)
+            diff, sigma, backdrop = backdrop_difference(seen, allowed)
+            # the body's shadow on the backdrop, against the backdrop's own colours: selected
+            # with the body, it widened it on one side; a neutral body's shaded side would look
+            # like one, so only a coloured body's is left out
+            shade, chroma = backdrop_shadows(
+                seen, backdrop, diff > _weak_threshold(sigma), diff > _threshold(sigma)
+            )
+            if chroma < BODY_CHROMA:
+                shade = None
         # any clear difference is body: a translucent body differs faintly (splitting the
         # differences in two, faint vs strong, cut translucent bodies down to their highlights)
-        thr = _threshold(sigma)
-        low = max(WEAK_SIGMAS * sigma, 0.5 * MIN_DIFFERENCE)
+        thr, low = _threshold(sigma), _weak_threshold(sigma)
         differs = _hysteresis(diff, thr, low)
         if shade is not None:
             lit = _hysteresis(np.where(shade, 0.0, diff), thr, low)
