@@ -547,7 +547,7 @@ SHADOW_RATIO_SPREAD = 0.12
 SHADOW_DARKEST, SHADOW_LIGHTEST = 0.3, 0.97
 #: ... and without an empty scene, against the backdrop's own colour, no darker than this: a
 #: grey clamp a third as bright as the backdrop is not the body's shadow (taken for one, the
-#: clamp left the selection and the base was read from what remained, 5-12 deg off)
+#: clamp left the selection and the drawn bodies of the tests read 4-13 deg off)
 SHADOW_DARKEST_NO_BACKGROUND = 0.5
 #: ... unless leaving the shadows out would lose this share of the selection (a neutral grey body
 #: darker than a neutral backdrop looks like a shadow; it is then all kept)
