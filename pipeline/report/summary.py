@@ -123,8 +123,10 @@ def results_table(data: ReportData) -> Table:
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
         notes.append(
-            "synthetic: the photos were rendered from this model, so their RMS against the model "
-            "checks the angle measurement, not the model."
+            "synthetic: the photos were rendered by 'synth' from a model curve with each "
+            "actuator's own stiffness and hysteresis, so their RMS tests neither the model nor "
+            "the measurement; the |ψ error| column below checks the angles against the "
+            "renderer's truth."
         )
     return Table(
         columns=(
