@@ -45,23 +45,22 @@ class AngleAccuracy:
     off: int = 0
 
     def cell(self) -> str:
-        r"""The figure in a table cell: median / 95th percentile, and on a second line what they
-        are against.
+        """The figure in a table cell: median / 95th percentile and what they are against.
 
         Examples
         --------
         >>> AngleAccuracy("truth", 40, 0.31, 1.24, 1).cell()
-        '0.31 / 1.2\ntruth, 1 ok > 5°'
+        '0.31 / 1.2 truth, 1 ok > 5°'
         >>> AngleAccuracy("truth", 40, 0.31, 1.24, 0).cell()
-        '0.31 / 1.2\ntruth'
+        '0.31 / 1.2 truth'
         >>> AngleAccuracy("trials", 12, 0.8, 2.14).cell()
-        '0.80 / 2.1\ntrials'
+        '0.80 / 2.1 trials'
         >>> AngleAccuracy("none", 0).cell()
         'n/a (one trial)'
         """
         if self.basis == "none":
             return "n/a (one trial)"
-        figure = f"{self.median_deg:.2f} / {self.p95_deg:.1f}\n{self.basis}"
+        figure = f"{self.median_deg:.2f} / {self.p95_deg:.1f} {self.basis}"
         return f"{figure}, {self.off} ok > {OFF_DEG:g}°" if self.off else figure
 
 
@@ -170,9 +169,8 @@ def angle_accuracy(angles: pd.DataFrame, truth: pd.DataFrame | None) -> AngleAcc
 
 #: the quality table's note on its error column
 ACCURACY_NOTE = (
-    "|ψ error|: median / 95th percentile (deg) over the ok photos: against the renderer's "
-    f"truth.csv (with the ok photos more than {OFF_DEG:g}° off, if any); else how far two trials "
-    "of one actuator at one pressure and direction differ, the rig's and the measurement's "
-    "scatter, blind to an error every photo shares (a base direction read off: give "
-    "fixed_direction_deg or an empty-scene photo)."
+    "|ψ error|: median / 95th percentile (deg) over the ok photos, against the renderer's "
+    f"truth.csv (and the ok photos over {OFF_DEG:g}° off), else between two trials of one "
+    "actuator at one pressure and direction: rig and measurement together, blind to an error "
+    "all photos share (give fixed_direction_deg or an empty scene to rule one out)."
 )

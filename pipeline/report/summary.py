@@ -123,10 +123,9 @@ def results_table(data: ReportData) -> Table:
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
         notes.append(
-            "synthetic: the photos were rendered by 'synth' from a model curve with each "
-            "actuator's own stiffness and hysteresis, so their RMS tests neither the model nor "
-            "the measurement; the |ψ error| column below checks the angles against the "
-            "renderer's truth."
+            "synthetic: rendered by 'synth' from the model with each actuator's own stiffness "
+            "and hysteresis, so their RMS tests neither model nor measurement; |ψ error| below "
+            "checks the angles."
         )
     return Table(
         columns=(
@@ -316,7 +315,7 @@ def quality_table(
             Column("ok"),
             Column("flagged"),
             Column("failed"),
-            Column("|ψ error| (deg)\nmedian / 95 %", "left"),
+            Column("|ψ error| (deg)\nmedian / 95 %", "left", wrap_pt=65.0),
             Column("Top reasons (photos)", "left", wrap_pt=200.0),
         )
         if not dated:  # the date line above says so once
