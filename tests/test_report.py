@@ -808,6 +808,41 @@ def test_one_material_without_optional_tables(tmp_path):
     assert "SS40: no row in --rms" in text
 
 
+def test_page_one_keeps_its_overview_plot_when_no_photo_is_doubted(tmp_path):
+    # the data-quality table's error column first took two lines per row and pushed page 1's
+    # plot off the default run's page (9db3cfe's first try); with every photo ok, as there, the
+    # tables leave room for it
+    from pipeline.report.summary import summary_page
+
+    datasets = []
+    for material in ("DS20", "DS30", "SS40", "SS50"):
+        d = make_dataset(tmp_path, material, overlays=False)
+        a = pd.read_csv(d.angles_csv)
+        a["psi_deg"] = a["psi_deg"].fillna(0.0)
+        a["status"], a["reason"] = "ok", ""
+        a.to_csv(d.angles_csv, index=False)
+        datasets.append(d)
+    hyst, rms = pipeline_tables(tmp_path, datasets)
+    data = load_report_data(
+        ReportInputs(datasets=tuple(datasets), hysteresis=tuple(hyst), rms=(rms,))
+    )
+    with report_style():
+        fig = summary_page(data, "0", [], [("a part", 2)] * 16)  # the default run's 16 parts
+    plotted = [ax for ax in fig.axes if ax.get_lines()]
+    assert plotted, "page 1 lost its overview plot"
+    # ... and the error column takes one line a row: no taller than with a one-word cell
+    from pipeline.layout.typeset import table_height_pt
+    from pipeline.report.summary import quality_table
+
+    table = quality_table(data, width_pt=511.0)
+    col = [c.header for c in table.columns].index("|ψ error| (deg)\nmedian / 95 %")
+    assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d trials", r[col]) for r in table.rows[:-1])
+    plain = dataclasses.replace(
+        table, rows=tuple((*r[:col], "0", *r[col + 1:]) for r in table.rows)
+    )
+    assert table_height_pt(table, 511.0) == table_height_pt(plain, 511.0)
+
+
 def test_increasing_only_photoset(tmp_path):
     d = make_dataset(tmp_path, "DS20", directions=("up",), overlays=False)
     hyst, rms = pipeline_tables(tmp_path, [d])

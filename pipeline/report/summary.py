@@ -315,7 +315,7 @@ def quality_table(
             Column("ok"),
             Column("flagged"),
             Column("failed"),
-            Column("|ψ error| (deg)\nmedian / 95 %", "left", wrap_pt=65.0),
+            Column("|ψ error| (deg)\nmedian / 95 %", "left"),
             Column("Top reasons (photos)", "left", wrap_pt=200.0),
         )
         if not dated:  # the date line above says so once
