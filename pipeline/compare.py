@@ -28,9 +28,10 @@ material beside the synthetic ramps of the same material and l0 is a row of its 
 ``curve`` ending in ``measured`` (the synthetic one's in ``synthetic``).
 
 What the RMS is (``rms_kind``): ``self-check`` when every dataset of the row is synthetic (its
-photos were rendered from this package's model, so the RMS checks the measurement chain, not the
-model), ``prediction`` when none is (no model parameter is fitted to these data: k_P is the
-paper's; ``k_p_fit`` is the one number fitted to them), ``mixed`` or ``unknown`` otherwise.
+photos were rendered from this package's model, with each actuator's own stiffness and
+hysteresis: the RMS validates neither the model nor the measurement), ``prediction`` when none
+is (no model parameter is fitted to these data: k_P is the paper's; ``k_p_fit`` is the one
+number fitted to them), ``mixed`` or ``unknown`` otherwise.
 
 Definitions (per row, on the mean curves of hysteresis.csv)
 -----------------------------------------------------------

@@ -22,10 +22,9 @@ from pipeline.report.data import ReportData
 #: what each ``rms_kind`` means, in words for the reader
 RMS_KIND_TEXT: dict[str, str] = {
     "self-check": (
-        "SELF-CHECK: the photos are synthetic, rendered from this package's model "
-        "(synth), "
-        "so the RMS checks the measurement chain against the model that drew them; it is not a "
-        "validation"
+        "SELF-CHECK: the photos are synthetic, rendered by synth from this package's model "
+        "with each actuator's own stiffness and hysteresis, so the RMS is not a validation, "
+        "nor the angles' error (page 1's |ψ error| is)"
     ),
     "prediction": "prediction: no model parameter was fitted to these data (k_P is the paper's); "
     "only k_P fitted is a fit to them",
