@@ -1103,6 +1103,24 @@ def file_problems(
                 warning=True,
             )
         )
+    guessed = [r for r in ps.rows if r is not None and r.fixed_end_px is None]
+    if guessed:
+        problems.append(
+            Problem(
+                str(folder / SETTINGS),
+                None,
+                f"fixed_end is auto for {len(guessed)} of {len(ps.rows)} rows: the end the "
+                "actuator leaves the clamp at is guessed in each photo"
+                + (
+                    ", and every body measured so is flagged ('fixed end guessed')"
+                    if any(r.target == "body" for r in guessed)
+                    else " (a line whose clamp is not seen is flagged 'fixed end guessed')"
+                ),
+                "set fixed_end: [x, y], the pixel where the actuator leaves the clamp (any image "
+                "viewer shows it; photoset preview marks the end each photo was measured from)",
+                warning=True,
+            )
+        )
     if any(
         r is not None and r.target == "line" and (r.free_end != "capped" or r.sealed_end_mm)
         for r in ps.rows

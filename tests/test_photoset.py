@@ -773,3 +773,22 @@ def test_check_warns_of_a_material_the_model_does_not_have(photo_folder):
         warning.message
     )
     assert "model.materials_file" in warning.fix
+
+
+def test_check_warns_that_a_fixed_end_left_auto_is_guessed(photo_folder):
+    # customer 25 left fixed_end out: check said OK, and measure then flagged all 36 bodies
+    # "fixed end guessed; set fixed_end" (the README said check would say so)
+    from pipeline.photoset_check import check_photoset
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0, "target": "body"})
+    (warning,) = [p for p in check_photoset(photo_folder, warnings=True) if "auto" in p.message]
+    assert warning.warning and warning.file.endswith(ps.SETTINGS)
+    assert "for 8 of 8 rows" in warning.message and "every body measured so is flagged" in (
+        warning.message
+    )
+    assert "fixed_end: [x, y]" in warning.fix
+    assert not check_photoset(photo_folder)  # a warning, not an error
+    yaml = photo_folder / ps.SETTINGS
+    yaml.write_text(yaml.read_text().replace("fixed_end: auto", "fixed_end: [3, 12]"))
+    assert ps.read_settings(photo_folder)["fixed_end"] == [3.0, 12.0]
+    assert not [p for p in check_photoset(photo_folder, warnings=True) if "auto" in p.message]

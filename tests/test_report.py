@@ -535,7 +535,7 @@ def test_page_one_quality_reasons_in_words_sources_and_dates(default):
     assert f"all {total} {(angles['status'] == 'ok').sum()}" in text
     # how well: these sets' truth.csv holds no psi_image_deg, so the trials' scatter, each
     # dataset's own figure (customer 24: the PDF said how many were flagged, not how good)
-    assert "|ψ error| (deg) median / 95 %" in text
+    assert "ψ check (deg) median / 95 %" in text
     assert "blind to an error all photos share" in text
     assert len(re.findall(r"\d\.\d\d / \d+\.\d trials", text)) == len(inputs.datasets)
     # the committed sample set's RMS is 70.8 deg rising, its angles 0.37 deg from its truth: the
@@ -835,7 +835,9 @@ def test_page_one_keeps_its_overview_plot_when_no_photo_is_doubted(tmp_path):
     from pipeline.report.summary import quality_table
 
     table = quality_table(data, width_pt=511.0)
-    col = [c.header for c in table.columns].index("|ψ error| (deg)\nmedian / 95 %")
+    col = [c.header for c in table.columns].index("ψ check (deg)\nmedian / 95 %")
+    # a real set's figure is how far its trials differ: no column calls it an error (customer 25)
+    assert not any("error" in c.header for c in table.columns)
     assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d trials", r[col]) for r in table.rows[:-1])
     plain = dataclasses.replace(
         table, rows=tuple((*r[:col], "0", *r[col + 1:]) for r in table.rows)
@@ -852,7 +854,7 @@ def test_a_synthetic_sets_rms_is_not_called_a_check_of_the_angles(default):
     n_pages = len(doc)
     doc.close()
     text = " ".join(" ".join(pdf_text(pdf, k).split()) for k in range(n_pages))
-    assert "nor the angles' error (page 1's |ψ error| is)" in text
+    assert "nor the angles' error (page 1's ψ check is)" in text
     assert "checks the measurement chain" not in text
 
 

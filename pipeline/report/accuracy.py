@@ -169,8 +169,9 @@ def angle_accuracy(angles: pd.DataFrame, truth: pd.DataFrame | None) -> AngleAcc
 
 #: the quality table's note on its error column
 ACCURACY_NOTE = (
-    "|ψ error|: median / 95th percentile (deg) over the ok photos, against the renderer's "
-    f"truth.csv (and the ok photos over {OFF_DEG:g}° off), else between two trials of one "
-    "actuator at one pressure and direction: rig and measurement together, blind to an error "
-    "all photos share (give fixed_direction_deg or an empty scene to rule one out)."
+    "ψ check (deg, median / 95th percentile of the ok photos): truth = error against the "
+    f"renderer's truth.csv (ok photos over {OFF_DEG:g}° off counted); trials = how far two "
+    "trials of one actuator differ at one pressure and direction: repeatability and measurement "
+    "together, not the angles' error, and blind to an error all photos share (give "
+    "fixed_direction_deg or an empty scene to rule one out)."
 )

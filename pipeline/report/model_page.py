@@ -24,7 +24,7 @@ RMS_KIND_TEXT: dict[str, str] = {
     "self-check": (
         "SELF-CHECK: the photos are synthetic, rendered by synth from this package's model "
         "with each actuator's own stiffness and hysteresis, so the RMS is not a validation, "
-        "nor the angles' error (page 1's |ψ error| is)"
+        "nor the angles' error (page 1's ψ check is)"
     ),
     "prediction": "prediction: no model parameter was fitted to these data (k_P is the paper's); "
     "only k_P fitted is a fit to them",

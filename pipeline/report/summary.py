@@ -124,7 +124,7 @@ def results_table(data: ReportData) -> Table:
     if any("synthetic" in s for s in sources.values()):
         notes.append(
             "synthetic: rendered by 'synth' from the model with each actuator's own stiffness "
-            "and hysteresis, so their RMS tests neither model nor measurement; |ψ error| below "
+            "and hysteresis, so their RMS tests neither model nor measurement; ψ check below "
             "checks the angles."
         )
     return Table(
@@ -315,7 +315,7 @@ def quality_table(
             Column("ok"),
             Column("flagged"),
             Column("failed"),
-            Column("|ψ error| (deg)\nmedian / 95 %", "left"),
+            Column("ψ check (deg)\nmedian / 95 %", "left"),
             Column("Top reasons (photos)", "left", wrap_pt=200.0),
         )
         if not dated:  # the date line above says so once
