@@ -968,9 +968,8 @@ def sealed_end_problems(ps: PhotoSet) -> list[Problem]:
             str(ps.folder / SETTINGS),
             None,
             "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
-            "runs on into a sealed end or cap; on rendered bodies one of 8-12 mm read |psi| "
-            "above 150 deg 5-7 deg high at 1280x960, and 8.8 deg high (up to 12) on a 12 MP set "
-            "with an 8 mm one, every row ok"
+            "runs on into a sealed end or cap that does not bend, so a curled body reads high "
+            "(|psi| above 150 deg: 5-12 deg on rendered bodies with an 8-12 mm one, every row ok)"
             + (
                 " (and without an empty scene, a doubtful body gets no second look against its "
                 "ramp's own photos)"
