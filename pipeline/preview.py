@@ -35,7 +35,7 @@ from pipeline.measure.overlay import (
     screen_directions,
     wrap_text,
 )
-from pipeline.measure.ramp_background import estimates_background
+from pipeline.measure.ramp_background import RAMP_BACKGROUND_MIN_PHOTOS, estimates_background
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
 from pipeline.video.clips import Clip, frame_settings, resolve_clips
@@ -87,18 +87,37 @@ def preview_tile(
     method: str = "auto",
     title: str = "",
     reason: str = "",
+    second_look: bool = False,
 ) -> np.ndarray:
-    """The preview of one photo: annotated photo beside its selection mask (BGR)."""
+    """The preview of one photo: annotated photo beside its selection mask (BGR).
+    ``second_look``: ``measure`` may look at it again (:func:`tile_reason`)."""
     data = np.fromfile(str(path), dtype=np.uint8) if Path(path).is_file() else np.empty(0, np.uint8)
-    return encoded_tile(data, Path(path).name, settings, method=method, title=title, reason=reason)
+    return encoded_tile(data, Path(path).name, settings, method=method, title=title, reason=reason,
+                        second_look=second_look)
 
 
-def tile_reason(res: AngleResult, settings: MeasureSettings | None) -> str:
+def tile_reason(
+    res: AngleResult, settings: MeasureSettings | None, *, second_look: bool = True
+) -> str:
     """A tile's reason; a doubtful body that ``measure`` looks at again against its ramp's own
     photos (the second look, :func:`~pipeline.measure.ramp_background.estimates_background`) is
     shown as its first look saw it, and says so (a customer saw flagged tiles whose rows
-    ``measure`` then wrote ``ok``)."""
-    again = res.status != "ok" and estimates_background(settings)
+    ``measure`` then wrote ``ok``).  ``second_look`` False: its ramp has too few photos for one,
+    or it is a video's frame (customer 26's one-photo ramps were told it would be looked at
+    again).
+
+    Examples
+    --------
+    >>> from pipeline.measure.core import failed
+    >>> from pipeline.measure.settings import resolve_settings
+    >>> body = resolve_settings(l0_mm=100.0, target="body", free_end="bends")
+    >>> res = failed("tangents", "end direction unstable")
+    >>> tile_reason(res, body)
+    "first look, measure looks again against its ramp's photos: end direction unstable"
+    >>> tile_reason(res, body, second_look=False)
+    'end direction unstable'
+    """
+    again = second_look and res.status != "ok" and estimates_background(settings)
     return ("first look, measure looks again against its ramp's photos: " if again else "") + (
         res.reason
     )
@@ -112,6 +131,7 @@ def encoded_tile(
     method: str = "auto",
     title: str = "",
     reason: str = "",
+    second_look: bool = False,
 ) -> np.ndarray:
     """:func:`preview_tile` of an encoded image (``data``: its bytes, e.g. a video's frame as a
     JPEG packet; ``name`` for messages)."""
@@ -184,7 +204,12 @@ def encoded_tile(
     text = [
         title,
         f"psi = {res.psi_deg:+.1f} deg  {res.status}" if res.status != "failed" else "failed",
-        *wrap_text(tile_reason(res, settings), 2 * tint.shape[1] - 16, TEXT_SCALE, REASON_LINES),
+        *wrap_text(
+            tile_reason(res, settings, second_look=second_look),
+            2 * tint.shape[1] - 16,
+            TEXT_SCALE,
+            REASON_LINES,
+        ),
     ]
     # the words in a band above the photo and its mask: the whole reason, none of the photo hidden
     band = np.full((12 + 20 * len(text), 2 * tint.shape[1], 3), 30, np.uint8)
@@ -457,6 +482,20 @@ def video_tiles(
     return tiles
 
 
+def second_look_rows(ps: PhotoSet) -> list[bool]:
+    """Per manifest row, whether ``measure`` may look at its body again against its ramp's own
+    photos: it :func:`~pipeline.measure.ramp_background.estimates_background` and its ramp has
+    at least :data:`~pipeline.measure.ramp_background.RAMP_BACKGROUND_MIN_PHOTOS` photos (a video
+    set's frames never are)."""
+    if ps.is_video or not set(RAMP_KEYS) <= set(ps.manifest.columns):
+        return [False] * len(ps.manifest)
+    size = ps.manifest.groupby(list(RAMP_KEYS), dropna=False)["image"].transform("size")
+    return [
+        estimates_background(row) and int(n) >= RAMP_BACKGROUND_MIN_PHOTOS
+        for row, n in zip(ps.rows, size, strict=True)
+    ]
+
+
 def write_preview(
     folder: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -491,6 +530,7 @@ def write_preview(
             "with --image NAME)"
         )
     tiles = video_tiles(ps, method, frames=frames, every=every) if ps.is_video else []
+    again = second_look_rows(ps)
     for i in [] if ps.is_video else preview_rows(ps, every, images):
         row = ps.manifest.iloc[i]
         title = (
@@ -504,6 +544,7 @@ def write_preview(
                 method=method,
                 title=title,
                 reason=ps.row_reason(i),
+                second_look=bool(again[i]),
             )
         )
     height, width = max(t.shape[0] for t in tiles), max(t.shape[1] for t in tiles)

@@ -130,3 +130,29 @@ def test_the_preview_says_a_doubtful_first_look_is_looked_at_again(translucent_r
     # an empty scene given: no second look, nothing said
     given = dataclasses.replace(doubtful[0][1], background_path="/x/empty.jpg")
     assert tile_reason(doubtful[0][0], given) == doubtful[0][0].reason
+
+
+def test_the_preview_says_a_second_look_only_where_measure_takes_one(photo_folder):
+    # customer 26 measured ten strips, each its own ramp: the preview said "measure looks again
+    # against its ramp's photos", which needs 8 photos of a ramp, and measure did not
+    import pandas as pd
+
+    from pipeline import photoset_init
+    from pipeline.photoset import load_photoset
+    from pipeline.preview import second_look_rows
+
+    photoset_init.init_photoset(
+        photo_folder, "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
+        settings={"l0_mm": 150.0, "target": "body", "free_end": "bends"},
+    )
+    assert second_look_rows(load_photoset(photo_folder)) == [False] * 8  # ramps of 5 and 3
+    manifest = photo_folder / "manifest.csv"
+    m = pd.read_csv(manifest)
+    m["trial"] = 1  # one ramp of 8 photos
+    m["step"] = range(len(m))
+    m.to_csv(manifest, index=False)
+    assert second_look_rows(load_photoset(photo_folder)) == [True] * 8
+    (photo_folder / "photoset.yaml").write_text(
+        (photo_folder / "photoset.yaml").read_text() + "line_color: red\n"
+    )
+    assert second_look_rows(load_photoset(photo_folder)) == [False] * 8  # told by its colour

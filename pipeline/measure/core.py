@@ -487,6 +487,7 @@ def measure_body(
         missed_tip_deg=missed_tip_deg,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,
+        excluded=bool(settings.exclude),
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along

@@ -273,6 +273,7 @@ def assess_body(
     missed_tip_deg: float = 0.0,
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
+    excluded: bool = False,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -288,8 +289,9 @@ def assess_body(
     narrower than :data:`FAINT_TIP_WIDTH` of the body, a faint side, or the line stops more than
     :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
     from ``fixed_end`` (not when ``fixed_direction_deg`` is given, ``base_mismatch_deg`` not
-    None: psi does not depend on it); the body closes on itself; or it is much shorter than
-    ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
+    None: psi does not depend on it); the body closes on itself (``excluded``: the row already
+    excludes a region, so the advice is to check that it crosses the gap); or it is much shorter
+    than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
     how psi was taken.
     """
@@ -354,7 +356,11 @@ def assess_body(
         )
     if line.branched_fraction > 0.05:
         flags.append(
-            "body closes on itself: where its two ends touch, an exclude box over the gap "
+            "body closes on itself: the selection still holds a loop with exclude given (the "
+            "box may miss the gap, or two other parts of the body touch: photoset preview shows "
+            "the outlines)"
+            if excluded
+            else "body closes on itself: where its two ends touch, an exclude box over the gap "
             "between them opens the ring (photoset preview shows the outlines)"
         )
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
