@@ -83,6 +83,21 @@ def test_pick_color_selects_what_was_picked(bgr, wraps):
     assert mask[20:40, 20:40].all() and mask.sum() == 400
 
 
+def test_a_picked_colour_does_not_reach_into_the_black_around_it():
+    # customer 26 picked c_20C's red layer (the real strip photos, on a near-black backdrop):
+    # the range went down to V 0, where the black's hue is noise, and took in a third of the
+    # photo, 20 % of it near-black
+    from pathlib import Path
+
+    img = cv2.imread(str(Path(__file__).parent / "data" / "xia2023_strips" / "c_20C.png"))
+    spec = pick_color(img, 105, 73)
+    selected = color_mask(img, spec) > 0
+    value = cv2.cvtColor(img, cv2.COLOR_BGR2HSV)[..., 2]
+    assert not (selected & (value < 25)).any()
+    assert selected.mean() < 0.2
+    assert selected[73, 105]
+
+
 def test_pick_color_outside_the_image_is_refused():
     with pytest.raises(ColorError, match="outside"):
         pick_color(np.zeros((10, 10, 3), np.uint8), 12, 3)

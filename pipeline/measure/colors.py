@@ -241,6 +241,10 @@ def color_mask(image_bgr: np.ndarray, spec: ColorSpec) -> np.ndarray:
     return (out > 0).astype(np.uint8)
 
 
+#: a picked colour's range reaches no darker than this value (V, 0-255) ...
+PICK_DARKEST_V = 40.0
+
+
 def pick_color(image_bgr: np.ndarray, x: float, y: float, radius_px: float = 4.0) -> ColorSpec:
     """An HSV range selecting the colour around a pixel (a disc of ``radius_px``).
 
@@ -279,11 +283,16 @@ def pick_color(image_bgr: np.ndarray, x: float, y: float, radius_px: float = 4.0
     hsv = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV)[disc].astype(float)
     s_lo, s_hi = np.percentile(hsv[:, 1], [2, 98])
     v_lo, v_hi = np.percentile(hsv[:, 2], [2, 98])
+    # hue is noise in near-black pixels, as in grey ones: a coloured range reaches no darker than
+    # PICK_DARKEST_V, or half the darkest sampled (a red strip's pick on a dark backdrop went
+    # down to V 0 and took in 20 % of the photo, its black surroundings)
+    dark_floor = min(PICK_DARKEST_V, 0.5 * v_lo)
     s_lo, v_lo = max(0.0, s_lo - 60.0), max(0.0, v_lo - 70.0)
     s_hi, v_hi = min(255.0, s_hi + 60.0), min(255.0, v_hi + 60.0)
     if np.median(hsv[:, 1]) < 45:  # grey: hue is noise
         lo, hi = (0, 0, int(v_lo)), (179, int(max(s_hi, 45)), int(v_hi))
         return parse_color(f"{lo[0]},{lo[1]},{lo[2]}-{hi[0]},{hi[1]},{hi[2]}")
+    v_lo = max(v_lo, dark_floor)
     ang = hsv[:, 0] * (2 * np.pi / 180.0)
     centre = float(np.angle(np.mean(np.exp(1j * ang))) % (2 * np.pi)) * 180.0 / (2 * np.pi)
     dev = (hsv[:, 0] - centre + 90.0) % 180.0 - 90.0
