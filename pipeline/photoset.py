@@ -1108,8 +1108,9 @@ def file_problems(
             Problem(
                 str(folder / SETTINGS),
                 None,
-                f"fixed_end is auto for {len(guessed)} of {len(ps.rows)} rows: the end the "
-                "actuator leaves the clamp at is guessed in each photo"
+                f"fixed_end is auto for {len(guessed)} of "
+                f"{sum(r is not None for r in ps.rows)} rows: the end the actuator leaves the "
+                "clamp at is guessed in each photo or frame"
                 + (
                     ", and every body measured so is flagged ('fixed end guessed')"
                     if any(r.target == "body" for r in guessed)

@@ -294,6 +294,21 @@ def _measure_photos(
     )
 
 
+def second_look_ramps(ps: PhotoSet) -> list[list[int]]:
+    """The rows of each ramp whose body ``measure`` may look at again against the empty scene
+    estimated from the ramp's photos: rows that :func:`estimates_background` and whose photo is
+    there, in ramps of at least :data:`RAMP_BACKGROUND_MIN_PHOTOS` such rows (the estimate also
+    needs that many photos that decode, of one size; a video set has none)."""
+    if ps.is_video or not set(RAMP_KEYS) <= set(ps.manifest.columns):
+        return []
+    ramps: dict[tuple[str, ...], list[int]] = {}
+    for i, (image, row) in enumerate(zip(ps.manifest["image"], ps.rows, strict=True)):
+        if estimates_background(row) and ps.image_path(str(image)).is_file():
+            key = tuple(str(ps.manifest[k].iloc[i]) for k in RAMP_KEYS)
+            ramps.setdefault(key, []).append(i)
+    return [m for m in ramps.values() if len(m) >= RAMP_BACKGROUND_MIN_PHOTOS]
+
+
 def _ramp_estimates(
     ps: PhotoSet, tasks: list[Task], rows: list[dict[str, Any]], folder: Path
 ) -> dict[int, Path]:
@@ -301,18 +316,9 @@ def _ramp_estimates(
     :func:`estimates_background`, its empty scene estimated from its photos and their first
     measurement (:mod:`pipeline.measure.ramp_background`), written into ``folder``: row -> file.
     """
-    if not set(RAMP_KEYS) <= set(ps.manifest.columns):
-        return {}
-    ramps: dict[tuple[str, ...], list[int]] = {}
-    for i, task in enumerate(tasks):
-        if estimates_background(task.settings) and Path(task.path).is_file():
-            key = tuple(str(ps.manifest[k].iloc[i]) for k in RAMP_KEYS)
-            ramps.setdefault(key, []).append(i)
     out: dict[int, Path] = {}
-    for number, members in enumerate(ramps.values()):
-        if len(members) < RAMP_BACKGROUND_MIN_PHOTOS or all(
-            rows[i]["status"] == "ok" for i in members
-        ):
+    for number, members in enumerate(second_look_ramps(ps)):
+        if all(rows[i]["status"] == "ok" for i in members):
             continue
         used: list[int] = []
         images: list[np.ndarray] = []

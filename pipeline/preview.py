@@ -35,9 +35,10 @@ from pipeline.measure.overlay import (
     screen_directions,
     wrap_text,
 )
-from pipeline.measure.ramp_background import RAMP_BACKGROUND_MIN_PHOTOS, estimates_background
+from pipeline.measure.ramp_background import estimates_background
 from pipeline.measure.settings import MeasureSettings
 from pipeline.photoset import PhotoSet, load_photoset
+from pipeline.photoset_measure import second_look_ramps
 from pipeline.video.clips import Clip, frame_settings, resolve_clips
 from pipeline.video.measure import spread_frames
 from pipeline.video.reader import read_frames
@@ -97,14 +98,14 @@ def preview_tile(
 
 
 def tile_reason(
-    res: AngleResult, settings: MeasureSettings | None, *, second_look: bool = True
+    res: AngleResult, settings: MeasureSettings | None, *, second_look: bool = False
 ) -> str:
     """A tile's reason; a doubtful body that ``measure`` looks at again against its ramp's own
     photos (the second look, :func:`~pipeline.measure.ramp_background.estimates_background`) is
     shown as its first look saw it, and says so (a customer saw flagged tiles whose rows
-    ``measure`` then wrote ``ok``).  ``second_look`` False: its ramp has too few photos for one,
-    or it is a video's frame (customer 26's one-photo ramps were told it would be looked at
-    again).
+    ``measure`` then wrote ``ok``).  ``second_look``: its row is in a ramp ``measure`` may look
+    at again (:func:`~pipeline.photoset_measure.second_look_ramps`; customer 26's one-photo
+    ramps were told they would be looked at again).
 
     Examples
     --------
@@ -112,9 +113,9 @@ def tile_reason(
     >>> from pipeline.measure.settings import resolve_settings
     >>> body = resolve_settings(l0_mm=100.0, target="body", free_end="bends")
     >>> res = failed("tangents", "end direction unstable")
-    >>> tile_reason(res, body)
+    >>> tile_reason(res, body, second_look=True)
     "first look, measure looks again against its ramp's photos: end direction unstable"
-    >>> tile_reason(res, body, second_look=False)
+    >>> tile_reason(res, body)
     'end direction unstable'
     """
     again = second_look and res.status != "ok" and estimates_background(settings)
@@ -482,20 +483,6 @@ def video_tiles(
     return tiles
 
 
-def second_look_rows(ps: PhotoSet) -> list[bool]:
-    """Per manifest row, whether ``measure`` may look at its body again against its ramp's own
-    photos: it :func:`~pipeline.measure.ramp_background.estimates_background` and its ramp has
-    at least :data:`~pipeline.measure.ramp_background.RAMP_BACKGROUND_MIN_PHOTOS` photos (a video
-    set's frames never are)."""
-    if ps.is_video or not set(RAMP_KEYS) <= set(ps.manifest.columns):
-        return [False] * len(ps.manifest)
-    size = ps.manifest.groupby(list(RAMP_KEYS), dropna=False)["image"].transform("size")
-    return [
-        estimates_background(row) and int(n) >= RAMP_BACKGROUND_MIN_PHOTOS
-        for row, n in zip(ps.rows, size, strict=True)
-    ]
-
-
 def write_preview(
     folder: str | os.PathLike[str],
     out: str | os.PathLike[str],
@@ -530,7 +517,7 @@ def write_preview(
             "with --image NAME)"
         )
     tiles = video_tiles(ps, method, frames=frames, every=every) if ps.is_video else []
-    again = second_look_rows(ps)
+    again = {i for ramp in second_look_ramps(ps) for i in ramp}
     for i in [] if ps.is_video else preview_rows(ps, every, images):
         row = ps.manifest.iloc[i]
         title = (
@@ -544,7 +531,7 @@ def write_preview(
                 method=method,
                 title=title,
                 reason=ps.row_reason(i),
-                second_look=bool(again[i]),
+                second_look=i in again,
             )
         )
     height, width = max(t.shape[0] for t in tiles), max(t.shape[1] for t in tiles)

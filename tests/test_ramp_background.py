@@ -123,36 +123,45 @@ def test_the_preview_says_a_doubtful_first_look_is_looked_at_again(translucent_r
     ]
     doubtful = [(r, s) for r, s in looks if r.status != "ok"]
     assert doubtful and all(
-        tile_reason(r, s).startswith("first look, measure looks again against its ramp's photos")
+        tile_reason(r, s, second_look=True).startswith(
+            "first look, measure looks again against its ramp's photos"
+        )
         for r, s in doubtful
     )
-    assert all(tile_reason(r, s) == r.reason for r, s in looks if r.status == "ok")
+    assert all(
+        tile_reason(r, s, second_look=True) == r.reason for r, s in looks if r.status == "ok"
+    )
     # an empty scene given: no second look, nothing said
     given = dataclasses.replace(doubtful[0][1], background_path="/x/empty.jpg")
-    assert tile_reason(doubtful[0][0], given) == doubtful[0][0].reason
+    assert tile_reason(doubtful[0][0], given, second_look=True) == doubtful[0][0].reason
 
 
 def test_the_preview_says_a_second_look_only_where_measure_takes_one(photo_folder):
     # customer 26 measured ten strips, each its own ramp: the preview said "measure looks again
-    # against its ramp's photos", which needs 8 photos of a ramp, and measure did not
+    # against its ramp's photos", which needs 8 photos of a ramp, and measure did not.  The
+    # preview and measure now ask the same function which rows a second look may cover
     import pandas as pd
 
     from pipeline import photoset_init
     from pipeline.photoset import load_photoset
-    from pipeline.preview import second_look_rows
+    from pipeline.photoset_measure import second_look_ramps
 
     photoset_init.init_photoset(
         photo_folder, "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg",
         settings={"l0_mm": 150.0, "target": "body", "free_end": "bends"},
     )
-    assert second_look_rows(load_photoset(photo_folder)) == [False] * 8  # ramps of 5 and 3
+    assert second_look_ramps(load_photoset(photo_folder)) == []  # ramps of 5 and 3
     manifest = photo_folder / "manifest.csv"
     m = pd.read_csv(manifest)
     m["trial"] = 1  # one ramp of 8 photos
     m["step"] = range(len(m))
     m.to_csv(manifest, index=False)
-    assert second_look_rows(load_photoset(photo_folder)) == [True] * 8
-    (photo_folder / "photoset.yaml").write_text(
-        (photo_folder / "photoset.yaml").read_text() + "line_color: red\n"
-    )
-    assert second_look_rows(load_photoset(photo_folder)) == [False] * 8  # told by its colour
+    assert second_look_ramps(load_photoset(photo_folder)) == [list(range(8))]
+    # a row told by its colour is not looked at again: 7 rows left, too few
+    m["line_color"] = [""] * 7 + ["red"]
+    m.to_csv(manifest, index=False)
+    assert second_look_ramps(load_photoset(photo_folder)) == []
+    m["line_color"] = ""
+    m.to_csv(manifest, index=False)
+    (photo_folder / m["image"].iloc[0]).unlink()  # a photo missing: 7 left
+    assert second_look_ramps(load_photoset(photo_folder)) == []

@@ -241,7 +241,8 @@ def color_mask(image_bgr: np.ndarray, spec: ColorSpec) -> np.ndarray:
     return (out > 0).astype(np.uint8)
 
 
-#: a picked colour's range reaches no darker than this value (V, 0-255) ...
+#: a picked colour's range reaches no darker than this value (V, 0-255), or half the sample's
+#: median value when that is darker
 PICK_DARKEST_V = 40.0
 
 
@@ -284,9 +285,9 @@ def pick_color(image_bgr: np.ndarray, x: float, y: float, radius_px: float = 4.0
     s_lo, s_hi = np.percentile(hsv[:, 1], [2, 98])
     v_lo, v_hi = np.percentile(hsv[:, 2], [2, 98])
     # hue is noise in near-black pixels, as in grey ones: a coloured range reaches no darker than
-    # PICK_DARKEST_V, or half the darkest sampled (a red strip's pick on a dark backdrop went
+    # PICK_DARKEST_V, or half the sample's median (a red strip's pick on a dark backdrop went
     # down to V 0 and took in 20 % of the photo, its black surroundings)
-    dark_floor = min(PICK_DARKEST_V, 0.5 * v_lo)
+    dark_floor = min(PICK_DARKEST_V, 0.5 * float(np.median(hsv[:, 2])))
     s_lo, v_lo = max(0.0, s_lo - 60.0), max(0.0, v_lo - 70.0)
     s_hi, v_hi = min(255.0, s_hi + 60.0), min(255.0, v_hi + 60.0)
     if np.median(hsv[:, 1]) < 45:  # grey: hue is noise

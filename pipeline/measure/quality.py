@@ -290,7 +290,7 @@ def assess_body(
     :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
     from ``fixed_end`` (not when ``fixed_direction_deg`` is given, ``base_mismatch_deg`` not
     None: psi does not depend on it); the body closes on itself (``excluded``: the row already
-    excludes a region, so the advice is to check that it crosses the gap); or it is much shorter
+    excludes a region, which may miss the gap); or it is much shorter
     than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
     how psi was taken.
@@ -356,12 +356,14 @@ def assess_body(
         )
     if line.branched_fraction > 0.05:
         flags.append(
-            "body closes on itself: the selection still holds a loop with exclude given (the "
-            "box may miss the gap, or two other parts of the body touch: photoset preview shows "
-            "the outlines)"
-            if excluded
-            else "body closes on itself: where its two ends touch, an exclude box over the gap "
-            "between them opens the ring (photoset preview shows the outlines)"
+            "body closes on itself: where its two ends touch, an exclude box over the gap "
+            "between them opens the ring ("
+            + (
+                "one given may miss the gap, or two other parts of the body touch: "
+                if excluded
+                else ""
+            )
+            + "photoset preview shows the outlines)"
         )
     elif line.ends_gap_px < 1.5 * line.width_px + 4.0:
         flags.append(f"ends almost touching ({line.ends_gap_px:.0f} px apart)")
