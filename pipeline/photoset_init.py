@@ -170,8 +170,9 @@ def init_photoset(
     Fields missing from the pattern come from ``defaults`` (``material``, ``actuator``,
     ``trial``).  When the pattern has no ``{direction}``, it is inferred per actuator and trial
     from the order of the photos (by ``step`` if present, else by file name): ``up`` until the
-    highest pressure, ``down`` after it.  Photos of several ramps taken one after another in one
-    folder (no ``{trial}`` in the pattern) are split into trials: by the trials' own
+    highest pressure, ``down`` after it (all ``up`` when the pressure never falls).  Photos of
+    several ramps taken one after another in one folder (no ``{trial}`` in the pattern) are
+    split into trials: by the trials' own
     ``pressures_kpa``, given in the order they were taken, whose photo counts add up to the
     folder's (keyed ``actuator/trial`` over several actuators, with no ``{actuator}`` in the
     pattern either: each actuator's ramps too); or, with one list for them all, wherever the
@@ -608,6 +609,19 @@ def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
 
 
 def _infer_directions(df: pd.DataFrame) -> pd.Series:
+    """Each ramp rises to its first highest pressure and falls after it: ``up`` to the peak,
+    ``down`` after it, unless the pressure never falls below the peak (a ramp held at its top,
+    or photos all at one pressure: customer 26's ten at 0 kPa were "1 up, 9 down").
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"material": "m", "actuator": "a", "trial": 1, "step": range(5),
+    ...                    "pressure_kpa": [0, 20, 40, 20, 0]})
+    >>> _infer_directions(df).tolist()
+    ['up', 'up', 'up', 'down', 'down']
+    >>> _infer_directions(df.assign(pressure_kpa=0)).tolist()
+    ['up', 'up', 'up', 'up', 'up']
+    """
     out = pd.Series("up", index=df.index, dtype=object)
     for _, g in df.groupby(list(RAMP_KEYS), sort=False):
         g = (
@@ -615,6 +629,8 @@ def _infer_directions(df: pd.DataFrame) -> pd.Series:
             if "step" in df.columns
             else g.sort_values("image", key=lambda names: names.map(natural_key))
         )
-        peak = int(np.argmax(g["pressure_kpa"].to_numpy()))
-        out.loc[g.index[peak + 1 :]] = "down"
+        pressure = g["pressure_kpa"].to_numpy()
+        peak = int(np.argmax(pressure))
+        if (pressure[peak + 1 :] < pressure[peak]).any():
+            out.loc[g.index[peak + 1 :]] = "down"
     return out

@@ -792,3 +792,20 @@ def test_check_warns_that_a_fixed_end_left_auto_is_guessed(photo_folder):
     yaml.write_text(yaml.read_text().replace("fixed_end: auto", "fixed_end: [3, 12]"))
     assert ps.read_settings(photo_folder)["fixed_end"] == [3.0, 12.0]
     assert not [p for p in check_photoset(photo_folder, warnings=True) if "auto" in p.message]
+
+
+def test_photos_all_at_one_pressure_are_all_taken_rising(tmp_path):
+    # customer 26 gave ten strips one pressure each, all 0 kPa: init called them "1 up, 9 down"
+    # (down after the first highest pressure, though it never fell)
+    for i in range(1, 6):
+        (tmp_path / f"IMG_{i}.JPG").write_bytes(b"")
+    df = photoset_init.init_photoset(
+        tmp_path, "IMG_*.JPG", defaults={"material": "DS20"}, pressures_kpa=(0.0,) * 5
+    )
+    assert df["direction"].tolist() == ["up"] * 5
+    # a ramp held at its top, then let down: the hold is still counted falling, as before
+    df = photoset_init.init_photoset(
+        tmp_path, "IMG_*.JPG", defaults={"material": "DS20"}, overwrite=True,
+        pressures_kpa=(0.0, 20.0, 20.0, 10.0, 0.0),
+    )
+    assert df["direction"].tolist() == ["up", "up", "down", "down", "down"]
