@@ -312,6 +312,25 @@ def test_steps_are_jumps_followed_by_a_hold_not_a_fast_ramp():
     assert step_times(PressureLog("r.csv", t, ramp.setpoint_kpa(t))).size == 0
 
 
+def test_a_frame_within_a_steps_log_interval_has_the_setpoint_in_force_not_one_never_set():
+    # customer 27's 720p step response: frames between the log's last row at 120 kPa and its
+    # first at 160 kPa (20 Hz) read 133.3 kPa, a pressure never asked for
+    t = np.arange(0, 20, 0.05)
+    steps = PressureProfile("steps", max_kpa=160, step_kpa=40, hold_s=2)
+    log = PressureLog("s.csv", t, steps.setpoint_kpa(t), steps.setpoint_kpa(t) + 0.3)
+    frames = np.arange(0.5, 19.5, 1 / 30)
+    c = frame_conditions(log, frames)
+    assert set(np.round(c["pressure_kpa"], 6)) <= {0.0, 40.0, 80.0, 120.0, 160.0}
+    # the step itself is where step_times puts it: the frame just before still has the old level
+    (j,) = np.flatnonzero(np.isclose(t, step_times(log)[1]))
+    before = frame_conditions(log, np.array([t[j] - 0.01, t[j]]))["pressure_kpa"]
+    assert before.tolist() == [log.pressure_kpa[j - 1], log.pressure_kpa[j]]
+    # the gauge's reading stays interpolated, and so does a continuous ramp's setpoint
+    assert not set(np.round(c["measured_pressure_kpa"], 6)) <= {0.3, 40.3, 80.3, 120.3, 160.3}
+    ramp = PressureLog("r.csv", np.array([0.0, 1.0, 2.0]), np.array([0.0, 10.0, 20.0]))
+    assert frame_conditions(ramp, np.array([0.5, 1.25]))["pressure_kpa"].tolist() == [5.0, 12.5]
+
+
 def test_pressure_log_problems_name_the_line(tmp_path):
     path = tmp_path / "log.csv"
     path.write_text("time_s,pressure_kpa\n0,0\n1,x\n")
@@ -571,13 +590,19 @@ def test_a_frame_sequence_is_measured_as_the_video_it_was_cut_from(video_set, me
     assert check_photoset(folder) == []
     out = measure_photoset(folder, jobs=2)
     pd.testing.assert_frame_equal(out[MEASURED], measured[MEASURED])
+    # each row names its file (customer 27 could not tell which file a flagged frame was: the
+    # image column holds the pattern, and frame counts from 0 where the files count from 1)
+    assert out["frame_file"].iloc[[0, 49]].tolist() == ["frames/f_0001.jpg", "frames/f_0050.jpg"]
     # a file missing from the sequence is that frame's failed row; the frames after it keep
     # their numbers, times and angles
     kept = (folder / "frames" / "f_0050.jpg").read_bytes()
     (folder / "frames" / "f_0050.jpg").unlink()
     gap = measure_photoset(folder, jobs=2)
     assert gap.loc[49, "status"] == "failed"
-    assert gap.loc[49, "reason"] == "frame 49 of f_%04d.jpg is missing from the sequence"
+    assert gap.loc[49, "reason"] == (
+        "frame 49 of f_%04d.jpg (f_0050.jpg) is missing from the sequence"
+    )
+    assert gap.loc[49, "frame_file"] == "frames/f_0050.jpg"
     pd.testing.assert_frame_equal(
         gap.drop(index=49)[MEASURED], measured.drop(index=49)[MEASURED]
     )

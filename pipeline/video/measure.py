@@ -25,7 +25,7 @@ from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import VIDEO_OPTIONAL_COLUMNS, PhotoSet
 from pipeline.pool import map_photos
 from pipeline.video.clips import Clip, frame_settings, resolve_clips, span_problem
-from pipeline.video.reader import SEQUENCE_NUMBER
+from pipeline.video.reader import SEQUENCE_NUMBER, sequence_file_name
 from pipeline.video.timeline import frame_conditions, span_text
 from pipeline.video.worker import CHUNK_COLUMNS, CHUNK_FRAMES, FrameChunk, run_chunk
 
@@ -56,6 +56,28 @@ def frame_overlay_name(video: str, frame: int) -> str:
     """
     stem = SEQUENCE_NUMBER.sub("", Path(video).stem).rstrip("_-. ") or "frame"
     return f"{stem}_f{int(frame):06d}.jpg"
+
+
+def sequence_file_names(
+    video: str, files: tuple[str, ...], frames: pd.api.extensions.ExtensionArray
+) -> list[str]:
+    """The file of each frame of a frame sequence, as the manifest names its folder (for a frame
+    missing from the sequence, the file it lacks; '' for a row without a frame).
+
+    Examples
+    --------
+    >>> frames = pd.array([0, 1, 2, None], dtype="Int64")
+    >>> sequence_file_names("cam/f_%04d.jpg", ("/d/cam/f_0001.jpg", "", "/d/cam/f_0003.jpg"),
+    ...                     frames)
+    ['cam/f_0001.jpg', 'cam/f_0002.jpg', 'cam/f_0003.jpg', '']
+    """
+    folder = Path(video).parent
+    return [
+        (folder / sequence_file_name(video, files, int(k))).as_posix()
+        if k is not pd.NA and 0 <= int(k) < len(files)
+        else ""
+        for k in frames
+    ]
 
 
 def chunk_ranges(
@@ -132,6 +154,8 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
     df = df.drop(columns=["frame", "pts_s"])
     df.insert(0, "image", clip.video)
     df["frame"] = frames
+    if clip.info.files:  # a frame sequence: which file each row is (frame counts from 0)
+        df["frame_file"] = sequence_file_names(clip.video, clip.info.files, frames)
     df["time_s"] = time_s
     if clip.log is not None:
         cond = frame_conditions(clip.log, time_s)

@@ -183,6 +183,27 @@ def sequence_files(path: str | Path) -> tuple[str, ...] | None:
     return tuple(numbers.get(n, "") for n in range(lo, hi + 1))
 
 
+def sequence_file_name(pattern: str, files: tuple[str, ...], k: int) -> str:
+    """The name of frame ``k``'s file in the sequence ``pattern`` whose files are ``files`` (as
+    :func:`sequence_files` gives them): the file found, or the one missing at that number.
+
+    Examples
+    --------
+    >>> files = ("/d/f_0007.jpg", "", "/d/f_0009.jpg")
+    >>> [sequence_file_name("d/f_%04d.jpg", files, k) for k in range(3)]
+    ['f_0007.jpg', 'f_0008.jpg', 'f_0009.jpg']
+    """
+    if files[k]:
+        return Path(files[k]).name
+    name = Path(pattern).name
+    m = SEQUENCE_NUMBER.search(name)
+    first = Path(next(f for f in files if f)).name
+    if m is None or not first:
+        return ""
+    number = int(first[m.start() : len(first) - (len(name) - m.end())]) + k
+    return name[: m.start()] + m.group(0) % number + name[m.end() :]
+
+
 def _probe_sequence(path: str, files: tuple[str, ...]) -> VideoInfo:
     """A frame sequence described as a video: its frames are its files, packets of one image
     each; seekable; no frame rate."""
@@ -333,4 +354,8 @@ def _sequence_frames(info: VideoInfo, first: int, end: int) -> Iterator[Frame]:
             yield Frame(k, math.nan, data)
             continue
         why = "is empty" if file else "is missing from the sequence"
-        yield Frame(k, math.nan, None, f"frame {k} of {Path(info.path).name} {why}")
+        its = sequence_file_name(info.path, info.files, k) if k < len(info.files) else ""
+        yield Frame(
+            k, math.nan, None,
+            f"frame {k} of {Path(info.path).name}{f' ({its})' if its else ''} {why}",
+        )

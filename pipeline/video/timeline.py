@@ -9,7 +9,9 @@ the log's clock.
 For each frame this module gives (:func:`frame_conditions`):
 
 ``pressure_kpa``, ``measured_pressure_kpa``
-    The log linearly interpolated at the frame's time (NaN outside the log's span).
+    The log linearly interpolated at the frame's time (NaN outside the log's span); across a
+    step (below) the setpoint is the one still in force until the step's row, never a value
+    between the two levels that was never asked for.
 ``direction``
     ``up`` / ``down`` from the trend of ``pressure_kpa``: turning points are the extremes the
     pressure leaves by more than :data:`TREND_DEADBAND_KPA` (so logging noise never flips it),
@@ -302,6 +304,20 @@ def turning_points(
 
 def step_times(log: PressureLog) -> np.ndarray:
     """Times (s, log clock) at which ``pressure_kpa`` steps (see the module docstring)."""
+    return log.time_s[step_rows(log)]
+
+
+def step_rows(log: PressureLog) -> np.ndarray:
+    """Rows of the log at which ``pressure_kpa`` steps: each step's first row at its new level.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 3.0, 0.5)
+    >>> step_rows(PressureLog("log.csv", t, np.array([0.0, 0, 40, 40, 40, 40]))).tolist()
+    [2]
+    >>> step_rows(PressureLog("log.csv", t, np.array([0.0, 8, 16, 24, 32, 40]))).tolist()  # ramp
+    []
+    """
     t, p = log.time_s, log.pressure_kpa
     jumps = np.flatnonzero(np.abs(np.diff(p)) >= STEP_MIN_KPA) + 1
     out = []
@@ -313,8 +329,8 @@ def step_times(log: PressureLog) -> np.ndarray:
         while i > 0 and abs(p[i - 1] - p[j - 1]) <= HOLD_TOLERANCE_KPA:
             i -= 1
         if t[k] - t[j] >= STEP_HOLD_MIN_S and t[j - 1] - t[i] >= STEP_HOLD_MIN_S:
-            out.append(t[j])
-    return np.array(out, dtype=float)
+            out.append(j)
+    return np.array(out, dtype=int)
 
 
 def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
@@ -329,9 +345,15 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
     t = np.asarray(time_s, float)
     lo, hi = log.span_s
     inside = np.isfinite(t) & (t >= lo) & (t <= hi)
-    out = pd.DataFrame(
-        {"pressure_kpa": np.where(inside, np.interp(t, log.time_s, log.pressure_kpa), np.nan)}
+    setpoint = np.interp(t, log.time_s, log.pressure_kpa)
+    rows = step_rows(log)
+    # a frame between a step's last row at the old level and its first at the new one: the old
+    # setpoint, still in force (interpolated, a customer's 120 -> 160 kPa step read 133.3 kPa)
+    after = np.searchsorted(log.time_s, t, side="right")  # the first row later than the frame
+    setpoint = np.where(
+        np.isin(after, rows), log.pressure_kpa[np.maximum(after - 1, 0)], setpoint
     )
+    out = pd.DataFrame({"pressure_kpa": np.where(inside, setpoint, np.nan)})
     if log.measured_kpa is not None:
         out["measured_pressure_kpa"] = np.where(
             inside, np.interp(t, log.time_s, log.measured_kpa), np.nan
