@@ -355,10 +355,16 @@ def test_a_loggers_own_header_with_units_is_read_and_init_says_when_a_log_cannot
     log, problems = read_pressure_log(path)
     assert problems == [] and log is not None
     assert log.pressure_kpa.tolist() == [0.0, 12.5] and log.measured_kpa.tolist() == [0.1, 11.9]
-    path.write_text("Time [ms],P set (bar)\n0,0\n500,0.8\n")
+    # check says which column was read as what (customer 27: nothing confirmed that its sensor
+    # column was the measured pressure)
+    assert log.read_from == ("t (s)", "setpoint (kPa)", "sensor (kPa)")
+    path.write_text("Time [ms],P set (bar),note\n0,0,a\n500,0.8,b\n")
     log, problems = read_pressure_log(path)
     assert problems == [] and log.time_s.tolist() == [0.0, 0.5]
     assert log.pressure_kpa.tolist() == [0.0, 80.0]
+    assert log.describe_columns() == (
+        "time from 'Time [ms]', setpoint from 'P set (bar)', no measured pressure"
+    )
     path.write_text("time,setpoint\n0,0\n1,10\n")
     (problem,) = read_pressure_log(path)[1]
     assert "'Setpoint (kPa)'" in problem

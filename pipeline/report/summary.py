@@ -17,7 +17,7 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from pipeline.aggregate import aggregate_hysteresis
+from pipeline.aggregate import aggregate_hysteresis, is_used, pressure_levels, settled_frames
 from pipeline.compare import branch
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
@@ -169,6 +169,11 @@ def coarse_crossing_notes(
     more than :data:`COARSE_CROSSING_DEG`: the interpolated P at psi = 0 is then a straight line
     across a jump (an actuator snapping through), uncertain by up to the step.
 
+    Where photos (or frames) lie between the two levels but none is in the curve (flagged or
+    failed), the note says so, with their commonest cause, instead of asking for smaller steps
+    (customer 27: all 60 frames at 120 kPa rising were flagged, the tip out of the picture, and
+    the note asked for smaller steps than the 40 kPa taken).
+
     Parameters
     ----------
     angles : pandas.DataFrame
@@ -181,17 +186,29 @@ def coarse_crossing_notes(
     >>> rows = [("up", 0, 210.0), ("up", 20, 190.0), ("up", 40, 128.0), ("up", 60, -18.0)]
     >>> angles = pd.DataFrame([{"dataset": "lab", "image": f"{p}.jpg", "material": "DS20",
     ...     "direction": d, "pressure_kpa": p, "psi_deg": s, "status": "ok", "actuator": "A1",
-    ...     "trial": 1} for d, p, s in rows])
+    ...     "trial": 1, "reason": ""} for d, p, s in rows])
     >>> (note,) = coarse_crossing_notes(angles)
     >>> print(note.replace(", where", ",\nwhere").replace(": its", ":\nits"))
     lab: ψ = 0 is crossed between 40 and 60 kPa rising,
     where the mean ψ jumps from +128 to -18 deg:
     its P at ψ = 0 is a straight line across that jump (take smaller pressure steps there)
+    >>> angles.loc[3, "pressure_kpa"] = 80.0
+    >>> hidden = angles.iloc[[3]].assign(pressure_kpa=60.0, psi_deg=40.0, status="flagged",
+    ...     reason="body touches the image border at its free end: the tip may be outside")
+    >>> (note,) = coarse_crossing_notes(pd.concat([angles, hidden], ignore_index=True))
+    >>> print(note.replace("; the", ";\nthe").replace(" (", "\n(").replace(": its", ":\nits"))
+    lab: ψ = 0 is crossed between 40 and 80 kPa rising, where the mean ψ jumps from +128 to -18 deg;
+    the 1 photo at 60 kPa between them is not in the curve
+    (flagged: body's tip at the image border, 1):
+    its P at ψ = 0 is a straight line across that jump
+    (see those rows' reasons in angles.csv; photoset preview shows them)
     """
+    opts = dict(options or {})
     out = []
     for name, g in angles.groupby("dataset", sort=True):
-        h = aggregate_hysteresis(g, **(options or {}))
+        h = aggregate_hysteresis(g, **opts)
         parts = []
+        unseen = []  # per part: whether rows between its two levels are left out
         for material in sorted(h["material"].astype(str).unique()):
             for direction, word in (("up", "rising"), ("down", "falling")):
                 p, psi = branch(h[h["material"].astype(str) == material], direction)
@@ -200,9 +217,14 @@ def coarse_crossing_notes(
                 for i in range(len(psi) - 1):
                     if psi[i] * psi[i + 1] < 0.0:
                         if abs(psi[i] - psi[i + 1]) > COARSE_CROSSING_DEG:
+                            between = _left_out_between(
+                                g[g["material"].astype(str) == material], direction,
+                                (float(p[i]), float(p[i + 1])), opts,
+                            )
+                            unseen.append(bool(between))
                             parts.append(
                                 f"between {p[i]:g} and {p[i + 1]:g} kPa {word}, where the mean ψ "
-                                f"jumps from {psi[i]:+.0f} to {psi[i + 1]:+.0f} deg"
+                                f"jumps from {psi[i]:+.0f} to {psi[i + 1]:+.0f} deg{between}"
                             )
                         break
         if parts:
@@ -211,9 +233,40 @@ def coarse_crossing_notes(
                 + " and ".join(parts)
                 + (": its P at ψ = 0 is a straight line across that jump" if len(parts) == 1
                    else ": its P at ψ = 0 values are straight lines across those jumps")
-                + " (take smaller pressure steps there)"
+                + (
+                    " (see those rows' reasons in angles.csv; photoset preview shows them)"
+                    if all(unseen)
+                    else " (take smaller pressure steps there)"
+                    if not any(unseen)
+                    else " (take smaller pressure steps where no row lies between; see the "
+                    "reasons of those left out in angles.csv)"
+                )
             )
     return out
+
+
+def _left_out_between(
+    rows: pd.DataFrame, direction: str, span_kpa: tuple[float, float], options: Mapping[str, Any]
+) -> str:
+    """'; the N photos at P kPa between them are not in the curve (flagged: ...)' for the rows of
+    one material and direction whose level lies strictly inside ``span_kpa`` and that the curve
+    leaves out; '' when there are none."""
+    settled = rows[settled_frames(rows)]
+    level = pressure_levels(settled, options.get("bin_kpa"))
+    lo, hi = sorted(span_kpa)
+    inside = (settled["direction"] == direction) & (level > lo + 1e-6) & (level < hi - 1e-6)
+    out = settled[inside & ~is_used(settled, bool(options.get("include_flagged")))]
+    if out.empty:
+        return ""
+    frames = "frame" in out.columns and out["frame"].notna().any()
+    unit = ("frame" if frames else "photo") + ("s" if len(out) > 1 else "")
+    levels = sorted(set(level[out.index]))
+    at = f"{levels[0]:g} kPa" if len(levels) == 1 else f"{levels[0]:g}-{levels[-1]:g} kPa"
+    causes = top_reasons(out.assign(dataset=""), limit=1).get("", [])
+    statuses = "/".join(sorted(set(out["status"].astype(str))))
+    why = f" ({statuses}: " + ", ".join(f"{c}, {n}" for c, n in causes) + ")" if causes else ""
+    verb = "is" if len(out) == 1 else "are"
+    return f"; the {len(out)} {unit} at {at} between them {verb} not in the curve{why}"
 
 
 def missing_notes(data: ReportData) -> list[str]:

@@ -97,7 +97,7 @@ class Clip:
         p = self.log.pressure_kpa
         return (
             f"{video}; {Path(self.log.path).name} covers {span_text(self.log.span_s)}, "
-            f"{np.nanmin(p):g} to {np.nanmax(p):g} kPa"
+            f"{np.nanmin(p):g} to {np.nanmax(p):g} kPa ({self.log.describe_columns()})"
         )
 
     def span_s(self) -> tuple[float, float]:

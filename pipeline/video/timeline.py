@@ -71,12 +71,32 @@ HOLD_TOLERANCE_KPA = 0.5
 
 @dataclass(frozen=True)
 class PressureLog:
-    """A validated pressure log (arrays of equal length, time strictly increasing)."""
+    """A validated pressure log (arrays of equal length, time strictly increasing); ``read_from``
+    names the log's own column each was read from (time, setpoint, measured; '' for none)."""
 
     path: str
     time_s: np.ndarray
     pressure_kpa: np.ndarray
     measured_kpa: np.ndarray | None = None
+    read_from: tuple[str, str, str] = ("time_s", "pressure_kpa", "")
+
+    def describe_columns(self) -> str:
+        """Which of the log's columns were read as what, for ``photoset check``.
+
+        Examples
+        --------
+        >>> log = PressureLog("l.csv", np.zeros(2), np.zeros(2), np.zeros(2),
+        ...                   ("t (s)", "Setpoint [bar]", "sensor_kpa"))
+        >>> log.describe_columns()
+        "time from 't (s)', setpoint from 'Setpoint [bar]', measured pressure from 'sensor_kpa'"
+        >>> PressureLog("l.csv", np.zeros(2), np.zeros(2)).describe_columns()
+        "time from 'time_s', setpoint from 'pressure_kpa', no measured pressure"
+        """
+        time, setpoint, measured = self.read_from
+        return (
+            f"time from {time!r}, setpoint from {setpoint!r}, "
+            + (f"measured pressure from {measured!r}" if measured else "no measured pressure")
+        )
 
     @property
     def span_s(self) -> tuple[float, float]:
@@ -199,7 +219,9 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         df = read_user_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         return None, [f"pressure log {name} cannot be parsed as CSV ({exc})"]
-    df = _in_kpa(_in_seconds(df.rename(columns=log_header_names(list(df.columns)))))
+    columns = [str(c) for c in df.columns]
+    own = log_header_names(columns)
+    df = _in_kpa(_in_seconds(df.rename(columns=own)))
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
         header = list(map(str, df.columns))
@@ -235,7 +257,22 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
                 )
     if problems:
         return None, problems
-    return PressureLog(str(path), t, p, m), []
+    return PressureLog(str(path), t, p, m, _read_from(columns, own, m is not None)), []
+
+
+def _read_from(columns: list[str], own: dict[str, str], measured: bool) -> tuple[str, str, str]:
+    """The log's own column that gave its time, setpoint and measured pressure ('' for none), as
+    :func:`_in_seconds` and :func:`_in_kpa` take them."""
+    renamed = {own.get(c, c): str(c) for c in columns}
+    out = []
+    for stem, units in (
+        ("time", tuple(SECONDS_PER_UNIT)),
+        ("pressure", ("kpa", *KPA_PER_UNIT)),
+        ("measured", ("kpa", *KPA_PER_UNIT) if measured else ()),
+    ):
+        hits = [renamed[f"{stem}_{u}"] for u in units if f"{stem}_{u}" in renamed]
+        out.append(hits[0] if hits else "")
+    return out[0], out[1], out[2]
 
 
 def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, list[str]]:
