@@ -265,6 +265,18 @@ def video_spikes(frames: pd.DataFrame) -> list[tuple[Any, float]]:
     return out
 
 
+def _unit(rows: pd.DataFrame) -> str:
+    """'frames' for the rows of a video, else 'photos' (customer 27: "the median of 600
+    photos" of a video's frames).
+
+    Examples
+    --------
+    >>> _unit(pd.DataFrame({"frame": [0, 1]})), _unit(pd.DataFrame({"image": ["a.jpg"]}))
+    ('frames', 'photos')
+    """
+    return "frames" if "frame" in rows.columns and rows["frame"].notna().any() else "photos"
+
+
 def _wrap_deg(angle: np.ndarray) -> np.ndarray:
     """Angles (deg) brought into [-180, 180)."""
     return (np.asarray(angle, float) + 180.0) % 360.0 - 180.0
@@ -374,7 +386,7 @@ def _compare_given(
     if abs(median) <= GIVEN_OFF_DEG or float(np.median(np.abs(off - median))) > BASE_SPREAD_DEG:
         return
     stated = float(np.median(given[ok]))
-    seen = f"{stated + median:+.1f} deg (the median of {int(ok.sum())} photos)"
+    seen = f"{stated + median:+.1f} deg (the median of {int(ok.sum())} {_unit(ramp)})"
     fix = (
         "if the actuator sits turned in its clamp, give this ramp's rows their own "
         f"fixed_direction_deg in manifest.csv ({stated + median:+.1f}), or leave the key out "
@@ -442,7 +454,7 @@ def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | Non
             setup,
             # the photo's overlay shows the psi of its own base
             f"psi {p:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, the "
-            f"median of {n} photos; {o:+.1f} from its own, {b:+.1f})"
+            f"median of {n} {_unit(run)}; {o:+.1f} from its own, {b:+.1f})"
             if abs(m) >= BASE_NOTE_DEG
             else "",
             f"the body leaves the fixed end {m:+.0f} deg off its ramp's direction: a hook at "

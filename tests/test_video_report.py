@@ -36,6 +36,10 @@ def test_one_page_per_video_dataset_with_its_step_table(measured, tmp_path):
     assert with_video.pages == len(plain) + 2
     pages = _text(tmp_path / "video.pdf")
     assert "0 photos, 135 video frames" in pages[0]  # not "135 photos"
+    # a point of one video trial is its frames' mean, not "one photo alone" (customer 27)
+    joined = " ".join(" ".join(pages).split())
+    assert "hollow points: one video trial (its frames' mean) alone (n = 1)" in joined
+    assert "one photo alone" not in joined
     # the contents name the video pages (customer 20 found them missing), at the first one
     first = 1 + next(i for i, p in enumerate(pages) if "Video dataset" in p)
     assert f"p. {first} One page per video: every frame, loops, steps" in " ".join(
@@ -115,3 +119,39 @@ def test_the_photo_strip_of_a_video_shows_its_frames(video_set, measured, tmp_pa
     )
     strip = build_strip(data, "SS40")
     assert strip is not None and all(p.source == "overlay" for p in strip.photos)
+
+
+def test_the_step_tables_headers_and_notes_stay_inside_their_cells(measured, tmp_path):
+    # customer 27: a note ("0 of the last 12 frames of the hold are ok: no final value") ran past
+    # the table's border and the headers "overshoot (%" and "pressure rise (s" were cut off
+    import matplotlib as mpl
+    import pandas as pd
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from pipeline.video.continuous import UNSETTLED
+
+    folder = tmp_path / "continuous" / "steps"
+    write_continuous(measured, folder)
+    steps = pd.read_csv(folder / "steps.csv")
+    notes = [
+        "no value before it: no ok frame ends the hold before",  # the longest step_response gives
+        "no final value: 123 of the hold's last 456 frames ok",
+        "too few ok frames after the step (4)",
+        UNSETTLED,
+    ]
+    steps = pd.concat([steps] * 2, ignore_index=True).head(len(notes)).assign(note=notes)
+    steps.to_csv(folder / "steps.csv", index=False)
+    with report_style():
+        (fig,) = figures(folder)
+        canvas = FigureCanvasAgg(fig)
+        with mpl.rc_context({"text.hinting": "no_hinting"}):  # as the PDF draws its glyphs
+            canvas.draw()
+        renderer = canvas.get_renderer()
+        (table,) = [t for ax in fig.axes for t in ax.tables]
+        cells = table.get_celld()
+        assert {cells[row, 8].get_text().get_text() for row in range(1, 5)} == set(notes)
+        for (row, col), cell in cells.items():
+            box = cell.get_window_extent(renderer)
+            text = cell.get_text().get_window_extent(renderer)
+            assert box.x0 <= text.x0 and text.x1 <= box.x1, (row, col, cell.get_text().get_text())
+            assert box.y0 <= text.y0 and text.y1 <= box.y1, (row, col, cell.get_text().get_text())

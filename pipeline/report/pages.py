@@ -183,7 +183,7 @@ def overview_page(data: ReportData) -> Figure:
         title="Each panel in its material's colour; shading: ± 1 standard deviation over actuators "
         "and trials"
         + (
-            "; hollow points: one photo alone (n = 1)"
+            f"; hollow points: {_alone(data.angles)} alone (n = 1)"
             if "n" in data.hysteresis.columns and (data.hysteresis["n"] == 1).any()
             else ""
         ),
@@ -418,7 +418,19 @@ def single_photo_note(data: ReportData, material: str) -> str:
             said.append(f"{head}{listed[-1]} kPa {word}")
     if not said:
         return ""
-    return f"Hollow points: one photo alone at {', '.join(said)} (n = 1, no spread)."
+    rows = data.angles if hasattr(data, "angles") else pd.DataFrame()
+    if "material" in rows.columns:
+        rows = rows[rows["material"].astype(str) == material]
+    return f"Hollow points: {_alone(rows)} alone at {', '.join(said)} (n = 1, no spread)."
+
+
+def _alone(angles: pd.DataFrame) -> str:
+    """What a point with n = 1 is: one photo, or one video trial (the mean of its frames at that
+    level; customer 27's read "one photo alone" for some 12 frames)."""
+    frames = angles["frame"].notna() if "frame" in angles.columns else pd.Series(False)
+    if not frames.any():
+        return "one photo"
+    return "one video trial (its frames' mean)" if frames.all() else "one photo or video trial"
 
 
 def material_page(data: ReportData, material: str) -> Figure:

@@ -261,6 +261,10 @@ def _crossing(t: np.ndarray, y: np.ndarray, level: float, rising: bool) -> float
     )
 
 
+#: the step table's note of a hold whose end still drifts
+UNSETTLED = "did not settle within the hold"
+
+
 def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float, before_deg: float,
                   noise: float | None = None) -> dict[str, float | str]:
     """Rise time, overshoot and settling time of one step (values after the step only are used).
@@ -302,14 +306,15 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
         "noise_sd": nan,
         "note": "",
     }
-    if t.size < 5 or not math.isfinite(before_deg):
-        out["note"] = "too few frames around the step"
+    if not math.isfinite(before_deg):  # customer 27's read "too few frames around the step"
+        out["note"] = "no value before it: no ok frame ends the hold before"
+        return out
+    if t.size < 5:
+        out["note"] = f"too few ok frames after the step ({t.size})"
         return out
     tail = int(end_ok.sum())
     if tail < SETTLED_MIN_FRAMES:  # the frames before it are the way there, not its final value
-        out["note"] = (
-            f"{tail} of the last {end_ok.size} frames of the hold are ok: no final value"
-        )
+        out["note"] = f"no final value: {tail} of the hold's last {end_ok.size} frames ok"
         return out
     final = float(np.mean(y[-tail:]))
     change = final - before_deg
@@ -330,7 +335,7 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     beyond = float(np.max((y - final) * np.sign(change)))
     outside = np.flatnonzero(np.abs(y - final) > band)
     if drift > band or (outside.size and outside[-1] >= t.size - tail):
-        out["note"] = "did not settle within the hold"
+        out["note"] = UNSETTLED
         return out
     out["rise_time_s"] = t90 - t10
     out["overshoot_pct"] = (beyond if beyond > three_sd else 0.0) / abs(change) * 100.0

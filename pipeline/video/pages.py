@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 
 from pipeline.constants import RAMP_KEYS
 from pipeline.layout.style import A4_PORTRAIT_IN, MIN_FONT_PT, footer_fraction, text_page
+from pipeline.video.continuous import UNSETTLED
 
 #: step rows shown in the table (the rest are counted)
 MAX_TABLE_ROWS = 12
@@ -89,7 +90,9 @@ def _fmt(value: object, digits: int = 2) -> str:
     return "n/a" if not np.isfinite(v) else f"{v:.{digits}f}"
 
 
-def cycle_summary(cycles: pd.DataFrame, *, stepped: bool) -> str:
+def cycle_summary(
+    cycles: pd.DataFrame, *, stepped: bool, steps: pd.DataFrame | None = None
+) -> str:
     r"""The line under the loops: each cycle's rates and loop width, and, for a continuous ramp
     (no steps), that its loop holds the actuator's lag as well as its hysteresis.
 
@@ -106,6 +109,14 @@ def cycle_summary(cycles: pd.DataFrame, *, stepped: bool) -> str:
     (the step table) tells the two apart.
     >>> cycle_summary(c, stepped=True)[:54]
     'DS30 A1 t1 cycle 1: in steps, loop width mean 45.7 deg'
+
+    A hold that did not settle is said (customer 27: its loop width was reported without it):
+
+    >>> s = pd.DataFrame({"from_kpa": [0.0, 160.0], "to_kpa": [160.0, 120.0],
+    ...                   "note": ["", "did not settle within the hold"]})
+    >>> print(textwrap.fill(cycle_summary(c, stepped=True, steps=s).split(".  ")[1], 90))
+    The hold after 160 -> 120 kPa did not settle (the step table): its loop point is the
+    hold's last frames, still moving.
     """
     text = "; ".join(
         f"{_label(c)} cycle {int(c['cycle'])}: "
@@ -121,6 +132,21 @@ def cycle_summary(cycles: pd.DataFrame, *, stepped: bool) -> str:
         f"area {_fmt(c['area_deg_kpa'], 0)} deg kPa"
         for _, c in cycles.iterrows()
     )
+    moving = (
+        steps[steps["note"].astype(str) == UNSETTLED]
+        if steps is not None and len(steps)
+        else pd.DataFrame()
+    )
+    if len(moving):
+        which = ", ".join(
+            f"{_fmt(r['from_kpa'], 0)} -> {_fmt(r['to_kpa'], 0)} kPa" for _, r in moving.iterrows()
+        )
+        holds = "hold after" if len(moving) == 1 else "holds after"
+        its = "its loop point is" if len(moving) == 1 else "their loop points are"
+        text += (
+            f".  The {holds} {which} did not settle (the step table): {its} the hold's last "
+            "frames, still moving."
+        )
     if not stepped:  # customer 20 read a ramp's loop as the material's hysteresis alone
         text += (
             ".  On a continuous ramp the loop holds the actuator's lag behind the pressure as "
@@ -208,13 +234,17 @@ def figures(folder: Path) -> list[Figure]:
         loops.groupby([*RAMP_KEYS, "cycle"], sort=False)
     ):
         for direction, d in g.groupby("direction", sort=False):
-            d = d[d["n"] > 0].sort_values("pressure_kpa")
+            d = d.sort_values("pressure_kpa")
+            # a bin whose frames are all left out (flagged) breaks the line there: no straight
+            # line across pressures without data (customer 27's 120 kPa rising)
             ax_l.plot(
                 d["pressure_kpa"],
-                d["psi_mean_deg"],
+                d["psi_mean_deg"].where(d["n"] > 0),
                 "-" if direction == "up" else "--",
                 color=f"C{j}",
                 lw=1.0,
+                marker="o",  # a level alone between gaps is still seen
+                ms=2.5,
                 label=f"{key[0]} {key[1]} t{key[2]} c{key[3]} "
                       f"{'rising' if direction == 'up' else 'falling'}",
             )
@@ -257,7 +287,8 @@ def figures(folder: Path) -> list[Figure]:
     ax_c.axis("off")
     if len(cycles):
         ax_c.text(
-            0.0, 1.0, cycle_summary(cycles, stepped=bool(len(steps))), va="top", fontsize=7,
+            0.0, 1.0, cycle_summary(cycles, stepped=bool(len(steps)), steps=steps), va="top",
+            fontsize=7,
             wrap=True, transform=ax_c.transAxes,
         )
 
@@ -285,20 +316,26 @@ def figures(folder: Path) -> list[Figure]:
                 "ramp",
                 "step",
                 "kPa",
-                "change (deg)",
-                "rise (s)",
-                "overshoot (%)",
-                "settling (s)",
-                "pressure rise (s)",
+                "change\n(deg)",
+                "rise\n(s)",
+                "overshoot\n(%)",
+                "settling\n(s)",
+                "pressure\nrise (s)",
                 "note",
             ],
-            colWidths=[0.11, 0.05, 0.09, 0.09, 0.07, 0.09, 0.08, 0.1, 0.32],
+            colWidths=[0.1, 0.04, 0.08, 0.07, 0.05, 0.08, 0.07, 0.08, 0.43],
             loc="upper center",
             cellLoc="center",
         )
         table.auto_set_font_size(False)
         table.set_fontsize(MIN_FONT_PT)
         table.scale(1.0, 1.15)
+        for (row, col), cell in table.get_celld().items():
+            if row == 0:  # two-line headers
+                cell.set_height(2 * cell.get_height())
+            elif col == 8:  # the notes read from their left, inside their column
+                cell.set_text_props(ha="left")
+                cell.PAD = 0.02
         more_rows = len(steps) - len(shown)
         ax_tab.set_title(
             "Step responses: rise 10-90 % of the change; settling into 2 % of it (or 3 noise sd)"
