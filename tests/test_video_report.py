@@ -155,3 +155,31 @@ def test_the_step_tables_headers_and_notes_stay_inside_their_cells(measured, tmp
             text = cell.get_text().get_window_extent(renderer)
             assert box.x0 <= text.x0 and text.x1 <= box.x1, (row, col, cell.get_text().get_text())
             assert box.y0 <= text.y0 and text.y1 <= box.y1, (row, col, cell.get_text().get_text())
+
+
+def test_page_one_says_a_crossing_is_coarse_because_the_frames_between_were_flagged():
+    # customer 27: every frame at 120 kPa rising was flagged (the tip out of the picture), and
+    # page 1 asked for "smaller pressure steps" than the 40 kPa taken
+    import pandas as pd
+
+    from pipeline.report.summary import coarse_crossing_notes
+
+    levels = [(0, 210.0), (40, 180.0), (80, 130.0), (120, 10.0), (160, -140.0)]
+    rows = [
+        {"dataset": "vid", "image": "v.avi", "frame": 10 * i + k, "material": "DS30",
+         "actuator": "A3", "trial": 1, "direction": "up", "pressure_kpa": float(p),
+         "psi_deg": psi, "status": "flagged" if p == 120 else "ok",
+         "reason": "body touches the image border at its free end: the tip may be outside"
+         if p == 120 else ""}
+        for i, (p, psi) in enumerate(levels)
+        for k in range(10)
+    ]
+    (note,) = coarse_crossing_notes(pd.DataFrame(rows))
+    assert "between 80 and 160 kPa rising" in note
+    assert "the 10 frames ending the hold at 120 kPa between them are not in the curve" in note
+    assert "(flagged: body's tip at the image border, 10)" in note
+    assert "smaller pressure steps" not in note and "reasons in angles.csv" in note
+    # the same frames ok: the jump is between 120 and 160 kPa, with nothing between them
+    (note,) = coarse_crossing_notes(pd.DataFrame(rows).assign(status="ok"))
+    assert "between 120 and 160 kPa rising" in note
+    assert "(take smaller pressure steps there)" in note

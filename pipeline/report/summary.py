@@ -258,15 +258,18 @@ def _left_out_between(
     out = settled[inside & ~is_used(settled, bool(options.get("include_flagged")))]
     if out.empty:
         return ""
-    frames = "frame" in out.columns and out["frame"].notna().any()
-    unit = ("frame" if frames else "photo") + ("s" if len(out) > 1 else "")
     levels = sorted(set(level[out.index]))
     at = f"{levels[0]:g} kPa" if len(levels) == 1 else f"{levels[0]:g}-{levels[-1]:g} kPa"
+    many = len(out) > 1
+    if "frame" in out.columns and out["frame"].notna().any():  # a video: its holds' ends count
+        holds = "holds" if len(levels) > 1 else "hold"
+        what = f"{len(out)} frame{'s' if many else ''} ending the {holds}"
+    else:
+        what = f"{len(out)} photo{'s' if many else ''}"
     causes = top_reasons(out.assign(dataset=""), limit=1).get("", [])
     statuses = "/".join(sorted(set(out["status"].astype(str))))
     why = f" ({statuses}: " + ", ".join(f"{c}, {n}" for c, n in causes) + ")" if causes else ""
-    verb = "is" if len(out) == 1 else "are"
-    return f"; the {len(out)} {unit} at {at} between them {verb} not in the curve{why}"
+    return f"; the {what} at {at} between them {'are' if many else 'is'} not in the curve{why}"
 
 
 def missing_notes(data: ReportData) -> list[str]:
