@@ -490,7 +490,9 @@ def comparison_notes(data: ReportData) -> list[str]:
         (
             "RMS: the model's loading branch at the measured pressure levels against the mean "
             "curve.  Crossings: interpolated linearly along each ramp.  n/a: not reached by the "
-            "mean curve, or not reported by the paper."
+            "mean curve, or not reported by the paper.  paper: what the paper reports for its "
+            "own actuators over its own pressure span (its RMS: its model against its mean "
+            "measured curve)."
         ),
         (
             "k_P is fitted to this run's photos at rising pressure, the model's loading branch "
@@ -499,7 +501,38 @@ def comparison_notes(data: ReportData) -> list[str]:
         ),
     ]
     note = comparison_note(data)
-    return notes + ([note] if note else [])
+    return notes + ([note] if note else []) + span_notes(data)
+
+
+def span_notes(data: ReportData) -> list[str]:
+    """Per material whose pressures stopped well short of the paper's span: its range and P at
+    psi = 0 are not comparable with the paper's (customer 28 read a 0-160 kPa ramp's range of
+    135 deg beside the paper's 265 deg over 255 kPa as a shortfall).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> rms = pd.DataFrame({"material": ["SS40", "DS20"], "range_kpa": [160.0, 250.0],
+    ...                     "paper_range_kpa": [255.0, 255.0]})
+    >>> print(*span_notes(SimpleNamespace(materials=["SS40", "DS20"], rms=rms)))
+    SS40: the photos reach 160 kPa, the paper's 255 kPa: its range of motion and P at ψ = 0 are \
+not comparable with the paper's (left and right bars below).
+    """
+    out = []
+    for m in data.materials:
+        g = rms_row(data, m)
+        ours, paper = float(g.get("range_kpa", math.nan)), float(g.get("paper_range_kpa", math.nan))
+        if math.isfinite(ours) and math.isfinite(paper) and ours < SPAN_SHORT * paper:
+            out.append(
+                f"{m}: the photos reach {ours:g} kPa, the paper's {paper:g} kPa: its range of "
+                "motion and P at ψ = 0 are not comparable with the paper's (left and right bars "
+                "below)."
+            )
+    return out
+
+
+#: a run whose pressures reach less than this fraction of the paper's span is said to stop short
+SPAN_SHORT = 0.9
 
 
 def comparison_table(data: ReportData) -> Table:
