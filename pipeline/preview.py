@@ -29,6 +29,8 @@ from pipeline.measure.body import body_mask
 from pipeline.measure.core import AngleResult, decode_for_work, load_background, measure_decoded
 from pipeline.measure.extract import line_mask, region_mask
 from pipeline.measure.overlay import (
+    EXCLUDE_BGR,
+    ROI_BGR,
     draw_direction,
     draw_fixed_end,
     draw_tip,
@@ -180,9 +182,9 @@ def encoded_tile(
         cv2.LINE_AA,
     )
     if settings.roi is not None:
-        cv2.polylines(tint, [_poly(settings.roi, kk)], True, (0, 230, 255), 2, cv2.LINE_AA, 4)
+        cv2.polylines(tint, [_poly(settings.roi, kk)], True, ROI_BGR, 2, cv2.LINE_AA, 4)
     for poly in settings.exclude:
-        cv2.polylines(tint, [_poly(poly, kk)], True, (40, 40, 230), 2, cv2.LINE_AA, 4)
+        cv2.polylines(tint, [_poly(poly, kk)], True, EXCLUDE_BGR, 2, cv2.LINE_AA, 4)
     colour = _STATUS_BGR.get(res.status, (255, 255, 255))
     if len(res.centreline_px):
         cv2.polylines(

@@ -494,6 +494,13 @@ def test_a_contact_sheet_keeps_each_overlays_aspect_and_fills_its_rows(tmp_path:
     height, width = np.ptp(dark, axis=0) + 1
     assert abs(height - width) <= 2  # its circle is still round
     assert sheet.shape[0] == round(520 * 480 / 640) + 4 * round(480 * 480 / 640)  # padded rows
+    # the shorter tiles of that row are padded in the bands' grey, not black (customer 28 took
+    # black gaps for missing photos); the empty place of the last row stays black
+    from pipeline.measure.overlay import BAND_BGR
+
+    pad = sheet[round(520 * 480 / 640) - 5 : round(520 * 480 / 640), :480]
+    assert (np.abs(pad.astype(int) - BAND_BGR) <= 3).all()
+    assert sheet[-5:, -480:].max() == 0
 
 
 def test_a_tip_read_before_a_sealed_end_moves_smoothly_with_the_read_point():
@@ -516,3 +523,24 @@ def test_a_tip_read_before_a_sealed_end_moves_smoothly_with_the_read_point():
         reads.append(np.rad2deg(end - start))
     assert np.abs(np.diff(reads)).max() < 0.15, np.round(reads, 2)  # 1.52 with cut chords
     assert np.abs(np.array(reads) - 200.0).max() < 1.0, np.round(reads, 2)
+
+
+def test_an_overlay_outlines_the_roi_and_the_exclude_polygons_as_the_preview_does():
+    # customer 28 drew exclude polygons over a clamp and a tube: the preview showed them, the
+    # overlays of measure did not
+    from pipeline.measure.core import failed
+    from pipeline.measure.overlay import EXCLUDE_BGR, ROI_BGR, draw_overlay
+
+    photo = np.full((480, 640, 3), 90, np.uint8)
+    kwargs = {"scale": 2.0, "title": "t"}
+    plain = draw_overlay(photo, failed("auto", "x"), **kwargs)
+    drawn = draw_overlay(photo, failed("auto", "x"), roi=((100, 100), (1100, 100), (1100, 900)),
+                         exclude=(((200, 200), (400, 200), (400, 400), (200, 400)),), **kwargs)
+    band = plain.shape[0] - 480
+    assert drawn.shape == plain.shape
+    photo_part = drawn[band:].astype(int)
+    # original px / 2 (the work image) = overlay px: the exclude square's top edge at y 100,
+    # x 100-200; the roi's top edge at y 50, x 50-550
+    assert np.abs(photo_part[100, 150] - EXCLUDE_BGR).max() <= 40
+    assert np.abs(photo_part[50, 300] - ROI_BGR).max() <= 40
+    assert (plain[band:] == 90).all()

@@ -22,6 +22,9 @@ TEXT_SCALE, LINE_PX, REASON_LINES = 0.5, 20, 5
 #: the text bands above and below the photo, and the 2-px line between band and photo (BGR; the
 #: report finds the bands by that line: no photo has a whole row of it)
 BAND_BGR, DIVIDER_BGR = (40, 40, 40), (200, 0, 200)
+#: outlines of the ``roi`` (yellow) and of each ``exclude`` polygon (red), in the overlays as in
+#: ``photoset preview``
+ROI_BGR, EXCLUDE_BGR = (0, 230, 255), (40, 40, 230)
 _COLOURS = {"ok": (60, 200, 60), "flagged": (0, 165, 255), "failed": (40, 40, 230)}
 
 
@@ -131,6 +134,8 @@ def draw_overlay(
     fixed_direction_deg: float | None = None,
     base_direction_deg: float | None = None,
     tip_direction_deg: float | None = None,
+    roi: Sequence[Sequence[float]] | None = None,
+    exclude: Sequence[Sequence[Sequence[float]]] = (),
 ) -> np.ndarray:
     """The photo with the extracted centre line and the fixed end drawn on it, and psi written in
     a band above it (not over it: a tip near the photo's top edge stays in view).
@@ -155,6 +160,9 @@ def draw_overlay(
     tip_direction_deg : float, optional
         The free end's direction as psi takes it (the base's turned by psi; deg counter-clockwise
         from +x on screen), drawn from where it was read (``result.tip_px``: :func:`draw_tip`).
+    roi, exclude : optional
+        The ``roi`` and ``exclude`` polygons as given (original px), outlined (customer 28 saw
+        them in the preview and not here).
 
     Returns
     -------
@@ -173,6 +181,10 @@ def draw_overlay(
     )
     k = f / scale
     colour = _COLOURS.get(result.status, (255, 255, 255))
+    outlines = ([(roi, ROI_BGR)] if roi is not None else []) + [(p, EXCLUDE_BGR) for p in exclude]
+    for poly, bgr in outlines:
+        corners = (np.asarray(poly, float) - (scale - 1) / 2) * k
+        cv2.polylines(out, [np.round(corners * 16).astype(np.int32)], True, bgr, 1, cv2.LINE_AA, 4)
     if len(result.centreline_px):
         pts = (result.centreline_px - (scale - 1) / 2) * k
         cv2.polylines(out, [np.round(pts * 16).astype(np.int32)], False, colour, 2, cv2.LINE_AA, 4)
@@ -342,7 +354,11 @@ def contact_sheet(
         row = tiles[r : r + columns]
         row += [np.zeros_like(row[0][:1])] * (columns - len(row))
         h = max(t.shape[0] for t in row)
-        rows.append(
-            np.hstack([np.vstack([t, np.zeros((h - t.shape[0], width, 3), np.uint8)]) for t in row])
-        )
+        # a shorter tile is padded in the bands' grey, not black (customer 28 read the black
+        # gaps under tiles without a band as missing photos); an empty place stays black
+        rows.append(np.hstack([
+            np.vstack([t, np.full((h - t.shape[0], width, 3), BAND_BGR if t.shape[0] > 1 else 0,
+                                  np.uint8)])
+            for t in row
+        ]))
     return np.vstack(rows)

@@ -100,6 +100,8 @@ def write_overlay(
         fixed_direction_deg=given.fixed_direction_deg if given else None,
         base_direction_deg=base_deg,
         tip_direction_deg=tip_deg,
+        roi=given.roi if given else None,
+        exclude=given.exclude if given else (),
     )
     Path(path).parent.mkdir(parents=True, exist_ok=True)  # a photo in a subfolder of its set
     cv2.imwrite(path, out, [cv2.IMWRITE_JPEG_QUALITY, 85])
