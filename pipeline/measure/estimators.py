@@ -514,13 +514,14 @@ def _end_angle(
     piece = float(s_mid[1] - s_mid[0]) if len(s_mid) > 1 else 1.0
     weights = None
     if not from_start and at < s_mid[-1] + piece:  # read inside the line (before a sealed end):
-        # the window ends there, over the part that bends only.  A chord counts by how much of
-        # the two chunks it joins lies before ``at``, so that what lies beyond (a hook where a
-        # cap begins) counts less the further it is, and psi moves smoothly with ``at``: with
+        # the window ends there, over the part that bends only.  A chord counts by the share of
+        # the two chunks it joins that lies before ``at`` (below), so that what lies beyond (a
+        # hook where a cap begins) counts less the further it is, and psi moves smoothly with
+        # ``at``, on into the fit over the line's last ``window`` at its end: with
         # chords cut at their middles a read point moved 7 px by a rough mm_per_px let a hooked
         # last chord in and psi moved 2.4 deg (a 12 MP ribbed body with an 8 mm cap)
         weights = np.clip((at - s_mid + piece) / (2.0 * piece), 0.0, 1.0) * np.clip(
-            (s_mid - (at - window)) / piece + 0.5, 0.0, 1.0
+            (s_mid - (at - piece - window)) / piece + 0.5, 0.0, 1.0
         )
         sel = weights > 0.0
     else:
@@ -531,10 +532,13 @@ def _end_angle(
         if not from_start:
             sel[-3:] = True
     deg = min(TANGENT_DEGREE, int(sel.sum()) - 2)
-    w = None if weights is None or not weights[sel].all() else weights[sel]
+    w = np.ones(int(sel.sum())) if weights is None or not weights[sel].all() else weights[sel]
+    # polyfit weighs the residuals: each chord's square residual counts by the square of its
+    # share, so that one mostly beyond ``at`` counts little (by its share alone, the test's 30 deg
+    # hook beyond the read point moved psi up to 1.1 deg, so 0.8); the RMS is weighed the same
     coef = np.polyfit(s_mid[sel], theta[sel], deg, w=w)
     resid = theta[sel] - np.polyval(coef, s_mid[sel])
-    return float(np.polyval(coef, at)), float(np.sqrt(np.mean(resid**2)))
+    return float(np.polyval(coef, at)), float(np.sqrt(np.average(resid**2, weights=w**2)))
 
 
 def end_tangents(
