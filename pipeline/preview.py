@@ -119,11 +119,20 @@ def tile_reason(
     "first look, measure looks again against its ramp's photos: end direction unstable"
     >>> tile_reason(res, body)
     'end direction unstable'
+
+    An ``ok`` one may change too: where its ramp has a doubtful row, ``measure`` takes the
+    second look if it is ``ok`` and more than 4 deg away (``SECOND_LOOK_APART_DEG``):
+
+    >>> from dataclasses import replace
+    >>> tile_reason(replace(res, status="ok", reason=""), body, second_look=True)
+    "first look (measure may look again against its ramp's photos)"
     """
-    again = second_look and res.status != "ok" and estimates_background(settings)
-    return ("first look, measure looks again against its ramp's photos: " if again else "") + (
-        res.reason
-    )
+    if not (second_look and estimates_background(settings)):
+        return res.reason
+    if res.status != "ok":
+        return f"first look, measure looks again against its ramp's photos: {res.reason}"
+    note = "first look (measure may look again against its ramp's photos)"
+    return f"{note}: {res.reason}" if res.reason else note
 
 
 def encoded_tile(

@@ -523,6 +523,15 @@ def test_a_tip_read_before_a_sealed_end_moves_smoothly_with_the_read_point():
         reads.append(np.rad2deg(end - start))
     assert np.abs(np.diff(reads)).max() < 0.15, np.round(reads, 2)  # 1.52 with cut chords
     assert np.abs(np.array(reads) - 200.0).max() < 1.0, np.round(reads, 2)
+    # nor does it step where the read point crosses the line's end (0.07 deg on a line whose
+    # curvature grows towards the tip, before the window's inner edge matched the fit over the
+    # line's end: a review's finding)
+    s = np.linspace(0.0, length, 2401)
+    theta = psi * (s / length) ** 1.5
+    growing = np.c_[np.cumsum(np.cos(theta)), np.cumsum(np.sin(theta))]
+    at_end = [np.rad2deg(np.subtract(*end_tangents(growing, ends_px=(0.0, e))[1::-1]))
+              for e in (-0.01, 0.0)]
+    assert abs(at_end[1] - at_end[0]) < 0.01, at_end
 
 
 def test_an_overlay_outlines_the_roi_and_the_exclude_polygons_as_the_preview_does():

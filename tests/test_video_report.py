@@ -168,6 +168,7 @@ def test_page_one_says_a_crossing_is_coarse_because_the_frames_between_were_flag
     rows = [
         {"dataset": "vid", "image": "v.avi", "frame": 10 * i + k, "material": "DS30",
          "actuator": "A3", "trial": 1, "direction": "up", "pressure_kpa": float(p),
+         "step": i, "since_step_s": 0.1 * k if i else float("nan"),
          "psi_deg": psi, "status": "flagged" if p == 120 else "ok",
          "reason": "body touches the image border at its free end: the tip may be outside"
          if p == 120 else ""}
@@ -176,8 +177,12 @@ def test_page_one_says_a_crossing_is_coarse_because_the_frames_between_were_flag
     ]
     (note,) = coarse_crossing_notes(pd.DataFrame(rows))
     assert "between 80 and 160 kPa rising" in note
-    assert "the 10 frames ending the hold at 120 kPa between them are not in the curve" in note
-    assert "(flagged: body's tip at the image border, 10)" in note
+    # the end of its hold: the settled frames, the last 3 of its 10 (SETTLED_MIN_FRAMES)
+    assert "the 3 frames ending the hold at 120 kPa between them are not in the curve" in note
+    # a video ramped continuously has no holds: its frames at those pressures (the review's)
+    (ramp,) = coarse_crossing_notes(pd.DataFrame(rows).assign(since_step_s=float("nan")))
+    assert "the 10 frames at 120 kPa between them are not in the curve" in ramp
+    assert "(flagged: body's tip at the image border, 3)" in note
     assert "smaller pressure steps" not in note and "reasons in angles.csv" in note
     # the same frames ok: the jump is between 120 and 160 kPa, with nothing between them
     (note,) = coarse_crossing_notes(pd.DataFrame(rows).assign(status="ok"))

@@ -505,29 +505,44 @@ def comparison_notes(data: ReportData) -> list[str]:
 
 
 def span_notes(data: ReportData) -> list[str]:
-    """Per material whose pressures stopped well short of the paper's span: its range and P at
-    psi = 0 are not comparable with the paper's (customer 28 read a 0-160 kPa ramp's range of
-    135 deg beside the paper's 265 deg over 255 kPa as a shortfall).
+    """Per material whose mean curve stops well short of the paper's pressure span: its range of
+    motion is not comparable with the paper's, nor P at psi = 0 where the paper's lies beyond
+    (customer 28 read a 0-160 kPa ramp's range of 135 deg beside the paper's 265 deg over 255 kPa
+    as a shortfall).
 
     Examples
     --------
     >>> from types import SimpleNamespace
-    >>> rms = pd.DataFrame({"material": ["SS40", "DS20"], "range_kpa": [160.0, 250.0],
-    ...                     "paper_range_kpa": [255.0, 255.0]})
-    >>> print(*span_notes(SimpleNamespace(materials=["SS40", "DS20"], rms=rms)))
-    SS40: the photos reach 160 kPa, the paper's 255 kPa: its range of motion and P at ψ = 0 are \
-not comparable with the paper's (left and right bars below).
+    >>> rms = pd.DataFrame({"material": ["SS40", "DS30"], "paper_range_kpa": [255.0, 175.0],
+    ...                     "paper_p_zero_kpa": [215.0, 105.0]})
+    >>> h = pd.DataFrame({"material": ["SS40"] * 2 + ["DS30"] * 2, "psi_mean_deg": 100.0,
+    ...                   "pressure_kpa": [0.0, 160.0, 0.0, 150.0]})
+    >>> for note in span_notes(SimpleNamespace(materials=["SS40", "DS30"], rms=rms, hysteresis=h)):
+    ...     print(note)
+    SS40: its mean curve reaches 160 kPa, the paper's 255 kPa: its range of motion is not \
+comparable with the paper's, nor P at ψ = 0, which the paper finds at 215 kPa.
+    DS30: its mean curve reaches 150 kPa, the paper's 175 kPa: its range of motion is not \
+comparable with the paper's.
     """
     out = []
     for m in data.materials:
         g = rms_row(data, m)
-        ours, paper = float(g.get("range_kpa", math.nan)), float(g.get("paper_range_kpa", math.nan))
-        if math.isfinite(ours) and math.isfinite(paper) and ours < SPAN_SHORT * paper:
-            out.append(
-                f"{m}: the photos reach {ours:g} kPa, the paper's {paper:g} kPa: its range of "
-                "motion and P at ψ = 0 are not comparable with the paper's (left and right bars "
-                "below)."
+        paper = float(g.get("paper_range_kpa", math.nan))
+        h = data.hysteresis
+        h = h[(h["material"].astype(str) == m) & np.isfinite(h["psi_mean_deg"].astype(float))]
+        top = float(h["pressure_kpa"].max()) if len(h) else math.nan
+        if not (math.isfinite(top) and math.isfinite(paper) and top < SPAN_SHORT * paper):
+            continue
+        p_zero = float(g.get("paper_p_zero_kpa", math.nan))
+        out.append(
+            f"{m}: its mean curve reaches {top:g} kPa, the paper's {paper:g} kPa: its range of "
+            "motion is not comparable with the paper's"
+            + (
+                f", nor P at ψ = 0, which the paper finds at {p_zero:g} kPa."
+                if math.isfinite(p_zero) and top < p_zero
+                else "."
             )
+        )
     return out
 
 

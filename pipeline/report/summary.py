@@ -261,11 +261,14 @@ def _left_out_between(
     levels = sorted(set(level[out.index]))
     at = f"{levels[0]:g} kPa" if len(levels) == 1 else f"{levels[0]:g}-{levels[-1]:g} kPa"
     many = len(out) > 1
-    if "frame" in out.columns and out["frame"].notna().any():  # a video: its holds' ends count
-        holds = "holds" if len(levels) > 1 else "hold"
-        what = f"{len(out)} frame{'s' if many else ''} ending the {holds}"
+    frames = "frame" in out.columns and out["frame"].notna().any()
+    since = pd.to_numeric(out.get("since_step_s", pd.Series(np.nan, index=out.index)),
+                          errors="coerce")
+    if frames and np.isfinite(since).any():  # a stepped video: the ends of its holds count
+        n_holds = len(out.groupby([c for c in ("image", "step") if c in out.columns]))
+        what = f"{len(out)} frame{'s' if many else ''} ending the hold{'s' if n_holds > 1 else ''}"
     else:
-        what = f"{len(out)} photo{'s' if many else ''}"
+        what = f"{len(out)} {'frame' if frames else 'photo'}{'s' if many else ''}"
     causes = top_reasons(out.assign(dataset=""), limit=1).get("", [])
     statuses = "/".join(sorted(set(out["status"].astype(str))))
     why = f" ({statuses}: " + ", ".join(f"{c}, {n}" for c, n in causes) + ")" if causes else ""

@@ -62,7 +62,8 @@ def sequence_file_names(
     video: str, files: tuple[str, ...], frames: pd.api.extensions.ExtensionArray
 ) -> list[str]:
     """The file of each frame of a frame sequence, as the manifest names its folder (for a frame
-    missing from the sequence, the file it lacks; '' for a row without a frame).
+    missing from the sequence or past its last file, the file it lacks; '' for a row without a
+    frame).
 
     Examples
     --------
@@ -70,11 +71,13 @@ def sequence_file_names(
     >>> sequence_file_names("cam/f_%04d.jpg", ("/d/cam/f_0001.jpg", "", "/d/cam/f_0003.jpg"),
     ...                     frames)
     ['cam/f_0001.jpg', 'cam/f_0002.jpg', 'cam/f_0003.jpg', '']
+    >>> sequence_file_names("f_%04d.jpg", ("/d/f_0001.jpg",), pd.array([1], dtype="Int64"))
+    ['f_0002.jpg']
     """
     folder = Path(video).parent
     return [
         (folder / sequence_file_name(video, files, int(k))).as_posix()
-        if k is not pd.NA and 0 <= int(k) < len(files)
+        if k is not pd.NA and int(k) >= 0 and any(files)
         else ""
         for k in frames
     ]

@@ -117,6 +117,12 @@ def cycle_summary(
     >>> print(textwrap.fill(cycle_summary(c, stepped=True, steps=s).split(".  ")[1], 90))
     The hold after 160 -> 120 kPa did not settle (the step table): its loop point is the
     hold's last frames, still moving.
+
+    With several ramps in the table, each hold names its ramp:
+
+    >>> two = s.assign(material="DS30", actuator=["A1", "A2"], trial=1, note=s["note"].iloc[1])
+    >>> cycle_summary(c, stepped=True, steps=two).split(".  ")[1][:70]
+    'The holds after 0 -> 160 kPa (DS30 A1 t1), 160 -> 120 kPa (DS30 A2 t1)'
     """
     text = "; ".join(
         f"{_label(c)} cycle {int(c['cycle'])}: "
@@ -138,8 +144,13 @@ def cycle_summary(
         else pd.DataFrame()
     )
     if len(moving):
+        several = set(RAMP_KEYS) <= set(moving.columns) and len(
+            steps.groupby(list(RAMP_KEYS))  # type: ignore[union-attr]
+        ) > 1
         which = ", ".join(
-            f"{_fmt(r['from_kpa'], 0)} -> {_fmt(r['to_kpa'], 0)} kPa" for _, r in moving.iterrows()
+            f"{_fmt(r['from_kpa'], 0)} -> {_fmt(r['to_kpa'], 0)} kPa"
+            + (f" ({_label(r)})" if several else "")
+            for _, r in moving.iterrows()
         )
         holds = "hold after" if len(moving) == 1 else "holds after"
         its = "its loop point is" if len(moving) == 1 else "their loop points are"

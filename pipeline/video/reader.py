@@ -190,11 +190,13 @@ def sequence_file_name(pattern: str, files: tuple[str, ...], k: int) -> str:
     Examples
     --------
     >>> files = ("/d/f_0007.jpg", "", "/d/f_0009.jpg")
-    >>> [sequence_file_name("d/f_%04d.jpg", files, k) for k in range(3)]
-    ['f_0007.jpg', 'f_0008.jpg', 'f_0009.jpg']
+    >>> [sequence_file_name("d/f_%04d.jpg", files, k) for k in range(4)]
+    ['f_0007.jpg', 'f_0008.jpg', 'f_0009.jpg', 'f_0010.jpg']
     """
-    if files[k]:
+    if k < len(files) and files[k]:
         return Path(files[k]).name
+    if not any(files):
+        return ""
     name = Path(pattern).name
     m = SEQUENCE_NUMBER.search(name)
     first = Path(next(f for f in files if f)).name
@@ -354,7 +356,7 @@ def _sequence_frames(info: VideoInfo, first: int, end: int) -> Iterator[Frame]:
             yield Frame(k, math.nan, data)
             continue
         why = "is empty" if file else "is missing from the sequence"
-        its = sequence_file_name(info.path, info.files, k) if k < len(info.files) else ""
+        its = sequence_file_name(info.path, info.files, k)
         yield Frame(
             k, math.nan, None,
             f"frame {k} of {Path(info.path).name}{f' ({its})' if its else ''} {why}",
