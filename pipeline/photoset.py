@@ -1087,7 +1087,8 @@ def file_problems(
                 else "no mm_per_px (optional for a body): a body's length is then checked "
                 "against the other photos of its ramp only, not against l0_mm",
                 "set mm_per_px if a ruler or a known length is in view (a body's width, in mm "
-                "over px, or its length when straight)"
+                "over px across its outline on the photo, not width_px, which a faint side "
+                "narrows; or its length when straight; a rough one does)"
                 + (
                     ": with sealed_end_mm it places the sealed end, which the body's own length, "
                     "changed by its bending, places less well (|psi| above 150 deg about 1 deg "

@@ -23,6 +23,7 @@ from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work
 from pipeline.measure.estimators import METHODS
+from pipeline.measure.quality import NOTES
 from pipeline.measure.ramp_background import (
     RAMP_BACKGROUND_MIN_PHOTOS,
     covered,
@@ -402,11 +403,33 @@ def _on_ramp_backgrounds(
             )
             if first["status"] == "ok":
                 read += f", {apart:.1f} deg apart: the second look is taken"
+            elif cause := first_cause(str(first["reason"] or "")):
+                read += f": {cause}"  # customer 29 had to run preview to learn why
             out[i] = {**row, "reason": f"{row['reason']} (the first look read {read})"}
             drawn, final = task.overlay_path, tasks[i].overlay_path
             if drawn is not None and final is not None:
                 shutil.move(drawn, final)  # the temporary folder may be on another disk
     return out
+
+
+def first_cause(reason: str) -> str:
+    """The first cause of a row's reason, without the notes on how psi was taken and without
+    its fix (what follows its first colon).
+
+    Examples
+    --------
+    >>> first_cause("psi from the free end's tangent against fixed_direction_deg; the centre "
+    ...             "line stops 24 px short of the body's free end (uneven outline there): check "
+    ...             "with photoset preview")
+    "the centre line stops 24 px short of the body's free end (uneven outline there)"
+    >>> first_cause("end direction unstable (-13 vs +11 deg over a longer end)")
+    'end direction unstable (-13 vs +11 deg over a longer end)'
+    """
+    for part in reason.split(";"):
+        text = part.strip()
+        if text and not text.startswith(NOTES):
+            return text.split(": ", 1)[0]
+    return ""
 
 
 def flag_doubtful_calibration(angles: pd.DataFrame) -> pd.DataFrame:

@@ -56,9 +56,12 @@ def test_a_translucent_ramp_without_its_empty_scene_is_measured_against_its_own_
     assert (angles.loc[again, "status"] == "ok").all()
     # and what the first look read, so that a user sees how much the second one changed
     assert angles.loc[again, "reason"].str.contains(
-        r"photos \(the first look read [-+]\d+\.\d deg, (?:flagged|ok, \d+\.\d deg apart: the "
-        r"second look is taken)\)|first look read failed"
+        r"photos \(the first look read [-+]\d+\.\d deg, (?:flagged: .+|ok, \d+\.\d deg apart: "
+        r"the second look is taken)\)|first look read failed"
     ).all(), angles.loc[again, "reason"].tolist()
+    # a flagged first look's reason names its first cause (customer 29 ran preview to learn it)
+    flagged_first = angles.loc[again, "reason"].str.extract(r"deg, flagged: (.+)\)$")[0].dropna()
+    assert len(flagged_first) and not flagged_first.str.startswith("psi from").any()
 
 
 def test_only_a_body_told_from_the_backdrop_whose_free_end_is_known_is_measured_again():
