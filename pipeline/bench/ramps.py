@@ -15,6 +15,8 @@ Examples
 --------
 >>> SETS[0]
 RampSet(material='DS20', scene='grey_dots_clear', seed=1, width=1280, height=960)
+>>> HELD_OUT[0].name
+'grey_dots_clear_SS50_s5_1280x960'
 """
 
 from __future__ import annotations
@@ -62,6 +64,18 @@ SETS: tuple[RampSet, ...] = (
     RampSet("DS20", "green_fibre", 21, 1280, 960),
     RampSet("DS20", "dark_translucent", 23, 1280, 960),
     RampSet("DS20", "grey_dots", 25, 1280, 960),
+)
+
+
+#: six sets not used to choose ``SECOND_LOOK_APART_DEG`` (``--held-out``): stiffer bodies, other
+#: seeds and sizes
+HELD_OUT: tuple[RampSet, ...] = (
+    RampSet("SS50", "grey_dots_clear", 5, 1280, 960),
+    RampSet("SS50", "grey_dots_clear", 6, 1920, 1440),
+    RampSet("SS40", "grey_dots_clear", 11, 1280, 720),
+    RampSet("DS30", "grey_dots_clear", 12, 1920, 1440),
+    RampSet("SS50", "dark_translucent", 13, 1280, 960),
+    RampSet("DS20", "grey_dots", 14, 1920, 1440),
 )
 
 
@@ -121,10 +135,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--camera", choices=CAMERAS, default="clean",
                         help="what the camera does to each photo (auto: its own exposure and "
                              "white balance; see bench realscenes --help) (default clean)")
+    parser.add_argument("--held-out", action="store_true",
+                        help=f"the {len(HELD_OUT)} sets not used to choose the threshold of two "
+                             "looks that disagree (docs/body.md), instead")
     args = parser.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench-ramps-") as tmp:
-        for spec in SETS[: args.sets]:
+        for spec in (HELD_OUT if args.held_out else SETS)[: args.sets]:
             folder = render(spec, Path(tmp), args.camera)
             for second_look in (False, True):
                 t0 = time.perf_counter()
