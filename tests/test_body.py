@@ -125,7 +125,9 @@ def test_textured_body_and_excluded_clamp(psi):
 def test_fixed_direction_gives_psi_against_the_known_clamp_direction():
     img, fe, _ = body_photo(100.0, seed=5)
     res = measure_image(img, settings_for(fe, fixed_direction_deg=0.0))
-    assert res.status == "ok" and "fixed_direction_deg" in res.reason
+    # no note saying so on every row (angles.csv's fixed_direction_deg column does; customer 29
+    # found the note on all 46 rows hid the ones that matter)
+    assert res.status == "ok" and res.reason == ""
     assert res.psi_deg == pytest.approx(100.0, abs=2.5)
     # a clamp direction that disagrees with the photo by 30 deg is used, and said to be doubtful
     off = measure_image(img, settings_for(fe, fixed_direction_deg=30.0))

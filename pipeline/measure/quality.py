@@ -437,12 +437,12 @@ def assess_body(
         flags.append(
             f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible"
         )
-    if base_mismatch_deg is not None:
-        notes.append(NOTE_FIXED_DIRECTION)
-        if abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
-            flags.append(
-                f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
-            )
+    # psi taken against the direction given is angles.csv's fixed_direction_deg column; a note
+    # saying so on every row hid the rows that matter (customer 29)
+    if base_mismatch_deg is not None and abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
+        flags.append(
+            f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
+        )
     if selected_fraction > 0.35:
         notes.append(f"{NOTE_SELECTION_COVERS} {100 * selected_fraction:.0f}% of the photo")
     if background_estimated:
