@@ -1444,6 +1444,22 @@ def geometry_problems(
                     "give roi in pixels of this photo (x right, y down)",
                 )
             )
+    if s.roi is not None or s.exclude:
+        from pipeline.measure.extract import region_mask
+
+        region = region_mask((h, w), s.roi, s.exclude)
+        if region is not None and not region.any():
+            out.append(
+                Problem(
+                    file,
+                    line,
+                    "roi and exclude leave nothing of the photo to measure"
+                    if s.roi is not None
+                    else "exclude covers the whole photo",
+                    f"give exclude boxes or polygons over what is not the actuator, in pixels of "
+                    f"this {w}x{h} photo (x right, y down; photoset preview draws them)",
+                )
+            )
     if s.background_path is not None:
         from pipeline.measure.core import same_aspect
 

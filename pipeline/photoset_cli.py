@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from pipeline import photoset, photoset_init
 from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
-from pipeline.measure.settings import POSITIVE_TURNS
+from pipeline.measure.settings import FREE_ENDS, POSITIVE_TURNS
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -124,6 +124,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "l0_mm + this)",
     )
     init.add_argument(
+        "--free-end",
+        choices=FREE_ENDS,
+        default=None,
+        help="body: capped (its end does not bend: a sealed end, a cap; the default) or bends (a "
+             "cut strip that bends to its end, as a free bilayer strip)",
+    )
+    init.add_argument(
+        "--exclude",
+        action="append",
+        metavar="X0,Y0,X1,Y1",
+        help="a box of the photo to leave out (a clamp plate, a ruler, a label), corner to corner "
+             "in pixels; repeat for several (a polygon: write it in photoset.yaml)",
+    )
+    init.add_argument(
         "--background",
         metavar="FILE",
         help="body: a photo of the empty scene in the folder (same camera, light and framing, "
@@ -229,6 +243,17 @@ def _xy(text: str, option: str) -> tuple[float, float]:
     return x, y
 
 
+def _box(text: str, option: str) -> tuple[float, float, float, float]:
+    try:
+        x0, y0, x1, y1 = (float(v) for v in text.split(","))
+    except ValueError:
+        raise UserInputError(
+            f"{option} {text!r}: write a box's two corners in pixels as X0,Y0,X1,Y1, e.g. "
+            "0,700,720,1440"
+        ) from None
+    return x0, y0, x1, y1
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``photoset init``, ``check``, ``preview`` or ``pick-color``."""
     if args.photoset_command == "init":
@@ -320,6 +345,10 @@ def _init(args: argparse.Namespace) -> int:
         settings["fixed_direction_deg"] = args.fixed_direction_deg
     if args.sealed_end_mm is not None:
         settings["sealed_end_mm"] = args.sealed_end_mm
+    if args.free_end is not None:
+        settings["free_end"] = args.free_end
+    if args.exclude:
+        settings["exclude"] = [list(_box(b, "--exclude")) for b in args.exclude]
     if args.background is not None:
         if not (Path(args.folder) / args.background).is_file():
             raise UserInputError(

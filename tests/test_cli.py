@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pandas as pd
 import pytest
 
 from pipeline.bench.cli import BENCHES
@@ -81,6 +82,7 @@ def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
     written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
     assert written["sealed_end_mm"] == 6.0 and written["target"] == "body"
     assert written["fixed_direction_deg"] == 46.5
+    assert "free_end" not in written and "exclude" not in written  # left to their defaults
     out = _run("photoset", "check", str(photo_folder))
     assert out.returncode == 0 and "no sealed_end_mm" not in out.stdout
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
@@ -150,3 +152,36 @@ def test_bench_model_prints_its_figures(capsys):
     assert main(["bench", "model", "--grid-sizes", "2", "4"]) == 0
     out = capsys.readouterr().out
     assert "max_rel_error" in out and "default grid (grid_n=4)" in out
+
+
+def test_photoset_init_writes_a_free_end_and_exclude_boxes(photo_folder):
+    # carried over from customer 26: a free strip and an exclude box had to be typed into
+    # photoset.yaml by hand after init; check reads what init writes
+    import yaml
+
+    args = ["photoset", "init", str(photo_folder), "--pattern",
+            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
+            "--target", "body", "--free-end", "bends", "--exclude", "0,0,10,8",
+            "--exclude", "28,20,32,24"]
+    out = _run(*args)
+    assert out.returncode == 0, out.stderr
+    written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
+    assert written["free_end"] == "bends"
+    assert written["exclude"] == [[0.0, 0.0, 10.0, 8.0], [28.0, 20.0, 32.0, 24.0]]
+    out = _run("photoset", "check", str(photo_folder))
+    assert out.returncode == 0, out.stdout + out.stderr
+    # an exclude over the whole photo: check names it (it crashed in the backdrop model), and
+    # measure gives failed rows that say why instead of a traceback
+    written["exclude"] = [[0, 0, 40, 30]]
+    (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(written))
+    out = _run("photoset", "check", str(photo_folder))
+    assert out.returncode != 0 and "exclude covers the whole photo" in out.stdout + out.stderr
+    out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "x.csv"))
+    angles = pd.read_csv(photo_folder.parent / "x.csv")
+    assert (angles["status"] == "failed").all(), out.stderr
+    assert angles["reason"].str.contains("roi / exclude leave nothing of the photo").all()
+    # a box written wrong is refused, naming the option and the form
+    (photo_folder / "photoset.yaml").unlink()
+    (photo_folder / "manifest.csv").unlink()
+    out = _run(*args[:-2], "--exclude", "0,0,40")
+    assert out.returncode != 0 and "--exclude '0,0,40': write a box's two corners" in out.stderr

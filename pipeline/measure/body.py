@@ -334,7 +334,11 @@ def light_falloff(image_bgr: np.ndarray, allowed: np.ndarray) -> float:
     >>> allowed = np.ones((60, 80), np.uint8)
     >>> round(light_falloff(even, allowed), 2), light_falloff(ramp, allowed) > 0.5
     (0.0, True)
+    >>> light_falloff(even, np.zeros((60, 80), np.uint8))  # roi / exclude leave nothing
+    0.0
     """
+    if not allowed.any():
+        return 0.0
     model = _main_backdrop(_lab(image_bgr), allowed)[0]
     light = model[:, :, 0][allowed > 0] / LIGHTNESS_WEIGHT
     lo, mid, hi = (float(v) for v in np.percentile(light, [2, 50, 98]))
@@ -641,6 +645,8 @@ def body_mask(
     allowed = np.ones((h, w), np.uint8) if region is None else region
     strength: np.ndarray = np.zeros((h, w), np.float32)
     contrast = float("inf")
+    if not allowed.any():  # roi / exclude leave nothing to look at (the backdrop model crashed)
+        return allowed.copy(), strength, contrast
     mask = allowed.copy()
     if settings.color is not None:
         mask &= color_mask(image_bgr, settings.color)
@@ -1479,6 +1485,11 @@ def extract_body(
     )
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     allowed_px = float(h * w if region is None else region.sum())
+    if allowed_px == 0:
+        raise NoLineFound(
+            "no body found: roi / exclude leave nothing of the photo to look at; fix them "
+            "(python -m pipeline photoset preview shows their outlines)"
+        )
     selected = float(raw.sum()) / max(allowed_px, 1.0)
     what = settings.describe_color()
     if raw.sum() < 20:
