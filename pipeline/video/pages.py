@@ -235,10 +235,12 @@ def figures(folder: Path) -> list[Figure]:
     ax_p.grid(False)
     lines = ax_t.get_legend_handles_labels()
     more = ax_p.get_legend_handles_labels()
+    # above the plot, not over it (customer 27: "best" still lay on the psi curve)
     ax_t.legend(
-        lines[0] + more[0], lines[1] + more[1], loc="best", fontsize=MIN_FONT_PT, ncol=2
+        lines[0] + more[0], lines[1] + more[1], loc="lower left", bbox_to_anchor=(0.0, 1.0),
+        fontsize=MIN_FONT_PT, ncol=4, frameon=False, borderaxespad=0.2,
     )
-    ax_t.set_title("Every frame measured (medians of short time bins)", fontsize=9)
+    ax_t.set_title("Every frame measured (medians of short time bins)", fontsize=9, pad=16)
 
     ax_l = fig.add_subplot(grid[1, 0])
     for j, (key, g) in enumerate(
