@@ -578,10 +578,15 @@ def test_a_video_dataset_runs_from_render_to_its_report_page(finished_run):
     steps = pd.read_csv(res / "continuous" / "vid" / "steps.csv")
     assert list(steps["to_kpa"]) == [40, 80, 40, 0] and steps["rise_time_s"].notna().all()
     assert (res / "continuous" / "vid" / "strip.jpg").is_file()
+    # each strip tile's caption, written on the page large enough to read (customer 27)
+    strip = pd.read_csv(res / "continuous" / "vid" / "strip.csv")
+    assert len(strip) == 6 and strip["frame"].is_monotonic_increasing
     doc = pdfium.PdfDocument(str(res / "report.pdf"))
     text = [doc[i].get_textpage().get_text_range() for i in range(len(doc))]
     doc.close()
     assert sum("Video dataset vid" in t for t in text) == 1
+    (page,) = [" ".join(t.split()) for t in text if "Video dataset vid" in t]
+    assert f"frame {int(strip['frame'].iloc[-1])}" in page
 
 
 @ON_THE_FINISHED_RUN

@@ -32,6 +32,9 @@ MAX_TABLE_ROWS = 12
 STRIP = "strip.jpg"
 #: frames in the strip
 STRIP_FRAMES = 6
+#: the strip's captions, one row per tile
+STRIP_CAPTIONS = "strip.csv"
+STRIP_CAPTION_COLUMNS: tuple[str, ...] = ("frame", "time_s", "pressure_kpa", "psi_deg", "status")
 
 
 def write_strip(
@@ -41,7 +44,7 @@ def write_strip(
     found)."""
     import cv2
 
-    from pipeline.fileio import atomic_write_bytes
+    from pipeline.fileio import atomic_write_bytes, write_table
     from pipeline.measure.overlay import contact_sheet
     from pipeline.video.measure import frame_overlay_name
 
@@ -50,22 +53,44 @@ def write_strip(
         Path(overlays_dir) / frame_overlay_name(str(i), int(k))
         for i, k in zip(frames["image"], frames["frame"])
     ]
-    paths = [p for p in paths if p.is_file()]
-    if not paths:
+    drawn = [j for j, p in enumerate(paths) if p.is_file()]
+    if not drawn:
         return None
     pick = [
-        paths[int(i)]
-        for i in np.unique(np.round(np.linspace(0, len(paths) - 1, min(n, len(paths)))).astype(int))
+        drawn[int(i)]
+        for i in np.unique(np.round(np.linspace(0, len(drawn) - 1, min(n, len(drawn)))).astype(int))
     ]
     ok, buf = cv2.imencode(
         ".jpg",
-        contact_sheet(pick, columns=len(pick), tile_width_px=320),
+        contact_sheet([paths[j] for j in pick], columns=len(pick), tile_width_px=320),
         [cv2.IMWRITE_JPEG_QUALITY, 85],
     )
     if not ok:
         return None
     atomic_write_bytes(Path(out_dir) / STRIP, buf.tobytes())
+    # the tiles' captions, written on the page at a size that can be read (their own bands are
+    # too small there: customer 27)
+    columns = [c for c in STRIP_CAPTION_COLUMNS if c in frames.columns]
+    write_table(frames.iloc[pick][columns], Path(out_dir) / STRIP_CAPTIONS)
     return Path(out_dir) / STRIP
+
+
+def strip_caption(row: pd.Series) -> str:
+    """A strip tile's caption: frame, time, pressure, psi and status.
+
+    Examples
+    --------
+    >>> strip_caption(pd.Series({"frame": 120, "time_s": 4.5, "pressure_kpa": 40.0,
+    ...                          "psi_deg": 183.42, "status": "ok"}))
+    'frame 120\\n4.50 s, 40 kPa\\nψ +183.4° ok'
+    """
+    psi = float(row.get("psi_deg", np.nan))
+    return (
+        f"frame {int(row['frame'])}\n{_fmt(row.get('time_s'))} s, "
+        f"{_fmt(row.get('pressure_kpa'), 0)} kPa\n"
+        + (f"ψ {psi:+.1f}° " if np.isfinite(psi) else "ψ n/a ")
+        + str(row.get("status", ""))
+    )
 
 
 def _read(folder: Path, name: str) -> pd.DataFrame:
@@ -366,6 +391,12 @@ def figures(folder: Path) -> list[Figure]:
             ax_f = fig.add_subplot(grid[4, :])
             ax_f.imshow(cv2.cvtColor(img, cv2.COLOR_BGR2RGB), interpolation="none")
             ax_f.set_axis_off()
+            captions = _read(folder, STRIP_CAPTIONS)
+            for k, (_, c) in enumerate(captions.iterrows()):
+                ax_f.text(
+                    (k + 0.5) / len(captions), -0.04, strip_caption(c), transform=ax_f.transAxes,
+                    ha="center", va="top", fontsize=MIN_FONT_PT,
+                )
             ax_f.set_title(
                 "Frames across the recording, extracted line drawn ('measure --overlays')",
                 fontsize=8,
