@@ -70,16 +70,24 @@ def test_photoset_init_then_check(photo_folder):
     assert "OK (8 photos" in out.stdout
 
 
+def _init_body(folder, *options: str) -> tuple[list[str], dict]:
+    """``photoset init`` of ``photo_folder`` as a body set with ``options``; its args and the
+    photoset.yaml it wrote."""
+    import yaml
+
+    args = ["photoset", "init", str(folder), "--pattern",
+            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
+            "--target", "body", *options]
+    out = _run(*args)
+    assert out.returncode == 0, out.stderr
+    return args, yaml.safe_load((folder / "photoset.yaml").read_text())
+
+
 def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
     import yaml
 
-    args = ["photoset", "init", str(photo_folder), "--pattern",
-            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
-            "--target", "body", "--mm-per-px", "0.3", "--sealed-end-mm", "6",
-            "--fixed-direction-deg", "46.5"]
-    out = _run(*args)
-    assert out.returncode == 0, out.stderr
-    written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
+    args, written = _init_body(photo_folder, "--mm-per-px", "0.3", "--sealed-end-mm", "6",
+                               "--fixed-direction-deg", "46.5")
     assert written["sealed_end_mm"] == 6.0 and written["target"] == "body"
     assert written["fixed_direction_deg"] == 46.5
     assert "free_end" not in written and "exclude" not in written  # left to their defaults
@@ -159,13 +167,8 @@ def test_photoset_init_writes_a_free_end_and_exclude_boxes(photo_folder):
     # photoset.yaml by hand after init; check reads what init writes
     import yaml
 
-    args = ["photoset", "init", str(photo_folder), "--pattern",
-            "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200",
-            "--target", "body", "--free-end", "bends", "--exclude", "0,0,10,8",
-            "--exclude", "28,20,32,24"]
-    out = _run(*args)
-    assert out.returncode == 0, out.stderr
-    written = yaml.safe_load((photo_folder / "photoset.yaml").read_text())
+    args, written = _init_body(photo_folder, "--free-end", "bends", "--exclude", "0,0,10,8",
+                               "--exclude", "28,20,32,24")
     assert written["free_end"] == "bends"
     assert written["exclude"] == [[0.0, 0.0, 10.0, 8.0], [28.0, 20.0, 32.0, 24.0]]
     out = _run("photoset", "check", str(photo_folder))
