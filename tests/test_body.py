@@ -1168,3 +1168,14 @@ def test_a_capped_tip_reads_the_same_with_a_rough_scale_as_with_the_exact_one():
     for cases in (scaled, derived):
         assert cases["error_deg"].abs().median() < 1.0, cases["error_deg"].round(1).tolist()
         assert cases["error_deg"].abs().max() < 2.0, cases["error_deg"].round(1).tolist()
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("roi", [[100, 100, 103, 102], [100, 100, 101, 101]])
+def test_a_roi_of_a_few_pixels_is_a_failed_row_not_a_crash(roi):
+    # found beside the exclude over a whole photo (which crashed check and measure): a region
+    # smaller than the backdrop model's sparse grid left it no pixel (IndexError in kmeans3)
+    img = np.full((960, 1280, 3), 120, np.uint8)
+    res = measure_image(img, resolve_settings(l0_mm=200.0, target="body", roi=roi,
+                                              sealed_end_mm=4.0))
+    assert res.status == "failed" and "no body found" in res.reason

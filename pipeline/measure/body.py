@@ -260,6 +260,8 @@ def backdrop_difference(
     for centre in others:
         diff = np.minimum(diff, lab_distance(lab, centre))
     vals = diff[ring & grid] if (ring & grid).sum() >= 12 else diff[(allowed > 0) & grid]
+    if vals.size < 3:  # a region smaller than the grid's step
+        vals = diff[allowed > 0]
     med = float(np.median(vals))
     sigma = max(1.4826 * float(np.median(np.abs(vals - med))), 0.5)
     return diff, sigma, (model, *others)
@@ -359,6 +361,8 @@ def _main_backdrop(
     sample = ring & grid
     if sample.sum() < 12:
         sample = (allowed > 0) & grid
+    if sample.sum() < 3:  # a region smaller than the grid's step (a roi of a few pixels)
+        sample = allowed > 0
     ring_px = lab[sample]
     labels, centres = kmeans3(ring_px[:: max(1, len(ring_px) // KMEANS_PIXELS)])
     d_ring = ((ring_px[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
