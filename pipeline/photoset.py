@@ -1433,9 +1433,11 @@ def geometry_problems(
                 "(or give this row its own calibration)",
             )
         )
+    roi_outside = False
     if s.roi is not None:
         xs, ys = [p[0] for p in s.roi], [p[1] for p in s.roi]
-        if max(xs) <= 0 or max(ys) <= 0 or min(xs) >= w or min(ys) >= h:
+        roi_outside = max(xs) <= 0 or max(ys) <= 0 or min(xs) >= w or min(ys) >= h
+        if roi_outside:
             out.append(
                 Problem(
                     file,
@@ -1444,7 +1446,7 @@ def geometry_problems(
                     "give roi in pixels of this photo (x right, y down)",
                 )
             )
-    if s.roi is not None or s.exclude:
+    if not roi_outside and (s.roi is not None or s.exclude):
         from pipeline.measure.extract import region_mask
 
         region = region_mask((h, w), s.roi, s.exclude)
@@ -1453,11 +1455,10 @@ def geometry_problems(
                 Problem(
                     file,
                     line,
-                    "roi and exclude leave nothing of the photo to measure"
-                    if s.roi is not None
+                    "exclude covers all of the roi" if s.roi is not None
                     else "exclude covers the whole photo",
-                    f"give exclude boxes or polygons over what is not the actuator, in pixels of "
-                    f"this {w}x{h} photo (x right, y down; photoset preview draws them)",
+                    "exclude only what is not the actuator (a plate, a ruler, a label), in pixels "
+                    f"of this {w}x{h} photo (x right, y down; photoset preview draws the outlines)",
                 )
             )
     if s.background_path is not None:

@@ -183,6 +183,14 @@ def test_photoset_init_writes_a_free_end_and_exclude_boxes(photo_folder):
     angles = pd.read_csv(photo_folder.parent / "x.csv")
     assert (angles["status"] == "failed").all(), out.stderr
     assert angles["reason"].str.contains("roi / exclude leave nothing of the photo").all()
+    # an exclude over all of a roi says so; a roi outside the photo is told once, not twice
+    for roi, exclude, said in (([4, 4, 12, 12], [[0, 0, 16, 16]], "exclude covers all of the roi"),
+                               ([100, 100, 200, 200], [], "lies outside the 32x24 photo")):
+        written.update(roi=roi, exclude=exclude)
+        (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(written))
+        out = _run("photoset", "check", str(photo_folder))
+        lines = [x for x in (out.stdout + out.stderr).splitlines() if "line 2:" in x]
+        assert out.returncode != 0 and len(lines) == 1 and said in lines[0], lines
     # a box written wrong is refused, naming the option and the form
     (photo_folder / "photoset.yaml").unlink()
     (photo_folder / "manifest.csv").unlink()
