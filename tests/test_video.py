@@ -331,6 +331,19 @@ def test_a_frame_within_a_steps_log_interval_has_the_setpoint_in_force_not_one_n
     assert frame_conditions(ramp, np.array([0.5, 1.25]))["pressure_kpa"].tolist() == [5.0, 12.5]
 
 
+def test_every_frame_of_a_stepped_ramps_top_hold_is_rising_and_every_one_after_it_falling():
+    # the frames after the log's last row at the top (and before its first a step lower) held
+    # the top's setpoint but were called 'down': one 160 kPa frame in the falling leg's loop
+    t = np.arange(0, 20, 0.05)
+    steps = PressureProfile("steps", max_kpa=160, step_kpa=40, hold_s=2)
+    log = PressureLog("s.csv", t, steps.setpoint_kpa(t))
+    c = frame_conditions(log, np.arange(0.5, 17.5, 1 / 30))
+    top = c["pressure_kpa"] == 160.0
+    assert top.sum() > 50 and (c.loc[top, "direction"] == "up").all()
+    after = c.index > c.index[top][-1]
+    assert (c.loc[after, "direction"] == "down").all() and after.sum() > 100
+
+
 def test_pressure_log_problems_name_the_line(tmp_path):
     path = tmp_path / "log.csv"
     path.write_text("time_s,pressure_kpa\n0,0\n1,x\n")

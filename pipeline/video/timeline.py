@@ -387,9 +387,8 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
     # a frame between a step's last row at the old level and its first at the new one: the old
     # setpoint, still in force (interpolated, a customer's 120 -> 160 kPa step read 133.3 kPa)
     after = np.searchsorted(log.time_s, t, side="right")  # the first row later than the frame
-    setpoint = np.where(
-        np.isin(after, rows), log.pressure_kpa[np.maximum(after - 1, 0)], setpoint
-    )
+    held = np.isin(after, rows)
+    setpoint = np.where(held, log.pressure_kpa[np.maximum(after - 1, 0)], setpoint)
     out = pd.DataFrame({"pressure_kpa": np.where(inside, setpoint, np.nan)})
     if log.measured_kpa is not None:
         out["measured_pressure_kpa"] = np.where(
@@ -398,7 +397,10 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
     tp = turning_points(log.pressure_kpa)
     # direction of each log interval: up until the first turning point, then alternating
     edges = log.time_s[tp]
-    n_turns = np.searchsorted(edges, t, side="left")  # a frame at a peak's own time is still rising
+    # a frame at a peak's own time is still rising, and so is one that holds the peak's setpoint
+    # until a step down (its time is then that of the log's last row at the peak: the last frame
+    # of a stepped ramp's top hold was 'down' at the peak's level)
+    n_turns = np.searchsorted(edges, np.where(held, log.time_s[np.maximum(after - 1, 0)], t))
     out["direction"] = np.where(n_turns % 2 == 0, *DIRECTIONS)
     steps = step_times(log)
     k = np.searchsorted(steps, t, side="right")
