@@ -1013,8 +1013,11 @@ def missing_image_problem(
     ps: PhotoSet, line: int, image: str, in_folder: Sequence[str]
 ) -> Problem:
     """The problem of manifest line ``line``, whose photo ``image`` is not in the set's folder,
-    naming the photo of the folder (``in_folder``, :func:`photo_names`) it probably means."""
-    near = near_name(image, in_folder)
+    naming the photo of the folder (``in_folder``, :func:`photo_names`) it probably means: one
+    that no other row names (a customer deleted ``IMG_4310.JPG`` and was told to rename the row
+    to ``IMG_4321.JPG``, another row's photo, which would then be measured twice)."""
+    named = set(ps.manifest["image"].astype(str))
+    near = near_name(image, [n for n in in_folder if n not in named])
     return Problem(
         str(ps.folder / MANIFEST),
         line,

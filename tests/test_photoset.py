@@ -425,6 +425,29 @@ def test_a_mistyped_photo_name_and_a_capitalised_direction_are_named_or_read_as_
     assert angles["direction"].tolist() == ["up", "up", "down"]
 
 
+def test_a_deleted_photo_is_not_pointed_at_another_rows_photo(tmp_path):
+    # customer 30 moved IMG_4310.JPG out of the folder; check said to rename the row to
+    # 'IMG_4321.JPG', the photo of another row, which would then be measured at two pressures
+    import cv2
+
+    for name in ("IMG_4310.JPG", "IMG_4321.JPG", "IMG_4311.JPG"):
+        cv2.imwrite(str(tmp_path / name), np.zeros((40, 60, 3), np.uint8))
+    (tmp_path / "IMG_4310.JPG").unlink()
+    ps.write_settings(tmp_path, {"l0_mm": 200.0})
+    (tmp_path / ps.MANIFEST).write_text(
+        "image,pressure_kpa,direction,material,actuator,trial\n"
+        "IMG_4310.JPG,100,up,DS20,A1,1\nIMG_4311.JPG,120,up,DS20,A1,1\n"
+        "IMG_4321.JPG,0,down,DS20,A1,1\n"
+    )
+    (missing,) = [p for p in ps.validate_photoset(tmp_path) if p.line == 2]
+    assert "it has" not in missing.message and "IMG_4321" not in missing.fix, missing
+    assert missing.fix == "copy the photo in or remove the row"
+    # a photo no row names is still offered
+    cv2.imwrite(str(tmp_path / "IMG_4310.jpg"), np.zeros((40, 60, 3), np.uint8))
+    (missing,) = [p for p in ps.validate_photoset(tmp_path) if p.line == 2]
+    assert missing.fix.startswith("correct the name in the 'image' column to 'IMG_4310.jpg'")
+
+
 def test_a_cameras_numbered_photos_take_the_ramps_pressures_in_number_order(tmp_path):
     # IMG_1.JPG ... IMG_11.JPG hold no pressure: init refused the pattern ('the pressure must come
     # from the file name'); now each ramp's pressures are given in photo order, IMG_9 before
