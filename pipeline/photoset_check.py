@@ -11,6 +11,7 @@ import os
 
 from pipeline.model.materials import load_materials
 from pipeline.photoset import MANIFEST, PhotoSet, Problem, file_problems, load_checked
+from pipeline.ramp_check import pressure_order_breaks
 from pipeline.video.clips import clip_problems
 
 
@@ -37,6 +38,7 @@ def check_photoset(
             problems += clip_problems(ps, decode=decode_images, require_files=require_images)
         problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
         problems += material_problems(ps)
+        problems += pressure_order_problems(ps)
     return [p for p in problems if warnings or not p.warning]
 
 
@@ -59,3 +61,23 @@ def material_problems(ps: PhotoSet) -> list[Problem]:
             warning=True,
         ))
     return out
+
+
+def pressure_order_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning for each manifest row whose pressure breaks its ramp's order
+    (:func:`pipeline.ramp_check.pressure_order_breaks`): ``measure`` flags it and leaves it out
+    of the curves (customer 30's 100 kPa typed as 1000 put a level at 1000 kPa in the curves and
+    check said OK)."""
+    if ps.is_video:
+        return []
+    return [
+        Problem(
+            str(ps.folder / MANIFEST),
+            int(ps.manifest.at[ix, "manifest_line"]),
+            why.replace(" a typo in the manifest?", " a typo?"),
+            "correct pressure_kpa (or step) on this line; until then measure flags the photo and "
+            "leaves it out of the curves",
+            warning=True,
+        )
+        for ix, why in pressure_order_breaks(ps.manifest).items()
+    ]

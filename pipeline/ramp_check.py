@@ -13,6 +13,8 @@ rest photos: DS20 turns through 300 deg between 0 and 80 kPa, and 70 deg from 80
   ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
   The worst photo goes first (one already flagged on its own before one that is not) and the
   leg is checked again without it, so one wrong photo never drags its neighbours down;
+- a photo whose pressure breaks its leg's order is ``flagged`` (a typo in the manifest:
+  :func:`pressure_order_breaks`), as its psi would go into the curves at the wrong pressure;
 - a photo whose measured line length is far from the ramp's median is ``flagged`` (a partial
   line); a body's centre line, half the body's width beside the layer that does not stretch, is
   first brought to that layer's length (:func:`layer_lengths`);
@@ -47,7 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import RAMP_KEYS
+from pipeline.constants import DIRECTIONS, RAMP_KEYS
 from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
@@ -130,6 +132,80 @@ def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
     return [*base_runs(own_deg[:k]), *(run + k for run in base_runs(own_deg[k:]))]
 
 
+#: a pressure out of its leg's order by more than this share of the leg's median step (and at
+#: least PRESSURE_SLACK_MIN_KPA) is a typo: a gauge's own reading wobbles far less
+PRESSURE_SLACK_STEPS, PRESSURE_SLACK_MIN_KPA = 0.5, 1.0
+
+
+def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
+    """The rows whose ``pressure_kpa`` breaks the order of its leg: a typo in the manifest.
+
+    Along a leg (a run of one ``direction`` of a ramp, in ``step`` order) the pressure rises
+    (``up``) or falls (``down``).  A pressure that does not (by more than
+    :data:`PRESSURE_SLACK_STEPS` of the leg's median step) is doubtful: the one farthest from
+    the middle of its two neighbours goes first, and the leg is checked again without it, so a
+    typo never blames its neighbours (a customer's 100 kPa typed as 1000 went into the curves:
+    a level at 1000 kPa).  Nothing is said without a ``step`` column (the rows' order is then
+    not the order taken), for a video's frames (their pressures come from its log, not typed)
+    or for a leg of fewer than 3 pressures.
+
+    Returns
+    -------
+    dict
+        Row index -> the reason, naming the pressures before and after it.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"pressure_kpa": [0, 20, 40, 60, 1000, 120, 140, 120, 100],
+    ...     "direction": ["up"] * 7 + ["down"] * 2, "step": range(9), "material": "M",
+    ...     "actuator": "A", "trial": "1"})
+    >>> for ix, why in pressure_order_breaks(df).items():  # doctest: +NORMALIZE_WHITESPACE
+    ...     print(ix, why)
+    4 pressure 1000 kPa is out of its ramp's order (60 -> 1000 -> 120 kPa by step): a typo in the
+    manifest?
+    """
+    if "step" not in rows.columns or "frame" in rows.columns or not set(RAMP_KEYS) <= set(
+        rows.columns
+    ):
+        return {}
+    p_all = pd.to_numeric(rows["pressure_kpa"], errors="coerce")
+    ordered = rows[p_all.notna()].sort_values("step", kind="stable")
+    out: dict[Any, str] = {}
+    for _, ramp in ordered.groupby(list(RAMP_KEYS), sort=False):
+        legs = (ramp["direction"] != ramp["direction"].shift()).cumsum()
+        for _, leg in ramp.groupby(legs, sort=False):
+            sign = 1.0 if leg["direction"].iloc[0] == DIRECTIONS[0] else -1.0
+            p = sign * p_all[leg.index].to_numpy(float)
+            keep = list(range(len(p)))
+            steps = np.abs(np.diff(p))
+            slack = max(
+                PRESSURE_SLACK_MIN_KPA,
+                PRESSURE_SLACK_STEPS * float(np.median(steps[steps > 0])) if steps.any() else 0.0,
+            )
+            while len(keep) >= 3:
+                q = p[keep]
+                worst: tuple[float, int] | None = None
+                for i in range(len(q)):
+                    before = q[i - 1] - q[i] if i > 0 else 0.0  # it falls below the one before
+                    after = q[i] - q[i + 1] if i + 1 < len(q) else 0.0  # or rises past the next
+                    if max(before, after) <= slack:
+                        continue
+                    near = [q[j] for j in (i - 1, i + 1) if 0 <= j < len(q)]
+                    off = abs(q[i] - float(np.mean(near)))
+                    if worst is None or off > worst[0]:
+                        worst = (off, i)
+                if worst is None:
+                    break
+                i = worst[1]
+                shown = [f"{sign * q[j]:g}" for j in (i - 1, i, i + 1) if 0 <= j < len(q)]
+                out[leg.index[keep[i]]] = (
+                    f"pressure {sign * q[i]:g} kPa is out of its ramp's order "
+                    f"({' -> '.join(shown)} kPa by step): a typo in the manifest?"
+                )
+                del keep[i]
+    return out
+
+
 def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
     """The range of psi that photo ``i`` of a monotone leg may take, from its neighbours."""
     n = len(psi)
@@ -175,9 +251,13 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
         out["status"].astype(str).to_numpy(copy=True),
         out["reason"].fillna("").astype(str).to_numpy(copy=True),
     )
+    position = {ix: k for k, ix in enumerate(out.index)}
+    for ix, why in pressure_order_breaks(out).items():
+        k = position[ix]
+        if status[k] != "failed":  # its pressure is in doubt, not psi: kept out of the curves
+            status[k], reason[k] = "flagged", _join(why, reason[k])
     keys = [c for c in ("step", "time_s") if c in out.columns]  # frames of a video: over time
     order = out.sort_values(keys, kind="stable").index if keys else out.index
-    position = {ix: k for k, ix in enumerate(out.index)}
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
         measured = ramp[ramp["status"] != "failed"]
         if "length_px" in measured.columns and len(measured) >= 3:

@@ -798,6 +798,26 @@ def test_check_warns_of_a_material_the_model_does_not_have(photo_folder):
     assert "model.materials_file" in warning.fix
 
 
+def test_check_warns_of_a_pressure_out_of_its_ramps_order_naming_the_line(photo_folder):
+    # customer 30 typed 100 kPa as 1000: check said OK and the curves got a level at 1000 kPa
+    from pipeline.photoset_check import check_photoset
+
+    def order(folder):
+        return [p for p in check_photoset(folder, warnings=True) if "ramp's order" in p.message]
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    assert not order(photo_folder)
+    m = ps.read_manifest(photo_folder).drop(columns="manifest_line")
+    m.loc[1, "pressure_kpa"] = 100.0  # trial 1: 0, 10, 20, 10, 0 kPa
+    m.to_csv(photo_folder / ps.MANIFEST, index=False)
+    (warning,) = order(photo_folder)
+    assert warning.warning and warning.line == 3 and warning.file.endswith(ps.MANIFEST)
+    assert warning.message == (
+        "pressure 100 kPa is out of its ramp's order (0 -> 100 -> 20 kPa by step): a typo?"
+    )
+    assert warning.fix.startswith("correct pressure_kpa (or step) on this line")
+
+
 def test_check_warns_that_a_fixed_end_left_auto_is_guessed(photo_folder):
     # customer 25 left fixed_end out: check said OK, and measure then flagged all 36 bodies
     # "fixed end guessed; set fixed_end" (the README said check would say so)

@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 from pipeline.ramp_check import check_ramps
+from pipeline.report.reasons import words
 
 UP = np.arange(0.0, 120.0, 10.0)
 
@@ -332,3 +333,35 @@ def test_a_video_frame_off_its_neighbours_by_a_few_degrees_breaks_its_ramp():
     assert broken.tolist() == [k == 150 for k in range(t.size)], checked[broken]
     as_photos = check_ramps(frames.drop(columns="frame"))
     assert (as_photos["status"] == "ok").all()
+
+
+@pytest.mark.parametrize(
+    ("k", "typed", "shown"),
+    [
+        (4, 400.0, "30 -> 400 -> 50"),  # 40 typed as 400 (customer 30: 100 as 1000)
+        (7, 7.0, "60 -> 7 -> 80"),  # 70 typed as 7
+        (0, 100.0, "100 -> 10"),  # the first photo
+        (13, 1100.0, "110 -> 1100 -> 90"),  # the top of the falling leg
+    ],
+)
+def test_a_pressure_out_of_its_legs_order_is_flagged_and_kept_out_of_the_curves(k, typed, shown):
+    df = _ramp(_ds20_like(), _ds20_like()[::-1])
+    df.loc[k, "pressure_kpa"] = typed
+    out = check_ramps(df)
+    assert out.loc[k, "status"] == "flagged", out.loc[k, "reason"]
+    assert out.loc[k, "reason"].startswith(
+        f"pressure {typed:g} kPa is out of its ramp's order ({shown} kPa by step)"
+    )
+    assert (out.drop(index=k)["status"] == "ok").all(), out[["pressure_kpa", "reason"]]
+    # page 1's top reasons say it in words
+    assert words(out.loc[k, "reason"]) == "pressure out of its ramp's order (a manifest typo?)"
+
+
+def test_pressures_that_repeat_or_wobble_like_a_gauge_are_in_order():
+    df = _ramp(_ds20_like(), _ds20_like()[::-1])
+    df["pressure_kpa"] += np.random.default_rng(0).normal(0.0, 1.0, len(df))  # a gauge's reading
+    df.loc[3, "pressure_kpa"] = df.loc[2, "pressure_kpa"]
+    assert (check_ramps(df)["status"] == "ok").all()
+    # without a step column the rows' order is not the order taken: nothing is said
+    df.loc[4, "pressure_kpa"] = 400.0
+    assert (check_ramps(df.drop(columns="step"))["status"] == "ok").all()

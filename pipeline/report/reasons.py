@@ -12,6 +12,10 @@ Examples
 'line partly hidden'
 >>> words("no line found: no long thin component of line_color=(((0, 0, 0), (180, 255, 80)),)")
 'no marker line found'
+>>> words("manifest line 7: pressure_kpa '8O' is not a number (fix: write the gauge pressure")
+'manifest row: pressure_kpa is not a number'
+>>> words("manifest line 12: image 'IMG_4310.JPG' does not exist in /lab/C (fix: copy it in")
+'manifest row: photo missing from the folder'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
@@ -58,6 +62,9 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
     (r"^psi may be [\d.]+ deg off: it is measured from the fixed_direction_deg",
      "bodies leave the clamp off fixed_direction_deg"),
+    (r"^pressure [-+\d.e]+ kPa is out of its ramp's order",
+     "pressure out of its ramp's order (a manifest typo?)"),
+    (r"^image .*does not exist", "photo missing from the folder"),
     # a body's causes
     (r"^the free end's direction is uncertain", "free end's direction uncertain"),
     (r"^the centre line stops \d+ px short of the body's free end where the body still turns",
@@ -88,6 +95,9 @@ def words(cause: str) -> str:
     text = cause.strip()
     if not text:
         return "no reason given"
+    row = re.match(r"manifest line \d+: (.*)", text)
+    if row:  # a row measure could not take: what is wrong with it, not its line (all differ)
+        return "manifest row: " + words(re.sub(r"'[^']*'", "", row.group(1)))
     for pattern, phrase in WORDS:
         if re.search(pattern, text):
             return phrase
