@@ -314,12 +314,26 @@ def test_two_actuators_in_one_photo_are_flagged_with_the_roi_fix_and_measured_wi
     fe_b = (fe_b[0], fe_b[1] + h)
     res = measure_image(both, settings_for(fe_a))
     assert res.status == "flagged" and res.reason.startswith("2 candidate bodies"), res.reason
-    assert "set roi around this one" in res.reason
+    assert "a roi around this actuator" in res.reason
     rows = ((fe_a, [0, 0, w - 1, h - 1], 120.0), (fe_b, [0, h, w - 1, 2 * h - 1], -150.0))
     for fe, roi, psi in rows:
         res = measure_image(both, settings_for(fe, roi=roi))
         assert res.status == "ok", res.reason
         assert res.psi_deg == pytest.approx(psi, abs=2.5)
+
+
+def test_a_ruler_in_view_is_flagged_with_the_exclude_fix_and_measured_with_it():
+    # customer 30 laid a ruler along the bottom of the frame, as the README suggests for the
+    # scale: every row was flagged 'another actuator in view ... set roi', which a ruler is not
+    img, fe, _ = body_photo(120.0, seed=3)
+    h, w = img.shape[:2]
+    img[h - 40 : h - 16, 20 : w - 20] = (90, 140, 200)  # as the body differs from the backdrop
+    res = measure_image(img, settings_for(fe))
+    assert res.status == "flagged" and res.reason.startswith("2 candidate bodies"), res.reason
+    assert "such as a ruler" in res.reason and "give exclude (a box over it)" in res.reason
+    res = measure_image(img, settings_for(fe, exclude=[[10, h - 50, w - 10, h - 6]]))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(120.0, abs=2.5)
 
 
 @pytest.mark.parametrize("psi", [150.0, -120.0, 200.0])

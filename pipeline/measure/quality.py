@@ -314,9 +314,10 @@ def assess_body(
     if line.n_candidates > 1:
         flags.append(
             f"{line.n_candidates} candidate bodies: another selection as large as this body lies "
-            "elsewhere (another actuator in view, or part of this one beyond a gap?); for another "
-            "actuator, set roi around this one (a photo of several actuators: one photo set per "
-            "actuator, each with its roi); check with photoset preview"
+            "elsewhere (another object in view, such as a ruler or another actuator, or part of "
+            "this one beyond a gap?); for an object, give exclude (a box over it) or a roi "
+            "around this actuator (a photo of several actuators: one photo set per actuator, "
+            "each with its roi); check with photoset preview"
         )
     if not line.fixed_end_found:
         flags.append("no body reaches fixed_end; used the largest")
