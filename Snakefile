@@ -28,3 +28,14 @@ rule all:
     default_target: True
     input:
         report=f"{RESULTS}/report.pdf",
+
+
+onsuccess:
+    import sys
+
+    from pipeline.photoset_measure import run_summaries
+
+    for line in run_summaries(
+        {name: f"{RESULTS}/datasets/{name}/angles.csv" for name in DATASETS}
+    ):
+        print(line, file=sys.stderr)

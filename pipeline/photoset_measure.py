@@ -498,3 +498,23 @@ def summary(angles: pd.DataFrame) -> str:
         "flagged, "
         f"{counts.get('failed', 0)} failed ({sec:.1f} s of work)"
     )
+
+
+def run_summaries(angles_paths: dict[str, Path]) -> list[str]:
+    """What the console says at the end of a workflow run: one line per dataset measured
+    (:func:`summary`), and where a set's flagged and failed rows say why.
+
+    Snakemake writes each job's output to its log, so a run ended with exit status 0 and nothing
+    on the console about a failed row (customer 30).  ``angles_paths`` maps a dataset's name to
+    its angles.csv; a missing file is skipped.
+    """
+    lines = []
+    for name, path in angles_paths.items():
+        if not Path(path).is_file():
+            continue
+        angles = pd.read_csv(path, usecols=lambda c: c in {"status", "seconds", "frame"})
+        line = f"{name}: {summary(angles)}"
+        if (angles["status"] != "ok").any():
+            line += f"; why: the 'reason' column of {path}"
+        lines.append(line)
+    return lines

@@ -553,3 +553,20 @@ def test_an_overlay_outlines_the_roi_and_the_exclude_polygons_as_the_preview_doe
     assert np.abs(photo_part[100, 150] - EXCLUDE_BGR).max() <= 40
     assert np.abs(photo_part[50, 300] - ROI_BGR).max() <= 40
     assert (plain[band:] == 90).all()
+
+
+def test_the_end_of_a_run_names_each_sets_counts_and_where_its_reasons_are(tmp_path):
+    # customer 30: snakemake ended with exit status 0 and nothing on the console of a failed row
+    from pipeline.photoset_measure import run_summaries
+
+    good, bad = tmp_path / "good.csv", tmp_path / "bad.csv"
+    pd.DataFrame({"status": ["ok", "ok"], "seconds": [0.1, 0.2]}).to_csv(good, index=False)
+    pd.DataFrame({"status": ["ok", "failed"], "seconds": [0.1, 0.0]}).to_csv(bad, index=False)
+    lines = run_summaries({"a": good, "b": bad, "gone": tmp_path / "none.csv"})
+    assert lines == [
+        "a: measured 2 photos: 2 ok, 0 flagged, 0 failed (0.3 s of work)",
+        (
+            "b: measured 2 photos: 1 ok, 0 flagged, 1 failed (0.1 s of work); why: the "
+            f"'reason' column of {bad}"
+        ),
+    ]

@@ -182,6 +182,10 @@ def test_outputs_exist_and_hold_real_numbers(finished_run):
     assert {"DS20", "SS50"} <= set(rms["material"])
     pdf = (res / "report.pdf").read_bytes()
     assert pdf.startswith(b"%PDF") and len(pdf) > 20_000
+    # the console ends with each set's counts (the jobs' own output is in their logs)
+    console = (workdir / "console.txt").read_text()
+    n = len(pd.read_csv(res / "datasets" / "sample" / "angles.csv"))
+    assert f"sample: measured {n} photos: " in console, console[-2000:]
     for sub in ("logs", "benchmarks"):
         assert any((res / sub).rglob("*")), f"no {sub} written"
 
