@@ -210,8 +210,15 @@ def rms_deg(psi_measured: np.ndarray, psi_model: np.ndarray) -> tuple[float, int
     return float(np.sqrt(np.mean((a[ok] - b[ok]) ** 2))), int(ok.sum()), n_nan
 
 
+#: a curve that starts within this of the level (deg) starts there: its crossing is the first
+#: after it has left that band (customer 31's actuator hung straight at rest, psi 0, dipped to
+#: -35 deg and came back through 0 at 77 kPa: "P at psi = 0" read 0 kPa, its rest)
+START_BAND_DEG = 2.0
+
+
 def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float) -> float:
-    """Pressure where a curve, walked in the given order, first reaches ``level_deg``.
+    """Pressure where a curve, walked in the given order, first reaches ``level_deg``, not
+    counting its start where it starts on the level (within :data:`START_BAND_DEG`).
 
     Parameters
     ----------
@@ -233,12 +240,20 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     16.667
     >>> round(crossing_kpa([20, 10, 0], [-40.0, 20.0, 100.0], 0.0), 3)  # decreasing-pressure walk
     13.333
+    >>> round(crossing_kpa([0, 10, 20, 30, 40], [0.4, -12.0, -30.0, -5.0, 15.0], 0.0), 3)
+    32.5
+    >>> crossing_kpa([0, 10, 20], [0.4, -12.0, -30.0], 0.0)  # only at its start
+    0.0
     """
     p = np.asarray(pressure_kpa, dtype=float)
     s = np.asarray(psi_deg, dtype=float)
     keep = np.isfinite(p) & np.isfinite(s)
     p, s = p[keep], s[keep]
     d = s - level_deg
+    if d.size and abs(d[0]) <= START_BAND_DEG:  # it starts on the level: from where it leaves
+        left = np.flatnonzero(np.abs(d) > START_BAND_DEG)
+        later = crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
+        return float(p[0]) if math.isnan(later) else later  # else at its start, and only there
     for i in range(d.size):
         if d[i] == 0.0:
             return float(p[i])

@@ -47,7 +47,9 @@ from pipeline.ramp_check import check_ramps
 #: :class:`~pipeline.measure.AngleResult`;
 #: empty on failed rows; ``width_px``: the line's or body's width, edge to edge;
 #: ``base_direction_deg``: the direction a body's psi is measured from, see
-#: :func:`pipeline.ramp_check.share_base_direction`; ``fixed_direction_deg``: the one given,
+#: :func:`pipeline.ramp_check.share_base_direction`; ``base_side_split_deg``: how far a body's
+#: two sides diverge there (:func:`pipeline.measure.body.base_side_split_deg`);
+#: ``fixed_direction_deg``: the one given,
 #: which psi is then measured from (in the same convention); ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
@@ -59,6 +61,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "length_px",
     "width_px",
     "base_direction_deg",
+    "base_side_split_deg",
     "fixed_direction_deg",
     "method",
     "residual_px",

@@ -86,6 +86,13 @@ GIVEN_OFF_DEG = 3.0
 #: off, ``ok``).  Above the bodies' own error (2.7 deg at most, see above) with room to spare,
 #: so a direction given within a degree or two of the truth is never doubted for it
 GIVEN_FLAG_DEG = 5.0
+#: the bodies of a ramp whose two sides diverge by more than this (deg, the median of their
+#: ``base_side_split_deg`` where their own base is read) leave the clamp in a direction that
+#: cannot be trusted: one side is faint or shaded there, or bulges, and the centre line turns
+#: with it.  Customer 31's white body on grey, its shaded side barely brighter than the backdrop:
+#: 2.7-3.5 deg, every base 8 deg off (41 rows ok and 7-10 deg off); 10 rendered ramp sets and a
+#: customer's silhouettes, all right: at most 0.9
+SIDE_SPLIT_DEG = 2.0
 
 
 def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
@@ -419,8 +426,10 @@ def share_base_direction(
         given = pd.to_numeric(
             ramp.get("fixed_direction_deg", pd.Series(np.nan, index=ramp.index)), errors="coerce"
         ).to_numpy(float)
+        uncertain = _sides_diverge(out, ramp, own_all, flag=not np.isfinite(given).any())
         if np.isfinite(given).any():  # psi is measured from the direction given: compared only
-            _compare_given(out, ramp, own_all, given)
+            if not uncertain:  # else the bodies' own is the doubtful one (customer 31)
+                _compare_given(out, ramp, own_all, given)
             continue
         used = (ramp["status"] != "failed").to_numpy() & np.isfinite(own_all)
         if used.sum() < BASE_MIN_PHOTOS:
@@ -430,6 +439,56 @@ def share_base_direction(
         for number, run in enumerate(runs):
             _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None)
     return out
+
+
+def _sides_diverge(
+    out: pd.DataFrame, ramp: pd.DataFrame, own: np.ndarray, *, flag: bool
+) -> bool:
+    """Whether the bodies of ``ramp``, held by a clamp, leave it with their two sides diverging:
+    the median of their ``base_side_split_deg`` more than :data:`SIDE_SPLIT_DEG`, over at least
+    :data:`BASE_MIN_PHOTOS` bodies whose own base directions (``own``) agree within
+    :data:`BASE_SPREAD_DEG` (free strips scatter: a cut end's sides need not run parallel, and
+    no clamp makes their start the direction of every photo).  With ``flag`` (psi is measured
+    from the bodies' own base) those rows are flagged in ``out``, in place.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"status": "ok", "reason": "",
+    ...     "base_side_split_deg": [-2.7, -3.5, -3.0, -2.9, -3.1, -2.2]})
+    >>> _sides_diverge(df, df, np.zeros(6), flag=True), df["status"].tolist()[:2]
+    (True, ['flagged', 'flagged'])
+    >>> df["reason"].iloc[0][:61]
+    "the body's two sides diverge by 3.0 deg where it leaves the c"
+    >>> df = df.assign(status="ok", reason="", base_side_split_deg=0.4)
+    >>> _sides_diverge(df, df, np.zeros(6), flag=True), df["status"].tolist()[:2]
+    (False, ['ok', 'ok'])
+    """
+    split = pd.to_numeric(
+        ramp.get("base_side_split_deg", pd.Series(np.nan, index=ramp.index)), errors="coerce"
+    ).to_numpy(float)
+    read = np.isfinite(split) & np.isfinite(own) & (ramp["status"] != "failed").to_numpy()
+    if read.sum() < BASE_MIN_PHOTOS:
+        return False
+    spread = _wrap_deg(own[read] - own[read][0])
+    if float(np.median(np.abs(spread - np.median(spread)))) > BASE_SPREAD_DEG:
+        return False
+    median = abs(float(np.median(split[read])))
+    if median <= SIDE_SPLIT_DEG:
+        return False
+    if flag:
+        why = (
+            f"the body's two sides diverge by {median:.1f} deg where it leaves the clamp (the "
+            f"median of {int(read.sum())} {_unit(ramp)} of this ramp): one side is faint or "
+            "shaded there, or bulges, so the direction psi is measured from may be several deg "
+            "off; give fixed_direction_deg, the clamp's direction (photoset preview draws the "
+            "base)"
+        )
+        for ix in ramp.index[read]:
+            reason = out.at[ix, "reason"]
+            out.at[ix, "reason"] = _join(why, reason if isinstance(reason, str) else "")
+            if out.at[ix, "status"] == "ok":
+                out.at[ix, "status"] = "flagged"
+    return True
 
 
 def _compare_given(

@@ -1193,3 +1193,21 @@ def test_a_roi_of_a_few_pixels_is_a_failed_row_not_a_crash(roi):
     res = measure_image(img, resolve_settings(l0_mm=200.0, target="body", roi=roi,
                                               sealed_end_mm=4.0))
     assert res.status == "failed" and "no body found" in res.reason
+
+
+@pytest.mark.parametrize("given", [False, True])
+def test_a_faint_tips_fix_names_the_empty_scene_only_where_none_was_given(given):
+    # customer 31 gave its empty scene and was told "or give the empty scene (background)"
+    from pipeline.measure.extract import LineExtraction
+    from pipeline.measure.quality import assess_body
+
+    pts = np.c_[np.zeros(200), np.arange(200.0)]
+    line = LineExtraction(pts, 20.0, False, 1, 100.0, 200.0, 0.0, False, True, (0.0, 0.0))
+    quality = assess_body(
+        line, psi_deg=10.0, psi_check_deg=10.0, widths_px=np.full(200, 20.0),
+        expected_length_px=None, length_px=200.0, base_mismatch_deg=None,
+        selected_fraction=0.05, end_short_px=25.0, missed_tip_deg=6.0, free_end_width_ratio=0.7,
+        background_given=given,
+    )
+    assert "a faint tip?" in quality.reason, quality.reason
+    assert ("or give the empty scene (background)" in quality.reason) is not given

@@ -365,3 +365,45 @@ def test_pressures_that_repeat_or_wobble_like_a_gauge_are_in_order():
     # without a step column the rows' order is not the order taken: nothing is said
     df.loc[4, "pressure_kpa"] = 400.0
     assert (check_ramps(df.drop(columns="step"))["status"] == "ok").all()
+
+
+def test_a_ramp_whose_bodies_sides_diverge_at_the_clamp_is_flagged_without_a_direction_given():
+    # customer 31: a white body on grey, its shaded side barely brighter than the backdrop but
+    # brighter before the clamp's shadow: the sides diverge 3 deg, every base read 8 deg off, and
+    # 41 rows were ok 7-10 deg off.  Its two sides say the base cannot be trusted
+    psi = _ds20_like()
+    split = -3.0 + 0.4 * np.sin(np.arange(12.0))
+    out = check_ramps(_bodies(psi, np.full(12, -98.4), base_side_split_deg=split))
+    assert (out["status"] == "flagged").all()
+    assert out["reason"].str.startswith(
+        "the body's two sides diverge by 3.0 deg where it leaves the clamp (the median of 12 "
+        "photos of this ramp)"
+    ).all(), out["reason"].iloc[0]
+    assert out["reason"].str.contains("give fixed_direction_deg, the clamp's direction").all()
+    # right bodies' sides diverge by at most 0.9 deg on ten rendered sets: nothing is said
+    calm = check_ramps(_bodies(psi, np.full(12, -98.4), base_side_split_deg=split / 4))
+    assert (calm["status"] == "ok").all() and not calm["reason"].str.contains("diverge").any()
+    # free strips (bases that scatter: no clamp) or fewer than 5 bodies: nothing is said
+    strips = check_ramps(_bodies(psi, np.arange(12.0) * 20.0, base_side_split_deg=split))
+    few = check_ramps(_bodies(psi[:4], np.zeros(4), base_side_split_deg=split[:4]))
+    for rows in (strips, few):
+        assert not rows["reason"].str.contains("diverge").any(), rows["reason"]
+
+
+def test_bodies_whose_sides_diverge_do_not_doubt_the_direction_given():
+    # customer 31 gave the true direction (-90); the bodies' own read -98.4, so every row was
+    # flagged 'psi may be 8.4 deg off ... give this ramp's rows their own (-98.4)', which would
+    # have put 70 rows 8 deg off and ok.  Their sides diverging, their own is the doubtful one
+    psi = _ds20_like()
+    split = np.full(12, -3.0)
+    out = check_ramps(
+        _bodies(psi, np.full(12, -98.4), fixed_direction_deg=-90.0, base_side_split_deg=split)
+    )
+    assert (out["status"] == "ok").all() and (out["reason"] == "").all(), out["reason"].iloc[0]
+    np.testing.assert_allclose(out["psi_deg"], psi)
+    # sides that agree: the given direction is still doubted (a body remounted turned)
+    turned = check_ramps(
+        _bodies(psi, np.full(12, -98.4), fixed_direction_deg=-90.0, base_side_split_deg=split / 4)
+    )
+    assert (turned["status"] == "flagged").all()
+    assert turned["reason"].str.startswith("psi may be 8.4 deg off").all()

@@ -91,6 +91,7 @@ def test_a_real_set_gets_the_trials_figure_and_the_note_says_what_it_cannot_see(
     assert info.accuracy.cell() == "0.50 / 0.5 trials"
     assert "blind to an error all photos share" in ACCURACY_NOTE
     assert "fixed_direction_deg" in ACCURACY_NOTE
+    assert "empty scene" not in ACCURACY_NOTE  # customer 31 gave one: its error was shared
     # customer 25's advisor would read "|ψ error| 11.26 / 19.7 trials" as an 11 deg error (its
     # true median was 0.36; two trials of a real actuator differ): the note says it is not one
     assert "not the angles' error" in ACCURACY_NOTE

@@ -944,6 +944,39 @@ def _trim_by_thickness(
     return path[i0 : i1 + 1], (float(s[i0]), float(s[-1] - s[i1]))
 
 
+def base_side_split_deg(
+    centreline_px: np.ndarray, widths_px: np.ndarray, window_fraction: float
+) -> float:
+    """The angle (deg) between the body's two sides where it leaves the fixed end: how fast its
+    measured width changes along the first ``window_fraction`` of its centre line (the stretch
+    its base direction is read over), signed (+ widening).
+
+    Where only one side moves (a faint or shaded side whose edge is found further in where the
+    light is dimmer, or a bulge at the clamp on one side) the centre line between them turns by
+    half of it, and the base direction with it: a white body on grey lit from one side, its
+    shaded side barely brighter than the backdrop and lit more strongly by the clamp, read
+    widths falling 3 deg and its base 8 deg off (customer 31).  NaN for fewer than 3 points.
+
+    Examples
+    --------
+    >>> s = np.linspace(0.0, 200.0, 201)
+    >>> line = np.c_[np.zeros_like(s), s]
+    >>> abs(round(base_side_split_deg(line, np.full(201, 20.0), 0.15), 3))
+    0.0
+    >>> round(base_side_split_deg(line, 30.0 - np.tan(np.deg2rad(3.0)) * s, 0.15), 2)
+    -3.0
+    """
+    pts = np.asarray(centreline_px, float)
+    w = np.asarray(widths_px, float)
+    if len(pts) < 3 or len(w) != len(pts):
+        return float("nan")
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
+    win = (s <= window_fraction * s[-1]) & np.isfinite(w)
+    if win.sum() < 3:
+        return float("nan")
+    return float(np.rad2deg(np.arctan(np.polyfit(s[win], w[win], 1)[0])))
+
+
 def local_widths(widths: np.ndarray, window: int) -> np.ndarray:
     """Running median of the body's width along its centre line (``window`` points), NaNs ignored.
 
@@ -1452,6 +1485,42 @@ def _bridge_gaps(
         gaps.append(float(np.hypot(q[0] - p[0], q[1] - p[1])))
 
 
+#: a photo with this much more of it white (every channel at least SATURATED) than its empty
+#: scene (or than this share, without one) is overexposed
+OVEREXPOSED_SHARE, SATURATED = 0.2, 250
+
+
+def overexposed(
+    image_bgr: np.ndarray, region: np.ndarray | None, background_bgr: np.ndarray | None
+) -> str:
+    """Why nothing may be found in a photo: ``"N% of the photo is white ...; "`` where it is
+    overexposed (a lamp switched on, the exposure changed: customer 31's read only "nothing
+    differs from the background photo"), else ``""``.
+
+    Examples
+    --------
+    >>> img = np.full((10, 10, 3), 120, np.uint8)
+    >>> overexposed(img, None, None)
+    ''
+    >>> img[:6] = 255
+    >>> overexposed(img, None, img[:, :, :] * 0 + 120)
+    '60% of the photo is white (overexposed: a lamp switched on, or the exposure changed?); '
+    """
+
+    def white(img: np.ndarray) -> float:
+        hit = (img.min(axis=2) >= SATURATED) if img.ndim == 3 else img >= SATURATED
+        return float(hit[region > 0].mean() if region is not None else hit.mean())
+
+    share = white(image_bgr)
+    before = white(background_bgr) if background_bgr is not None else 0.0
+    if share - before < OVEREXPOSED_SHARE:
+        return ""
+    return (
+        f"{100 * share:.0f}% of the photo is white (overexposed: a lamp switched on, or the "
+        "exposure changed?); "
+    )
+
+
 def extract_body(
     image_bgr: np.ndarray,
     settings: MeasureSettings,
@@ -1498,8 +1567,10 @@ def extract_body(
     what = settings.describe_color()
     if raw.sum() < 20:
         raise NoLineFound(
-            f"no body found: nothing {what}; check line_color / background / roi (python -m "
-            "pipeline photoset preview shows what they select)"
+            f"no body found: nothing {what}; "
+            + overexposed(image_bgr, region, background_bgr)
+            + "check line_color / background / roi (python -m pipeline photoset preview shows "
+            "what they select)"
         )
     if selected > 0.6:
         raise NoLineFound(

@@ -103,6 +103,9 @@ class AngleResult:
         ``fixed_direction_deg`` given psi is not measured from it, but it is still read where
         the body's start is seen (the ramp check compares the two).  NaN for a line, a body
         whose start is not seen with the direction given, or when failed.
+    base_side_split_deg : float
+        A body's two sides, where it leaves the fixed end, diverge by this (deg, + widening):
+        :func:`pipeline.measure.body.base_side_split_deg`.  NaN for a line or when failed.
     tip_px : (float, float) or None
         A body's point where its free end's tangent was read (x right, y down, original px):
         the centre line's end, moved back along it or on along the tangent by what the tangent
@@ -122,6 +125,7 @@ class AngleResult:
     degree: int = 0
     length_px: float = float("nan")
     base_direction_deg: float = float("nan")
+    base_side_split_deg: float = float("nan")
     tip_px: tuple[float, float] | None = None
 
 
@@ -382,7 +386,7 @@ def measure_body(
     rarely an arc); any other method may be asked for.  A known ``fixed_direction_deg`` replaces
     the measured base tangent.
     """
-    from pipeline.measure.body import extract_body
+    from pipeline.measure.body import base_side_split_deg, extract_body
 
     background = None
     if settings.background_path is not None and image_bgr is not None:
@@ -483,6 +487,7 @@ def measure_body(
         side_on_border=body.side_on_border,
         tip_at_region_edge=body.tip_at_region_edge,
         background_estimated=settings.background_estimated,
+        background_given=settings.background_path is not None and not settings.background_estimated,
         video_frame=settings.video_frame,
         missed_tip_deg=missed_tip_deg,
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
@@ -499,6 +504,12 @@ def measure_body(
         est, line, quality, settings, used,
     )
     own_base_deg = float(np.rad2deg(sign * start))
+    measured = replace(
+        measured,
+        base_side_split_deg=base_side_split_deg(
+            line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION
+        ),
+    )
     if est is not tip:
         return measured
     tip_px = read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))

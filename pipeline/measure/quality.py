@@ -269,6 +269,7 @@ def assess_body(
     side_on_border: bool = False,
     tip_at_region_edge: bool = False,
     background_estimated: bool = False,
+    background_given: bool = False,
     video_frame: bool = False,
     missed_tip_deg: float = 0.0,
     smooth_mismatch_deg: float = 0.0,
@@ -423,8 +424,8 @@ def assess_body(
             f"({end_short_px / line.width_px:.1f} widths) short of the body's free end, which "
             f"still turns (about {abs(missed_tip_deg):.0f} deg at its curvature, not carried on) "
             f"and is {100 * free_end_width_ratio:.0f}% as wide as the body there (a faint tip?): "
-            "psi may miss part of the tip's turn; check with photoset preview, or give the empty "
-            "scene (background)"
+            "psi may miss part of the tip's turn; check with photoset preview"
+            + ("" if background_given else ", or give the empty scene (background)")
         )
     if not start_seen(start_gap_px, line.width_px) and base_mismatch_deg is None:
         # with the base known psi is the free end's tangent against it: the gap cannot change it

@@ -116,6 +116,7 @@ def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
         "length_px": res.length_px,
         "width_px": res.line_width_px,
         "base_direction_deg": res.base_direction_deg,
+        "base_side_split_deg": res.base_side_split_deg,
         "method": res.method,
         "residual_px": res.residual_px,
         "status": res.status,

@@ -172,6 +172,6 @@ ACCURACY_NOTE = (
     "ψ check (deg, median / 95th percentile of the ok photos): truth = error against the "
     f"renderer's truth.csv (ok photos over {OFF_DEG:g}° off counted); trials = how far two "
     "trials of one actuator differ at one pressure and direction: repeatability and measurement "
-    "together, not the angles' error, and blind to an error all photos share (give "
-    "fixed_direction_deg or an empty scene to rule one out)."
+    "together, not the angles' error, and blind to an error all photos share, such as a base "
+    "direction read off (give fixed_direction_deg, the clamp's, to rule that out)."
 )

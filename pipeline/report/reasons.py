@@ -65,6 +65,7 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^pressure [-+\d.e]+ kPa is out of its ramp's order",
      "pressure out of its ramp's order (a manifest typo?)"),
     (r"^image .*does not exist", "photo missing from the folder"),
+    (r"^the body's two sides diverge", "body's sides diverge at the clamp (a faint side?)"),
     # a body's causes
     (r"^the free end's direction is uncertain", "free end's direction uncertain"),
     (r"^the centre line stops \d+ px short of the body's free end where the body still turns",

@@ -184,6 +184,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
             "length_px",
             "width_px",
             "base_direction_deg",
+            "base_side_split_deg",
             "residual_px",
             "degree",
         ):

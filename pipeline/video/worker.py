@@ -45,6 +45,7 @@ CHUNK_COLUMNS: tuple[str, ...] = (
     "length_px",
     "width_px",
     "base_direction_deg",
+    "base_side_split_deg",
     "method",
     "residual_px",
     "status",

@@ -1,0 +1,111 @@
+"""A body with a faint side near its clamp (customer 31): a white body hanging on grey, lit from
+one side, its shaded side barely brighter than the backdrop except before the clamp's shadow,
+where the empty scene is darker.  The shaded side is found there and lost further on, so the
+centre line leaves the clamp turned and every base read 11 deg off: the ramp's rows were ``ok``
+up to 10 deg off.  Measured as a user measures it (the real pipeline, an empty-scene photo)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline.photoset_measure import measure_photoset
+
+W, H = 800, 600
+BACKDROP = 170.0
+FIXED_END = (W / 2, 60.0)
+#: a ramp up and back down, its psi (deg)
+PSI = (0.0, 20.0, 45.0, 75.0, 110.0, 150.0, 190.0, 150.0, 100.0, 40.0, 0.0)
+
+
+def faint_photo(psi_deg: float | None, *, seed: int, length: float = 380.0, width: float = 56.0):
+    """The scene (``psi_deg`` None: the empty scene): a body of constant curvature leaving the
+    clamp straight down, its lit side 60 grey levels above the backdrop and its shaded side 5, its
+    soft shadow beside it, and the clamp's shadow darkening the backdrop below the clamp."""
+    rng = np.random.default_rng(seed)
+    img = np.full((H, W), BACKDROP)
+    fe = np.array(FIXED_END)
+    body = np.zeros((H, W), bool)
+    if psi_deg is not None:
+        s = np.linspace(0.0, length, 240)
+        th = -np.pi / 2 + np.deg2rad(psi_deg) / length * s  # y up
+        c = np.c_[np.cumsum(np.cos(th)), np.cumsum(np.sin(th))] * (s[1] - s[0])
+        n = np.c_[-np.sin(th), np.cos(th)]
+
+        def px(q: np.ndarray) -> np.ndarray:
+            return np.c_[q[:, 0], -q[:, 1]] + fe
+
+        shadow = np.zeros((H, W), np.uint8)
+        outline = np.r_[px(c + n * width / 2), px(c - n * width / 2)[::-1]] + [10, 8]
+        cv2.fillPoly(shadow, [np.round(outline).astype(np.int32)], 1)
+        img -= 25 * cv2.GaussianBlur(shadow.astype(float), (0, 0), 6)
+        strips = 14
+        for i in range(len(s) - 1):
+            for j in range(strips):
+                a, b = j / strips - 0.5, (j + 1) / strips - 0.5
+                u = (j + 0.5) / strips  # 0: the lit side .. 1: the shaded side
+                quad = np.r_[
+                    px(c[i : i + 2] - n[i : i + 2] * a * width),
+                    px(c[i : i + 2][::-1] - n[i : i + 2][::-1] * b * width),
+                ]
+                pts = [np.round(quad * 8).astype(np.int32)]
+                cv2.fillPoly(img, pts, BACKDROP + 60 * (1 - u) + 5 * u, cv2.LINE_AA, 3)
+                m = np.zeros((H, W), np.uint8)
+                cv2.fillPoly(m, pts, 1, cv2.LINE_8, 3)
+                body |= m > 0
+    clamp = np.zeros((H, W))
+    clamp[: int(fe[1]), int(fe[0] - 45) : int(fe[0] + 45)] = 1.0
+    shade = cv2.GaussianBlur(np.roll(clamp, (30, 12), axis=(0, 1)), (0, 0), 14)
+    img = np.where(body, img, img - 35 * shade)
+    img = np.where(clamp > 0, 150.0, img)
+    img = cv2.GaussianBlur(img, (0, 0), 1.2) + rng.normal(0, 1.5, img.shape)
+    return np.repeat(np.clip(img, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
+
+
+def _ramp_set(folder: Path, **settings: object) -> Path:
+    folder.mkdir()
+    rows = []
+    for i, psi in enumerate(PSI):
+        name = f"p{i:02d}.png"
+        cv2.imwrite(str(folder / name), faint_photo(psi, seed=i))
+        top = len(PSI) // 2
+        rows.append((name, 20 * min(i, 2 * top - i), "up" if i <= top else "down", "M", "A", 1, i))
+    cv2.imwrite(str(folder / "empty.png"), faint_photo(None, seed=99))
+    columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    pd.DataFrame(rows, columns=columns).to_csv(folder / "manifest.csv", index=False)
+    lines = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]",
+             "background: empty.png", *(f"{k}: {v}" for k, v in settings.items())]
+    (folder / "photoset.yaml").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def faint_sets(tmp_path_factory) -> tuple[Path, Path]:
+    root = tmp_path_factory.mktemp("faint")
+    return _ramp_set(root / "own"), _ramp_set(root / "given", fixed_direction_deg=-90)
+
+
+def _measured(folder: Path) -> pd.DataFrame:
+    angles = measure_photoset(folder)
+    return angles.assign(error_deg=(angles["psi_deg"] - np.array(PSI)).abs())
+
+
+def test_bodies_whose_sides_diverge_at_the_clamp_are_never_ok_and_wrong(faint_sets):
+    angles = _measured(faint_sets[0])
+    wrong_ok = angles[(angles["status"] == "ok") & (angles["error_deg"] > 5.0)]
+    assert wrong_ok.empty, wrong_ok[["image", "psi_deg", "error_deg", "reason"]]
+    diverge = angles["reason"].str.contains("the body's two sides diverge by")
+    assert diverge.sum() >= 9, angles[["image", "base_side_split_deg", "reason"]]
+    assert (angles["base_side_split_deg"].abs() > 2.0).sum() >= 9
+
+
+def test_with_the_clamps_direction_given_they_are_measured_from_it(faint_sets):
+    angles = _measured(faint_sets[1])
+    # the bodies' own direction, 11 deg off, no longer doubts the right one given
+    assert not angles["reason"].str.contains("psi may be").any(), angles["reason"].iloc[0]
+    assert (angles["status"] == "ok").sum() >= 9
+    assert angles["error_deg"].median() < 3.0
