@@ -259,11 +259,12 @@ def read_table(
 FLOAT_FORMAT = "%.6g"
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, durable: bool = True) -> None:
     """Write ``data`` to ``path`` atomically: temporary file in the same folder, fsync, rename.
 
     The folder is created when missing; the file gets the usual permissions (umask), not the
-    0600 of a temporary file.
+    0600 of a temporary file.  ``durable=False`` skips the fsyncs (the file is still whole or
+    absent, but a power cut may lose it: for what can be made again, such as a cache entry).
 
     Examples
     --------
@@ -280,13 +281,15 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
         os.fchmod(fd, 0o666 & ~_current_umask())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+            if durable:
+                fh.flush()
+                os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    _fsync_dir(path.parent)
+    if durable:
+        _fsync_dir(path.parent)
 
 
 def _current_umask() -> int:

@@ -47,6 +47,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="worker processes (photos measured in parallel; default 1)",
     )
     parser.add_argument(
+        "--cache",
+        metavar="DIR",
+        default=None,
+        help="keep each photo's measurement in DIR: a run cut off resumes, and only photos "
+             "changed since the last run (or all, after a setting or the program changed) are "
+             "measured again; one folder per photo set",
+    )
+    parser.add_argument(
         "--no-ramp-check",
         dest="ramp_check",
         action="store_false",
@@ -62,7 +70,10 @@ def run(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     ps = load_photoset(args.photoset)
-    kw = {"method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check}
+    kw = {
+        "method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check,
+        "cache_dir": args.cache,
+    }
     if args.overlays is None:
         angles = measure_photoset(ps, **kw)
     else:  # the overlay folder appears only when complete
@@ -75,6 +86,8 @@ def run(args: argparse.Namespace) -> int:
         print(problem, file=sys.stderr)
     used = sorted(set(angles["method"].dropna().astype(str)) - {args.method})
     took = f" (rows say which it took: {', '.join(used)})" if used else ""
+    if angles.attrs.get("from_cache"):
+        took += f"; {angles.attrs['from_cache']} as measured by an earlier run (--cache)"
     print(
         f"{summary(angles)} in {time.perf_counter() - t0:.1f} s, method {args.method}{took} -> "
         f"{args.out}"

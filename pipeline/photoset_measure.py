@@ -31,7 +31,7 @@ from pipeline.measure.ramp_background import (
     estimates_background,
 )
 from pipeline.measure.settings import OVERRIDE_COLUMNS
-from pipeline.measure.worker import Task, run_task
+from pipeline.measure.worker import Task
 from pipeline.photoset import (
     PhotoSet,
     load_photoset,
@@ -41,6 +41,7 @@ from pipeline.photoset import (
 )
 from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
+from pipeline.result_cache import CachedTask, cached_tasks, prune, run_cached
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
@@ -127,6 +128,7 @@ def measure_photoset(
     overlays_dir: str | os.PathLike[str] | None = None,
     ramp_check: bool = True,
     second_look: bool = True,
+    cache_dir: str | os.PathLike[str] | None = None,
 ) -> pd.DataFrame:
     """Measure psi on every photo of a photo set; a bad photo or manifest row is a ``failed`` row.
 
@@ -147,6 +149,11 @@ def measure_photoset(
     second_look : bool
         Measure a doubtful body again against its ramp's estimate of the empty scene
         (:func:`estimates_background`); off only to compare (``python -m pipeline bench ramps``).
+    cache_dir : path, optional
+        Keep each photo's measurement there (:mod:`pipeline.result_cache`): a run cut off
+        resumes, and a photo, setting or program unchanged since the last run is not measured
+        again (the table's ``attrs["from_cache"]`` counts them); the folder then holds this set's
+        entries only.  Photos of a video set are always measured.
 
     Returns
     -------
@@ -177,7 +184,10 @@ def measure_photoset(
 
         out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
     else:
-        out = _measure_photos(ps, method, jobs, odir, second_look)
+        out = _measure_photos(
+            ps, method, jobs, odir, second_look, None if cache_dir is None else Path(cache_dir)
+        )
+    from_cache = int(out.attrs.get("from_cache", 0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
         out = check_ramps(out)
@@ -189,6 +199,7 @@ def measure_photoset(
         if not ps.is_video:
             note_changed_statuses(out, drawn, odir)
         write_contact_sheets(out, odir)
+    out.attrs["from_cache"] = from_cache
     return out
 
 
@@ -281,15 +292,38 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
             atomic_write_bytes(path, buf.tobytes())
 
 
+def _measured(
+    tasks: list[Task], jobs: int, cache_dir: Path | None, used: list[CachedTask]
+) -> list[dict[str, Any]]:
+    """Each task's angles.csv fields (:func:`pipeline.measure.worker.run_task`), taken from
+    ``cache_dir`` where an earlier run measured the same (:mod:`pipeline.result_cache`); the
+    entries are appended to ``used``."""
+    items = cached_tasks(tasks, cache_dir)
+    used.extend(items)
+    return map_photos(
+        run_cached, items, jobs=jobs, preload=["pipeline.measure.worker", "pipeline.result_cache"]
+    )
+
+
 def _measure_photos(
-    ps: PhotoSet, method: str, jobs: int, odir: Path | None, second_look: bool = True
+    ps: PhotoSet,
+    method: str,
+    jobs: int,
+    odir: Path | None,
+    second_look: bool = True,
+    cache_dir: Path | None = None,
 ) -> pd.DataFrame:
-    """The angles.csv table of a photo set of images (one row per manifest row)."""
+    """The angles.csv table of a photo set of images (one row per manifest row); its ``attrs``
+    hold ``from_cache``, how many photos an earlier run had measured (with ``cache_dir``)."""
     manifest = ps.manifest
     tasks = _tasks(ps, method, odir)
-    rows = map_photos(run_task, tasks, jobs=jobs, preload=["pipeline.measure.worker"])
+    used: list[CachedTask] = []
+    rows = _measured(tasks, jobs, cache_dir, used)
+    from_cache = sum(bool(r.pop("from_cache")) for r in rows)
     if second_look:
-        rows = _on_ramp_backgrounds(ps, tasks, rows, jobs)
+        rows = _on_ramp_backgrounds(ps, tasks, rows, jobs, cache_dir, used)
+    if cache_dir is not None:
+        prune(cache_dir, used)
     result = pd.DataFrame(rows, index=manifest.index).drop(columns="centreline_px")
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
@@ -301,9 +335,11 @@ def _measure_photos(
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     carried += [c for c in manifest.columns if c not in drop and c not in carried]
-    return pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
+    out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
         drop=True
     )
+    out.attrs["from_cache"] = from_cache
+    return out
 
 
 def second_look_ramps(ps: PhotoSet) -> list[list[int]]:
@@ -355,7 +391,12 @@ def _ramp_estimates(
 
 
 def _on_ramp_backgrounds(
-    ps: PhotoSet, tasks: list[Task], rows: list[dict[str, Any]], jobs: int
+    ps: PhotoSet,
+    tasks: list[Task],
+    rows: list[dict[str, Any]],
+    jobs: int,
+    cache_dir: Path | None = None,
+    used: list[CachedTask] | None = None,
 ) -> list[dict[str, Any]]:
     """``rows``, where a body's first measurement is doubtful (flagged or failed), with its
     measurement against the empty scene estimated from its ramp's photos when that one is
@@ -386,12 +427,12 @@ def _on_ramp_backgrounds(
                 overlay_path=None if overlay is None else str(Path(tmp) / f"{i}.jpg"),
             )))
         measured = (
-            map_photos(run_task, [t for _, t in again], jobs=jobs,
-                       preload=["pipeline.measure.worker"])
+            _measured([t for _, t in again], jobs, cache_dir, [] if used is None else used)
             if again
             else []
         )
         for (i, task), row in zip(again, measured, strict=True):
+            row.pop("from_cache")
             first = rows[i]
             apart = abs(float(row["psi_deg"]) - float(first["psi_deg"]))
             if row["status"] != "ok" or (

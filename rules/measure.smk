@@ -11,6 +11,8 @@ rule measure:
         folder=lambda wc: photoset_dir(wc.dataset),
         method=measure_method_option(),
         overlays=lambda wc, output: overlays_option(output.overlays),
+        # each photo's measurement, kept across runs (not an output: an interrupted job keeps it)
+        cache=lambda wc: f"{RESULTS}/cache/measure/{wc.dataset}",
     log:
         log_file("measure/{dataset}"),
     benchmark:
@@ -24,4 +26,5 @@ rule measure:
         logged(
             "mkdir -p {output.overlays:q} && python -m pipeline measure {params.folder:q}"
             " --out {output.angles:q} {params.method:q} {params.overlays:q} --jobs {threads}"
+            " --cache {params.cache:q}"
         )

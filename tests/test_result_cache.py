@@ -1,0 +1,100 @@
+"""measure's cache (``--cache``; the workflow keeps one per dataset): a run cut off resumes, and
+only what changed is measured again (customer 30: Ctrl-C during measure lost all 84 photos of
+the set, and one re-shot photo re-measured all of them)."""
+
+from __future__ import annotations
+
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from pipeline.photoset_measure import measure_photoset
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _sample(folder: Path, rows: int, copies: int = 1) -> Path:
+    """The committed sample set's first ``rows`` photos (``copies`` times, as other trials)."""
+    folder.mkdir()
+    shutil.copy(REPO / "sample_images" / "photoset.yaml", folder)
+    manifest = pd.read_csv(REPO / "sample_images" / "manifest.csv").head(rows)
+    parts = []
+    for k in range(copies):
+        part = manifest.copy()
+        part["image"] = [f"c{k}_{name}" for name in manifest["image"]]
+        part["trial"] = [f"{t}{k}" for t in manifest["trial"].astype(str)]
+        for src, dst in zip(manifest["image"], part["image"], strict=True):
+            shutil.copy(REPO / "sample_images" / src, folder / dst)
+        parts.append(part)
+    pd.concat(parts).to_csv(folder / "manifest.csv", index=False)
+    return folder
+
+
+def _entries(cache: Path) -> list[Path]:
+    return sorted(cache.glob("*.json"))
+
+
+def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_path):
+    folder, cache = _sample(tmp_path / "set", 12), tmp_path / "cache"
+    first = measure_photoset(folder, cache_dir=cache, overlays_dir=tmp_path / "ov1")
+    assert first.attrs["from_cache"] == 0 and len(_entries(cache)) == 12
+    again = measure_photoset(folder, cache_dir=cache, overlays_dir=tmp_path / "ov2")
+    assert again.attrs["from_cache"] == 12
+    pd.testing.assert_frame_equal(first, again)
+    for overlay in (tmp_path / "ov1").glob("*.jpg"):
+        assert overlay.read_bytes() == (tmp_path / "ov2" / overlay.name).read_bytes()
+    # a run cut off before 4 photos were done: those are measured, the rest read back
+    for entry in _entries(cache)[:4]:
+        entry.unlink()
+    resumed = measure_photoset(folder, cache_dir=cache)
+    assert resumed.attrs["from_cache"] == 8
+    pd.testing.assert_frame_equal(first.drop(columns="seconds"), resumed.drop(columns="seconds"))
+    # a photo re-shot under the same name: that one is measured again, and reads its new psi
+    images = first["image"].tolist()
+    shutil.copy(folder / images[9], folder / images[2])
+    reshot = measure_photoset(folder, cache_dir=cache)
+    assert reshot.attrs["from_cache"] == 11
+    assert reshot.at[2, "psi_deg"] == pytest.approx(first.at[9, "psi_deg"], abs=1e-9)
+    assert reshot.at[2, "psi_deg"] != pytest.approx(first.at[2, "psi_deg"], abs=1.0)
+    assert len(_entries(cache)) == 12  # the old photo's entry is gone
+    # a setting changed: every photo again
+    settings = folder / "photoset.yaml"
+    settings.write_text(settings.read_text().replace("positive_turn: ccw", "positive_turn: cw"))
+    turned = measure_photoset(folder, cache_dir=cache)
+    assert turned.attrs["from_cache"] == 0
+    assert turned.at[0, "psi_deg"] == pytest.approx(-reshot.at[0, "psi_deg"], abs=1e-9)
+
+
+def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
+    folder, cache = _sample(tmp_path / "set", 42, copies=6), tmp_path / "cache"
+    cmd = [sys.executable, "-m", "pipeline", "measure", str(folder), "--out",
+           str(tmp_path / "a.csv"), "--cache", str(cache)]
+    run = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while len(_entries(cache)) < 40 and run.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    run.send_signal(signal.SIGINT)
+    run.communicate(timeout=60)
+    done = len(_entries(cache))
+    assert done >= 40
+    resumed = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{done} as measured by an earlier run (--cache)" in resumed.stdout, resumed.stdout
+    clean = measure_photoset(folder)
+    pd.testing.assert_frame_equal(
+        pd.read_csv(tmp_path / "a.csv").drop(columns="seconds"),
+        pd.read_csv(_written(clean, tmp_path / "clean.csv")).drop(columns="seconds"),
+    )
+
+
+def _written(angles: pd.DataFrame, path: Path) -> Path:
+    from pipeline.photoset_measure import write_angles
+
+    write_angles(angles, path)
+    return path
