@@ -32,6 +32,7 @@ from __future__ import annotations
 import difflib
 import functools
 import os
+import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -1246,6 +1247,10 @@ def repeated_level_problems(ps: PhotoSet) -> list[Problem]:
     ]
 
 
+#: a photo named like a calibration board's
+BOARD_NAME = re.compile(r"checker|chess|board|calib|charuco", re.IGNORECASE)
+
+
 def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     """A warning when photos in the set's folder (or its subfolders) are neither rows of
     ``manifest.csv`` nor files its settings name (the empty scene, calibration boards): a photo
@@ -1271,6 +1276,7 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     if not left:
         return []
     shown = ", ".join(repr(n) for n in left[:3]) + (", ..." if len(left) > 3 else "")
+    boards = [n for n in left if BOARD_NAME.search(Path(n).stem)]
     return [
         Problem(
             str(ps.folder / MANIFEST),
@@ -1278,8 +1284,17 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
             f"{len(left)} photo{'s' if len(left) > 1 else ''} in the folder "
             f"{'are' if len(left) > 1 else 'is'} not in manifest.csv and will not be measured: "
             f"{shown}",
-            "add a row for each (or rename them to photoset init's pattern and run it again with "
-            "--overwrite), or move them out of the folder if they do not belong to the set",
+            (
+                f"if {boards[0]!r} and the like are photos of a checkerboard for the camera's "
+                "calibration, name them in photoset.yaml (calibration: {board: [...], "
+                "square_mm: ..., inner_corners: [..., ...]}; README, 'A tilted camera or a real "
+                "lens'): without it a camera not square to the plane or a lens that distorts "
+                "puts psi off; else "
+                if boards and "calibration" not in ps.settings
+                else ""
+            )
+            + "add a row for each (or rename them to photoset init's pattern and run it again "
+            "with --overwrite), or move them out of the folder if they do not belong to the set",
             warning=True,
         )
     ]
@@ -1363,6 +1378,20 @@ def validate_photoset(
     return [p for p in problems if warnings or not p.warning]
 
 
+def scale_too_fine(l0_mm: float, mm_per_px: float, image_size: tuple[int, int]) -> bool:
+    """Whether a line of ``l0_mm`` at ``mm_per_px`` could not lie in a photo of ``image_size``
+    even curled into a ring (its diameter, l0 / pi, longer than the photo's diagonal): a scale ten
+    times too fine, such as a board's ``square_mm`` of 2.5 for 25 mm squares (customer 32:
+    "0.0106 mm per px" passed calibrate and check, and every row read "10% of l0 visible").
+
+    Examples
+    --------
+    >>> scale_too_fine(210.0, 0.0106, (4032, 3024)), scale_too_fine(210.0, 0.106, (4032, 3024))
+    (True, False)
+    """
+    return l0_mm / mm_per_px / np.pi > float(np.hypot(*image_size))
+
+
 def _calibration_problems(ps: PhotoSet) -> list[Problem]:
     """Doubts about the calibrations: a large reprojection error (every row using it), not stored,
     mm_per_px unused."""
@@ -1390,6 +1419,19 @@ def _calibration_problems(ps: PhotoSet) -> list[Problem]:
             )
         if cal.key not in seen:
             seen.add(cal.key)
+            if s is not None and scale_too_fine(s.l0_mm, cal.plane.mm_per_px, cal.plane.image_size):
+                out.append(
+                    Problem(
+                        sname,
+                        None,
+                        f"calibration {board} gives {cal.plane.mm_per_px:.4g} mm per px, at which "
+                        f"l0_mm = {s.l0_mm:g} is {s.l0_mm / cal.plane.mm_per_px:.0f} px long: "
+                        "more than the photo could hold even curled into a ring",
+                        "check the calibration's square_mm (the side of one square, in mm: 25 "
+                        "for 25 mm squares, not 2.5) and l0_mm",
+                        warning=True,
+                    )
+                )
             if not cal.stored:
                 out.append(
                     Problem(

@@ -230,6 +230,21 @@ def test_wrong_inner_corner_count_is_refused(calibrated, tmp_path: Path) -> None
     assert "board.jpg" in text and "7x5 inner corners" in text
 
 
+def test_a_square_size_ten_times_too_small_is_named_by_check(calibrated, tmp_path: Path) -> None:
+    # customer 32 gave square_mm 2.5 for 25 mm squares: calibrate and check said nothing, and
+    # every row read "line partly hidden: 10% of l0 visible"
+    from pipeline.photoset_check import check_photoset
+
+    folder = _copy(calibrated[0], tmp_path / "set")
+    assert not [p for p in check_photoset(folder, warnings=True) if "mm per px" in p.message]
+    settings = _yaml(folder)
+    settings["calibration"]["square_mm"] = settings["calibration"]["square_mm"] / 10
+    write_settings(folder, settings)
+    (scale,) = [p for p in check_photoset(folder, warnings=True) if "mm per px" in p.message]
+    assert "more than the photo could hold even curled into a ring" in scale.message
+    assert scale.fix.startswith("check the calibration's square_mm")
+
+
 def test_board_of_another_resolution_is_refused_and_its_rows_fail(
     calibrated, tmp_path: Path
 ) -> None:

@@ -852,3 +852,22 @@ def test_photos_all_at_one_pressure_are_all_taken_rising(tmp_path):
         pressures_kpa=(0.0, 20.0, 20.0, 10.0, 0.0),
     )
     assert df["direction"].tolist() == ["up", "up", "down", "down", "down"]
+
+
+def test_check_names_calibration_for_unlisted_checkerboard_photos(photo_folder):
+    # customer 32's tilted phone: the checkerboard photos were only "not in manifest.csv", and
+    # measured without the calibration every row was ok and up to 20 deg off
+    from pipeline.photoset_check import check_photoset
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 150.0})
+    (photo_folder / "checkerboard_1.jpg").write_bytes((photo_folder / next(
+        p.name for p in photo_folder.glob("*.jpg"))).read_bytes())
+    (unlisted,) = [p for p in check_photoset(photo_folder, warnings=True)
+                   if "not in manifest.csv" in p.message]
+    assert unlisted.fix.startswith("if 'checkerboard_1.jpg' and the like are photos of a "
+                                   "checkerboard for the camera's calibration, name them")
+    # a photo named otherwise: the fix as before
+    (photo_folder / "checkerboard_1.jpg").rename(photo_folder / "IMG_9.jpg")
+    (unlisted,) = [p for p in check_photoset(photo_folder, warnings=True)
+                   if "not in manifest.csv" in p.message]
+    assert unlisted.fix.startswith("add a row for each")
