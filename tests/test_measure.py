@@ -572,3 +572,17 @@ def test_the_end_of_a_run_names_each_sets_counts_and_where_its_reasons_are(tmp_p
             f"'reason' column of {bad}"
         ),
     ]
+
+
+def test_a_line_short_of_l0_names_the_scale_and_an_oblique_camera_as_well_as_hiding():
+    # customer 32's phone looked at the plane 22 deg off square: without a calibration, with
+    # mm_per_px, 21 rows read "line partly hidden: 90-93% of l0 visible"; nothing was hidden
+    from pipeline.measure.extract import LineExtraction
+    from pipeline.measure.quality import line_flags
+
+    pts = np.c_[np.zeros(100), np.arange(100.0)]
+    line = LineExtraction(pts, 3.0, False, 1, 100.0, 50.0, 0.0, False, True, (0.0, 0.0))
+    (flag,) = line_flags(line, 90.0, 100.0)
+    assert flag.startswith("line partly hidden: 90% of l0 visible (or the scale is off")
+    assert "a camera not square to the actuator's plane, which a calibration corrects" in flag
+    assert ";" not in flag  # one cause: the ramp check may still trust it again as cosmetic

@@ -84,7 +84,11 @@ def line_flags(
     if expected_length_px:
         ratio = length_px / expected_length_px
         if ratio < LENGTH_LOW:
-            flags.append(f"line partly hidden: {100 * ratio:.0f}% of l0 visible")
+            flags.append(
+                f"line partly hidden: {100 * ratio:.0f}% of l0 visible (or the scale is off: "
+                "mm_per_px, a calibration's square_mm, or a camera not square to the "
+                "actuator's plane, which a calibration corrects)"
+            )
         elif ratio > LENGTH_HIGH:
             flags.append(
                 f"line {100 * ratio:.0f}% of l0: check mm_per_px or marks joined to the line"
