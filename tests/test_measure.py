@@ -586,3 +586,18 @@ def test_a_line_short_of_l0_names_the_scale_and_an_oblique_camera_as_well_as_hid
     assert flag.startswith("line partly hidden: 90% of l0 visible (or the scale is off")
     assert "a camera not square to the actuator's plane, which a calibration corrects" in flag
     assert ";" not in flag  # one cause: the ramp check may still trust it again as cosmetic
+
+
+def test_the_preview_measures_a_black_line_as_measure_does():
+    # the preview measured the colour decoding, measure the luma one: customer 32 read psi 209.9
+    # on the preview and 208.7 in angles.csv for the same photo (0.5 deg apart on the sample)
+    from pipeline.measure.core import decode_for_work, measure_file
+    from pipeline.photoset import load_photoset
+    from pipeline.preview import measured_as_measure_does
+
+    ps = load_photoset(Path(__file__).resolve().parents[1] / "sample_images")
+    for i in range(12):
+        path = ps.image_path(str(ps.manifest["image"].iloc[i]))
+        data = np.fromfile(str(path), np.uint8)
+        seen = measured_as_measure_does(data, *decode_for_work(data), ps.rows[i], "auto")
+        assert seen.psi_deg == measure_file(path, ps.rows[i])[0].psi_deg
