@@ -148,8 +148,9 @@ def measured_as_measure_does(
     times): a black line is measured on the luma decoding, as ``measure`` does (on the colour
     one, customer 32's 12 MP phone photos read up to 1.2 deg from ``measure``'s psi)."""
     if decodes_grey(settings):
-        grey, factor = decode_for_work(data, grey=True)
-        img = img if grey is None else grey
+        grey, grey_factor = decode_for_work(data, grey=True)
+        if grey is not None:
+            img, factor = grey, grey_factor
     return measure_decoded(data, img, factor, settings, method=method)
 
 
