@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import DIRECTIONS, STATUSES
+from pipeline.constants import DIRECTIONS, PRESSURE_OUT_OF_ORDER, STATUSES
 from pipeline.errors import UserInputError
 from pipeline.fileio import read_table
 
@@ -173,15 +173,22 @@ def measured_pressure(angles: pd.DataFrame) -> pd.Series:
 
 def is_used(angles: pd.DataFrame, include_flagged: bool = False) -> pd.Series:
     """Whether each row's psi may enter a curve by its status: ``ok``, and ``flagged`` if asked
-    (``failed`` never).
+    (``failed`` never, nor a row whose pressure breaks its ramp's order: a manifest typo's
+    psi would enter at a pressure never set).
 
     Examples
     --------
-    >>> status = pd.DataFrame({"status": ["ok", "flagged", "failed"]})
+    >>> status = pd.DataFrame({"status": ["ok", "flagged", "failed", "flagged"], "reason": [
+    ...     "", "", "", "pressure 400 kPa is out of its ramp's order (30 -> 400 -> 50 kPa)"]})
     >>> is_used(status, include_flagged=True).tolist()
-    [True, True, False]
+    [True, True, False, False]
     """
-    return angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
+    used = angles["status"].isin(("ok", "flagged") if include_flagged else ("ok",))
+    if "reason" in angles.columns:
+        used &= ~angles["reason"].fillna("").astype(str).str.contains(
+            PRESSURE_OUT_OF_ORDER, regex=False
+        )
+    return used
 
 
 def settled_frames(angles: pd.DataFrame) -> pd.Series:

@@ -242,8 +242,10 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     13.333
     >>> round(crossing_kpa([0, 10, 20, 30, 40], [0.4, -12.0, -30.0, -5.0, 15.0], 0.0), 3)
     32.5
-    >>> crossing_kpa([0, 10, 20], [0.4, -12.0, -30.0], 0.0)  # only at its start
-    0.0
+    >>> round(crossing_kpa([0, 10, 20], [0.4, -12.0, -30.0], 0.0), 3)  # only at its start
+    0.323
+    >>> crossing_kpa([100, 80, 60], [1.5, 20.0, 60.0], 0.0)  # never: near it is not on it
+    nan
     """
     p = np.asarray(pressure_kpa, dtype=float)
     s = np.asarray(psi_deg, dtype=float)
@@ -253,8 +255,9 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     if d.size and abs(d[0]) <= START_BAND_DEG:  # it starts on the level: from where it leaves
         left = np.flatnonzero(np.abs(d) > START_BAND_DEG)
         later = crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
-        return float(p[0]) if math.isnan(later) else later  # else at its start, and only there
-    for i in range(d.size):
+        if not math.isnan(later):
+            return later
+    for i in range(d.size):  # (else the first crossing or touch, its start's included)
         if d[i] == 0.0:
             return float(p[i])
         if i + 1 < d.size and d[i] * d[i + 1] < 0.0:

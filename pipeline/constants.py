@@ -17,6 +17,9 @@ DIRECTION_WORDS: dict[str, str] = {
 RAMP_KEYS: tuple[str, ...] = ("material", "actuator", "trial")
 #: measurement status of a row: a trusted number, a doubtful number, no number
 STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
+#: how a row whose pressure breaks its ramp's order (a manifest typo) says so in its reason: its
+#: psi never enters a curve, flagged rows included (its pressure, not psi, is in doubt)
+PRESSURE_OUT_OF_ORDER = "is out of its ramp's order"
 #: rest bending angle psi0 of the paper's actuators (deg, DESIGN.md): the fallback where no material
 #: says its own (a material's is ``Material.psi0_deg``, from the materials file)
 PSI0_DEG: float = 210.0

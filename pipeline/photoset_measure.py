@@ -41,7 +41,7 @@ from pipeline.photoset import (
 )
 from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
-from pipeline.result_cache import CachedTask, cached_tasks, prune, run_cached
+from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cached
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
@@ -184,9 +184,10 @@ def measure_photoset(
 
         out = measure_video_set(ps, method=method, jobs=jobs, overlays_dir=odir)
     else:
-        out = _measure_photos(
-            ps, method, jobs, odir, second_look, None if cache_dir is None else Path(cache_dir)
-        )
+        cache = None if cache_dir is None else Path(cache_dir)
+        if cache is not None:
+            check_cache_dir(cache, ps.folder)
+        out = _measure_photos(ps, method, jobs, odir, second_look, cache)
     from_cache = int(out.attrs.get("from_cache", 0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
@@ -293,16 +294,19 @@ def note_changed_statuses(angles: pd.DataFrame, drawn: pd.DataFrame, overlays_di
 
 
 def _measured(
-    tasks: list[Task], jobs: int, cache_dir: Path | None, used: list[CachedTask]
+    tasks: list[Task], jobs: int, cache_dir: Path | None, used: set[str]
 ) -> list[dict[str, Any]]:
     """Each task's angles.csv fields (:func:`pipeline.measure.worker.run_task`), taken from
     ``cache_dir`` where an earlier run measured the same (:mod:`pipeline.result_cache`); the
-    entries are appended to ``used``."""
-    items = cached_tasks(tasks, cache_dir)
-    used.extend(items)
-    return map_photos(
-        run_cached, items, jobs=jobs, preload=["pipeline.measure.worker", "pipeline.result_cache"]
+    entries are added to ``used``."""
+    rows = map_photos(
+        run_cached,
+        cached_tasks(tasks, cache_dir),
+        jobs=jobs,
+        preload=["pipeline.measure.worker", "pipeline.result_cache"],
     )
+    used.update(name for r in rows if (name := r.pop("cache_entry")) is not None)
+    return rows
 
 
 def _measure_photos(
@@ -317,7 +321,7 @@ def _measure_photos(
     hold ``from_cache``, how many photos an earlier run had measured (with ``cache_dir``)."""
     manifest = ps.manifest
     tasks = _tasks(ps, method, odir)
-    used: list[CachedTask] = []
+    used: set[str] = set()
     rows = _measured(tasks, jobs, cache_dir, used)
     from_cache = sum(bool(r.pop("from_cache")) for r in rows)
     if second_look:
@@ -396,7 +400,7 @@ def _on_ramp_backgrounds(
     rows: list[dict[str, Any]],
     jobs: int,
     cache_dir: Path | None = None,
-    used: list[CachedTask] | None = None,
+    used: set[str] | None = None,
 ) -> list[dict[str, Any]]:
     """``rows``, where a body's first measurement is doubtful (flagged or failed), with its
     measurement against the empty scene estimated from its ramp's photos when that one is
@@ -427,7 +431,7 @@ def _on_ramp_backgrounds(
                 overlay_path=None if overlay is None else str(Path(tmp) / f"{i}.jpg"),
             )))
         measured = (
-            _measured([t for _, t in again], jobs, cache_dir, [] if used is None else used)
+            _measured([t for _, t in again], jobs, cache_dir, set() if used is None else used)
             if again
             else []
         )

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import DIRECTIONS, RAMP_KEYS
+from pipeline.constants import DIRECTIONS, PRESSURE_OUT_OF_ORDER, RAMP_KEYS
 from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
@@ -93,6 +93,9 @@ GIVEN_FLAG_DEG = 5.0
 #: 2.7-3.5 deg, every base 8 deg off (41 rows ok and 7-10 deg off); 10 rendered ramp sets and a
 #: customer's silhouettes, all right: at most 0.9
 SIDE_SPLIT_DEG = 2.0
+#: ... their own base may then be this far (deg) off a direction given without doubting it
+#: (customer 31: 8.4); farther, the direction given is doubted as ever (a sign typo: 170 off)
+SIDES_EXCUSE_DEG = 15.0
 
 
 def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
@@ -142,6 +145,10 @@ def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
 #: a pressure out of its leg's order by more than this share of the leg's median step (and at
 #: least PRESSURE_SLACK_MIN_KPA) is a typo: a gauge's own reading wobbles far less
 PRESSURE_SLACK_STEPS, PRESSURE_SLACK_MIN_KPA = 0.5, 1.0
+#: ... and so is a leg's first or last pressure whose step is more than this many times the step
+#: beside it (a typo at the top of a ramp keeps its leg in order: 90 -> 1100; a ramp that doubles
+#: its steps, 40 -> 80 -> 160, is no typo)
+PRESSURE_END_STEPS = 4.0
 
 
 def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
@@ -152,7 +159,9 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
     :data:`PRESSURE_SLACK_STEPS` of the leg's median step) is doubtful: the one farthest from
     the middle of its two neighbours goes first, and the leg is checked again without it, so a
     typo never blames its neighbours (a customer's 100 kPa typed as 1000 went into the curves:
-    a level at 1000 kPa).  Nothing is said without a ``step`` column (the rows' order is then
+    a level at 1000 kPa); then a leg's first or last pressure whose step is more than
+    :data:`PRESSURE_END_STEPS` times the step beside it (a typo at a ramp's top).  Nothing is
+    said without a ``step`` column (the rows' order is then
     not the order taken), for a video's frames (their pressures come from its log, not typed)
     or for a leg of fewer than 3 pressures.
 
@@ -206,10 +215,21 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
                 i = worst[1]
                 shown = [f"{sign * q[j]:g}" for j in (i - 1, i, i + 1) if 0 <= j < len(q)]
                 out[leg.index[keep[i]]] = (
-                    f"pressure {sign * q[i]:g} kPa is out of its ramp's order "
+                    f"pressure {sign * q[i]:g} kPa {PRESSURE_OUT_OF_ORDER} "
                     f"({' -> '.join(shown)} kPa by step): a typo in the manifest?"
                 )
                 del keep[i]
+            if len(keep) >= 3:  # a typo that overshoots at a leg's end keeps it in order
+                q = p[keep]
+                for i, j, k in ((len(q) - 1, len(q) - 2, len(q) - 3), (0, 1, 2)):
+                    step, before = abs(q[i] - q[j]), abs(q[j] - q[k])
+                    if step > slack and step > PRESSURE_END_STEPS * max(before, slack):
+                        shown = [f"{sign * q[n]:g}" for n in sorted((i, j))]
+                        out[leg.index[keep[i]]] = (
+                            f"pressure {sign * q[i]:g} kPa {PRESSURE_OUT_OF_ORDER} "
+                            f"({' -> '.join(shown)} kPa by step, {step / max(before, slack):.0f} "
+                            "times the step beside it): a typo in the manifest?"
+                        )
     return out
 
 
@@ -428,8 +448,9 @@ def share_base_direction(
         ).to_numpy(float)
         uncertain = _sides_diverge(out, ramp, own_all, flag=not np.isfinite(given).any())
         if np.isfinite(given).any():  # psi is measured from the direction given: compared only
-            if not uncertain:  # else the bodies' own is the doubtful one (customer 31)
-                _compare_given(out, ramp, own_all, given)
+            # with the bodies' sides diverging, their own is the doubtful one (customer 31: 8.4
+            # deg off the true direction given), unless it is too far off for that
+            _compare_given(out, ramp, own_all, given, excused_deg=SIDES_EXCUSE_DEG * uncertain)
             continue
         used = (ramp["status"] != "failed").to_numpy() & np.isfinite(own_all)
         if used.sum() < BASE_MIN_PHOTOS:
@@ -492,13 +513,18 @@ def _sides_diverge(
 
 
 def _compare_given(
-    out: pd.DataFrame, ramp: pd.DataFrame, own: np.ndarray, given: np.ndarray
+    out: pd.DataFrame,
+    ramp: pd.DataFrame,
+    own: np.ndarray,
+    given: np.ndarray,
+    excused_deg: float = 0.0,
 ) -> None:
     """Note in every row of ``ramp`` (in place in ``out``) when its bodies' own base directions
     (``own``), agreeing among themselves, lie more than :data:`GIVEN_OFF_DEG` from the
     ``fixed_direction_deg`` given (``given``, in the same convention); flag its measured rows
     when they lie more than :data:`GIVEN_FLAG_DEG` from it.  psi stays measured from the
-    direction given.
+    direction given.  Nothing is said where the bodies' own lie within ``excused_deg`` of it
+    (their sides diverge at the clamp: :func:`_sides_diverge`).
 
     Examples
     --------
@@ -522,7 +548,8 @@ def _compare_given(
         return
     off = _wrap_deg(own[ok] - given[ok])
     median = float(np.median(off))
-    if abs(median) <= GIVEN_OFF_DEG or float(np.median(np.abs(off - median))) > BASE_SPREAD_DEG:
+    spread = float(np.median(np.abs(off - median)))
+    if abs(median) <= max(GIVEN_OFF_DEG, excused_deg) or spread > BASE_SPREAD_DEG:
         return
     stated = float(np.median(given[ok]))
     seen = f"{stated + median:+.1f} deg (the median of {int(ok.sum())} {_unit(ramp)})"

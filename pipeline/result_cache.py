@@ -1,13 +1,15 @@
 """Each photo's measurement kept on disk, so that an interrupted ``measure`` resumes and a set
 with one photo changed measures that photo only.
 
-An entry is named by the sha256 of everything the measurement depends on: the photo's bytes, the
-row's resolved settings (an empty scene by its bytes, not its path), the method, the overlay's
-title, and the code that measures (every source file of the package and the versions of OpenCV,
-NumPy and SciPy), so a changed photo, setting or program is measured again and an entry is
-never stale.  Each photo's entry is written by the worker that measured it, as soon as it is
-done (atomically: a run cut off leaves whole entries only).  ``measure --cache DIR`` uses one;
-the workflow keeps one per dataset under ``results/cache/``.
+An entry is named by the sha256 of everything the measurement depends on: the photo's bytes (as
+the worker read them to measure), the row's resolved settings (an empty scene by its bytes, not
+its path), the method, the overlay's title, and the code that measures (every source file of the
+package and the versions of OpenCV, NumPy and SciPy), so a changed photo, setting or program is
+measured again and an entry is never stale.  Each photo's entry is written by the worker that
+measured it, as soon as it is done (atomically: a run cut off leaves whole entries only; one that
+cannot be written is skipped, the cache being only a saving).  ``measure --cache DIR`` uses one:
+a folder of its own, outside the photo set, as :func:`prune` deletes the entries a run no longer
+needs; the workflow keeps one per dataset under ``results/cache/``.
 """
 
 from __future__ import annotations
@@ -16,26 +18,35 @@ import functools
 import hashlib
 import json
 import pickle
+import re
+import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes
 from pipeline.measure.worker import Task, run_task
 
 #: the suffixes of an entry's files: its fields, and its overlay when one was drawn
 FIELDS, OVERLAY = ".json", ".jpg"
+#: an entry's file (what :func:`prune` may delete), and one left half-written by a worker killed
+ENTRY = re.compile(r"^[0-9a-f]{64}\.(json|jpg)$")
+STRAY = re.compile(r"^\.[0-9a-f]{64}\.(json|jpg)\..*\.tmp$")
+#: a half-written file is deleted once older than this (s): younger, another run may be writing it
+STRAY_AGE_S = 600.0
 
 
 @dataclass(frozen=True)
 class CachedTask:
-    """A :class:`~pipeline.measure.worker.Task` with the cache entry that holds (or will hold)
-    its result: ``entry`` is a path without suffix, None for no cache."""
+    """A :class:`~pipeline.measure.worker.Task` with the cache folder its entry lives in and the
+    digest of all but its photo (:func:`settings_key`); None for no cache."""
 
     task: Task
-    entry: str | None = None
+    folder: str | None = None
+    settings_key: str | None = None
 
 
 @functools.lru_cache(maxsize=1)
@@ -61,32 +72,53 @@ def _file_digest(path: str) -> str:
     return h.hexdigest()
 
 
-def task_key(task: Task) -> str | None:
-    """The name of ``task``'s entry (see the module docstring); None where its photo or empty
-    scene cannot be read (it is measured, and fails, every time)."""
+def settings_key(task: Task) -> str | None:
+    """The digest of everything ``task``'s result depends on but its photo (see the module
+    docstring); None for a row that cannot be measured or whose empty scene cannot be read (it
+    is measured, and fails, every time)."""
     settings = task.settings
+    if settings is None:
+        return None
     try:
-        photo = _file_digest(task.path) if settings is not None else ""
-        if settings is not None and settings.background_path is not None:
+        if settings.background_path is not None:
             settings = replace(settings, background_path=_file_digest(settings.background_path))
     except OSError:
         return None
     h = hashlib.sha256(code_fingerprint().encode())
-    h.update(photo.encode())
     h.update(pickle.dumps((settings, task.method, task.title, task.reason)))
     return h.hexdigest()
 
 
+def entry_name(key: str, photo: np.ndarray) -> str:
+    """The entry of a task of :func:`settings_key` ``key`` measuring ``photo`` (its bytes)."""
+    return hashlib.sha256(key.encode() + hashlib.sha256(photo.tobytes()).digest()).hexdigest()
+
+
 def cached_tasks(tasks: list[Task], cache_dir: Path | None) -> list[CachedTask]:
-    """``tasks`` with their entries in ``cache_dir`` (none without one)."""
+    """``tasks`` with the cache folder ``cache_dir`` (none without one)."""
     if cache_dir is None:
         return [CachedTask(t) for t in tasks]
     cache_dir.mkdir(parents=True, exist_ok=True)
-    out = []
-    for t in tasks:
-        key = task_key(t)
-        out.append(CachedTask(t, None if key is None else str(cache_dir / key)))
-    return out
+    return [CachedTask(t, str(cache_dir), settings_key(t)) for t in tasks]
+
+
+def check_cache_dir(cache_dir: Path, photoset_dir: Path) -> None:
+    """Refuse a cache folder that is the photo set's folder or lies inside it: :func:`prune`
+    deletes what it does not need there (a customer's review: ``--cache SET`` deleted the set's
+    photos).
+
+    Raises
+    ------
+    UserInputError
+        Naming both folders and the fix.
+    """
+    cache, folder = cache_dir.resolve(), photoset_dir.resolve()
+    if cache == folder or folder in cache.parents:
+        raise UserInputError(
+            f"--cache {cache_dir} lies in the photo set {photoset_dir}: give a folder of its own "
+            "outside it (the cache deletes the entries it no longer needs), e.g. "
+            f"{photoset_dir.name}_cache beside it"
+        )
 
 
 def _encode(value: Any) -> Any:
@@ -105,38 +137,50 @@ def _decode(value: Any) -> Any:
 
 def run_cached(item: CachedTask) -> dict[str, Any]:
     """:func:`~pipeline.measure.worker.run_task`, or its result kept in the entry: read back,
-    overlay copied, with ``from_cache`` True."""
-    task, entry = item.task, item.entry
-    if entry is not None:
-        fields = Path(entry + FIELDS)
-        overlay = Path(entry + OVERLAY)
-        if fields.is_file() and (task.overlay_path is None or overlay.is_file()):
-            try:
-                row = {k: _decode(v) for k, v in json.loads(fields.read_text()).items()}
-                if task.overlay_path is not None:
-                    Path(task.overlay_path).parent.mkdir(parents=True, exist_ok=True)
-                    atomic_write_bytes(task.overlay_path, overlay.read_bytes(), durable=False)
-                return {**row, "from_cache": True}
-            except (OSError, ValueError):
-                pass  # a damaged entry: measured again
-    row = run_task(task)
-    if entry is not None:  # (an entry without an overlay serves a run that asks for none)
+    overlay copied.  The row says whether it came from the cache (``from_cache``) and names its
+    entry (``cache_entry``, None without one) for :func:`prune`."""
+    task = item.task
+    if item.folder is None or item.settings_key is None:
+        return {**run_task(task), "from_cache": False, "cache_entry": None}
+    try:
+        photo = np.fromfile(task.path, dtype=np.uint8)
+    except OSError:
+        return {**run_task(task), "from_cache": False, "cache_entry": None}
+    name = entry_name(item.settings_key, photo)
+    entry = Path(item.folder) / name
+    fields, overlay = entry.with_suffix(FIELDS), entry.with_suffix(OVERLAY)
+    try:
+        if fields.is_file() and (task.overlay_path is None or overlay.stat().st_size > 0):
+            row = {k: _decode(v) for k, v in json.loads(fields.read_text()).items()}
+            if task.overlay_path is not None:
+                atomic_write_bytes(task.overlay_path, overlay.read_bytes(), durable=False)
+            return {**row, "from_cache": True, "cache_entry": name}
+    except (OSError, ValueError):
+        pass  # a damaged or missing entry: measured again
+    row = run_task(task, photo)
+    try:  # (an entry without an overlay serves a run that asks for none)
         if task.overlay_path is not None and Path(task.overlay_path).is_file():
-            atomic_write_bytes(
-                entry + OVERLAY, Path(task.overlay_path).read_bytes(), durable=False
-            )
+            atomic_write_bytes(overlay, Path(task.overlay_path).read_bytes(), durable=False)
         else:
-            Path(entry + OVERLAY).unlink(missing_ok=True)
+            overlay.unlink(missing_ok=True)
         text = json.dumps({k: _encode(v) for k, v in row.items()}, allow_nan=True)
-        atomic_write_bytes(entry + FIELDS, text.encode(), durable=False)  # last: it is whole
-    return {**row, "from_cache": False}
+        atomic_write_bytes(fields, text.encode(), durable=False)  # last: the entry is whole
+    except OSError:
+        pass  # a full or read-only disk: this photo is measured again next time
+    return {**row, "from_cache": False, "cache_entry": name}
 
 
-def prune(cache_dir: Path, used: list[CachedTask]) -> None:
+def prune(cache_dir: Path, used: set[str]) -> None:
     """Delete the entries of ``cache_dir`` that no task of this run used (photos changed or
-    gone, settings or code changed): the cache holds one set's current results only."""
-    keep = {Path(c.entry).name for c in used if c.entry is not None}
+    gone, settings or code changed), and files a killed worker left half-written: the folder
+    holds one set's current results only.  Files that are not entries are never touched."""
+    now = time.time()
     for path in cache_dir.iterdir():
-        stray = path.name.startswith(".") and path.suffix == ".tmp"  # a worker killed mid-write
-        if stray or (path.suffix in (FIELDS, OVERLAY) and path.stem not in keep):
-            path.unlink(missing_ok=True)
+        try:
+            if ENTRY.match(path.name):
+                if path.stem not in used:
+                    path.unlink(missing_ok=True)
+            elif STRAY.match(path.name) and now - path.stat().st_mtime > STRAY_AGE_S:
+                path.unlink(missing_ok=True)
+        except OSError:
+            continue

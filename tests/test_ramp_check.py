@@ -341,7 +341,7 @@ def test_a_video_frame_off_its_neighbours_by_a_few_degrees_breaks_its_ramp():
         (4, 400.0, "30 -> 400 -> 50"),  # 40 typed as 400 (customer 30: 100 as 1000)
         (7, 7.0, "60 -> 7 -> 80"),  # 70 typed as 7
         (0, 100.0, "100 -> 10"),  # the first photo
-        (13, 1100.0, "110 -> 1100 -> 90"),  # the top of the falling leg
+        (13, 1100.0, "110 -> 1100 -> 90"),  # the second of the falling leg
     ],
 )
 def test_a_pressure_out_of_its_legs_order_is_flagged_and_kept_out_of_the_curves(k, typed, shown):
@@ -407,3 +407,34 @@ def test_bodies_whose_sides_diverge_do_not_doubt_the_direction_given():
     )
     assert (turned["status"] == "flagged").all()
     assert turned["reason"].str.startswith("psi may be 8.4 deg off").all()
+
+
+@pytest.mark.parametrize(
+    ("k", "typed", "shown"), [(11, 1100.0, "100 -> 1100"), (12, 1100.0, "1100 -> 100")]
+)
+def test_a_typo_at_the_top_of_a_ramp_is_flagged_though_its_leg_stays_in_order(k, typed, shown):
+    # the review: 110 typed as 1100 as the rising leg's last, or the falling leg's first,
+    # overshoots in the leg's own direction and kept it in order: nothing was said
+    df = _ramp(_ds20_like(), _ds20_like()[::-1])
+    df.loc[k, "pressure_kpa"] = typed
+    out = check_ramps(df)
+    assert out.loc[k, "status"] == "flagged", out.loc[k, "reason"]
+    assert out.loc[k, "reason"].startswith(
+        f"pressure {typed:g} kPa is out of its ramp's order ({shown} kPa by step, 100 times"
+    ), out.loc[k, "reason"]
+    assert (out.drop(index=k)["status"] == "ok").all()
+    # a ramp that doubles its steps is no typo
+    doubling = _ramp(_ds20_like(7))
+    doubling["pressure_kpa"] = [0.0, 5, 10, 20, 40, 80, 160]
+    assert (check_ramps(doubling)["status"] == "ok").all()
+
+
+def test_a_direction_given_far_off_is_doubted_even_where_the_sides_diverge():
+    # the review: with the sides diverging the comparison was skipped, so a sign typo (+90 for
+    # -90: 171 deg off the bodies' own) or a direction 38 deg off passed every row ok
+    psi = _ds20_like()
+    for given in (90.0, -60.0):
+        out = check_ramps(_bodies(psi, np.full(12, -98.4), fixed_direction_deg=given,
+                                  base_side_split_deg=np.full(12, -3.0)))
+        assert (out["status"] == "flagged").all(), (given, out["reason"].iloc[0])
+        assert out["reason"].str.startswith("psi may be").all()

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+import yaml
 
 from pipeline.photoset_measure import measure_photoset
 
@@ -82,7 +83,8 @@ def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
     run.send_signal(signal.SIGINT)
     run.communicate(timeout=60)
     done = len(_entries(cache))
-    assert done >= 40
+    assert done >= 40 and run.returncode != 0, (done, run.returncode)  # cut off part-way
+    assert done < 6 * 42
     resumed = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{done} as measured by an earlier run (--cache)" in resumed.stdout, resumed.stdout
@@ -98,3 +100,45 @@ def _written(angles: pd.DataFrame, path: Path) -> Path:
 
     write_angles(angles, path)
     return path
+
+
+def test_a_cache_folder_in_the_photo_set_is_refused_and_other_files_are_never_pruned(tmp_path):
+    # the review: --cache SET pruned every .jpg and .json of the set: the photos were deleted
+    from pipeline.errors import UserInputError
+
+    folder = _sample(tmp_path / "set", 4)
+    photos = sorted(p.name for p in folder.glob("*.jpg"))
+    for inside in (folder, folder / "cache"):
+        with pytest.raises(UserInputError, match="give a folder of its own outside it"):
+            measure_photoset(folder, cache_dir=inside)
+    assert sorted(p.name for p in folder.glob("*.jpg")) == photos
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    (cache / "notes.json").write_text("{}")
+    (cache / "photo.jpg").write_bytes(b"x")
+    measure_photoset(folder, cache_dir=cache)
+    assert (cache / "notes.json").is_file() and (cache / "photo.jpg").is_file()
+    assert len(_entries(cache)) == 4 + 1
+
+
+def test_a_replaced_empty_scene_is_measured_again_in_the_same_process(tmp_path):
+    # the review: the empty scene was kept per path in a process, so a replaced one was read as
+    # the old, and that result stored under the new one's key and served to later runs
+    import cv2
+
+    from pipeline.synth.photoset_writer import render_photoset
+
+    folder, cache = tmp_path / "set", tmp_path / "cache"
+    render_photoset(folder, "DS20", actuators=1, trials=1, seed=2, scene="green_fibre",
+                    step_kpa=80.0, scene_overrides={"width": 640, "height": 480})
+    background = folder / str(yaml.safe_load((folder / "photoset.yaml").read_text())["background"])
+    first = measure_photoset(folder, cache_dir=cache)
+    empty = cv2.imread(str(background))
+    cv2.imwrite(str(background), cv2.flip(empty, 1))  # another empty scene
+    again = measure_photoset(folder, cache_dir=cache)
+    assert again.attrs["from_cache"] == 0
+    fresh = measure_photoset(folder)
+    pd.testing.assert_frame_equal(again.drop(columns="seconds"), fresh.drop(columns="seconds"))
+    assert not again["psi_deg"].equals(first["psi_deg"]) or not again["status"].equals(
+        first["status"]
+    )

@@ -12,6 +12,7 @@ measured line (mean curvature x measured length).
 from __future__ import annotations
 
 import functools
+import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -345,10 +346,23 @@ def plane_centreline(
     )
 
 
-@functools.lru_cache(maxsize=4)
 def load_background(path: str, shape: tuple[int, int]) -> np.ndarray | str:
-    """The empty-scene photo, resized to the work image (cached per worker: one decode), or why
-    it cannot be used."""
+    """The empty-scene photo, resized to the work image (cached per worker: one decode, again
+    when the file changes), or why it cannot be used."""
+    try:
+        stamp = os.stat(path)
+        return _load_background(path, shape, (stamp.st_mtime_ns, stamp.st_size))
+    except OSError:
+        return _load_background(path, shape, None)
+
+
+@functools.lru_cache(maxsize=4)
+def _load_background(
+    path: str, shape: tuple[int, int], stamp: tuple[int, int] | None
+) -> np.ndarray | str:
+    """:func:`load_background` of the file as it was at ``stamp`` (its mtime and size): a photo
+    of the empty scene replaced between two measurements in one process was read as the old one
+    (and, with ``measure --cache``, stored as measured against the new one)."""
     img = read_image(path)
     name = Path(path).name
     if img is None:

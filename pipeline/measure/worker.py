@@ -41,8 +41,9 @@ class Task:
     reason: str = ""
 
 
-def run_task(task: Task) -> dict[str, Any]:
-    """Measure one photo; return the angles.csv fields (without the manifest columns)."""
+def run_task(task: Task, data: np.ndarray | None = None) -> dict[str, Any]:
+    """Measure one photo (``data``: its bytes when already read); return the angles.csv fields
+    (without the manifest columns)."""
     t0 = time.perf_counter()
     img, f = None, 1
     res: AngleResult
@@ -50,7 +51,8 @@ def run_task(task: Task) -> dict[str, Any]:
         if task.settings is None:
             res = failed(task.method, task.reason)
         else:
-            data = np.fromfile(task.path, dtype=np.uint8)
+            if data is None:
+                data = np.fromfile(task.path, dtype=np.uint8)
             if data.size:
                 img, f = decode_for_work(data, grey=decodes_grey(task.settings))
             res = (
