@@ -1211,3 +1211,14 @@ def test_a_faint_tips_fix_names_the_empty_scene_only_where_none_was_given(given)
     )
     assert "a faint tip?" in quality.reason, quality.reason
     assert ("or give the empty scene (background)" in quality.reason) is not given
+
+
+def test_a_selection_shorter_than_the_sealed_end_is_a_failed_row_not_a_negative_length():
+    # customer 33's clear body: only bright edges were selected, shorter than the 7 mm sealed
+    # end, and the rows read lengths of -8 px, "-3% of l0 visible" and psi -222 deg
+    img, fe, _ = body_photo(90.0, seed=2)
+    res = measure_image(img, settings_for(fe, mm_per_px=0.3, sealed_end_mm=200.0))
+    assert res.status == "failed", (res.psi_deg, res.length_px, res.reason)
+    assert "shorter than the sealed end (sealed_end_mm)" in res.reason
+    ok = measure_image(img, settings_for(fe, mm_per_px=0.3, sealed_end_mm=5.0))
+    assert ok.status == "ok" and ok.length_px > 0

@@ -447,6 +447,16 @@ def measure_body(
         # psi is carried on over the tip the centre line stops short of (carried_on_psi_deg,
         # below): its tangent is not also carried on to where the bending stops (twice the turn)
         ends = (ends[0], min(ends[1], 0.0))
+    seen_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
+    if seen_px + ends[0] + ends[1] <= 0.0:
+        # read before a sealed end longer than the centre line found: nothing of the bending part
+        # is seen, and its length read negative (customer 33's clear body: -8 px, psi -222)
+        return failed(
+            method,
+            "no body found: what is selected is shorter than the sealed end (sealed_end_mm), a "
+            "piece of the body, not all of it; check with photoset preview (a clear or faint body "
+            "needs its empty scene: background)",
+        )
     rng = np.random.default_rng(SEED)
     base = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
