@@ -1155,3 +1155,24 @@ def test_a_material_pages_table_says_what_psi0_and_each_n_a_are(pages):
             said = " ".join(" ".join(t.text for t in texts).split())
             assert re.search(r"ψ0 = 2\d\d\.\d°, the rest angle \(the model's;", said), label
             assert "another n/a: not reached within the run's pressures" in said, label
+
+
+def test_a_set_of_which_no_photo_is_ok_says_so_on_page_one(tmp_path):
+    # customer 33's clear body: 0 of 68 ok, and page 1 showed an empty plot over 0-0.05 kPa,
+    # "n/a (one trial)" for two trials, and "never reaches psi = 0 (smallest mean psi n/a)"
+    from pipeline.report.summary import summary_page
+
+    d = make_dataset(tmp_path, "SS40", overlays=False)
+    a = pd.read_csv(d.angles_csv)
+    a["status"], a["reason"] = "flagged", "centre line wobbles"
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    with report_style():
+        fig = summary_page(data, "0", [], [("a part", 2)])
+    text = " ".join(" ".join(t.get_text() for t in fig.texts).split())
+    assert f"{d.name}: none of its {len(a)} photos was measured ok" in text, text[:2000]
+    assert "SS40: no photo was measured ok, so there is no curve" in text
+    assert "never reaches" not in text and "n/a (one trial)" not in text
+    assert "n/a (no ok photo)" in text
+    assert not [ax for ax in fig.axes if ax.get_lines()]  # no empty plot

@@ -57,15 +57,21 @@ class AngleAccuracy:
         '0.80 / 2.1 trials'
         >>> AngleAccuracy("none", 0).cell()
         'n/a (one trial)'
+        >>> AngleAccuracy("no ok photo", 0).cell()
+        'n/a (no ok photo)'
         """
         if self.basis == "none":
             return "n/a (one trial)"
+        if self.basis == NO_OK:
+            return f"n/a ({NO_OK})"
         figure = f"{self.median_deg:.2f} / {self.p95_deg:.1f} {self.basis}"
         return f"{figure}, {self.off} ok > {OFF_DEG:g}°" if self.off else figure
 
 
-#: no figure: no truth and one trial per actuator (or no ok photo)
+#: no figure: no truth and one trial per actuator
 NO_ACCURACY = AngleAccuracy("none", 0)
+#: ... or no photo measured ok (customer 33 read "n/a (one trial)" for two trials of 68 photos)
+NO_OK = "no ok photo"
 
 
 def truth_errors(angles: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
@@ -149,6 +155,8 @@ def angle_accuracy(angles: pd.DataFrame, truth: pd.DataFrame | None) -> AngleAcc
     >>> angle_accuracy(a, None)
     AngleAccuracy(basis='trials', n=1, median_deg=7.0, p95_deg=7.0, off=0)
     """
+    if not is_used(angles).any():
+        return AngleAccuracy(NO_OK, 0)
     if truth is not None:
         err = np.abs(truth_errors(angles, truth))
         if len(err):

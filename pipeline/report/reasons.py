@@ -78,6 +78,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"direction turns \d+ deg when fitted over half", "hook at an end of the centre line"),
     (r"^line length \d+% of its ramp's median", "length far from its ramp's median"),
     (r"^the body starts \d+ px from fixed_end", "body starts away from fixed_end"),
+    (r"^the body leaves the clamp [-+\d]+ deg off fixed_direction_deg",
+     "body leaves the clamp far off fixed_direction_deg"),
     (r"^the body leaves the fixed end [-+\d]+ deg off its ramp's direction",
      "body leaves the clamp off its ramp's direction"),
     (r"^the free end is \d+% as wide as the body: smeared",
@@ -115,7 +117,8 @@ def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[st
     angles : pandas.DataFrame
         angles rows with ``dataset``, ``status`` and ``reason``.
     limit : int
-        Causes kept per dataset; the rest are summed as ``"other causes"``.
+        Causes kept per dataset; the photos with any other cause are counted, once each, as
+    ``"other causes"``.
 
     Returns
     -------
@@ -127,20 +130,24 @@ def top_reasons(angles: pd.DataFrame, limit: int = 3) -> dict[str, list[tuple[st
     bad = angles[angles["status"].astype(str) != "ok"]
     for dataset, g in bad.groupby("dataset", sort=True):
         counts: Counter[str] = Counter()
+        per_photo = []
         for status, reason in zip(
             g["status"].astype(str), g["reason"].fillna("").astype(str), strict=True
         ):
             causes = [reason] if status == "failed" else reason.split(";")
             # a note says how psi was taken, not why the row is doubted
-            counts.update(
-                {
-                    words(p)
-                    for p in causes
-                    if not (p.strip().startswith(NOTES) or CONTINUATION.match(p.strip()))
-                }
-            )
+            said = {
+                words(p)
+                for p in causes
+                if not (p.strip().startswith(NOTES) or CONTINUATION.match(p.strip()))
+            }
+            per_photo.append(said)
+            counts.update(said)
         ordered = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
         if len(ordered) > limit:
-            ordered = ordered[:limit] + [("other causes", sum(c for _, c in ordered[limit:]))]
+            # photos with another cause, each once (a sum over the causes counted 260 for 68)
+            shown = {phrase for phrase, _ in ordered[:limit]}
+            others = sum(bool(said - shown) for said in per_photo)
+            ordered = ordered[:limit] + [("other causes", others)]
         out[str(dataset)] = ordered
     return out

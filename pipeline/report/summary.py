@@ -283,8 +283,15 @@ def missing_notes(data: ReportData) -> list[str]:
         if not g:
             out.append(f"{m}: no row in rms.csv, so its comparison values read n/a.")
             continue
+        h = data.hysteresis[data.hysteresis["material"] == m]
+        if not h["psi_mean_deg"].notna().any():
+            out.append(
+                f"{m}: no photo was measured ok, so there is no curve and every value reads n/a "
+                "(the quality table gives the reasons; photoset preview shows what the settings "
+                "select)."
+            )
+            continue
         if not np.isfinite(float(g.get("p_zero_up_kpa", np.nan))):
-            h = data.hysteresis[data.hysteresis["material"] == m]
             low = fmt(h["psi_mean_deg"].min(), 0)
             top = fmt(h["pressure_kpa"].max(), 0)
             paper = (
@@ -419,6 +426,20 @@ def calibration_summary(data: ReportData) -> list[tuple[str, str]]:
     return lines
 
 
+def nothing_ok(data: ReportData) -> list[str]:
+    """A warning for each dataset of which no photo was measured ok: its curves are empty, and
+    the page otherwise said so only as n/a (customer 33's 68 photos of a clear body)."""
+    out = []
+    for name, g in data.angles.groupby("dataset", sort=True):
+        if not (g["status"] == "ok").any():
+            out.append(
+                f"{name}: none of its {len(g)} photos was measured ok, so it adds nothing to the "
+                "curves or the comparison; the quality table below gives the reasons, and "
+                "photoset preview shows what the settings select"
+            )
+    return out
+
+
 def summary_page(data: ReportData, version: str, warnings: Sequence[str],
                  contents: Sequence[tuple[str, int]]) -> Figure:
     """Page 1 (portrait A4).
@@ -450,10 +471,11 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
     flow.table(results_table(data))
     flow.space(4.0)
     notes = list(data.notes)
-    shown = list(warnings[:MAX_WARNINGS])
-    if len(warnings) > MAX_WARNINGS:
+    every = [*nothing_ok(data), *warnings]
+    shown = every[:MAX_WARNINGS]
+    if len(every) > MAX_WARNINGS:
         shown.append(
-            f"... and {len(warnings) - MAX_WARNINGS} more warning(s), listed on the provenance page"
+            f"... and {len(every) - MAX_WARNINGS} more warning(s), listed on the provenance page"
         )
     contents_h = 9.0 * 1.32 * (1 + int(np.ceil(len(contents) / 2))) + 14.0
     notes_h = sum(8.0 * 1.32 * (1 + len(n) // 110) for n in notes) + 16.0
@@ -474,7 +496,7 @@ def summary_page(data: ReportData, version: str, warnings: Sequence[str],
         flow.heading("Warnings", size=9.5)
         flow.bullets(shown, color="#b00000")
     plot_h = min(MAX_PLOT_PT, flow.remaining_pt - contents_h - notes_h - 8.0)
-    if plot_h >= MIN_PLOT_PT and len(data.hysteresis):
+    if plot_h >= MIN_PLOT_PT and data.hysteresis["psi_mean_deg"].notna().any():
         flow.space(6.0)
         overview_axes(flow.axes(plot_h, top_pad_pt=20.0), data)
     if notes:
