@@ -4,14 +4,14 @@ Workers are started by a forkserver (never plain ``fork``: forking a process tha
 BLAS threads can deadlock), which preloads the light worker modules once so each worker starts
 fast; each worker runs OpenCV and BLAS on one thread (the pool is the parallelism; see
 :mod:`pipeline.worker_env`).  Results come back in
-task order; a progress bar is shown on an interactive terminal only.
+task order; a progress bar is shown on an interactive terminal only.  On Ctrl-C the workers are
+stopped at once (:meth:`multiprocessing.pool.Pool.terminate`), never waited for.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from typing import TypeVar
 
 T = TypeVar("T")
@@ -19,10 +19,14 @@ R = TypeVar("R")
 
 
 def init_worker() -> None:
-    """Pool initialiser: one OpenCV thread per process."""
+    """Pool initialiser: one OpenCV thread per process, and Ctrl-C left to the parent (which
+    stops the workers: each printed a KeyboardInterrupt traceback)."""
+    import signal
+
     import cv2
 
     cv2.setNumThreads(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def map_photos(
@@ -68,5 +72,16 @@ def map_photos(
     if "forkserver" in methods:
         ctx.set_forkserver_preload(["pipeline.worker_env", *preload])
     chunk = max(1, len(tasks) // (4 * jobs))
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=init_worker) as pool:
-        return list(tqdm(pool.map(func, tasks, chunksize=chunk), **bar))  # type: ignore[call-overload]
+    pool = ctx.Pool(processes=jobs, initializer=init_worker)
+    try:
+        out = list(tqdm(pool.imap(func, tasks, chunksize=chunk), **bar))  # type: ignore[call-overload]
+    except BaseException:
+        # Ctrl-C (or any error): the workers are stopped, not waited for.  A process pool shut
+        # down by waiting after a KeyboardInterrupt hung now and then with a worker still
+        # waiting for work (a Snakemake run's measure job did not stop within 120 s of Ctrl-C)
+        pool.terminate()
+        pool.join()
+        raise
+    pool.close()
+    pool.join()
+    return out

@@ -4,6 +4,7 @@ the set, and one re-shot photo re-measured all of them)."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import signal
 import subprocess
@@ -75,13 +76,20 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
 def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
     folder, cache = _sample(tmp_path / "set", 42, copies=6), tmp_path / "cache"
     cmd = [sys.executable, "-m", "pipeline", "measure", str(folder), "--out",
-           str(tmp_path / "a.csv"), "--cache", str(cache)]
-    run = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+           str(tmp_path / "a.csv"), "--cache", str(cache), "--jobs", "2"]
+    # Ctrl-C as a terminal sends it: to the whole process group, the pool's workers too
+    run = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           start_new_session=True)
     deadline = time.monotonic() + 60
     while len(_entries(cache)) < 40 and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
-    run.send_signal(signal.SIGINT)
-    run.communicate(timeout=60)
+    os.killpg(run.pid, signal.SIGINT)
+    try:
+        run.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(run.pid, signal.SIGKILL)
+        run.communicate()
+        pytest.fail("measure --jobs 2 did not stop within 60 s of Ctrl-C")
     done = len(_entries(cache))
     assert done >= 40 and run.returncode != 0, (done, run.returncode)  # cut off part-way
     assert done < 6 * 42
