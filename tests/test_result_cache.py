@@ -74,14 +74,16 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
 
 
 def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
-    folder, cache = _sample(tmp_path / "set", 42, copies=6), tmp_path / "cache"
+    # 840 photos: seconds of work, so that Ctrl-C lands part-way (252 were done before it came
+    # on a fast run)
+    folder, cache = _sample(tmp_path / "set", 42, copies=20), tmp_path / "cache"
     cmd = [sys.executable, "-m", "pipeline", "measure", str(folder), "--out",
            str(tmp_path / "a.csv"), "--cache", str(cache), "--jobs", "2"]
     # Ctrl-C as a terminal sends it: to the whole process group, the pool's workers too
     run = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                            start_new_session=True)
     deadline = time.monotonic() + 60
-    while len(_entries(cache)) < 40 and run.poll() is None and time.monotonic() < deadline:
+    while len(_entries(cache)) < 10 and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
     os.killpg(run.pid, signal.SIGINT)
     try:
@@ -91,12 +93,12 @@ def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
         run.communicate()
         pytest.fail("measure --jobs 2 did not stop within 60 s of Ctrl-C")
     done = len(_entries(cache))
-    assert done >= 40 and run.returncode != 0, (done, run.returncode)  # cut off part-way
-    assert done < 6 * 42
+    assert done >= 10 and run.returncode != 0, (done, run.returncode)  # cut off part-way
+    assert done < 20 * 42
     resumed = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert resumed.returncode == 0, resumed.stderr
     assert f"{done} as measured by an earlier run (--cache)" in resumed.stdout, resumed.stdout
-    clean = measure_photoset(folder)
+    clean = measure_photoset(folder, jobs=2)
     pd.testing.assert_frame_equal(
         pd.read_csv(tmp_path / "a.csv").drop(columns="seconds"),
         pd.read_csv(_written(clean, tmp_path / "clean.csv")).drop(columns="seconds"),
