@@ -73,9 +73,9 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
     assert turned.at[0, "psi_deg"] == pytest.approx(-reshot.at[0, "psi_deg"], abs=1e-9)
 
 
-def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path):
-    # 840 photos: seconds of work, so that Ctrl-C lands part-way (252 were done before it came
-    # on a fast run)
+def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path, sigint_as_in_a_terminal):
+    # 840 photos: seconds of work, so that Ctrl-C lands part-way (and SIGINT as a terminal sends
+    # it: under pytest-xdist the workers ignore it, and so did measure, which ran to the end)
     folder, cache = _sample(tmp_path / "set", 42, copies=20), tmp_path / "cache"
     cmd = [sys.executable, "-m", "pipeline", "measure", str(folder), "--out",
            str(tmp_path / "a.csv"), "--cache", str(cache), "--jobs", "2"]
