@@ -178,7 +178,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "the plane, print "
         "the reprojection error in px and mm and store the result in DIR/calibration.json, which "
         "measuring then reads. "
-        "Exit 1 if a calibration cannot be computed.",
+        "Exit 1 if the set names no calibration, 2 if one cannot be computed (the board photo "
+        "and the fix are named).",
     )
     calibrate.add_argument("folder", metavar="DIR", help="photo-set folder")
     calibrate.add_argument(

@@ -218,7 +218,10 @@ def test_board_not_found_is_refused_naming_the_file_and_the_board_size(
     run = _run("photoset", "check", str(folder))
     assert run.returncode == 1 and "board.jpg" in run.stderr and "9x6 inner corners" in run.stderr
     bad = _run("photoset", "calibrate", str(folder))
-    assert bad.returncode != 0 and "9x6 inner corners" in bad.stderr
+    assert bad.returncode == 2 and "9x6 inner corners" in bad.stderr  # as its --help says
+    assert "2 if one cannot be computed" in " ".join(
+        _run("photoset", "calibrate", "--help").stdout.split()
+    )
 
 
 def test_wrong_inner_corner_count_is_refused(calibrated, tmp_path: Path) -> None:
