@@ -72,16 +72,20 @@ def _file_digest(path: str) -> str:
     return h.hexdigest()
 
 
-def settings_key(task: Task) -> str | None:
+def settings_key(task: Task, digests: dict[str, str] | None = None) -> str | None:
     """The digest of everything ``task``'s result depends on but its photo (see the module
     docstring); None for a row that cannot be measured or whose empty scene cannot be read (it
-    is measured, and fails, every time)."""
+    is measured, and fails, every time).  ``digests`` keeps each empty scene's digest over the
+    tasks of one run (read once, not once per photo: 84 reads of one 12 MP photo)."""
     settings = task.settings
     if settings is None:
         return None
+    known = {} if digests is None else digests
     try:
-        if settings.background_path is not None:
-            settings = replace(settings, background_path=_file_digest(settings.background_path))
+        if (path := settings.background_path) is not None:
+            if path not in known:
+                known[path] = _file_digest(path)
+            settings = replace(settings, background_path=known[path])
     except OSError:
         return None
     h = hashlib.sha256(code_fingerprint().encode())
@@ -99,7 +103,8 @@ def cached_tasks(tasks: list[Task], cache_dir: Path | None) -> list[CachedTask]:
     if cache_dir is None:
         return [CachedTask(t) for t in tasks]
     cache_dir.mkdir(parents=True, exist_ok=True)
-    return [CachedTask(t, str(cache_dir), settings_key(t)) for t in tasks]
+    digests: dict[str, str] = {}
+    return [CachedTask(t, str(cache_dir), settings_key(t, digests)) for t in tasks]
 
 
 def check_cache_dir(cache_dir: Path, photoset_dir: Path) -> None:
