@@ -242,12 +242,13 @@ def test_the_centre_line_stops_at_a_rigid_cap_wider_than_the_body():
 
 def test_a_wobbly_centre_line_is_flagged_not_an_ok_psi():
     # the translucent body with dots on grey at 720p: its faint side makes the centre line wobble
-    # near both ends, and the end tangents read -32.8 deg for -22.3 (it was ok); a smooth fit of
-    # the whole centre line's turning disagrees, and says so
+    # near both ends, and the end tangents read -32.7 deg for -22.3 (it was ok); a smooth fit of
+    # the whole centre line's turning disagrees, and says so (seed 36, the first such photo,
+    # reads -20.1 and ok since the inside its outline encloses is taken in: fill_outlined)
     from pipeline.synth import render_actuator, scene_from
 
     psi = float(np.linspace(215.0, -220.0, 12)[6])
-    r = render_actuator(psi, 270.0, scene_from("grey_dots_clear", width=1280, height=720), seed=36)
+    r = render_actuator(psi, 270.0, scene_from("grey_dots_clear", width=1280, height=720), seed=39)
     img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
     res = measure_image(img, settings_for(r.fixed_end_px))
     assert res.status == "flagged" and "smooth fit of the whole centre line" in res.reason

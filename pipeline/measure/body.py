@@ -7,7 +7,8 @@ line of the body between its two long edges gives psi.  Steps:
    differs from the background: from a ``background`` photo of the empty scene when there is one,
    else from the backdrop, modelled as a smooth colour field (a quadratic in x and y per Lab
    channel, fitted robustly to the pixels that look like backdrop, starting from the border of
-   the ``roi``); ``roi`` and ``exclude`` restrict it;
+   the ``roi``); ``roi`` and ``exclude`` restrict it; a clear body whose edges differ clearly
+   and whose inside only faintly is what its outline encloses (:func:`fill_outlined`);
 2. clean-up: a closing as wide as the texture (fibre winding, ribs, pleats, dots and highlights
    leave gaps and holes), holes filled unless they are large (the inside of a ring), specks
    opened away, and the component at the fixed end (else the largest) kept;
@@ -48,6 +49,13 @@ GROW_FRACTION = 0.012
 LIGHTNESS_WEIGHT = 0.6
 #: holes larger than this fraction of the body's area stay open (the inside of a ring)
 MAX_HOLE_FRACTION = 0.04
+#: a region enclosed by the selection (and the region left out: a clamp plate under ``exclude``)
+#: is the inside of a clear body when it differs from the background by more than this many
+#: noise sigmas (median over it) and the selection runs along at least this share of its rim;
+#: it is never larger than this share of the photo, and at least this many times as long as it
+#: is wide (area over the square of its widest inscribed disc's diameter)
+OUTLINE_FILL_SIGMAS, OUTLINE_RIM_SHARE, OUTLINE_MAX_SHARE = 3.0, 0.8, 0.25
+OUTLINE_MIN_ELONGATION = 3.0
 #: the centre line is smoothed over this many half-widths (ragged, textured edges)
 SMOOTH_HALF_WIDTHS = 0.6
 
@@ -689,6 +697,8 @@ def body_mask(
             lit = _hysteresis(np.where(shade, 0.0, diff), thr, low)
             if lit.sum() >= SHADOW_KEEP * differs.sum():
                 differs = lit
+        if background_bgr is None or not settings.background_estimated:
+            differs = fill_outlined(differs, diff, allowed, OUTLINE_FILL_SIGMAS * sigma)
         mask &= differs
         strength = diff / max(thr, 1e-6)
         sel = diff[mask > 0]
@@ -696,14 +706,80 @@ def body_mask(
     return mask, strength, contrast
 
 
+def _texture_disc(shape: tuple[int, ...]) -> np.ndarray:
+    """The structuring element as wide as a body's texture gaps in a photo of ``shape``."""
+    k = max(3, round(0.006 * max(shape[:2])) | 1)
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+
+
+def fill_outlined(
+    differs: np.ndarray, diff: np.ndarray, allowed: np.ndarray, faint: float
+) -> np.ndarray:
+    """``differs`` (0/1) with the inside of a clear body its outline encloses added.
+
+    A clear silicone body on a backdrop of its grey shows its edges brightly (they refract the
+    light) and its inside only a few levels off the backdrop seen through it: customer 33's,
+    8 Lab units off its empty scene, was selected as its two edges, read as two bodies, and 0 of
+    68 photos were ``ok`` (4 with the empty scene).  A region that the selection, closed over
+    texture gaps, encloses, together with the region left out (``allowed`` 0: the clamp plate
+    under ``exclude``, where the outline is open), is taken in when its median ``diff`` is over
+    ``faint`` (the backdrop inside a ring is not), the selection runs along at least
+    :data:`OUTLINE_RIM_SHARE` of its rim (a pocket of backdrop between a body and the plate is
+    bounded by the plate) and it is elongated (:data:`OUTLINE_MIN_ELONGATION`: the face of a
+    clamp block outlined at the fixed end is not; taken in, it moved the base of rendered
+    translucent bodies and read one 5.6 deg off), or is compact in a photo where an elongated
+    one is taken in (a tip cap outlined on its own: left out, customer 33's tips read 6-11 deg
+    low, ``ok``).  Regions that reach the photo's border or are
+    larger than :data:`OUTLINE_MAX_SHARE` of the allowed area are never taken in.
+
+    Examples
+    --------
+    >>> differs = np.zeros((60, 80), np.uint8)
+    >>> differs[8:10, 5:45] = 1; differs[20:22, 5:45] = 1; differs[8:22, 43:45] = 1  # an outline
+    >>> allowed = np.ones_like(differs); allowed[:, :6] = 0                        # a plate
+    >>> diff = np.zeros((60, 80), np.float32); diff[10:20, 6:43] = 5.0          # a faint inside
+    >>> int(fill_outlined(differs, diff, allowed, 3.0)[15, 20])
+    1
+    >>> int(fill_outlined(differs, 0 * diff, allowed, 3.0)[15, 20])  # backdrop inside a ring
+    0
+    """
+    h, w = differs.shape
+    disc = _texture_disc(differs.shape)
+    wall = cv2.morphologyEx(
+        ((differs > 0) | (allowed == 0)).astype(np.uint8), cv2.MORPH_CLOSE, disc
+    )
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(1 - wall, connectivity=4)
+    near = cv2.dilate(differs, disc)
+    long_fill = np.zeros_like(differs)
+    compact: list[tuple[tuple[slice, slice], np.ndarray]] = []
+    largest = OUTLINE_MAX_SHARE * float(allowed.sum())
+    for lab in range(1, n):
+        x, y, bw, bh, area = (int(v) for v in stats[lab])
+        if x == 0 or y == 0 or x + bw == w or y + bh == h or area > largest:
+            continue
+        box = (slice(y - 1, y + bh + 1), slice(x - 1, x + bw + 1))
+        inside = (labels[box] == lab).astype(np.uint8)
+        rim = cv2.dilate(inside, np.ones((3, 3), np.uint8)) - inside
+        on_outline = float((rim & near[box]).sum()) / max(1.0, float(rim.sum()))
+        if on_outline < OUTLINE_RIM_SHARE or float(np.median(diff[box][inside > 0])) <= faint:
+            continue
+        widest = 2.0 * float(cv2.distanceTransform(inside, cv2.DIST_L2, 3).max())
+        if area >= OUTLINE_MIN_ELONGATION * widest**2:
+            long_fill[box][inside > 0] = 1
+        else:
+            compact.append((box, inside))
+    out = differs | long_fill
+    if long_fill.any():  # with the body's inside: its tip cap, outlined on its own
+        for box, inside in compact:
+            out[box][inside > 0] = 1
+    return out
+
+
 def _clean(mask: np.ndarray) -> np.ndarray:
     """Close texture gaps, fill small holes, open away specks."""
-    h, w = mask.shape
-    k = max(3, round(0.006 * max(h, w)) | 1)
-    m = cv2.morphologyEx(
-        mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
-    )
-    m = cv2.morphologyEx(m, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
+    disc = _texture_disc(mask.shape)
+    m = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, disc)
+    m = cv2.morphologyEx(m, cv2.MORPH_OPEN, disc)
     contours, hier = cv2.findContours(m, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
     if hier is not None:
         area = float(m.sum())
