@@ -552,10 +552,13 @@ def _compare_given(
     if abs(median) <= max(GIVEN_OFF_DEG, excused_deg) or spread > BASE_SPREAD_DEG:
         return
     stated = float(np.median(given[ok]))
-    seen = f"{stated + median:+.1f} deg (the median of {int(ok.sum())} {_unit(ramp)})"
+    # on screen, within -180..180 (a direction given as 90 for one hanging down at -97 read
+    # "+262.6")
+    leaves = float(_wrap_deg(np.array([stated + median]))[0])
+    seen = f"{leaves:+.1f} deg (the median of {int(ok.sum())} {_unit(ramp)})"
     fix = (
         "if the actuator sits turned in its clamp, give this ramp's rows their own "
-        f"fixed_direction_deg in manifest.csv ({stated + median:+.1f}), or leave the key out "
+        f"fixed_direction_deg in manifest.csv ({leaves:+.1f}), or leave the key out "
         "where the base is seen (photoset preview draws the one given along the base)"
     )
     # up to GIVEN_FLAG_DEG off, either may be the wrong one (a translucent body's own base reads

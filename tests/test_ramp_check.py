@@ -179,6 +179,18 @@ def test_a_ramp_whose_bodies_leave_the_clamp_off_the_direction_given_says_so():
         assert (near["reason"] == "").all() and np.allclose(near["psi_deg"], psi)
 
 
+def test_a_direction_given_with_y_down_is_answered_with_the_bodies_own_on_screen():
+    # customer 31 gave fixed_direction_deg 90 for a body hanging down (-90 on screen): the ramp
+    # named the bodies' own as "+262.6 deg"; it is -97.4, as a user would give it
+    psi = _ds20_like()
+    base = -97.4 + 0.3 * np.sin(np.arange(12.0))
+    out = check_ramps(_bodies(psi, base, fixed_direction_deg=90.0))
+    assert (out["status"] == "flagged").all()
+    assert out["reason"].str.contains(r"leave the clamp at -97\.\d deg").all(), out["reason"][0]
+    assert out["reason"].str.contains(r"manifest\.csv \(-97\.\d\)").all()
+    assert not out["reason"].str.contains("262").any()
+
+
 def test_a_ramp_whose_bodies_leave_the_clamp_far_off_the_direction_given_is_flagged():
     # a customer gave one direction for two trials; the second was remounted 4 deg turned and
     # its bodies leave 5.1 deg off it (their own read 1.5 deg off the truth): every psi 5-8 deg

@@ -502,6 +502,7 @@ def measure_body(
         expected_length_px=settings.l0_mm / settings.mm_per_px if settings.mm_per_px else None,
         length_px=est.length_px,
         base_mismatch_deg=mismatch,
+        fixed_direction_deg=settings.fixed_direction_deg,
         selected_fraction=body.selected_fraction,
         continues=body.continues,
         start_gap_px=body.start_gap_px,

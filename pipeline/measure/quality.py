@@ -255,6 +255,28 @@ def start_seen(start_gap_px: float, width_px: float) -> bool:
     return start_gap_px <= 2.0 * width_px + 4.0
 
 
+#: a body this far (deg) off the ``fixed_direction_deg`` given is told the direction it leaves at
+MISREAD_DIRECTION_DEG = 45.0
+
+
+def _direction_hint(given_deg: float | None, mismatch_deg: float) -> str:
+    """What a body far off the ``fixed_direction_deg`` given says of its own direction: a
+    direction read with y down (90 for a body hanging down) is a sign off (customer 31 was told
+    only "-171 deg off").
+
+    Examples
+    --------
+    >>> _direction_hint(90.0, -171.0)
+    ' (it leaves at -99 deg, counter-clockwise from +x: 90 is up, -90 down)'
+    >>> _direction_hint(90.0, -25.0), _direction_hint(None, -171.0)
+    ('', '')
+    """
+    if given_deg is None or abs(mismatch_deg) <= MISREAD_DIRECTION_DEG:
+        return ""
+    own = (given_deg - mismatch_deg + 180.0) % 360.0 - 180.0
+    return f" (it leaves at {own:+.0f} deg, counter-clockwise from +x: 90 is up, -90 down)"
+
+
 def assess_body(
     line: LineExtraction,
     *,
@@ -279,6 +301,7 @@ def assess_body(
     smooth_mismatch_deg: float = 0.0,
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
     excluded: bool = False,
+    fixed_direction_deg: float | None = None,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -448,6 +471,7 @@ def assess_body(
     if base_mismatch_deg is not None and abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
         flags.append(
             f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
+            + _direction_hint(fixed_direction_deg, base_mismatch_deg)
         )
     if selected_fraction > 0.35:
         notes.append(f"{NOTE_SELECTION_COVERS} {100 * selected_fraction:.0f}% of the photo")
