@@ -8,8 +8,8 @@ package and the versions of OpenCV, NumPy and SciPy), so a changed photo, settin
 measured again and an entry is never stale.  Each photo's entry is written by the worker that
 measured it, as soon as it is done (atomically: a run cut off leaves whole entries only; one that
 cannot be written is skipped, the cache being only a saving).  ``measure --cache DIR`` uses one:
-a folder of its own, outside the photo set, as :func:`prune` deletes the entries a run no longer
-needs; the workflow keeps one per dataset under ``results/cache/``.
+a folder of its own, outside the photo set, as :func:`prune` deletes the entries least recently
+used beyond twice the set's; the workflow keeps one per dataset under ``results/cache/``.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import os
 import pickle
 import re
 import time
@@ -175,17 +176,37 @@ def run_cached(item: CachedTask) -> dict[str, Any]:
     return {**row, "from_cache": False, "cache_entry": name}
 
 
+#: a run keeps the entries it did not use (another setting's, a photo's before it was re-shot, an
+#: earlier program's) up to this many for each it used, the least recently used deleted first: a
+#: setting changed and changed back is read back (customer 33's set was measured again in full)
+KEEP_UNUSED_PER_USED = 2
+
+
 def prune(cache_dir: Path, used: set[str]) -> None:
-    """Delete the entries of ``cache_dir`` that no task of this run used (photos changed or
-    gone, settings or code changed), and files a killed worker left half-written: the folder
-    holds one set's current results only.  Files that are not entries are never touched."""
+    """Mark the entries of ``cache_dir`` that this run used as just used, and delete the least
+    recently used of the others beyond :data:`KEEP_UNUSED_PER_USED` for each used one, and files
+    a killed worker left half-written.  Files that are not entries are never touched."""
     now = time.time()
+    unused: dict[str, list[Path]] = {}
     for path in cache_dir.iterdir():
         try:
             if ENTRY.match(path.name):
-                if path.stem not in used:
-                    path.unlink(missing_ok=True)
+                if path.stem in used:
+                    os.utime(path, (now, now))
+                else:
+                    unused.setdefault(path.stem, []).append(path)
             elif STRAY.match(path.name) and now - path.stat().st_mtime > STRAY_AGE_S:
                 path.unlink(missing_ok=True)
         except OSError:
             continue
+
+    def last_used(stem: str) -> float:
+        try:
+            return max(p.stat().st_mtime for p in unused[stem])
+        except OSError:
+            return 0.0
+
+    newest_first = sorted(unused, key=lambda stem: (-last_used(stem), stem))
+    for stem in newest_first[KEEP_UNUSED_PER_USED * len(used) :]:
+        for path in unused[stem]:
+            path.unlink(missing_ok=True)

@@ -5,6 +5,7 @@ the set, and one re-shot photo re-measured all of them)."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -16,7 +17,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from pipeline.photoset_measure import measure_photoset
+from pipeline.photoset_measure import measure_photoset, summary
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -49,6 +50,9 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
     again = measure_photoset(folder, cache_dir=cache, overlays_dir=tmp_path / "ov2")
     assert again.attrs["from_cache"] == 12
     pd.testing.assert_frame_equal(first, again)
+    # its summary counts the seconds of this run's work, none (customer 33 read "17.4 s")
+    assert summary(again).endswith("(0.0 s of work)")
+    assert not summary(first).endswith("(0.0 s of work)")
     for overlay in (tmp_path / "ov1").glob("*.jpg"):
         assert overlay.read_bytes() == (tmp_path / "ov2" / overlay.name).read_bytes()
     # a run cut off before 4 photos were done: those are measured, the rest read back
@@ -64,13 +68,33 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
     assert reshot.attrs["from_cache"] == 11
     assert reshot.at[2, "psi_deg"] == pytest.approx(first.at[9, "psi_deg"], abs=1e-9)
     assert reshot.at[2, "psi_deg"] != pytest.approx(first.at[2, "psi_deg"], abs=1.0)
-    assert len(_entries(cache)) == 12  # the old photo's entry is gone
-    # a setting changed: every photo again
+    assert len(_entries(cache)) == 13  # the old photo's entry is kept (up to 2 per used one)
+    # a setting changed: every photo again; changed back: every photo read back (customer 33's
+    # set was measured again in full)
     settings = folder / "photoset.yaml"
-    settings.write_text(settings.read_text().replace("positive_turn: ccw", "positive_turn: cw"))
+    ccw = settings.read_text()
+    settings.write_text(ccw.replace("positive_turn: ccw", "positive_turn: cw"))
     turned = measure_photoset(folder, cache_dir=cache)
     assert turned.attrs["from_cache"] == 0
     assert turned.at[0, "psi_deg"] == pytest.approx(-reshot.at[0, "psi_deg"], abs=1e-9)
+    settings.write_text(ccw)
+    back = measure_photoset(folder, cache_dir=cache)
+    assert back.attrs["from_cache"] == 12
+    pd.testing.assert_frame_equal(reshot.drop(columns="seconds"), back.drop(columns="seconds"))
+
+
+def test_the_cache_keeps_the_least_recently_used_entries_up_to_twice_the_sets(tmp_path):
+    folder, cache = _sample(tmp_path / "set", 2), tmp_path / "cache"
+    settings = folder / "photoset.yaml"
+    text = settings.read_text()
+    assert "l0_mm: " in text
+    for l0 in (250, 251, 252, 253):  # four settings: the first one's 2 entries are one too many
+        settings.write_text(re.sub(r"l0_mm: .*", f"l0_mm: {l0}", text))
+        assert measure_photoset(folder, cache_dir=cache).attrs["from_cache"] == 0
+    assert len(_entries(cache)) == 6
+    for l0, cached in ((251, 2), (250, 0)):
+        settings.write_text(re.sub(r"l0_mm: .*", f"l0_mm: {l0}", text))
+        assert measure_photoset(folder, cache_dir=cache).attrs["from_cache"] == cached
 
 
 def test_measure_cut_off_by_ctrl_c_resumes_where_it_stopped(tmp_path, sigint_as_in_a_terminal):
