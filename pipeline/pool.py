@@ -4,18 +4,47 @@ Workers are started by a forkserver (never plain ``fork``: forking a process tha
 BLAS threads can deadlock), which preloads the light worker modules once so each worker starts
 fast; each worker runs OpenCV and BLAS on one thread (the pool is the parallelism; see
 :mod:`pipeline.worker_env`).  Results come back in
-task order; a progress bar is shown on an interactive terminal only.  On Ctrl-C the workers are
-stopped at once (:meth:`multiprocessing.pool.Pool.terminate`), never waited for.
+task order; a progress bar is shown on an interactive terminal, and elsewhere (a Snakemake job's
+log) a line of progress every :data:`PROGRESS_EVERY_S`.  On Ctrl-C the workers are stopped at
+once (:meth:`multiprocessing.pool.Pool.terminate`), never waited for.
 """
 
 from __future__ import annotations
 
 import multiprocessing
-from collections.abc import Callable, Sequence
-from typing import TypeVar
+import sys
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import TextIO, TypeVar
 
 T = TypeVar("T")
 R = TypeVar("R")
+
+#: without a terminal, a line of progress at most this often (s): a measure job's log stayed
+#: empty until it ended (customer 33), so a long one could not be watched
+PROGRESS_EVERY_S = 30.0
+
+
+def progress_lines(
+    results: Iterable[R], total: int, desc: str, every_s: float, out: TextIO
+) -> Iterator[R]:
+    """``results``, writing ``"<desc>: i of total done (s s)"`` to ``out`` at most every
+    ``every_s`` seconds (never for the last one: the caller's summary follows).
+
+    Examples
+    --------
+    >>> import io
+    >>> log = io.StringIO()
+    >>> list(progress_lines(range(3), 3, "photos", 0.0, log)), log.getvalue()
+    ([0, 1, 2], 'photos: 1 of 3 done (0 s)\\nphotos: 2 of 3 done (0 s)\\n')
+    """
+    start = last = time.monotonic()
+    for i, result in enumerate(results, 1):
+        now = time.monotonic()
+        if i < total and now - last >= every_s:
+            print(f"{desc}: {i} of {total} done ({now - start:.0f} s)", file=out, flush=True)
+            last = now
+        yield result
 
 
 def init_worker() -> None:
@@ -64,9 +93,14 @@ def map_photos(
     """
     from tqdm import tqdm
 
-    bar = {"total": len(tasks), "desc": desc, "unit": "photo", "disable": None, "leave": False}
+    def shown(results: Iterable[R]) -> Iterable[R]:
+        if sys.stderr.isatty():
+            bar = {"total": len(tasks), "desc": desc, "unit": "photo", "leave": False}
+            return tqdm(results, **bar)  # type: ignore[call-overload,no-any-return]
+        return progress_lines(results, len(tasks), desc, PROGRESS_EVERY_S, sys.stderr)
+
     if jobs <= 1 or len(tasks) <= 1:
-        return [func(t) for t in tqdm(tasks, **bar)]  # type: ignore[call-overload]
+        return list(shown(func(t) for t in tasks))
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
     if "forkserver" in methods:
@@ -74,7 +108,7 @@ def map_photos(
     chunk = max(1, len(tasks) // (4 * jobs))
     pool = ctx.Pool(processes=jobs, initializer=init_worker)
     try:
-        out = list(tqdm(pool.imap(func, tasks, chunksize=chunk), **bar))  # type: ignore[call-overload]
+        out = list(shown(pool.imap(func, tasks, chunksize=chunk)))
     except BaseException:
         # Ctrl-C (or any error): the workers are stopped, not waited for.  A process pool shut
         # down by waiting after a KeyboardInterrupt hung now and then with a worker still
