@@ -224,6 +224,21 @@ def test_board_not_found_is_refused_naming_the_file_and_the_board_size(
     )
 
 
+def test_a_pose_photo_without_the_board_may_be_left_out(calibrated, tmp_path: Path) -> None:
+    # one blurred pose photo stopped the calibration of a whole set; the fix names leaving it out
+    folder = _copy(calibrated[0], tmp_path / "set")
+    first = str(pd.read_csv(folder / "manifest.csv")["image"].iloc[0])
+    shutil.copy(folder / first, folder / "pose.jpg")  # a photo without a board
+    settings = _yaml(folder)
+    settings["calibration"]["board"] = ["board.jpg", "pose.jpg"]
+    write_settings(folder, settings)
+    text = "\n".join(map(str, validate_photoset(folder)))
+    assert "'pose.jpg'" in text and "leave pose.jpg out of board" in text, text
+    settings["calibration"]["board"] = ["board.jpg"]
+    write_settings(folder, settings)
+    assert not validate_photoset(folder)
+
+
 def test_wrong_inner_corner_count_is_refused(calibrated, tmp_path: Path) -> None:
     folder = _copy(calibrated[0], tmp_path / "set")
     settings = _yaml(folder)

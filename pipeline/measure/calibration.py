@@ -529,10 +529,18 @@ def describe_problem(cal: Calibration, exc: Exception) -> tuple[str, str]:
     """(message, fix) of a calibration that cannot be computed."""
     text = str(exc)
     if "no chessboard" in text:
+        # a pose photo other than the first (which gives the plane) may simply be left out
+        poses = [Path(b).name for b in cal.boards[1:]]
+        spare = next((n for n in poses if f"{n!r}" in text), None)
         return text, (
             "check inner_corners (count where four squares meet: a board of 10 x 7 squares has 9 x "
             "6) "
             "and that the whole board is in the photo, flat, sharp and evenly lit"
+            + (
+                f"; or leave {spare} out of board (a pose photo: the others still calibrate)"
+                if spare is not None
+                else ""
+            )
         )
     if "px but" in text:
         return text, "take every board photo with the camera and resolution of the actuator photos"
