@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import signal
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
+import pandas as pd
 import pytest
 
 REPO = Path(__file__).resolve().parent.parent
@@ -96,3 +98,33 @@ def soft_ss50() -> str:
         "geometry: {b_mm: 3.8, a0_mm: 6.4, t0_mm: 3.8, psi0_deg: 210.0, l0_mm: 240.0}\n"
         "materials:\n  SS50: {mu_mpa: [0.34], alpha: [2.0], k_p: 2.2, k_t: null}\n"
     )
+
+
+def write_ramp_set(
+    folder: Path, photos: Sequence[np.ndarray], settings: Sequence[str],
+    empty_scene: np.ndarray | None = None,
+) -> Path:
+    """A photo set of one ramp, up and back down, 20 kPa a step: ``photos`` as ``p00.png`` ...,
+    ``settings`` the lines of its ``photoset.yaml``, and its ``empty.png`` when given (named
+    there as ``background``)."""
+    folder.mkdir()
+    rows = []
+    top = len(photos) // 2
+    for i, photo in enumerate(photos):
+        name = f"p{i:02d}.png"
+        cv2.imwrite(str(folder / name), photo)
+        rows.append((name, 20 * min(i, 2 * top - i), "up" if i <= top else "down", "M", "A", 1, i))
+    columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
+    pd.DataFrame(rows, columns=columns).to_csv(folder / "manifest.csv", index=False)
+    lines = list(settings)
+    if empty_scene is not None:
+        cv2.imwrite(str(folder / "empty.png"), empty_scene)
+        lines.append("background: empty.png")
+    (folder / "photoset.yaml").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+@pytest.fixture(scope="session")
+def ramp_set_writer() -> Callable[..., Path]:
+    """:func:`write_ramp_set`, for tests that render a scene of their own."""
+    return write_ramp_set

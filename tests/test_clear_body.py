@@ -6,11 +6,8 @@ pipeline), with the clamp plate under ``exclude``."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import cv2
 import numpy as np
-import pandas as pd
 import pytest
 
 from pipeline.photoset_measure import measure_photoset
@@ -62,30 +59,17 @@ def clear_photo(psi_deg: float | None, *, seed: int, length: float = LENGTH_PX,
     return cv2.imdecode(cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 85])[1], 1)
 
 
-def _ramp_set(folder: Path, *, empty_scene: bool) -> Path:
-    folder.mkdir()
-    rows = []
-    for i, psi in enumerate(PSI):
-        name = f"p{i:02d}.png"
-        cv2.imwrite(str(folder / name), clear_photo(psi, seed=i))
-        top = len(PSI) // 2
-        rows.append((name, 20 * min(i, 2 * top - i), "up" if i <= top else "down", "M", "A", 1, i))
-    columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
-    pd.DataFrame(rows, columns=columns).to_csv(folder / "manifest.csv", index=False)
-    x0, y0, x1, y1 = PLATE
-    lines = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]",
-             "fixed_direction_deg: 0", "sealed_end_mm: 10", f"mm_per_px: {100 / LENGTH_PX}",
-             f"exclude: [[{x0 - 2}, {y0 - 2}, {x1}, {y1 + 2}]]"]
-    if empty_scene:
-        cv2.imwrite(str(folder / "empty.png"), clear_photo(None, seed=99))
-        lines.append("background: empty.png")
-    (folder / "photoset.yaml").write_text("\n".join(lines) + "\n")
-    return folder
-
-
 @pytest.mark.parametrize("empty_scene", [True, False], ids=["empty-scene", "backdrop-only"])
-def test_a_clear_body_is_measured_between_its_bright_edges(tmp_path, empty_scene):
-    angles = measure_photoset(_ramp_set(tmp_path / "clear", empty_scene=empty_scene))
+def test_a_clear_body_is_measured_between_its_bright_edges(tmp_path, ramp_set_writer, empty_scene):
+    x0, y0, x1, y1 = PLATE
+    settings = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]",
+                "fixed_direction_deg: 0", "sealed_end_mm: 10", f"mm_per_px: {100 / LENGTH_PX}",
+                f"exclude: [[{x0 - 2}, {y0 - 2}, {x1}, {y1 + 2}]]"]
+    folder = ramp_set_writer(
+        tmp_path / "clear", [clear_photo(psi, seed=i) for i, psi in enumerate(PSI)], settings,
+        clear_photo(None, seed=99) if empty_scene else None,
+    )
+    angles = measure_photoset(folder)
     angles = angles.assign(error_deg=(angles["psi_deg"] - np.array(PSI)).abs())
     ok = angles["status"] == "ok"
     shown = angles[["image", "psi_deg", "error_deg", "status", "reason"]]

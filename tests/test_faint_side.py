@@ -66,27 +66,14 @@ def faint_photo(psi_deg: float | None, *, seed: int, length: float = 380.0, widt
     return np.repeat(np.clip(img, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
 
 
-def _ramp_set(folder: Path, **settings: object) -> Path:
-    folder.mkdir()
-    rows = []
-    for i, psi in enumerate(PSI):
-        name = f"p{i:02d}.png"
-        cv2.imwrite(str(folder / name), faint_photo(psi, seed=i))
-        top = len(PSI) // 2
-        rows.append((name, 20 * min(i, 2 * top - i), "up" if i <= top else "down", "M", "A", 1, i))
-    cv2.imwrite(str(folder / "empty.png"), faint_photo(None, seed=99))
-    columns = ["image", "pressure_kpa", "direction", "material", "actuator", "trial", "step"]
-    pd.DataFrame(rows, columns=columns).to_csv(folder / "manifest.csv", index=False)
-    lines = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]",
-             "background: empty.png", *(f"{k}: {v}" for k, v in settings.items())]
-    (folder / "photoset.yaml").write_text("\n".join(lines) + "\n")
-    return folder
-
-
 @pytest.fixture(scope="module")
-def faint_sets(tmp_path_factory) -> tuple[Path, Path]:
+def faint_sets(tmp_path_factory, ramp_set_writer) -> tuple[Path, Path]:
     root = tmp_path_factory.mktemp("faint")
-    return _ramp_set(root / "own"), _ramp_set(root / "given", fixed_direction_deg=-90)
+    photos = [faint_photo(psi, seed=i) for i, psi in enumerate(PSI)]
+    settings = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]"]
+    empty = faint_photo(None, seed=99)
+    return (ramp_set_writer(root / "own", photos, settings, empty),
+            ramp_set_writer(root / "given", photos, [*settings, "fixed_direction_deg: -90"], empty))
 
 
 def _measured(folder: Path) -> pd.DataFrame:
