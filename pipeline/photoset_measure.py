@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from pipeline.camera_turn import RampPhotos, ramp_turns
 from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
@@ -50,6 +51,8 @@ from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cach
 #: ``base_direction_deg``: the direction a body's psi is measured from, see
 #: :func:`pipeline.ramp_check.share_base_direction`; ``base_side_split_deg``: how far a body's
 #: two sides diverge there (:func:`pipeline.measure.body.base_side_split_deg`);
+#: ``camera_turn_deg``: how far the camera turned since the ramp's first photo
+#: (:mod:`pipeline.camera_turn`, in the convention of ``base_direction_deg``);
 #: ``fixed_direction_deg``: the one given,
 #: which psi is then measured from (in the same convention); ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
@@ -63,6 +66,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "width_px",
     "base_direction_deg",
     "base_side_split_deg",
+    "camera_turn_deg",
     "fixed_direction_deg",
     "method",
     "residual_px",
@@ -332,7 +336,9 @@ def _measure_photos(
         rows = _on_ramp_backgrounds(ps, tasks, rows, jobs, cache_dir, used)
     if cache_dir is not None:
         prune(cache_dir, used)
+    turns = _camera_turns(ps, tasks, rows, jobs)
     result = pd.DataFrame(rows, index=manifest.index).drop(columns="centreline_px")
+    result["camera_turn_deg"] = turns
     result["degree"] = result["degree"].astype("Int64")
     result.insert(0, "image", manifest["image"].astype(str))
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
@@ -349,6 +355,47 @@ def _measure_photos(
     out.attrs["from_cache"] = sum(cached)
     out.attrs["cached_seconds"] = cached_s
     return out
+
+
+def _camera_turns(
+    ps: PhotoSet, tasks: list[Task], rows: list[dict[str, Any]], jobs: int
+) -> np.ndarray:
+    """Each body row's camera turn since its ramp's first photo (:func:`ramp_turns`, in the
+    convention of ``base_direction_deg``: clockwise with ``positive_turn: cw``); NaN for a drawn
+    line (its psi does not depend on the camera's turn) and where unknown."""
+    turns = np.full(len(rows), np.nan)
+    if not set(RAMP_KEYS) <= set(ps.manifest.columns):
+        return turns
+    order = ps.manifest["step"] if "step" in ps.manifest.columns else pd.Series(range(len(rows)))
+    ramps: dict[tuple[str, ...], list[int]] = {}
+    for i, settings in enumerate(ps.rows):
+        if settings is not None and settings.target == "body" and Path(tasks[i].path).is_file():
+            key = tuple(str(ps.manifest[k].iloc[i]) for k in RAMP_KEYS)
+            ramps.setdefault(key, []).append(i)
+    groups = [
+        sorted(m, key=lambda i: (pd.to_numeric(order.iloc[i], errors="coerce"), i))
+        for m in ramps.values()
+        if len(m) >= 2
+    ]
+    photos = []
+    for members in groups:
+        found = [rows[i]["status"] != "failed" for i in members]
+        photos.append(RampPhotos(
+            tuple(tasks[i].path for i in members),
+            tuple(rows[i]["centreline_px"] if f else None
+                  for i, f in zip(members, found, strict=True)),
+            tuple(float(rows[i]["width_px"]) if f else float("nan")
+                  for i, f in zip(members, found, strict=True)),
+        ))
+    for members, got in zip(
+        groups, map_photos(ramp_turns, photos, jobs=jobs, preload=["pipeline.camera_turn"],
+                           desc="ramps"), strict=True
+    ):
+        for i, turn in zip(members, got, strict=True):
+            settings = ps.rows[i]
+            assert settings is not None
+            turns[i] = settings.sign * turn
+    return turns
 
 
 def second_look_ramps(ps: PhotoSet) -> list[list[int]]:

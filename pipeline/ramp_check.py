@@ -442,7 +442,10 @@ def share_base_direction(
     order = [c for c in ("step", "time_s") if c in out.columns]  # as the photos were taken
     for _, whole in out.groupby(list(keys), sort=False):
         ramp = whole.sort_values(order, kind="stable") if order else whole
-        own_all = ramp["base_direction_deg"].to_numpy(float)
+        # each body's own base as the ramp's first photo sees it: a camera held by hand turned
+        # between photos (customer 34: psi off by each photo's turn, 14 rows ok 5-7 deg off)
+        turn = _camera_turn(out, ramp)
+        own_all = ramp["base_direction_deg"].to_numpy(float) - turn
         given = pd.to_numeric(
             ramp.get("fixed_direction_deg", pd.Series(np.nan, index=ramp.index)), errors="coerce"
         ).to_numpy(float)
@@ -450,6 +453,7 @@ def share_base_direction(
         if np.isfinite(given).any():  # psi is measured from the direction given: compared only
             # with the bodies' sides diverging, their own is the doubtful one (customer 31: 8.4
             # deg off the true direction given), unless it is too far off for that
+            _turn_given(out, ramp, turn, given)
             _compare_given(out, ramp, own_all, given, excused_deg=SIDES_EXCUSE_DEG * uncertain)
             continue
         used = (ramp["status"] != "failed").to_numpy() & np.isfinite(own_all)
@@ -458,7 +462,8 @@ def share_base_direction(
         runs = base_runs(own_all[used])
         first = float(np.median(own_all[used][runs[0]]))
         for number, run in enumerate(runs):
-            _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None)
+            _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None,
+                       turn=turn[used][run])
     return out
 
 
@@ -585,14 +590,74 @@ def _compare_given(
         out.loc[rows[(ramp["status"] == "ok").to_numpy()], "status"] = "flagged"
 
 
-def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None) -> None:
+def _camera_turn(out: pd.DataFrame, ramp: pd.DataFrame) -> np.ndarray:
+    """Each row's ``camera_turn_deg`` (:mod:`pipeline.camera_turn`), 0 where unknown; where
+    the camera turned between the ramp's photos, a row whose turn is unknown is flagged (in
+    place in ``out``): its psi may be off by as much.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"camera_turn_deg": [0.0, 2.5, np.nan], "reason": "", "status": "ok"})
+    >>> _camera_turn(df, df).tolist(), df["status"].tolist()
+    ([0.0, 2.5, 0.0], ['ok', 'ok', 'flagged'])
+    """
+    turn = pd.to_numeric(
+        ramp.get("camera_turn_deg", pd.Series(0.0, index=ramp.index)), errors="coerce"
+    ).to_numpy(float)
+    known = np.isfinite(turn)
+    unknown = ~known & (ramp["status"] != "failed").to_numpy()
+    if unknown.any() and (np.abs(turn[known]) > 0).any():
+        rows = ramp.index[unknown]
+        most = float(np.max(np.abs(turn[known])))
+        out.loc[rows, "status"] = "flagged"
+        out.loc[rows, "reason"] = [
+            _join(r, f"the camera turned between this ramp's photos (up to {most:.1f} deg) and "
+                     "this photo could not be lined up with its first: psi may be off by as much "
+                     "(a camera on a stand keeps every photo lined up)")
+            for r in out.loc[rows, "reason"].fillna("").astype(str)
+        ]
+    return np.where(known, turn, 0.0)
+
+
+def _turn_given(out: pd.DataFrame, ramp: pd.DataFrame, turn: np.ndarray, given: np.ndarray) -> None:
+    """psi of the rows of ``ramp`` (in place in ``out``) measured from the
+    ``fixed_direction_deg`` given as turned with the camera since the ramp's first photo: the
+    body leaves the clamp that much further round in a turned photo.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"psi_deg": [100.0, 120.0], "reason": ["", ""], "status": "ok"})
+    >>> _turn_given(df, df, np.array([0.0, 2.5]), np.array([0.0, 0.0]))
+    >>> df["psi_deg"].tolist(), df["reason"].iloc[1][:60]
+    ([100.0, 117.5], 'psi measured from fixed_direction_deg turned by +2.5 deg, as')
+    """
+    moved = (np.abs(turn) > 0) & np.isfinite(given) & (ramp["status"] != "failed").to_numpy()
+    rows = ramp.index[moved]
+    if not len(rows):
+        return
+    psi = out.loc[rows, "psi_deg"].to_numpy(float) - turn[moved]
+    out.loc[rows, "psi_deg"] = psi
+    if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
+        out.loc[rows, "kappa_per_mm"] = np.deg2rad(psi) / out.loc[rows, "l0_mm"].to_numpy(float)
+    out.loc[rows, "reason"] = [
+        _join(r, f"psi measured from fixed_direction_deg turned by {t:+.1f} deg, as the camera "
+                 "turned since the ramp's first photo")
+        for r, t in zip(out.loc[rows, "reason"].fillna("").astype(str), turn[moved], strict=True)
+    ]
+
+
+def _share_run(
+    out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None, turn: np.ndarray
+) -> None:
     """Measure the bodies of one run of a ramp (one setting of camera and clamp) from their
     shared base direction, in place in ``out``.
 
     ``first_base_deg``: the base direction of the ramp's first run, when this run comes after the
-    setup moved (every photo of it says so).
+    setup moved (every photo of it says so).  ``turn``: each photo's camera turn since the
+    ramp's first photo (:mod:`pipeline.camera_turn`): the shared direction is that much further
+    round in it.
     """
-    own = run["base_direction_deg"].to_numpy(float)
+    own = run["base_direction_deg"].to_numpy(float) - turn
     rows, n = run.index, len(own)
     shared = float(own[0] + np.median(_wrap_deg(own - own[0])))
     moved = _wrap_deg(own - shared)
@@ -613,7 +678,7 @@ def _share_run(out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | Non
     off = np.abs(moved) > BASE_MISMATCH_DEG
     if np.isfinite(shared):
         out.loc[rows, "psi_deg"] = psi
-        out.loc[rows, "base_direction_deg"] = shared
+        out.loc[rows, "base_direction_deg"] = shared + turn
         if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
             out.loc[rows, "kappa_per_mm"] = np.deg2rad(psi) / out.loc[rows, "l0_mm"].to_numpy(float)
         out.loc[rows[off], "status"] = "flagged"

@@ -333,7 +333,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:18]) == [
+    assert list(par.columns[:19]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
@@ -342,6 +342,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "width_px",
         "base_direction_deg",
         "base_side_split_deg",
+        "camera_turn_deg",
         "fixed_direction_deg",
         "method",
         "residual_px",
@@ -355,8 +356,9 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     ]
     assert par["base_direction_deg"].isna().all()  # drawn lines: no body base to share
     assert par["base_side_split_deg"].isna().all()
+    assert par["camera_turn_deg"].isna().all()  # a drawn line's psi does not depend on it
     assert par["fixed_direction_deg"].isna().all()
-    assert list(par.columns[18:24]) == [
+    assert list(par.columns[19:25]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -401,7 +403,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "method turning ->" in run.stdout  # what was asked is what every row took
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[13:19]) == [
+    assert list(angles.columns[14:20]) == [
         "seconds",
         "degree",
         "l0_mm",
