@@ -28,18 +28,28 @@ import cv2
 import numpy as np
 
 from pipeline.measure.core import decode_for_work
+from pipeline.measure.extract import region_mask
+from pipeline.measure.settings import Polygon
 
 #: photos are registered at about this width (px): a turn of 0.05 deg moves their corners by
 #: a fifth of a pixel
 REGISTER_WIDTH_PX = 640
-#: a ramp whose photos all turned less than this (deg) stood still (a tripod): nothing changes
-TURN_MIN_DEG = 0.3
+#: a ramp fewer of whose photos than MIN_TURNED_SHARE turned by this (deg) stood still (a
+#: tripod): nothing changes.  A phone held by hand turns by 1-3 deg; a still camera's photos
+#: read up to 0.7 where a tube swayed with the pressure (the review)
+TURN_MIN_DEG = 1.0
 #: a registration whose correlation is below this did not find the scene again: no turn is taken
 MIN_CORRELATION = 0.8
 #: each body is left out of the registration over this many of its widths (its shadow beside it)
 BODY_MARGIN_WIDTHS = 2.0
-#: a photo of which less than this share is left (the two bodies cover the rest) is not registered
+#: a ramp whose bodies (and exclude) leave less than this share of the photo is not registered
 MIN_SCENE_SHARE = 0.1
+#: the bodies are left out over this share of the photo's width more (the camera moved them)
+MOTION_MARGIN = 0.02
+#: an exclude region this near the fixed end (a share of the diagonal) covers the clamp
+CLAMP_REACH = 0.05
+#: the camera turned when at least this share of a ramp's photos (and two) turned
+MIN_TURNED_SHARE = 0.25
 #: ECC stops after this many iterations or once a step changes the warp by less than this
 ECC_ITERATIONS, ECC_EPS = 50, 1e-4
 #: ... first on the photos reduced by this factor
@@ -92,56 +102,112 @@ def _reduced(path: str) -> tuple[np.ndarray | None, int]:
 
 @dataclass(frozen=True)
 class RampPhotos:
-    """The photos of one ramp in the order taken, and each one's measured body in its own
-    pixels (a None centre line or a NaN width where none was found)."""
+    """The photos of one ramp in the order taken, each one's measured body in its own pixels (a
+    None centre line or a NaN width where none was found), and the set's ``exclude`` regions and
+    ``fixed_end`` (original pixels)."""
 
     paths: tuple[str, ...]
     centrelines_px: tuple[np.ndarray | None, ...]
     widths_px: tuple[float, ...]
+    exclude: tuple[Polygon, ...] = ()
+    fixed_end_px: tuple[float, float] | None = None
+
+
+def _loose_parts(
+    ramp: RampPhotos, shape: tuple[int, ...], factor: int, small: tuple[int, int]
+) -> np.ndarray:
+    """The ``exclude`` regions that reach no nearer the fixed end than :data:`CLAMP_REACH` of the
+    photo's diagonal, 0/1 at ``small``: a supply tube, which sways with the pressure (swaying
+    10-20 px at a still camera's edge it read turns of 0.3-1.4 deg), or a ruler; a region over
+    the clamp stays in, the steadiest part of the scene (without it a plate's mottled backdrop
+    could not be lined up)."""
+    loose = np.zeros((small[1], small[0]), np.uint8)
+    for polygon in ramp.exclude:
+        inside = region_mask(shape, None, (polygon,), float(factor))
+        assert inside is not None
+        part = (1 - inside).astype(np.uint8)
+        if ramp.fixed_end_px is not None:
+            fx, fy = ((v - (factor - 1) / 2) / factor for v in ramp.fixed_end_px)
+            x = int(np.clip(round(fx), 0, shape[1] - 1))
+            y = int(np.clip(round(fy), 0, shape[0] - 1))
+            gap = float(cv2.distanceTransform(1 - part, cv2.DIST_L2, 3)[y, x])
+            if gap <= CLAMP_REACH * float(np.hypot(shape[0], shape[1])):
+                continue
+        loose = np.maximum(loose, cv2.resize(part, small, interpolation=cv2.INTER_NEAREST))
+    return loose
 
 
 def ramp_turns(ramp: RampPhotos) -> np.ndarray:
-    """Each photo's scene turn against the first (deg, counter-clockwise on screen; 0 for the
-    first; NaN where unknown), all 0 when none reaches :data:`TURN_MIN_DEG`.  Each photo's body
-    and the first photo's are left out of the registration.  Each photo is first registered
-    roughly (:func:`scene_turn_deg` without ``fine``); only when one of them turned by half of
-    :data:`TURN_MIN_DEG` or more are they all registered in full (on rendered still ramps the
-    full registration took a quarter of the measurement's time)."""
-    paths, centrelines_px, widths_px = ramp.paths, ramp.centrelines_px, ramp.widths_px
-    first, first_factor = _reduced(paths[0])
-    turns = np.full(len(paths), np.nan)
-    if first is None:
+    """Each photo's scene turn against the ramp's first photo with a body found (deg,
+    counter-clockwise on screen; NaN where unknown), all 0 unless the camera turned.
+
+    What is lined up is the scene without any of the ramp's bodies (each over
+    :data:`BODY_MARGIN_WIDTHS` of its width, and :data:`MOTION_MARGIN` of the photo's width
+    more, as the camera moves: with only the two photos' bodies left out, a body's shadow read
+    a still camera's turn as 0.7 deg) and without the ``exclude`` regions away from the fixed
+    end (:func:`_loose_parts`).  Each photo is registered roughly first
+    (:func:`scene_turn_deg` without ``fine``); only when at least :data:`MIN_TURNED_SHARE` of
+    them (and two) turned by half of :data:`TURN_MIN_DEG` are they registered in full, and the
+    turns are kept only when as many reach :data:`TURN_MIN_DEG`: a tube that sways with the
+    pressure reads a still camera's turn up to 0.7 deg (on rendered still ramps the full
+    registration took a quarter of the measurement's time).
+    """
+    n = len(ramp.paths)
+    turns = np.full(n, np.nan)
+    found = [
+        c is not None and np.isfinite(w) for c, w in zip(ramp.centrelines_px, ramp.widths_px,
+                                                         strict=True)
+    ]
+    images: list[np.ndarray | None] = []
+    bodies: list[np.ndarray | None] = []
+    small: tuple[int, int] | None = None
+    shape: tuple[int, ...] | None = None
+    for i, path in enumerate(ramp.paths):
+        img, factor = _reduced(path)
+        if img is None or (shape is not None and img.shape != shape) or (
+            shape is None and not found[i]
+        ):
+            images.append(None)
+            bodies.append(None)
+            continue
+        if shape is None:
+            shape = img.shape
+            scale = min(1.0, REGISTER_WIDTH_PX / img.shape[1])
+            small = (round(img.shape[1] * scale), round(img.shape[0] * scale))
+        assert small is not None
+        images.append(cv2.resize(img, small, interpolation=cv2.INTER_AREA))
+        body = None
+        if found[i]:
+            line = (np.asarray(ramp.centrelines_px[i], float).reshape(-1, 2) - (factor - 1) / 2)
+            mask = np.zeros(img.shape[:2], np.uint8)
+            thick = max(3, round(BODY_MARGIN_WIDTHS * float(ramp.widths_px[i]) / factor))
+            cv2.polylines(mask, [np.round(line / factor).astype(np.int32)], False, 1,
+                          thickness=thick)
+            body = cv2.resize(mask, small, interpolation=cv2.INTER_NEAREST)
+            body = np.maximum(body, _loose_parts(ramp, img.shape, factor, small))
+        bodies.append(body)
+    reference = next((i for i in range(n) if images[i] is not None and found[i]), None)
+    if reference is None or small is None:
         return turns
-    turns[0] = 0.0
-
-    def body(i: int, factor: int, shape: tuple[int, ...]) -> np.ndarray:
-        size = (shape[0], shape[1])
-        line = centrelines_px[i]
-        if line is None or not np.isfinite(widths_px[i]):
-            return np.ones(size, bool)  # unknown: the whole photo may be the body
-        line = (np.asarray(line, float).reshape(-1, 2) - (factor - 1) / 2) / factor
-        mask = np.zeros(size, np.uint8)
-        thick = max(3, round(BODY_MARGIN_WIDTHS * float(widths_px[i]) / factor))
-        cv2.polylines(mask, [np.round(line).astype(np.int32)], False, 1, thickness=thick)
-        return mask > 0
-
-    scale = min(1.0, REGISTER_WIDTH_PX / first.shape[1])
-    small = (round(first.shape[1] * scale), round(first.shape[0] * scale))
-    ref = cv2.resize(first, small, interpolation=cv2.INTER_AREA)
-    ref_body = cv2.resize(body(0, first_factor, first.shape).astype(np.uint8), small)
-    for fine in (False, True):
-        for i in range(1, len(paths)):
-            img, factor = _reduced(paths[i])
-            if img is None or img.shape != first.shape:
-                continue
-            mine = cv2.resize(body(i, factor, img.shape).astype(np.uint8), small)
-            keep = ((ref_body == 0) & (mine == 0)).astype(np.uint8)
-            if keep.mean() < MIN_SCENE_SHARE:
-                continue
-            photo = cv2.resize(img, small, interpolation=cv2.INTER_AREA)
+    union: np.ndarray = np.zeros((small[1], small[0]), np.uint8)
+    for body in bodies:
+        if body is not None:
+            union = np.maximum(union, body)
+    margin = max(3, round(MOTION_MARGIN * small[0])) | 1
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (margin, margin))
+    keep = (1 - cv2.dilate(union, disc)).astype(np.uint8)
+    if keep.mean() < MIN_SCENE_SHARE:
+        return turns
+    ref = images[reference]
+    assert ref is not None
+    turns[reference] = 0.0
+    others = [i for i in range(n) if i != reference and images[i] is not None]
+    least = max(2, MIN_TURNED_SHARE * len(others))
+    for fine, threshold in ((False, TURN_MIN_DEG / 2), (True, TURN_MIN_DEG)):
+        for i in others:
+            photo = images[i]
+            assert photo is not None
             turns[i] = scene_turn_deg(ref, photo, keep, fine=fine)
-        if not fine and not (np.abs(turns[np.isfinite(turns)]) >= TURN_MIN_DEG / 2).any():
-            return np.where(np.isfinite(turns), 0.0, np.nan)  # a camera that stood still
-    if not (np.abs(turns[np.isfinite(turns)]) >= TURN_MIN_DEG).any():
-        return np.where(np.isfinite(turns), 0.0, np.nan)
+        if (np.abs(turns[others]) >= threshold).sum() < least:  # a camera that stood still
+            return np.where(np.isfinite(turns), 0.0, np.nan)
     return turns

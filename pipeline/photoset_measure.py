@@ -386,6 +386,8 @@ def _camera_turns(
                   for i, f in zip(members, found, strict=True)),
             tuple(float(rows[i]["width_px"]) if f else float("nan")
                   for i, f in zip(members, found, strict=True)),
+            first.exclude if (first := ps.rows[members[0]]) is not None else (),
+            first.fixed_end_px if first is not None else None,
         ))
     for members, got in zip(
         groups, map_photos(ramp_turns, photos, jobs=jobs, preload=["pipeline.camera_turn"],

@@ -622,14 +622,15 @@ def _camera_turn(out: pd.DataFrame, ramp: pd.DataFrame) -> np.ndarray:
 def _turn_given(out: pd.DataFrame, ramp: pd.DataFrame, turn: np.ndarray, given: np.ndarray) -> None:
     """psi of the rows of ``ramp`` (in place in ``out``) measured from the
     ``fixed_direction_deg`` given as turned with the camera since the ramp's first photo: the
-    body leaves the clamp that much further round in a turned photo.
+    body leaves the clamp that much further round in a turned photo (``camera_turn_deg`` says
+    by how much: a note in the reason kept flagged rows from being trusted again, `_check_leg`).
 
     Examples
     --------
     >>> df = pd.DataFrame({"psi_deg": [100.0, 120.0], "reason": ["", ""], "status": "ok"})
     >>> _turn_given(df, df, np.array([0.0, 2.5]), np.array([0.0, 0.0]))
-    >>> df["psi_deg"].tolist(), df["reason"].iloc[1][:60]
-    ([100.0, 117.5], 'psi measured from fixed_direction_deg turned by +2.5 deg, as')
+    >>> df["psi_deg"].tolist(), df["reason"].tolist()
+    ([100.0, 117.5], ['', ''])
     """
     moved = (np.abs(turn) > 0) & np.isfinite(given) & (ramp["status"] != "failed").to_numpy()
     rows = ramp.index[moved]
@@ -639,11 +640,6 @@ def _turn_given(out: pd.DataFrame, ramp: pd.DataFrame, turn: np.ndarray, given: 
     out.loc[rows, "psi_deg"] = psi
     if {"kappa_per_mm", "l0_mm"} <= set(out.columns):
         out.loc[rows, "kappa_per_mm"] = np.deg2rad(psi) / out.loc[rows, "l0_mm"].to_numpy(float)
-    out.loc[rows, "reason"] = [
-        _join(r, f"psi measured from fixed_direction_deg turned by {t:+.1f} deg, as the camera "
-                 "turned since the ramp's first photo")
-        for r, t in zip(out.loc[rows, "reason"].fillna("").astype(str), turn[moved], strict=True)
-    ]
 
 
 def _share_run(
