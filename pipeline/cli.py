@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import signal
 import sys
 import threading
@@ -132,6 +133,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except UserInputError as exc:  # bad input: one clear message, no traceback
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # output piped into a reader that stopped (`| head`): no traceback
+        # (customer 34); what is left to print goes nowhere, as Python's own docs advise
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141  # as a shell reports a command stopped by SIGPIPE
     except KeyboardInterrupt:
         print(f"{command}: interrupted", file=sys.stderr)
         return 130

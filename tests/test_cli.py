@@ -196,3 +196,18 @@ def test_photoset_init_writes_a_free_end_and_exclude_boxes(photo_folder):
     (photo_folder / "manifest.csv").unlink()
     out = _run(*args[:-2], "--exclude", "0,0,40")
     assert out.returncode != 0 and "--exclude '0,0,40': write a box's two corners" in out.stderr
+
+
+def test_output_piped_into_a_reader_that_stopped_ends_without_a_traceback(photo_folder):
+    # customer 34: `photoset init ... | head` ended in a BrokenPipeError traceback
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pipeline", "photoset", "init", str(photo_folder), "--pattern",
+         "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.close()  # the reader stops before anything is printed
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err
+    assert "Traceback" not in err and "BrokenPipeError" not in err, err
+    assert (photo_folder / "manifest.csv").is_file()  # the work was done
