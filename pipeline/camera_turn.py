@@ -6,9 +6,9 @@ ramp check measures every body of a ramp from the ramp's one base direction
 direction for every photo.  Both hold on screen only while the camera stands still.  Turned by a
 hand by up to 3 deg between photos, every psi was off by its photo's turn (customer 34: 14 rows
 ``ok`` 5-7 deg off).  Each photo is registered to its ramp's first photo (OpenCV's ECC, a
-rotation and a shift, on a reduced grey copy, the bodies of both left out), and the turn is the
-rotation of the scene on screen: a direction of the first photo is that much further
-counter-clockwise in this one.
+rotation and a shift, on a reduced grey copy, every body of the ramp and the ``exclude`` regions
+away from the clamp left out: :func:`ramp_turns`), and the turn is the rotation of the scene on
+screen: a direction of the first photo is that much further counter-clockwise in this one.
 
 Examples
 --------
@@ -149,7 +149,7 @@ def ramp_turns(ramp: RampPhotos) -> np.ndarray:
     (:func:`scene_turn_deg` without ``fine``); only when at least :data:`MIN_TURNED_SHARE` of
     them (and two) turned by half of :data:`TURN_MIN_DEG` are they registered in full, and the
     turns are kept only when as many reach :data:`TURN_MIN_DEG`: a tube that sways with the
-    pressure reads a still camera's turn up to 0.7 deg (on rendered still ramps the full
+    pressure read a still camera's turn as 0.3-1.4 deg (on rendered still ramps the full
     registration took a quarter of the measurement's time).
     """
     n = len(ramp.paths)
@@ -162,6 +162,7 @@ def ramp_turns(ramp: RampPhotos) -> np.ndarray:
     bodies: list[np.ndarray | None] = []
     small: tuple[int, int] | None = None
     shape: tuple[int, ...] | None = None
+    shape_factor = 1
     for i, path in enumerate(ramp.paths):
         img, factor = _reduced(path)
         if img is None or (shape is not None and img.shape != shape) or (
@@ -171,7 +172,7 @@ def ramp_turns(ramp: RampPhotos) -> np.ndarray:
             bodies.append(None)
             continue
         if shape is None:
-            shape = img.shape
+            shape, shape_factor = img.shape, factor
             scale = min(1.0, REGISTER_WIDTH_PX / img.shape[1])
             small = (round(img.shape[1] * scale), round(img.shape[0] * scale))
         assert small is not None
@@ -184,12 +185,12 @@ def ramp_turns(ramp: RampPhotos) -> np.ndarray:
             cv2.polylines(mask, [np.round(line / factor).astype(np.int32)], False, 1,
                           thickness=thick)
             body = cv2.resize(mask, small, interpolation=cv2.INTER_NEAREST)
-            body = np.maximum(body, _loose_parts(ramp, img.shape, factor, small))
         bodies.append(body)
     reference = next((i for i in range(n) if images[i] is not None and found[i]), None)
     if reference is None or small is None:
         return turns
-    union: np.ndarray = np.zeros((small[1], small[0]), np.uint8)
+    assert shape is not None
+    union = _loose_parts(ramp, shape, shape_factor, small)  # the same in every photo of a size
     for body in bodies:
         if body is not None:
             union = np.maximum(union, body)
