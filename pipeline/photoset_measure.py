@@ -54,7 +54,8 @@ from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cach
 #: ``camera_turn_deg``: how far the camera turned since the ramp's first photo
 #: (:mod:`pipeline.camera_turn`, in the convention of ``base_direction_deg``);
 #: ``fixed_direction_deg``: the one given,
-#: which psi is then measured from (in the same convention); ``l0_mm``: the
+#: which psi is then measured from (in the same convention); ``positive_turn``: that convention,
+#: psi's (``cw``: the three directions clockwise from +x); ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
 RESULT_COLUMNS: tuple[str, ...] = (
@@ -68,6 +69,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "base_side_split_deg",
     "camera_turn_deg",
     "fixed_direction_deg",
+    "positive_turn",
     "method",
     "residual_px",
     "status",
@@ -343,6 +345,7 @@ def _measure_photos(
     result.insert(0, "image", manifest["image"].astype(str))
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
     result["fixed_direction_deg"] = [np.nan if r is None else r.base_given_deg for r in ps.rows]
+    result["positive_turn"] = [None if r is None else r.positive_turn for r in ps.rows]
     rms = [(np.nan, np.nan) if r is None else r.calibration_rms for r in ps.rows]
     result["calibration_px"] = [px for px, _ in rms]
     result["calibration_mm"] = [mm for _, mm in rms]

@@ -384,6 +384,22 @@ def _unit(rows: pd.DataFrame) -> str:
     return "frames" if "frame" in rows.columns and rows["frame"].notna().any() else "photos"
 
 
+def _screen_sign(rows: pd.DataFrame) -> float:
+    """-1 where the rows count a clockwise turning positive (``positive_turn: cw``), else +1: a
+    direction in psi's convention (``base_direction_deg``) times it is the one on screen, as a
+    user gives ``fixed_direction_deg`` (with cw the ramp named -49 "+49.0" and its fix, the
+    bodies' own, with the wrong sign).
+
+    Examples
+    --------
+    >>> _screen_sign(pd.DataFrame({"positive_turn": ["cw"]})), _screen_sign(pd.DataFrame())
+    (-1.0, 1.0)
+    """
+    if "positive_turn" not in rows.columns or rows.empty:
+        return 1.0
+    return -1.0 if str(rows["positive_turn"].iloc[0]) == "cw" else 1.0
+
+
 def _wrap_deg(angle: np.ndarray) -> np.ndarray:
     """Angles (deg) brought into [-180, 180)."""
     return (np.asarray(angle, float) + 180.0) % 360.0 - 180.0
@@ -556,10 +572,11 @@ def _compare_given(
     spread = float(np.median(np.abs(off - median)))
     if abs(median) <= max(GIVEN_OFF_DEG, excused_deg) or spread > BASE_SPREAD_DEG:
         return
-    stated = float(np.median(given[ok]))
+    screen = _screen_sign(ramp)
+    stated = screen * float(np.median(given[ok]))
     # on screen, within -180..180 (a direction given as 90 for one hanging down at -97 read
     # "+262.6")
-    leaves = float(_wrap_deg(np.array([stated + median]))[0])
+    leaves = float(_wrap_deg(np.array([stated + screen * median]))[0])
     seen = f"{leaves:+.1f} deg (the median of {int(ok.sum())} {_unit(ramp)})"
     fix = (
         "if the actuator sits turned in its clamp, give this ramp's rows their own "
@@ -576,7 +593,7 @@ def _compare_given(
         f"psi may be {abs(median):.{d}f} deg off: it is measured from the fixed_direction_deg "
         f"given ({stated:+.1f}), but the bodies of this ramp leave the clamp at {seen}, so {fix}"
         if abs(median) > GIVEN_FLAG_DEG
-        else f"{NOTE_GIVEN_OFF} {seen}, {median:+.{d}f} deg off the "
+        else f"{NOTE_GIVEN_OFF} {seen}, {screen * median:+.{d}f} deg off the "
         f"fixed_direction_deg given ({stated:+.1f}), which psi is measured from (the bodies' "
         "own reading may be a few deg off where the base is faint: photoset preview draws the "
         "one given along the base; if it lies off the base, give the ramp's own in "
@@ -662,10 +679,12 @@ def _share_run(
         # too few to share, or they scatter (free strips, a clamp that let go): each its own
         shared, moved = float("nan"), np.zeros(n)
     reasons = out.loc[rows, "reason"].fillna("").astype(str).to_numpy()
+    screen = _screen_sign(run)  # the notes' directions as on screen
     setup = (
         ""
         if first_base_deg is None
-        else f"the base direction is {_wrap_deg(np.array(run_base - first_base_deg)):+.0f} deg off "
+        else f"the base direction is {screen * _wrap_deg(np.array(run_base - first_base_deg)):+.0f}"
+        " deg off "
         "the ramp's first photos from here on (the camera or the clamp moved?): psi is measured "
         "from these photos' own"
     )
@@ -683,12 +702,12 @@ def _share_run(
             before,
             setup,
             # the photo's overlay shows the psi of its own base
-            f"psi {p:+.1f} deg against its ramp's base direction ({shared:+.1f} deg, the "
-            f"median of {n} {_unit(run)}; {o:+.1f} from its own, {b:+.1f})"
+            f"psi {p:+.1f} deg against its ramp's base direction ({screen * shared:+.1f} deg, "
+            f"the median of {n} {_unit(run)}; {o:+.1f} from its own, {screen * b:+.1f})"
             if abs(m) >= BASE_NOTE_DEG
             else "",
-            f"the body leaves the fixed end {m:+.0f} deg off its ramp's direction: a hook at "
-            "the clamp, or fixed_end is off; check with photoset preview"
+            f"the body leaves the fixed end {screen * m:+.0f} deg off its ramp's direction: a "
+            "hook at the clamp, or fixed_end is off; check with photoset preview"
             if abs(m) > BASE_MISMATCH_DEG
             else "",
         )

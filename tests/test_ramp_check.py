@@ -191,6 +191,24 @@ def test_a_direction_given_with_y_down_is_answered_with_the_bodies_own_on_screen
     assert not out["reason"].str.contains("262").any()
 
 
+def test_with_clockwise_positive_the_directions_named_are_the_ones_on_screen():
+    # positive_turn: cw, fixed_direction_deg -49 given: the table holds the directions in psi's
+    # convention (+49, the bodies' own +43.9); the ramp named the one given "+49.0" and, as its
+    # fix, "+43.9" for bodies leaving at -43.9 on screen
+    psi = _ds20_like()
+    base = 43.9 + 0.3 * np.sin(np.arange(12.0))
+    out = check_ramps(_bodies(psi, base, fixed_direction_deg=49.0).assign(positive_turn="cw"))
+    assert (out["status"] == "flagged").all()
+    assert out["reason"].str.contains(r"given \(-49\.0\), but the bodies of this ramp leave the "
+                                      r"clamp at -43\.\d deg").all(), out["reason"].iloc[0]
+    assert out["reason"].str.contains(r"manifest\.csv \(-43\.\d\)").all()
+    # shared without a direction given: the ramp's base direction named on screen too
+    base = np.r_[np.full(11, 43.9), 46.0]
+    shared = check_ramps(_bodies(psi, base).assign(positive_turn="cw"))
+    assert "base direction (-43.9 deg" in shared["reason"].iloc[11], shared["reason"].iloc[11]
+    assert "from its own, -46.0" in shared["reason"].iloc[11]
+
+
 def test_a_ramp_whose_bodies_leave_the_clamp_far_off_the_direction_given_is_flagged():
     # a customer gave one direction for two trials; the second was remounted 4 deg turned and
     # its bodies leave 5.1 deg off it (their own read 1.5 deg off the truth): every psi 5-8 deg

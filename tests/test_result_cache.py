@@ -77,6 +77,7 @@ def test_an_unchanged_photo_is_read_back_and_a_changed_one_measured_again(tmp_pa
     turned = measure_photoset(folder, cache_dir=cache)
     assert turned.attrs["from_cache"] == 0
     assert turned.at[0, "psi_deg"] == pytest.approx(-reshot.at[0, "psi_deg"], abs=1e-9)
+    assert set(turned["positive_turn"]) == {"cw"} and set(reshot["positive_turn"]) == {"ccw"}
     settings.write_text(ccw)
     back = measure_photoset(folder, cache_dir=cache)
     assert back.attrs["from_cache"] == 12
