@@ -333,7 +333,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:19]) == [
+    assert list(par.columns[:20]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
@@ -344,6 +344,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "base_side_split_deg",
         "camera_turn_deg",
         "fixed_direction_deg",
+        "positive_turn",
         "method",
         "residual_px",
         "status",
@@ -358,7 +359,8 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     assert par["base_side_split_deg"].isna().all()
     assert par["camera_turn_deg"].isna().all()  # a drawn line's psi does not depend on it
     assert par["fixed_direction_deg"].isna().all()
-    assert list(par.columns[19:25]) == [
+    assert (par["positive_turn"] == "ccw").all()
+    assert list(par.columns[20:26]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -403,7 +405,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "method turning ->" in run.stdout  # what was asked is what every row took
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[14:20]) == [
+    assert list(angles.columns[15:21]) == [
         "seconds",
         "degree",
         "l0_mm",
