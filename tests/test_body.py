@@ -132,6 +132,9 @@ def test_fixed_direction_gives_psi_against_the_known_clamp_direction():
     # a clamp direction that disagrees with the photo by 30 deg is used, and said to be doubtful
     off = measure_image(img, settings_for(fe, fixed_direction_deg=30.0))
     assert off.status == "flagged" and "off fixed_direction_deg" in off.reason
+    # the body's own against the one given: it leaves 30 deg below it (customer 35 read the sign
+    # reversed, "-24 deg off" for a body leaving 24 deg above the direction given)
+    assert "leaves the clamp -30 deg off fixed_direction_deg" in off.reason, off.reason
     assert off.psi_deg == pytest.approx(res.psi_deg - 30.0, abs=1.0)
     # the body's own base direction is still read, beside the one given (the ramp check
     # compares them), and is the same whichever was given

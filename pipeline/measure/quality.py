@@ -470,7 +470,7 @@ def assess_body(
     # saying so on every row hid the rows that matter (customer 29)
     if base_mismatch_deg is not None and abs(base_mismatch_deg) > BASE_MISMATCH_DEG:
         flags.append(
-            f"the body leaves the clamp {base_mismatch_deg:+.0f} deg off fixed_direction_deg"
+            f"the body leaves the clamp {-base_mismatch_deg:+.0f} deg off fixed_direction_deg"
             + _direction_hint(fixed_direction_deg, base_mismatch_deg)
         )
     if selected_fraction > 0.35:
