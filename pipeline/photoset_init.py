@@ -338,9 +338,19 @@ def init_video_photoset(
     ...                     defaults={"material": "DS20"}).to_dict("records")
     [{'video': 'GX010071.MP4', 'pressure_log': 'GX010071_log.csv', 'material': 'DS20', \
 'actuator': 'A1', 'trial': '1', 'clock_offset_s': 0.5}]
+
+    Several videos of one actuator, the pattern naming no trial, are its trials in name order
+    (each was trial 1, and ``check`` refused the manifest it had just written):
+
+    >>> _ = (root / "GX010072.MP4").write_bytes(b"")
+    >>> _ = (root / "GX010072_log.csv").write_text("t (s),Setpoint (kPa)\\n0,0\\n9,80\\n")
+    >>> init_video_photoset(root, "GX*.MP4", "{video}_log.csv", defaults={"material": "DS20"},
+    ...                     overwrite=True)[["video", "trial"]].to_dict("records")
+    [{'video': 'GX010071.MP4', 'trial': '1'}, {'video': 'GX010072.MP4', 'trial': '2'}]
     """
     folder = _new_manifest_folder(folder, overwrite)
     regex = pattern_to_regex(pattern, pressure_in_name=False)
+    given_defaults = defaults
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     rows = []
     frames = sequence_files(folder / pattern)
@@ -377,6 +387,12 @@ def init_video_photoset(
             f"{', '.join(VIDEO_SUFFIXES)}; a frame sequence is named like frame_%04d.jpg)"
         )
     df = pd.DataFrame(rows)
+    if "trial" not in regex.groupindex and "trial" not in (given_defaults or {}):
+        keys = ["material", "actuator"]
+        shared = df.groupby(keys, dropna=False)["video"].transform("size") > 1
+        df.loc[shared, "trial"] = (df[shared].groupby(keys, dropna=False).cumcount() + 1).astype(
+            str
+        )
     write_manifest(folder, df)
     if not (folder / SETTINGS).exists():
         write_settings(folder, {"l0_mm": None, **dict(settings or {})})
