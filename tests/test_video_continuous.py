@@ -15,7 +15,7 @@ from pipeline.aggregate import aggregate_hysteresis
 from pipeline.errors import UserInputError
 from pipeline.synth.video import Dynamics, simulate, toy_actuator
 from pipeline.video import continuous
-from pipeline.video.continuous import loops, step_response, steps, write_continuous
+from pipeline.video.continuous import UNSETTLED, loops, step_response, steps, write_continuous
 from pipeline.video.profile import PressureProfile
 
 T = np.arange(0.0, 6.0, 0.01)
@@ -235,3 +235,17 @@ def test_tables_are_deterministic(measured, tmp_path):
     write_continuous(measured, tmp_path / "b")
     for name in continuous.FILES:
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_one_frame_off_in_the_hold_is_the_measurements_not_an_unsettled_step():
+    # customer 35's 80 -> 40 kPa step: one frame of the still actuator read 2.1 deg off the
+    # hold's mean (the others within 1.5) and the step "did not settle within the hold"
+    psi = _first_order(0.3) + np.random.default_rng(3).normal(0.0, 0.1, T.size)
+    late = int(np.searchsorted(T, 5.5))  # in the hold's last fifth, its final value
+    once = psi.copy()
+    once[late] += 2.0
+    r = step_response(T, once, step_time_s=1.0, before_deg=50.0)
+    assert r["note"] == "" and r["settling_time_s"] == pytest.approx(0.3 * np.log(50), abs=0.1)
+    # three frames in a row that far off are the actuator's: not settled
+    psi[late : late + 3] += 2.0
+    assert step_response(T, psi, step_time_s=1.0, before_deg=50.0)["note"] == UNSETTLED
