@@ -128,12 +128,12 @@ def cycle_summary(
     ...     "width_max_deg": 105.8, "width_max_at_kpa": 105.0, "area_deg_kpa": 7524.0}])
     >>> import textwrap
     >>> print(textwrap.fill(cycle_summary(c, stepped=False), 90))
-    DS30 A1 t1 cycle 1: rising 8.0 kPa/s, falling 8.0 kPa/s, loop width mean 45.7 deg (largest
-    105.8 deg at 105 kPa), area 7524 deg kPa.  On a continuous ramp the loop holds the
-    actuator's lag behind the pressure as well as its hysteresis; a stepped profile with holds
-    (the step table) tells the two apart.
-    >>> cycle_summary(c, stepped=True)[:54]
-    'DS30 A1 t1 cycle 1: in steps, loop width mean 45.7 deg'
+    DS30 A1 t1 cycle 1: rising 8.0 kPa/s, falling 8.0 kPa/s, loop width (psi rising minus
+    falling; negative: falling above) mean 45.7 deg (largest 105.8 deg at 105 kPa), area 7524
+    deg kPa.  On a continuous ramp the loop holds the actuator's lag behind the pressure as
+    well as its hysteresis; a stepped profile with holds (the step table) tells the two apart.
+    >>> cycle_summary(c, stepped=True)[:41]
+    'DS30 A1 t1 cycle 1: in steps, loop width '
 
     A hold that did not settle is said (customer 27: its loop width was reported without it):
 
@@ -157,7 +157,7 @@ def cycle_summary(
             else f"rising {_fmt(c['rate_up_kpa_s'], 1)} kPa/s, falling "
             f"{_fmt(c['rate_down_kpa_s'], 1)} kPa/s"
         )
-        + ", loop width mean "
+        + ", loop width (psi rising minus falling; negative: falling above) mean "
         f"{_fmt(c['width_mean_deg'], 1)} deg "
         f"(largest {_fmt(c['width_max_deg'], 1)} deg at {_fmt(c['width_max_at_kpa'], 0)} kPa), "
         f"area {_fmt(c['area_deg_kpa'], 0)} deg kPa"
