@@ -1176,3 +1176,21 @@ def test_a_set_of_which_no_photo_is_ok_says_so_on_page_one(tmp_path):
     assert "never reaches" not in text and "n/a (one trial)" not in text
     assert "n/a (no ok photo)" in text
     assert not [ax for ax in fig.axes if ax.get_lines()]  # no empty plot
+
+
+def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
+    # customer 35's actuator, straight at rest: "the mean curve never reaches ψ = 0 up to 120 kPa
+    # (smallest mean ψ 0°)"
+    from pipeline.report.summary import missing_notes
+
+    d = make_dataset(tmp_path, "SS40", overlays=False)
+    a = pd.read_csv(d.angles_csv)
+    a["psi_deg"] = 0.3 + 0.8 * a["pressure_kpa"]
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    notes = " ".join(missing_notes(data))
+    assert "SS40: the curve starts at ψ = 0° (straight at rest) and does not come back" in notes, (
+        notes
+    )
+    assert "never reaches" not in notes

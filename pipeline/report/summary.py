@@ -299,12 +299,22 @@ def missing_notes(data: ReportData) -> list[str]:
                 if not np.isfinite(float(g.get("paper_p_zero_kpa", np.nan)))
                 else ""
             )
+            smallest = float(h["psi_mean_deg"].abs().min())
             out.append(
-                f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ "
-                f"{low}°), "
-                f"so P at ψ = 0 reads n/a{paper}."
+                # customer 35's straight-at-rest actuator read "never reaches ψ = 0 ...
+                # (smallest mean ψ 0°)"
+                f"{m}: the curve starts at ψ = {low}° (straight at rest) and does not come back "
+                f"through ψ = 0 up to {top} kPa, so P at ψ = 0 (the paper's actuators are bent "
+                f"back at rest) reads n/a{paper}."
+                if smallest < STRAIGHT_AT_REST_DEG
+                else f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ "
+                f"{low}°), so P at ψ = 0 reads n/a{paper}."
             )
     return out
+
+
+#: a curve whose smallest mean |psi| is below this (deg) starts straight: it has no P at psi = 0
+STRAIGHT_AT_REST_DEG = 1.0
 
 
 #: a dataset with at most this many flagged or failed photos names them beside its top reasons
