@@ -83,7 +83,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument(
         "--actuator", help="actuator label when the pattern has no {actuator} (default A1)"
     )
-    init.add_argument("--trial", help="trial label when the pattern has no {trial} (default 1)")
+    init.add_argument(
+        "--trial",
+        help="trial label when the pattern has no {trial} (default 1; several videos of one "
+        "actuator: 1, 2, ... in name order)",
+    )
     init.add_argument(
         "--l0-mm",
         type=float,
@@ -369,7 +373,8 @@ def _init(args: argparse.Namespace) -> int:
             settings=settings,
             overwrite=args.overwrite,
         )
-        print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s)")
+        trials = ", ".join(f"{r.video} trial {r.trial}" for r in df.itertuples())
+        print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s): {trials}")
         _print_next(args, kept)
         return 0
     for option, value in (("--clock-offset-s", args.clock_offset_s), ("--fps", args.fps)):

@@ -392,12 +392,12 @@ def _screen_sign(rows: pd.DataFrame) -> float:
 
     Examples
     --------
-    >>> _screen_sign(pd.DataFrame({"positive_turn": ["cw"]})), _screen_sign(pd.DataFrame())
+    >>> _screen_sign(pd.DataFrame({"positive_turn": [None, "cw"]})), _screen_sign(pd.DataFrame())
     (-1.0, 1.0)
     """
-    if "positive_turn" not in rows.columns or rows.empty:
-        return 1.0
-    return -1.0 if str(rows["positive_turn"].iloc[0]) == "cw" else 1.0
+    given = rows["positive_turn"].dropna() if "positive_turn" in rows.columns else pd.Series()
+    # the ramp's own (a row whose settings could not be read has none)
+    return -1.0 if len(given) and given.mode().iloc[0] == "cw" else 1.0
 
 
 def _wrap_deg(angle: np.ndarray) -> np.ndarray:

@@ -1194,3 +1194,12 @@ def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
         notes
     )
     assert "never reaches" not in notes
+    # bent the other way, from straight: it starts at 0 too (review: "starts at ψ = -200°")
+    a["psi_deg"] = -a["psi_deg"]
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    notes = " ".join(missing_notes(data))
+    assert "SS40: the curve starts at ψ = -0° (straight at rest)" in notes or (
+        "SS40: the curve starts at ψ = 0° (straight at rest)" in notes
+    ), notes

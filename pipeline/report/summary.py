@@ -299,14 +299,17 @@ def missing_notes(data: ReportData) -> list[str]:
                 if not np.isfinite(float(g.get("paper_p_zero_kpa", np.nan)))
                 else ""
             )
-            smallest = float(h["psi_mean_deg"].abs().min())
+            # where the curve starts: its lowest pressure, going up
+            up = h[h["direction"] == "up"].dropna(subset=["psi_mean_deg"])
+            first = up.sort_values("pressure_kpa")["psi_mean_deg"].iloc[0] if len(up) else np.nan
             out.append(
                 # customer 35's straight-at-rest actuator read "never reaches ψ = 0 ...
                 # (smallest mean ψ 0°)"
-                f"{m}: the curve starts at ψ = {low}° (straight at rest) and does not come back "
+                f"{m}: the curve starts at ψ = {fmt(first, 0)}° (straight at rest) and does not "
+                "come back "
                 f"through ψ = 0 up to {top} kPa, so P at ψ = 0 (the paper's actuators are bent "
                 f"back at rest) reads n/a{paper}."
-                if smallest < STRAIGHT_AT_REST_DEG
+                if abs(first) < STRAIGHT_AT_REST_DEG
                 else f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ "
                 f"{low}°), so P at ψ = 0 reads n/a{paper}."
             )
