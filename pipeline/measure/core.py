@@ -130,6 +130,10 @@ class AngleResult:
     tip_px: tuple[float, float] | None = None
 
 
+#: no actuator turns further than this (deg): a psi beyond it is a line that is not its own
+MAX_PSI_DEG = 400.0
+
+
 def failed(method: str, reason: str) -> AngleResult:
     """An :class:`AngleResult` for a photo that could not be measured."""
     nan = float("nan")
@@ -148,8 +152,33 @@ def _measured(
     quality.
 
     ``settings`` are those the fit used (on a calibrated plane: the plane's ``mm_per_px``).
+    A psi beyond :data:`MAX_PSI_DEG` is ``failed``: no actuator turns so far, the line measured
+    is not its own (customer 36's clear body read -2006 deg, flagged, its "line length -283 %
+    of its ramp's median").
+
+    Examples
+    --------
+    >>> from pipeline.measure.quality import Quality
+    >>> from pipeline.measure.settings import resolve_settings
+    >>> est = CurveEstimate(0.0, 0.0, 100.0, 1.0, 1, 0.0)
+    >>> line = LineExtraction(np.zeros((2, 2)), 5.0, False, 1, 100.0, 0.0, 0.0, False, False)
+    >>> r = _measured(-2006.5, est, line, Quality("flagged", "wobbles"),
+    ...               resolve_settings({"l0_mm": 100}), "tangents")
+    >>> r.status, r.psi_deg, r.reason[:50]
+    ('failed', nan, 'psi read -2006 deg, more than a full turn: the lin')
     """
     mm_per_px = settings.mm_per_px
+    if abs(psi) > MAX_PSI_DEG:
+        what = "body" if settings.target == "body" else "line"
+        return replace(
+            failed(
+                method,
+                f"psi read {psi:+.0f} deg, more than a full turn: the line measured is not the "
+                f"{what}'s (photoset preview shows what the settings select)"
+                + (f"; {quality.reason}" if quality.reason else ""),
+            ),
+            centreline_px=line.centreline_px,
+        )
     return AngleResult(
         psi_deg=psi,
         kappa_per_mm=float(np.deg2rad(psi) / settings.l0_mm),
