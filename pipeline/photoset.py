@@ -1249,6 +1249,8 @@ def repeated_level_problems(ps: PhotoSet) -> list[Problem]:
 
 #: a photo named like a calibration board's
 BOARD_NAME = re.compile(r"checker|chess|board|calib|charuco", re.IGNORECASE)
+#: ... and like a photo of the empty scene
+EMPTY_NAME = re.compile(r"empty|background|backdrop|bg", re.IGNORECASE)
 
 
 def unlisted_problems(ps: PhotoSet) -> list[Problem]:
@@ -1267,6 +1269,12 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     ...     "image,pressure_kpa,direction,material,actuator,trial\\na_0kPa.jpg,0,up,DS20,A1,1\\n")
     >>> print(unlisted_problems(load_photoset(root))[0].message)
     1 photo in the folder is not in manifest.csv and will not be measured: 'a_10kpa.jpg'
+
+    A photo named like an empty scene's is pointed to ``background``:
+
+    >>> _ = (root / "empty_scene_A2.jpg").write_bytes(b"")
+    >>> unlisted_problems(load_photoset(root))[0].fix[:52]
+    "if 'empty_scene_A2.jpg' and the like are photos of t"
     """
     left = unlisted_photos(
         ps.folder,
@@ -1277,6 +1285,7 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
         return []
     shown = ", ".join(repr(n) for n in left[:3]) + (", ..." if len(left) > 3 else "")
     boards = [n for n in left if BOARD_NAME.search(Path(n).stem)]
+    empties = [n for n in left if EMPTY_NAME.search(Path(n).stem)]
     return [
         Problem(
             str(ps.folder / MANIFEST),
@@ -1291,6 +1300,15 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
                 "lens'): without it a camera not square to the plane or a lens that distorts "
                 "puts psi off; else "
                 if boards and "calibration" not in ps.settings
+                else ""
+            )
+            + (
+                # customer 36 was told to move its empty scenes out of the folder
+                f"if {empties[0]!r} and the like are photos of the empty scene, name them as "
+                "background (photoset.yaml: background: NAME; or a background column in "
+                "manifest.csv, each actuator's rows their own; README, 'Measuring photos "
+                "without a drawn line'); else "
+                if empties
                 else ""
             )
             + "add a row for each (or rename them to photoset init's pattern and run it again "
