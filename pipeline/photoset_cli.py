@@ -145,7 +145,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--background",
         metavar="FILE",
         help="body: a photo of the empty scene in the folder (same camera, light and framing, "
-             "no actuator; recommended for translucent bodies and busy scenes)",
+             "no actuator; recommended for translucent bodies and busy scenes); with {actuator} "
+             "in it (and * if need be), each actuator's own: '{actuator}/empty_*.JPG'",
     )
     init.add_argument(
         "--line-color",
@@ -335,6 +336,19 @@ def _calibrate(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def _own_backgrounds(folder: str, pattern: str, df: pd.DataFrame) -> pd.DataFrame:
+    """The manifest ``df`` written again with each actuator's own empty scene (``pattern`` with
+    ``{actuator}``) in a ``background`` column (customer 36 could give ``--background`` one file
+    for the whole set)."""
+    found = photoset_init.backgrounds_by_actuator(
+        folder, pattern, sorted(df["actuator"].astype(str).unique())
+    )
+    df = df.assign(background=df["actuator"].astype(str).map(found))
+    photoset.write_manifest(folder, df)
+    print("background: " + ", ".join(f"{a} {f}" for a, f in found.items()))
+    return df
+
+
 def _init(args: argparse.Namespace) -> int:
     defaults = {k: getattr(args, k) for k in RAMP_KEYS if getattr(args, k)}
     settings: dict[str, object] = {"l0_mm": args.l0_mm, "positive_turn": args.positive_turn}
@@ -354,7 +368,8 @@ def _init(args: argparse.Namespace) -> int:
         settings["free_end"] = args.free_end
     if args.exclude:
         settings["exclude"] = [list(_box(b, "--exclude")) for b in args.exclude]
-    if args.background is not None:
+    per_actuator = args.background is not None and "{actuator}" in args.background
+    if args.background is not None and not per_actuator:
         if not (Path(args.folder) / args.background).is_file():
             raise UserInputError(
                 f"--background {args.background}: no such file in {args.folder}; put the photo "
@@ -373,6 +388,8 @@ def _init(args: argparse.Namespace) -> int:
             settings=settings,
             overwrite=args.overwrite,
         )
+        if per_actuator:
+            df = _own_backgrounds(args.folder, args.background, df)
         trials = ", ".join(f"{r.video} trial {r.trial}" for r in df.itertuples())
         print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s): {trials}")
         _print_next(args, kept)
@@ -392,6 +409,8 @@ def _init(args: argparse.Namespace) -> int:
             else photoset_init.pressure_specs(args.pressures_kpa)
         ),
     )
+    if per_actuator:
+        df = _own_backgrounds(args.folder, args.background, df)
     n_up = int((df["direction"] == "up").sum())
     print(
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "

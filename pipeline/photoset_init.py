@@ -284,6 +284,42 @@ def init_photoset(
     return df
 
 
+def backgrounds_by_actuator(
+    folder: str | os.PathLike[str], pattern: str, actuators: Sequence[str]
+) -> dict[str, str]:
+    """Each actuator's photo of the empty scene: ``pattern`` (a name in ``folder``, ``*`` and
+    ``?`` allowed) with ``{actuator}`` standing for its label; exactly one file must match.
+
+    Raises
+    ------
+    UserInputError
+        Naming the actuator, the pattern and what matched.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> root = Path(tempfile.mkdtemp())
+    >>> for name in ("A1/empty_0146.JPG", "A2/empty_0101.JPG"):
+    ...     (root / name).parent.mkdir(exist_ok=True); _ = (root / name).write_bytes(b"")
+    >>> backgrounds_by_actuator(root, "{actuator}/empty_*.JPG", ["A1", "A2"])
+    {'A1': 'A1/empty_0146.JPG', 'A2': 'A2/empty_0101.JPG'}
+    """
+    root = Path(folder)
+    out = {}
+    for actuator in actuators:
+        wanted = pattern.replace("{actuator}", str(actuator))
+        found = sorted(p.relative_to(root).as_posix() for p in root.glob(wanted) if p.is_file())
+        if len(found) != 1:
+            raise UserInputError(
+                f"--background {pattern}: actuator {actuator} has "
+                + (f"{len(found)} photos of the empty scene ({', '.join(found[:3])})" if found
+                   else f"no photo of the empty scene ({wanted} matches nothing in {root})")
+                + "; give each actuator exactly one (or one --background FILE for the set)"
+            )
+        out[str(actuator)] = found[0]
+    return out
+
+
 def init_video_photoset(
     folder: str | os.PathLike[str],
     pattern: str,

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import pytest
@@ -871,3 +872,25 @@ def test_check_names_calibration_for_unlisted_checkerboard_photos(photo_folder):
     (unlisted,) = [p for p in check_photoset(photo_folder, warnings=True)
                    if "not in manifest.csv" in p.message]
     assert unlisted.fix.startswith("add a row for each")
+
+
+def test_init_gives_each_actuator_its_own_empty_scene(tmp_path, capsys):
+    # customer 36 photographed the empty scene once per actuator; --background took one file
+    from pipeline.cli import main
+
+    for actuator, empty in (("O1", "empty_0146.jpg"), ("T1", "empty_0101.jpg")):
+        for name in (f"{actuator}/trial1/IMG_01.jpg", f"{actuator}/trial1/IMG_02.jpg",
+                     f"{actuator}/{empty}"):
+            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(str(tmp_path / name), np.zeros((8, 8, 3), np.uint8))
+    init = ["photoset", "init", str(tmp_path), "--pattern", "{actuator}/trial{trial}/IMG_*.jpg",
+            "--pressures-kpa", "0,20", "--l0-mm", "100", "--target", "body", "--material", "DS20"]
+    assert main([*init, "--background", "{actuator}/empty_*.jpg"]) == 0
+    manifest = pd.read_csv(tmp_path / "manifest.csv")
+    assert dict(zip(manifest["actuator"], manifest["background"], strict=True)) == {
+        "O1": "O1/empty_0146.jpg", "T1": "T1/empty_0101.jpg"}
+    assert "background: O1 O1/empty_0146.jpg, T1 T1/empty_0101.jpg" in capsys.readouterr().out
+    # an actuator without one, or with two, is named
+    (tmp_path / "T1/empty_0102.jpg").write_bytes(b"")
+    assert main([*init, "--background", "{actuator}/empty_*.jpg", "--overwrite"]) == 2
+    assert "actuator T1 has 2 photos of the empty scene" in capsys.readouterr().err
