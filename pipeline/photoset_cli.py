@@ -403,6 +403,14 @@ def _init(args: argparse.Namespace) -> int:
         defaults=defaults,
         settings=settings,
         overwrite=args.overwrite,
+        leave_out=(
+            [
+                p.relative_to(args.folder).as_posix()
+                for p in Path(args.folder).glob(args.background.replace("{actuator}", "*"))
+            ]
+            if per_actuator
+            else ()
+        ),
         pressures_kpa=(
             None
             if args.pressures_kpa is None

@@ -164,6 +164,7 @@ def init_photoset(
     settings: Mapping[str, Any] | None = None,
     overwrite: bool = False,
     pressures_kpa: Sequence[float] | Mapping[str | None, Sequence[float]] | None = None,
+    leave_out: Sequence[str] = (),
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) from image file names.
 
@@ -199,6 +200,9 @@ def init_photoset(
         numbers as numbers).  A mapping gives ramps their own (:func:`pressure_specs`): keyed by
         trial label, or ``actuator/trial``, or None for every other ramp.
 
+    leave_out : sequence of str
+        Photos in the folder that are no ramp's (each actuator's own empty scene).
+
     Returns
     -------
     pandas.DataFrame
@@ -220,6 +224,7 @@ def init_photoset(
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     # the empty scene and calibration boards the settings name are no photos of a ramp
     named = files_named_in(folder, dict(settings or {}), pd.DataFrame()) | named_files(folder)
+    named |= {(folder / name).resolve() for name in leave_out}
     rows, unmatched = [], []
     for name in sorted(photo_names(folder, subfolders="/" in pattern), key=natural_key):
         if (folder / name).resolve() in named:

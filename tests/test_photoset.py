@@ -879,16 +879,17 @@ def test_init_gives_each_actuator_its_own_empty_scene(tmp_path, capsys):
     from pipeline.cli import main
 
     for actuator, empty in (("O1", "empty_0146.jpg"), ("T1", "empty_0101.jpg")):
-        for name in (f"{actuator}/trial1/IMG_01.jpg", f"{actuator}/trial1/IMG_02.jpg",
-                     f"{actuator}/{empty}"):
+        for name in (f"{actuator}/IMG_01.jpg", f"{actuator}/IMG_02.jpg", f"{actuator}/{empty}"):
             (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
             cv2.imwrite(str(tmp_path / name), np.zeros((8, 8, 3), np.uint8))
-    init = ["photoset", "init", str(tmp_path), "--pattern", "{actuator}/trial{trial}/IMG_*.jpg",
+    # the pattern takes the empty scenes in too: they are left out of the ramps
+    init = ["photoset", "init", str(tmp_path), "--pattern", "{actuator}/*.jpg",
             "--pressures-kpa", "0,20", "--l0-mm", "100", "--target", "body", "--material", "DS20"]
     assert main([*init, "--background", "{actuator}/empty_*.jpg"]) == 0
     manifest = pd.read_csv(tmp_path / "manifest.csv")
     assert dict(zip(manifest["actuator"], manifest["background"], strict=True)) == {
         "O1": "O1/empty_0146.jpg", "T1": "T1/empty_0101.jpg"}
+    assert len(manifest) == 4 and not manifest["image"].str.contains("empty").any()
     assert "background: O1 O1/empty_0146.jpg, T1 T1/empty_0101.jpg" in capsys.readouterr().out
     # an actuator without one, or with two, is named
     (tmp_path / "T1/empty_0102.jpg").write_bytes(b"")
