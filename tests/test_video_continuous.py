@@ -260,3 +260,12 @@ def test_ringing_filmed_two_frames_a_lobe_still_counts_against_settling():
     r = step_response(t, y, step_time_s=1.0, before_deg=0.0)
     outside = np.flatnonzero(np.abs(y - 50.0) > 0.02 * 50.0)
     assert r["settling_time_s"] >= t[outside[-1]] - 1.0 - 1.0 / 30.0, r
+
+
+
+def test_a_hold_still_swinging_has_not_settled_however_wide_it_swings():
+    # the band that follows the hold's own scatter (a still actuator's noise) must not take in a
+    # swing that runs on through the hold: 1.5 deg at 2 Hz after a 50 deg step (3 % of it)
+    t = np.arange(0.0, 6.0, 1.0 / 30.0)
+    y = 50.0 * (t >= 1.0) + 1.5 * np.sin(2 * np.pi * 2.0 * (t - 1.0)) * (t >= 1.0)
+    assert step_response(t, y, step_time_s=1.0, before_deg=0.0)["note"] == UNSETTLED

@@ -169,7 +169,7 @@ def _measured(
     """
     mm_per_px = settings.mm_per_px
     if abs(psi) > MAX_PSI_DEG:
-        what = "body" if settings.target == "body" else "line"
+        what = "body" if settings.target == "body" else "drawn line"
         return replace(
             failed(
                 method,

@@ -316,7 +316,8 @@ def missing_notes(data: ReportData) -> list[str]:
     return out
 
 
-#: a curve whose smallest mean |psi| is below this (deg) starts straight: it has no P at psi = 0
+#: a curve whose mean |psi| at its lowest pressure going up is below this (deg) starts straight:
+#: it has no P at psi = 0 to come back through
 STRAIGHT_AT_REST_DEG = 1.0
 
 

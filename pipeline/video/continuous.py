@@ -265,6 +265,11 @@ def _crossing(t: np.ndarray, y: np.ndarray, level: float, rising: bool) -> float
 UNSETTLED = "did not settle within the hold"
 
 
+#: the hold's last fifth scatters like noise while the lag-1 correlation of its residuals stays
+#: below this (customer 35's still actuator: -0.5 to 0.2; a 2 Hz swing filmed at 30 fps: 0.9)
+SMOOTH_SCATTER = 0.5
+
+
 def _excursions(outside: np.ndarray) -> np.ndarray:
     """``outside`` (bool per frame) but for a lone frame outside, with no other within two
     frames: that one frame off is the measurement's (a still actuator's frame 2.1 deg off its
@@ -349,9 +354,13 @@ def step_response(time_s: np.ndarray, values: np.ndarray, *, step_time_s: float,
     three_sd = 3.0 * (sd if math.isfinite(sd) else 0.0)
     # the final window's own scatter about its straight-line fit: a frame-to-frame noise sd
     # misses noise that holds over a few frames (customer 35's still actuator: 0.8 deg sd in the
-    # last second, frames up to 2.1 deg off, read "did not settle"; the noise sd said 0.5)
+    # last second, frames up to 2.1 deg off, read "did not settle"; the noise sd said 0.5), but
+    # not a scatter that runs smoothly from frame to frame: a hold still swinging (a regulator
+    # hunting) has not settled however wide it swings
     fit = np.polyfit(t[-tail:], y[-tail:], 1)
-    scatter = float(np.std(y[-tail:] - np.polyval(fit, t[-tail:])))
+    resid = y[-tail:] - np.polyval(fit, t[-tail:])
+    smooth = tail > 3 and float(np.corrcoef(resid[:-1], resid[1:])[0, 1]) >= SMOOTH_SCATTER
+    scatter = 0.0 if smooth else float(np.std(resid))
     band = max(SETTLING_BAND * abs(change), three_sd, 3.0 * scatter)
     # settled: the final window itself no longer drifts (its straight-line fit moves less than the
     # band)
