@@ -69,7 +69,7 @@ def selection(
 ) -> np.ndarray:
     """0/1 mask of what the settings select in a (reduced) photo, before any candidate is chosen."""
     if settings.target == "body":
-        return body_mask(image_bgr, settings, scale=scale, background_bgr=background)[0]
+        return body_mask(image_bgr, settings, scale=scale, background_bgr=background).mask
     assert settings.color is not None
     mask = line_mask(image_bgr, settings.color)[0]
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)

@@ -808,11 +808,11 @@ def test_a_shadow_beside_the_body_is_left_out_but_a_neutral_grey_body_is_kept():
 
     settings = settings_for((30.0, 50.0))
     photo, empty = _band_photo((60, 60, 200), shadow_bgr=(150, 150, 150))
-    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    mask = body_mask(photo, settings, background_bgr=empty).mask
     assert mask[40:60, 40:260].all() and not mask[62:75, 40:260].any()
     # a neutral grey body darker than a neutral backdrop looks like a shadow all over: kept
     photo, empty = _band_photo((110, 110, 110))
-    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    mask = body_mask(photo, settings, background_bgr=empty).mask
     assert mask[40:60, 40:260].all()
 
 
@@ -833,7 +833,7 @@ def test_a_shadow_is_left_out_against_the_empty_scene_estimated_from_the_ramp(tm
     settings = dataclasses.replace(
         settings_for((30.0, 50.0)), background_path=str(estimate), background_estimated=True
     )
-    mask, _, _ = body_mask(photo, settings, background_bgr=empty)
+    mask = body_mask(photo, settings, background_bgr=empty).mask
     assert mask[40:60, 40:260].all() and not mask[62:75, 40:260].any()
 
 

@@ -547,6 +547,7 @@ def measure_body(
         smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,
         excluded=bool(settings.exclude),
+        hollow_outline=body.hollow_outline,
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along

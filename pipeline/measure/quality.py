@@ -302,6 +302,7 @@ def assess_body(
     short_end_shift_deg: tuple[float, float] = (0.0, 0.0),
     excluded: bool = False,
     fixed_direction_deg: float | None = None,
+    hollow_outline: bool = False,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -318,7 +319,9 @@ def assess_body(
     :data:`FAINT_TIP_SHORT_WIDTHS` widths short, a faint stretch of the tip); the body starts far
     from ``fixed_end`` (not when ``fixed_direction_deg`` is given, ``base_mismatch_deg`` not
     None: psi does not depend on it); the body closes on itself (``excluded``: the row already
-    excludes a region, which may miss the gap); or it is much shorter
+    excludes a region, which may miss the gap); the selection is the outline of a long region
+    whose inside does not differ from the background (``hollow_outline``: a clear body seen by
+    its rims, which may be measured instead of its middle); or it is much shorter
     than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
     how psi was taken.
@@ -339,7 +342,14 @@ def assess_body(
             "the body's free end reaches the edge of roi / exclude: the tip may be cut off there "
             "(photoset preview shows the outlines)"
         )
-    if line.n_candidates > 1:
+    if hollow_outline:
+        flags.append(
+            "the selection is the outline of a long region whose inside does not differ from the "
+            + ("empty scene" if background_given else "backdrop")
+            + ": a clear body seen only by its rims? Photograph it on a backdrop it shows "
+            "against (darker, or of another colour), or tint it; check with photoset preview"
+        )
+    elif line.n_candidates > 1:
         flags.append(
             f"{line.n_candidates} candidate bodies: another selection as large as this body lies "
             "elsewhere (another object in view, such as a ruler or another actuator, or part of "

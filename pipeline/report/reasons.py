@@ -75,6 +75,7 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^the centre line stops \d+ px \([\d.]+ widths\) short",
      "centre line stops short of a faint tip"),
     (r"^the end tangents and a smooth fit", "centre line wobbles"),
+    (r"^the selection is the outline of a long region", "a clear body seen only by its rims"),
     (r"direction turns \d+ deg when fitted over half", "hook at an end of the centre line"),
     (r"^line length \d+% of its ramp's median", "length far from its ramp's median"),
     (r"^the body starts \d+ px from fixed_end", "body starts away from fixed_end"),
