@@ -970,7 +970,8 @@ def sealed_end_problems(ps: PhotoSet) -> list[Problem]:
             None,
             "no sealed_end_mm: the tip angle is read where the body's centre line stops, which "
             "runs on into a sealed end or cap that does not bend, so a curled body reads high "
-            "(|psi| above 150 deg: 5-12 deg on rendered bodies with an 8-12 mm one, every row ok)"
+            "(|psi| above 100 deg: 2-7 deg on a customer's body with an 8 mm one, 5-12 deg above "
+            "150 on rendered bodies with 8-12 mm; the rows stay ok, each saying so)"
             + (
                 " (and without an empty scene, a doubtful body gets no second look against its "
                 "ramp's own photos)"

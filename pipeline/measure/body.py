@@ -56,6 +56,9 @@ MAX_HOLE_FRACTION = 0.04
 #: is wide (area over the square of its widest inscribed disc's diameter)
 OUTLINE_FILL_SIGMAS, OUTLINE_RIM_SHARE, OUTLINE_MAX_SHARE = 3.0, 0.8, 0.25
 OUTLINE_MIN_ELONGATION = 3.0
+#: a long region the selection outlines and leaves out is a clear body seen by its rims when it
+#: is at least this many times as wide as what is measured (a rim: a few px)
+HOLLOW_WIDTHS = 4.0
 #: the centre line is smoothed over this many half-widths (ragged, textured edges)
 SMOOTH_HALF_WIDTHS = 0.6
 
@@ -105,7 +108,9 @@ class BodyExtraction:
         course: a rigid cap, over which the body does not bend.
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
-        (:attr:`BodySelection.hollow_outline`).
+        (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
+        the body measured: a clear body seen by its rims (an opaque body's hairpin closing a
+        pocket of backdrop against the clamp is as wide as the pocket's width over its own).
     """
 
     line: LineExtraction
@@ -647,7 +652,7 @@ def _hysteresis(diff: np.ndarray, high: float, low: float) -> np.ndarray:
     return seeded[labels].astype(np.uint8)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BodySelection:
     """What the settings select in a photo, before one component is chosen (:func:`body_mask`).
 
@@ -658,15 +663,16 @@ class BodySelection:
         How clearly each pixel differs (for previews), 0 where not computed.
     contrast : float
         Median difference of the selected pixels in backdrop-noise sigmas (inf for colour only).
-    hollow_outline : bool
-        The selection outlines a long region, larger than itself, whose inside does not differ
-        from the background (:func:`fill_outlined`): a clear body seen by its rims only.
+    hollow_width_px : float
+        The width (work px) of a long region the selection outlines, larger than itself, whose
+        inside does not differ from the background (:func:`fill_outlined`; 0 for none): a clear
+        body seen by its rims only, when far wider than what is measured.
     """
 
     mask: np.ndarray
     strength: np.ndarray
     contrast: float
-    hollow_outline: bool = False
+    hollow_width_px: float = 0.0
 
 
 def body_mask(
@@ -698,7 +704,7 @@ def body_mask(
     allowed = np.ones((h, w), np.uint8) if region is None else region
     strength: np.ndarray = np.zeros((h, w), np.float32)
     contrast = float("inf")
-    hollow = False
+    hollow = 0.0
     if not allowed.any():  # roi / exclude leave nothing to look at (the backdrop model crashed)
         return BodySelection(allowed.copy(), strength, contrast)
     mask = allowed.copy()
@@ -764,10 +770,10 @@ def _texture_disc(shape: tuple[int, ...]) -> np.ndarray:
 
 def fill_outlined(
     differs: np.ndarray, diff: np.ndarray, allowed: np.ndarray, faint: float
-) -> tuple[np.ndarray, bool]:
-    """``differs`` (0/1) with the inside of a clear body its outline encloses added, and whether
-    a long region it outlines was left out (larger than the outline: a clear body whose inside
-    does not differ, measured as its rims).
+) -> tuple[np.ndarray, float]:
+    """``differs`` (0/1) with the inside of a clear body its outline encloses added, and the
+    width (px, 0 for none) of a long region it outlines and left out, larger than the selection,
+    where nothing was taken in (a clear body whose inside does not differ, seen by its rims).
 
     A clear silicone body on a backdrop of its grey shows its edges brightly (they refract the
     light) and its inside only a few levels off the backdrop seen through it: customer 33's,
@@ -786,7 +792,7 @@ def fill_outlined(
 
     Where nothing passes and the selection is the outline of a long region larger than itself,
     that region is taken in when its median ``diff`` is over nine in ten of the backdrop's (the
-    pixels outside the closed selection) and over half ``faint``: customer 36's clear body on
+    regions that reach the photo's border) and over half ``faint``: customer 36's clear body on
     grey differed 2.3-2.6 noise sigmas inside, the backdrop 1.8 at its ninth tenth, and was
     read as its rims (no photo ``ok``).  Smaller regions are not: a sliver between a highlight
     and an edge, taken in so, brought the clamp block's face in with it (a compact region) and
@@ -800,13 +806,13 @@ def fill_outlined(
     >>> diff = np.zeros((60, 80), np.float32); diff[10:20, 6:43] = 5.0          # a faint inside
     >>> filled, hollow = fill_outlined(differs, diff, allowed, 3.0)
     >>> int(filled[15, 20]), hollow
-    (1, False)
+    (1, 0.0)
     >>> filled, hollow = fill_outlined(differs, 0.4 * diff, allowed, 3.0)  # over the backdrop's
     >>> int(filled[15, 20]), hollow
-    (1, False)
+    (1, 0.0)
     >>> filled, hollow = fill_outlined(differs, 0 * diff, allowed, 3.0)  # the backdrop's own
-    >>> int(filled[15, 20]), hollow
-    (0, True)
+    >>> int(filled[15, 20]), round(hollow)                     # left out: 10 px wide
+    (0, 10)
     """
     h, w = differs.shape
     disc = _texture_disc(differs.shape)
@@ -819,7 +825,9 @@ def fill_outlined(
     compact: list[tuple[tuple[slice, slice], np.ndarray]] = []
     largest = OUTLINE_MAX_SHARE * float(allowed.sum())
     # the largest long region whose inside is fainter, when larger than the selection (hollow)
-    hollow: tuple[int, float, tuple[slice, slice], np.ndarray] | None = None
+    # long regions whose inside is fainter, larger than the whole selection: (area, median,
+    # box, inside, widest)
+    hollow: list[tuple[int, float, tuple[slice, slice], np.ndarray, float]] = []
     for lab in range(1, n):
         x, y, bw, bh, area = (int(v) for v in stats[lab])
         if x == 0 or y == 0 or x + bw == w or y + bh == h or area > largest:
@@ -838,20 +846,26 @@ def fill_outlined(
                 long_fill[box][inside > 0] = 1
             else:
                 compact.append((box, inside))
-        elif elongated and area > differs.sum() and (hollow is None or area > hollow[0]):
-            hollow = (area, median, box, inside)
-    if hollow is not None and not long_fill.any():
+        elif elongated and area > differs.sum():
+            hollow.append((area, median, box, inside, widest))
+    if long_fill.any():
+        hollow = []  # the body's inside is found: a long pocket of backdrop is no outline
+    elif hollow:
         # all the selection is the outline: its inside is taken in when it differs more than
-        # nine in ten of the backdrop's pixels do, outside the closed selection
-        backdrop = diff[(wall == 0) & (allowed > 0)]
-        if backdrop.size and hollow[1] > max(float(np.percentile(backdrop, 90)), 0.5 * faint):
-            long_fill[hollow[2]][hollow[3] > 0] = 1
-            hollow = None
+        # nine in ten of the backdrop's pixels do (the regions reaching the photo's border)
+        border = np.unique(np.r_[labels[0], labels[-1], labels[:, 0], labels[:, -1]])
+        backdrop = diff[np.isin(labels, border[border > 0]) & (allowed > 0)]
+        level = max(float(np.percentile(backdrop, 90)) if backdrop.size else np.inf, 0.5 * faint)
+        for region in sorted(hollow, key=lambda r: -r[1]):  # the clearest first
+            if region[1] > level:
+                long_fill[region[2]][region[3] > 0] = 1
+                hollow = []
+                break
     out = differs | long_fill
     if long_fill.any():  # with the body's inside: its tip cap, outlined on its own
         for box, inside in compact:
             out[box][inside > 0] = 1
-    return out, hollow is not None
+    return out, max((r[4] for r in hollow), default=0.0)
 
 
 def _clean(mask: np.ndarray) -> np.ndarray:
@@ -1844,7 +1858,7 @@ def extract_body(
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,
         tip_capped=tip_capped,
-        hollow_outline=selection.hollow_outline,
+        hollow_outline=selection.hollow_width_px >= HOLLOW_WIDTHS * 2.0 * half,
         tip_face_px=(
             0.0
             if settings.sealed_end_mm is None

@@ -548,6 +548,7 @@ def measure_body(
         short_end_shift_deg=short_shift,
         excluded=bool(settings.exclude),
         hollow_outline=body.hollow_outline,
+        sealed_end_unknown=settings.sealed_end_mm is None and settings.free_end == "capped",
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along

@@ -234,7 +234,11 @@ NOTE_SELECTION_COVERS = "selection covers"
 NOTE_GIVEN_OFF = "the bodies of this ramp leave the clamp at"
 #: a doubtful body measured again against its ramp's estimate of the empty scene, and kept
 NOTE_RAMP_BACKGROUND = "measured against the empty scene estimated from its ramp's photos"
+#: a capped body measured without ``sealed_end_mm``, bent this much (deg) or more
+NOTE_NO_SEALED_END = "no sealed_end_mm"
+NO_SEALED_END_PSI_DEG = 100.0
 NOTES: tuple[str, ...] = (
+    NOTE_NO_SEALED_END,
     NOTE_FIXED_DIRECTION,
     NOTE_SIDE_ON_BORDER,
     NOTE_SELECTION_COVERS,
@@ -303,6 +307,7 @@ def assess_body(
     excluded: bool = False,
     fixed_direction_deg: float | None = None,
     hollow_outline: bool = False,
+    sealed_end_unknown: bool = False,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -324,7 +329,8 @@ def assess_body(
     its rims, which may be measured instead of its middle); or it is much shorter
     than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
-    how psi was taken.
+    how psi was taken, and that a capped body bent :data:`NO_SEALED_END_PSI_DEG` or more was
+    read without its sealed end's length (``sealed_end_unknown``): its |psi| reads high.
     """
     import numpy as np
 
@@ -337,6 +343,14 @@ def assess_body(
             f"{NOTE_SIDE_ON_BORDER}: the centre line there is half the body's width from the "
             "other edge"
         )
+    if sealed_end_unknown and abs(psi_deg) >= NO_SEALED_END_PSI_DEG:
+        # every row says it, not only check and the report's first page (customer 37: 36 of 116
+        # rows ok 5-7 deg off, their reasons empty)
+        notes.append(
+            f"{NOTE_NO_SEALED_END}: psi read where the centre line stops, as if the body bent to "
+            "its end; a straight sealed end and cap there read |psi| high (2-7 deg at |psi| "
+            "100-220 for an 8 mm one): give sealed_end_mm"
+        )
     if tip_at_region_edge:
         flags.append(
             "the body's free end reaches the edge of roi / exclude: the tip may be cut off there "
@@ -347,7 +361,9 @@ def assess_body(
             "the selection is the outline of a long region whose inside does not differ from the "
             + ("empty scene" if background_given else "backdrop")
             + ": a clear body seen only by its rims? Photograph it on a backdrop it shows "
-            "against (darker, or of another colour), or tint it; check with photoset preview"
+            "against (darker, or patterned: its refraction bends the pattern), or tint it"
+            + ("" if background_given else ", or give the empty scene (background)")
+            + "; check with photoset preview"
         )
     elif line.n_candidates > 1:
         flags.append(
