@@ -146,3 +146,23 @@ def test_a_clear_hairpins_inside_is_taken_in_and_the_pocket_it_closes_is_not_cal
     assert filled[80, 200] and filled[200, 200]  # both arms' insides
     assert not filled[140, 200]  # the pocket
     assert hollow_width == 0.0
+
+
+def test_a_faint_clear_body_is_taken_in_with_another_object_in_view():
+    # from the review: the region had to be larger than the whole photo's selection, so a
+    # ruler or a second object in view turned the fill of a faint inside off; it is now
+    # weighed against its own walls (before: not taken in)
+    from pipeline.measure.body import fill_outlined
+
+    noise = np.abs(np.random.default_rng(0).normal(0.0, 1.0, (500, 520))).astype(np.float32)
+    allowed = np.ones((500, 520), np.uint8)
+    allowed[:, :40] = 0
+    body = np.zeros((500, 520), np.uint8)
+    body[60:100, 38:440] = 1
+    rim = body - cv2.erode(body, np.ones((7, 7), np.uint8))
+    rim[:, :40] = body[:, :40]
+    diff = noise + 2.2 * ((body > 0) & (rim == 0))
+    rim[300:400, 100:300] = 1  # an opaque object, larger than the body's inside
+    diff[300:400, 100:300] = 20.0
+    filled, hollow_width = fill_outlined(rim, diff, allowed, 3.0)
+    assert filled[80, 200] and hollow_width == 0.0

@@ -664,7 +664,7 @@ class BodySelection:
     contrast : float
         Median difference of the selected pixels in backdrop-noise sigmas (inf for colour only).
     hollow_width_px : float
-        The width (work px) of a long region the selection outlines, larger than itself, whose
+        The width (work px) of a long region the selection outlines, larger than its walls, whose
         inside does not differ from the background (:func:`fill_outlined`; 0 for none): a clear
         body seen by its rims only, when far wider than what is measured.
     """
@@ -772,7 +772,7 @@ def fill_outlined(
     differs: np.ndarray, diff: np.ndarray, allowed: np.ndarray, faint: float
 ) -> tuple[np.ndarray, float]:
     """``differs`` (0/1) with the inside of a clear body its outline encloses added, and the
-    width (px, 0 for none) of a long region it outlines and left out, larger than the selection,
+    width (px, 0 for none) of a long region it outlines and left out, larger than its walls,
     where nothing was taken in (a clear body whose inside does not differ, seen by its rims).
 
     A clear silicone body on a backdrop of its grey shows its edges brightly (they refract the
@@ -790,7 +790,7 @@ def fill_outlined(
     low, ``ok``).  Regions that reach the photo's border or are
     larger than :data:`OUTLINE_MAX_SHARE` of the allowed area are never taken in.
 
-    Where nothing passes and the selection is the outline of a long region larger than itself,
+    Where nothing passes and the selection is the outline of a long region larger than its walls,
     that region is taken in when its median ``diff`` is over nine in ten of the backdrop's (the
     regions that reach the photo's border) and over half ``faint``: customer 36's clear body on
     grey differed 2.3-2.6 noise sigmas inside, the backdrop 1.8 at its ninth tenth, and was
@@ -824,9 +824,8 @@ def fill_outlined(
     long_fill = np.zeros_like(differs)
     compact: list[tuple[tuple[slice, slice], np.ndarray]] = []
     largest = OUTLINE_MAX_SHARE * float(allowed.sum())
-    # the largest long region whose inside is fainter, when larger than the selection (hollow)
-    # long regions whose inside is fainter, larger than the whole selection: (area, median,
-    # box, inside, widest)
+    # long regions whose inside is fainter, larger than their walls: (area, median, box,
+    # inside, widest)
     hollow: list[tuple[int, float, tuple[slice, slice], np.ndarray, float]] = []
     for lab in range(1, n):
         x, y, bw, bh, area = (int(v) for v in stats[lab])
@@ -846,7 +845,7 @@ def fill_outlined(
                 long_fill[box][inside > 0] = 1
             else:
                 compact.append((box, inside))
-        elif elongated and area > differs.sum():
+        elif elongated and area > _walls_px(labels, lab, (x, y, bw, bh), differs, widest):
             hollow.append((area, median, box, inside, widest))
     if long_fill.any():
         hollow = []  # the body's inside is found: a long pocket of backdrop is no outline
@@ -866,6 +865,25 @@ def fill_outlined(
         for box, inside in compact:
             out[box][inside > 0] = 1
     return out, max((r[4] for r in hollow), default=0.0)
+
+
+def _walls_px(
+    labels: np.ndarray,
+    lab: int,
+    box_xywh: tuple[int, int, int, int],
+    differs: np.ndarray,
+    reach_px: float,
+) -> int:
+    """How many selected pixels lie within ``reach_px`` (the width of region ``lab``) of it: its
+    walls, not all of the photo's selection (a ruler or a second object in view turned the fill
+    of a clear body's faint inside off).  A clear body's rims are a few px thick; the arms of
+    an opaque body's hairpin that close a pocket of backdrop are as large as the pocket."""
+    x, y, bw, bh = box_xywh
+    k = max(int(np.ceil(reach_px)), 1)
+    box = (slice(max(y - k, 0), y + bh + k), slice(max(x - k, 0), x + bw + k))
+    region = (labels[box] == lab).astype(np.uint8)
+    band = cv2.dilate(region, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * k + 1,) * 2))
+    return int((band & (1 - region) & differs[box]).sum())
 
 
 def _clean(mask: np.ndarray) -> np.ndarray:
