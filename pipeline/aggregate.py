@@ -395,6 +395,60 @@ def aggregate_per_actuator(
     return out[list(PER_ACTUATOR_COLUMNS)]
 
 
+#: an actuator's rising curve "bends one way" when its psi changes by at least this much (deg)
+#: from its lowest to its highest pressure
+OPPOSITE_BEND_DEG = 30.0
+
+
+def opposite_bending(
+    angles: pd.DataFrame, *, bin_kpa: float | None = None, include_flagged: bool = False
+) -> pd.DataFrame:
+    """Materials whose actuators bend opposite ways as the pressure rises.
+
+    An actuator's rise is the change of its mean psi from its lowest to its highest pressure on
+    the rising branch.  Actuators of one material are averaged into one curve; where one rises
+    by :data:`OPPOSITE_BEND_DEG` or more and another falls as far, that mean is neither's curve
+    (customer 38's three chambers of one actuator, each photographed as an actuator of one
+    material: a curve with a spike of +106 deg and an sd of 229 deg).  Actuators that bend the
+    same way but from different rest angles, or by different amounts, are not listed.
+
+    Parameters
+    ----------
+    angles, bin_kpa, include_flagged
+        As in :func:`aggregate_hysteresis`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per actuator of such a material: ``material``, ``actuator``, ``rise_deg``, and
+        the pressures it runs between, ``from_kpa`` and ``to_kpa``; sorted by material and rise.
+
+    Examples
+    --------
+    >>> rows = [(a, p, s * p) for a, s in (("1", 2.0), ("2", -1.0), ("3", 0.1)) for p in (0, 50)]
+    >>> angles = pd.DataFrame([{"image": f"{a}_{p}.jpg", "material": "SIL", "actuator": a,
+    ...     "trial": 1, "direction": "up", "pressure_kpa": p, "psi_deg": psi, "status": "ok"}
+    ...     for a, p, psi in rows])
+    >>> opposite_bending(angles)[["actuator", "rise_deg"]].to_numpy().tolist()
+    [['2', -50.0], ['3', 5.0], ['1', 100.0]]
+    >>> opposite_bending(angles[angles["actuator"] != "2"]).empty
+    True
+    """
+    curves = aggregate_per_actuator(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
+    rising = curves[(curves["direction"] == "up") & np.isfinite(curves["psi_mean_deg"])]
+    rows = []
+    for (material, actuator), g in rising.groupby(["material", "actuator"], sort=True):
+        if len(g) >= 2:
+            g = g.sort_values("pressure_kpa")
+            rise = float(g["psi_mean_deg"].iloc[-1] - g["psi_mean_deg"].iloc[0])
+            rows.append((material, actuator, rise, *g["pressure_kpa"].iloc[[0, -1]].tolist()))
+    out = pd.DataFrame(rows, columns=["material", "actuator", "rise_deg", "from_kpa", "to_kpa"])
+    both = out.groupby("material")["rise_deg"].transform(
+        lambda r: bool((r >= OPPOSITE_BEND_DEG).any() and (r <= -OPPOSITE_BEND_DEG).any())
+    )
+    return out[both.astype(bool)].sort_values(["material", "rise_deg"]).reset_index(drop=True)
+
+
 def actuator_keys(angles: pd.DataFrame) -> pd.Series:
     """Actuator identity of each row (text): the ``actuator`` value, qualified by ``dataset``
     (``"<dataset>/<actuator>"``) when the rows come from more than one dataset."""

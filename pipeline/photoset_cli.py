@@ -32,7 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             "{trial}, {actuator}, {material}, {step}, {_} or * (ignored). Without {direction}, "
             "photos before the highest pressure of each ramp are 'up', after it 'down'. A "
             "pattern with '/' matches the photos' paths in DIR's subfolders, e.g. "
-            "'chamber{actuator}/{step}_{pressure_kpa}kPa.jpg'. For videos give --pressure-log: "
+            "'actuator{actuator}/{step}_{pressure_kpa}kPa.jpg' (chambers of one actuator: "
+            "'chamber{material}/...', each its own curve). For videos give --pressure-log: "
             "one row per video (init DIR --pattern 'GX*.MP4' --pressure-log log.csv)."
         ),
     )

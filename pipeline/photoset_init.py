@@ -652,13 +652,17 @@ def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
     >>> print("\n".join(ramp_lines(m)))
     A1 trial 1: IMG_1.JPG ... IMG_3.JPG, 3 photos, 0 -> 20 -> 0 kPa
     A1 trial 2: IMG_4.JPG ... IMG_6.JPG, 3 photos, 0 -> 40 -> 0 kPa
+    >>> print(ramp_lines(m.assign(material=["1"] * 3 + ["2"] * 3))[1])
+    material 2, A1 trial 2: IMG_4.JPG ... IMG_6.JPG, 3 photos, 0 -> 40 -> 0 kPa
     """
     lines = []
-    for (_, actuator, trial), g in manifest.groupby(list(RAMP_KEYS), sort=False):
+    several = manifest["material"].nunique() > 1  # then each line names its material
+    for (material, actuator, trial), g in manifest.groupby(list(RAMP_KEYS), sort=False):
         p = g["pressure_kpa"].to_numpy(float)
         lines.append(
-            f"{actuator} trial {trial}: {g['image'].iloc[0]} ... {g['image'].iloc[-1]}, {len(g)} "
-            f"photos, {p[0]:g} -> {p.max():g} -> {p[-1]:g} kPa"
+            (f"material {material}, " if several else "")
+            + f"{actuator} trial {trial}: {g['image'].iloc[0]} ... {g['image'].iloc[-1]}, "
+            f"{len(g)} photos, {p[0]:g} -> {p.max():g} -> {p[-1]:g} kPa"
         )
     if len(lines) > limit:
         lines = [*lines[: limit - 1], f"... and {len(lines) - limit + 1} more ramps"]

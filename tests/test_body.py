@@ -161,6 +161,20 @@ def test_a_body_leaving_the_photo_is_flagged():
     assert res.status == "flagged" and "border at its free end" in res.reason
 
 
+def test_a_body_shorter_than_l0_with_its_tip_in_view_is_said_to_maybe_bend_out_of_the_plane():
+    # customer 38's chambers bending 120 deg round from the photo's plane looked short: "body
+    # partly hidden: 69% of l0 visible" with the whole body in view
+    img, fe, _ = body_photo(60.0)
+    res = measure_image(img, settings_for(fe, mm_per_px=0.2))  # l0 is 900 px: 600 are seen
+    assert res.status == "flagged"
+    assert ("body partly hidden: 64% of l0 visible with its tip in view: it may bend out of the "
+            "photo's plane (towards or away from the camera") in res.reason, res.reason
+    # its tip out of the photo: hidden indeed
+    img, fe, _ = body_photo(20.0, shift=(420.0, 0.0))
+    res = measure_image(img, settings_for(fe, mm_per_px=0.2))
+    assert "body partly hidden" in res.reason and "tip in view" not in res.reason, res.reason
+
+
 @pytest.mark.parametrize(("scene", "i"), [("dark_translucent", 9), ("lab", 9), ("green_fibre", 9)])
 def test_a_side_along_the_image_border_is_measured_from_the_other_edge(scene, i):
     # 720p frames with the clamp at the top edge: the body's upper side runs out of the photo

@@ -1028,6 +1028,47 @@ def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in
     assert not [w for w in res.warnings if "sealed_end" in w], res.warnings
 
 
+def test_actuators_of_one_material_bending_opposite_ways_are_warned_on_page_one(tmp_path):
+    # customer 38 followed the README's 'chamber{actuator}/...' for the three chambers of one
+    # actuator: averaged as actuators of one material, chamber 1 bending one way and chambers 2
+    # and 3 the other, the page-1 curve had a spike of +106 deg and an sd of 229 deg, and
+    # nothing said why
+    d = make_dataset(tmp_path, "DS20", actuators=3, trials=1, photos=False, overlays=False)
+    out = tmp_path / "r.pdf"
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    assert not [w for w in res.warnings if "opposite ways" in w], res.warnings
+    angles = pd.read_csv(d.angles_csv)
+    third = angles["actuator"] == "A3"
+    angles.loc[third, "psi_deg"] = 420.0 - angles.loc[third, "psi_deg"]  # from 210 deg, up
+    angles.to_csv(d.angles_csv, index=False)
+    res = build_report(ReportInputs(datasets=(d,)), out)
+    (warning,) = [w for w in res.warnings if "opposite ways" in w]
+    assert warning.startswith("DS20: its actuators bend opposite ways as the pressure rises")
+    assert "actuator A3 +" in warning and "actuator A1 -" in warning, warning
+    assert "its own material" in warning
+    assert "DS20: its actuators bend opposite ways" in " ".join(pdf_text(out, 0).split())
+
+
+def test_a_set_of_several_long_material_names_stays_on_page_one(tmp_path):
+    # customer 38's three chambers, a material each, in one photo set: the data-quality table's
+    # material cell ran the top reasons off the page's right edge
+    d = make_dataset(tmp_path, "DS20", actuators=3, trials=1, photos=False, overlays=False,
+                     timestamps="2026-12-03 09:00")
+    angles = pd.read_csv(d.angles_csv)
+    angles["material"] = "SIL3CH_chamber" + angles["actuator"].str[1:]
+    causes = ["body partly hidden: 69% of l0 visible", "end direction unstable (+18 vs +9 deg)",
+              "the end tangents and a smooth fit of the whole centre line disagree by 11 deg"]
+    flagged = angles.index[::4]
+    angles.loc[flagged, "status"] = "flagged"
+    angles.loc[flagged, "reason"] = [causes[i % 3] for i in range(len(flagged))]
+    angles.to_csv(d.angles_csv, index=False)
+    with report_style():
+        summary = report_figures(load_report_data(ReportInputs(datasets=(d,))))[0][0]
+        texts = drawn_texts(summary)
+    assert outside_page(texts) == [] and overlapping_texts(texts) == []
+    assert any("SIL3CH_chamber3" in t.text for t in texts)
+
+
 def test_a_title_of_several_lines_is_among_the_drawn_texts():
     # matplotlib draws each line of a text of several lines without naming the Text: the
     # overlap and font-size checks never saw such titles (the force page's three-line one)

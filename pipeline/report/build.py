@@ -29,6 +29,7 @@ from pipeline.layout.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.data import (
     ReportData,
     ReportInputs,
+    aggregate_options,
     force_inputs,
     load_report_data,
     modelled_materials,
@@ -36,7 +37,7 @@ from pipeline.report.data import (
 from pipeline.report.model_page import model_provenance_page
 from pipeline.report.pages import comparison_page, material_page, overview_page
 from pipeline.report.provenance import provenance_pages
-from pipeline.report.summary import summary_page
+from pipeline.report.summary import opposite_bending_warnings, summary_page
 from pipeline.report.textcheck import FOOTER_GID
 from pipeline.study import pages as study_pages
 from pipeline.video import pages as video_pages
@@ -205,6 +206,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
     for info in data.datasets:
         warnings += info.doubts
+    warnings += opposite_bending_warnings(data.angles, aggregate_options(data.run_config))
     body = (
         [overview_page(data)]
         + [material_page(data, m) for m in data.materials]

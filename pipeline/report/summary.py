@@ -17,7 +17,13 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from pipeline.aggregate import aggregate_hysteresis, is_used, pressure_levels, settled_frames
+from pipeline.aggregate import (
+    aggregate_hysteresis,
+    is_used,
+    opposite_bending,
+    pressure_levels,
+    settled_frames,
+)
 from pipeline.compare import branch
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
@@ -245,6 +251,45 @@ def coarse_crossing_notes(
     return out
 
 
+def opposite_bending_warnings(
+    angles: pd.DataFrame, options: Mapping[str, Any] | None = None
+) -> list[str]:
+    """A warning per material whose actuators bend opposite ways as the pressure rises
+    (:func:`~pipeline.aggregate.opposite_bending`): its mean curve is none of theirs.
+
+    Examples
+    --------
+    >>> rows = [(a, p, s * p) for a, s in (("1", 2.0), ("2", -1.0)) for p in (0, 50)]
+    >>> angles = pd.DataFrame([{"image": f"{a}_{p}.jpg", "material": "SIL", "actuator": a,
+    ...     "trial": 1, "direction": "up", "pressure_kpa": p, "psi_deg": psi, "status": "ok"}
+    ...     for a, p, psi in rows])
+    >>> (text,) = opposite_bending_warnings(angles)
+    >>> print(text[:text.index(":", 5)])
+    SIL: its actuators bend opposite ways as the pressure rises (ψ from 0 to 50 kPa rising)
+    >>> print(text[text.index("actuator 2"):text.index(";")])
+    actuator 2 -50 deg, actuator 1 +100 deg
+    """
+    found = opposite_bending(angles, **dict(options or {}))
+    out = []
+    for material, g in found.groupby("material", sort=True):
+        spans = {(f, t) for f, t in zip(g["from_kpa"], g["to_kpa"], strict=True)}
+        span = (
+            f"ψ from {g['from_kpa'].iloc[0]:g} to {g['to_kpa'].iloc[0]:g} kPa rising"
+            if len(spans) == 1
+            else "ψ from each one's lowest to its highest pressure, rising"
+        )
+        each = ", ".join(
+            f"actuator {a} {r:+.0f} deg" for a, r in zip(g["actuator"], g["rise_deg"], strict=True)
+        )
+        out.append(
+            f"{material}: its actuators bend opposite ways as the pressure rises ({span}): {each}; "
+            "its mean curve, range and P at ψ = 0 are none of theirs.  Give each actuator or "
+            "chamber that bends its own way its own material (the manifest's material column, "
+            "or photoset init --pattern 'chamber{material}/...')"
+        )
+    return out
+
+
 def _left_out_between(
     rows: pd.DataFrame, direction: str, span_kpa: tuple[float, float], options: Mapping[str, Any]
 ) -> str:
@@ -387,9 +432,9 @@ def quality_table(
         total = sum(counts, np.zeros(4, dtype=int))
         body.append(("all", "", "", "", *(str(int(v)) for v in total), "", ""))
         columns: tuple[Column, ...] = (
-            Column("Dataset", "left"),
+            Column("Dataset", "left", wrap_pt=90.0),
             Column("Data", "left"),
-            Column("Material", "left"),
+            Column("Material", "left", wrap_pt=90.0),  # a set's several: one a line
             Column("Photos taken", "left"),
             Column("photos"),
             Column("ok"),
