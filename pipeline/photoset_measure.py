@@ -43,6 +43,7 @@ from pipeline.photoset import (
 from pipeline.pool import map_photos
 from pipeline.ramp_check import check_ramps
 from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cached
+from pipeline.sealed_end_check import check_sealed_ends
 
 #: angles.csv: the measurement columns, in this order, then the manifest's own columns
 #: (``degree``: curve-model complexity the estimator used, see
@@ -57,7 +58,9 @@ from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cach
 #: which psi is then measured from (in the same convention); ``positive_turn``: that convention,
 #: psi's (``cw``: the three directions clockwise from +x); ``l0_mm``: the
 #: length psi was computed with; ``calibration_px`` /
-#: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated)
+#: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated;
+#: ``sealed_end_mm``: the one given; ``straight_end_mm``: the straight end seen on a capped
+#: body's centre line, see :mod:`pipeline.sealed_end_check`)
 RESULT_COLUMNS: tuple[str, ...] = (
     "image",
     "psi_deg",
@@ -79,6 +82,8 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "l0_mm",
     "calibration_px",
     "calibration_mm",
+    "sealed_end_mm",
+    "straight_end_mm",
 )
 #: an ``ok`` first look and an ``ok`` second look further apart than this (deg): the second is
 #: taken.  A first look told from a model of the backdrop misses a faint side of a translucent
@@ -201,7 +206,7 @@ def measure_photoset(
     if ramp_check:
         out = check_ramps(out)
     if not ps.is_video:
-        out = note_uneven_light(ps, out)
+        out = check_sealed_ends(note_uneven_light(ps, out))
     if "calibration_px" in out.columns:
         out = flag_doubtful_calibration(out)
     if odir is not None:
@@ -346,6 +351,7 @@ def _measure_photos(
     result["l0_mm"] = [np.nan if r is None else r.l0_mm for r in ps.rows]
     result["fixed_direction_deg"] = [np.nan if r is None else r.base_given_deg for r in ps.rows]
     result["positive_turn"] = [None if r is None else r.positive_turn for r in ps.rows]
+    result["sealed_end_mm"] = [np.nan if r is None else r.sealed_end_mm for r in ps.rows]
     rms = [(np.nan, np.nan) if r is None else r.calibration_rms for r in ps.rows]
     result["calibration_px"] = [px for px, _ in rms]
     result["calibration_mm"] = [mm for _, mm in rms]

@@ -333,7 +333,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:20]) == [
+    assert list(par.columns[:22]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
@@ -354,13 +354,16 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "l0_mm",
         "calibration_px",
         "calibration_mm",
+        "sealed_end_mm",
+        "straight_end_mm",
     ]
     assert par["base_direction_deg"].isna().all()  # drawn lines: no body base to share
+    assert par["straight_end_mm"].isna().all()  # a drawn line's
     assert par["base_side_split_deg"].isna().all()
     assert par["camera_turn_deg"].isna().all()  # a drawn line's psi does not depend on it
     assert par["fixed_direction_deg"].isna().all()
     assert (par["positive_turn"] == "ccw").all()
-    assert list(par.columns[20:26]) == [
+    assert list(par.columns[22:28]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -405,12 +408,14 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "method turning ->" in run.stdout  # what was asked is what every row took
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[15:21]) == [
+    assert list(angles.columns[15:23]) == [
         "seconds",
         "degree",
         "l0_mm",
         "calibration_px",
         "calibration_mm",
+        "sealed_end_mm",
+        "straight_end_mm",
         "pressure_kpa",
     ]
     assert (angles["degree"][:6] >= 1).all() and np.isnan(angles["degree"].iloc[-1])

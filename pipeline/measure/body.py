@@ -102,7 +102,7 @@ class BodyExtraction:
     tip_face_px : float
         How far the tip's face (the body's last pixel on the centre line's course, cap included)
         lies beyond the centre line's free end (original px); computed only when
-        ``sealed_end_mm`` is given (0 otherwise).
+        ``sealed_end_mm`` is given or the free end is capped (0 otherwise).
     tip_capped : bool
         The centre line stopped at the free end where the body goes on wider, centred on its
         course: a rigid cap, over which the body does not bend.
@@ -1879,7 +1879,7 @@ def extract_body(
         hollow_outline=selection.hollow_width_px >= HOLLOW_WIDTHS * 2.0 * half,
         tip_face_px=(
             0.0
-            if settings.sealed_end_mm is None
+            if settings.sealed_end_mm is None and settings.free_end != "capped"
             else _extensions(comp, dt, pts, half, None, free_end_bends=True)[1] * scale
         ),
     )

@@ -32,6 +32,7 @@ from pipeline.measure.estimators import (
     end_curvature,
     end_tangents,
     hyper,
+    straight_end,
     tangents,
     turning,
     turning_quick,
@@ -112,6 +113,10 @@ class AngleResult:
         the centre line's end, moved back along it or on along the tangent by what the tangent
         was carried (to the tip's face, or back to where a sealed end starts); None for a line or
         when failed.  The overlays draw the tip's direction from it.
+    straight_end_mm : float
+        A capped body's straight end seen on its centre line, with the tip's face beyond it (mm,
+        :func:`~pipeline.measure.estimators.straight_end`): NaN where none shows, for a line,
+        for ``free_end: bends`` and when failed.
     """
 
     psi_deg: float
@@ -128,6 +133,7 @@ class AngleResult:
     base_direction_deg: float = float("nan")
     base_side_split_deg: float = float("nan")
     tip_px: tuple[float, float] | None = None
+    straight_end_mm: float = float("nan")
 
 
 #: no actuator turns further than this (deg): a psi beyond it is a line that is not its own
@@ -448,13 +454,17 @@ def measure_body(
         pts, ends, settings = plane_centreline(line, settings, image_bgr.shape, scale)
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
+    per_image_px = _work_per_image_px(line, pts)
+    mm_per_work_px = settings.mm_per_px or length_scale_mm_per_px(
+        float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) + body.tip_face_px * per_image_px,
+        settings.l0_mm + (settings.sealed_end_mm or 0.0),
+    )
+    # the straight end seen on the centre line, and the tip's face beyond it (mm): checked
+    # against sealed_end_mm over the actuator's photos (pipeline.sealed_end_check)
+    straight_px = straight_end(pts) if settings.free_end == "capped" else float("nan")
+    straight_end_mm = (straight_px + body.tip_face_px * per_image_px) * mm_per_work_px
     sealed_px = 0.0  # the known sealed end, image px
     if settings.sealed_end_mm is not None:
-        per_image_px = _work_per_image_px(line, pts)
-        mm_per_work_px = settings.mm_per_px or length_scale_mm_per_px(
-            float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) + body.tip_face_px * per_image_px,
-            settings.l0_mm + settings.sealed_end_mm,
-        )
         sealed_px = settings.sealed_end_mm / mm_per_work_px / per_image_px
         ends = _read_before_sealed_end(body.tip_face_px, ends, sealed_px, per_image_px)
         if body.tip_capped:
@@ -565,6 +575,7 @@ def measure_body(
         base_side_split_deg=base_side_split_deg(
             line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION
         ),
+        straight_end_mm=straight_end_mm,
     )
     if est is not tip:
         return measured

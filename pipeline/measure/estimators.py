@@ -597,6 +597,65 @@ def end_tangents(
     return a, b, float(np.hypot(ra, rb) / np.sqrt(2.0))
 
 
+#: straight_end: the last this fraction of the line is searched for a straight end ...
+STRAIGHT_END_WINDOW = 0.35
+#: ... which turns at most this fraction of the rate of the part before it
+STRAIGHT_END_TURN_RATIO = 0.25
+#: ... and fits this fraction or less of the square misfit of one constant turning rate
+STRAIGHT_END_FIT_RATIO = 0.3
+
+
+def straight_end(points: np.ndarray, window_fraction: float = STRAIGHT_END_WINDOW) -> float:
+    """Length of a straight stretch ending the line (its units), where the line bends up to it: a
+    sealed end seen on the centre line; NaN where none shows.
+
+    Over the last ``window_fraction``, the tangent angle against arc length is fitted with two
+    joined straight pieces; the stretch after the join counts as straight when it turns at most
+    :data:`STRAIGHT_END_TURN_RATIO` of the rate before it, at least one and a half chunks
+    long (:func:`chunk_means`), and the two pieces fit much better than one
+    (:data:`STRAIGHT_END_FIT_RATIO`).  A line bending to its end, or one whose end is too
+    little bent for a join to show, gives NaN.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, np.deg2rad(200.0), 800)
+    >>> arc = np.c_[np.sin(t), 1.0 - np.cos(t)] * 100.0  # 349 units long
+    >>> tail = arc[-1] + np.outer(np.linspace(0.5, 30.0, 60), [np.cos(t[-1]), np.sin(t[-1])])
+    >>> round(straight_end(np.r_[arc, tail]))
+    30
+    >>> bool(np.isnan(straight_end(arc)))
+    True
+    """
+    means, piece = chunk_means(points)
+    d = np.diff(means, axis=0)
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    s = np.arange(1, len(means)) * piece
+    total = len(means) * piece
+    # not the last chord: where a cap begins, the centre line's last chunk may hook either way
+    # (a ribbed body's turned back 1.3 deg after turning 2-3 a chunk, read as the start of a
+    # straight end 11 mm long)
+    near = (s >= total * (1.0 - window_fraction)) & (s < s[-1])
+    s, theta = s[near], theta[near]
+    if len(s) < 6:
+        return float("nan")
+    one = np.c_[np.ones_like(s), s]
+    misfit_one = float(np.sum((one @ np.linalg.lstsq(one, theta, rcond=None)[0] - theta) ** 2))
+    best = (np.inf, 0.0, np.zeros(3))
+    for join in s[3:-1]:
+        two = np.c_[np.ones_like(s), np.minimum(s, join), np.maximum(s - join, 0.0)]
+        coef = np.linalg.lstsq(two, theta, rcond=None)[0]
+        misfit = float(np.sum((two @ coef - theta) ** 2))
+        if misfit < best[0]:
+            best = (misfit, float(join), coef)
+    misfit, join, (_, before, after) = best
+    straight = (
+        abs(after) <= STRAIGHT_END_TURN_RATIO * abs(before)
+        and misfit <= STRAIGHT_END_FIT_RATIO * misfit_one
+        and total - join >= 1.5 * piece
+    )
+    return float(total - join) if straight else float("nan")
+
+
 def end_curvature(points: np.ndarray, window_fraction: float = TANGENT_WINDOW_FRACTION) -> float:
     """Curvature (rad per px, signed as the turning of ``points``) over the last
     ``window_fraction`` of the line: the slope of its tangent angle against arc length there.

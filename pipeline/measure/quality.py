@@ -348,7 +348,7 @@ def assess_body(
         # rows ok 5-7 deg off, their reasons empty)
         notes.append(
             f"{NOTE_NO_SEALED_END}: psi read where the centre line stops, as if the body bent to "
-            "its end; a straight sealed end and cap there read |psi| high (2-7 deg at |psi| "
+            "its end, and a straight sealed end and cap there read |psi| high (2-7 deg at |psi| "
             "100-220 for an 8 mm one): give sealed_end_mm"
         )
     if tip_at_region_edge:

@@ -125,4 +125,5 @@ def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
         "reason": res.reason,
         "seconds": seconds,
         "degree": res.degree if res.status != "failed" else None,
+        "straight_end_mm": res.straight_end_mm,
     }

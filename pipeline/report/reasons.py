@@ -49,6 +49,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^curvature fit failed", "curvature fit failed"),
     (r"^internal error", "internal error (please report)"),
     (r"^body touches the image border", "body's tip at the image border"),
+    (r"^sealed end shorter than the photos show", "sealed_end_mm shorter than the photos show"),
+    (r"^sealed end not given, and", "no sealed_end_mm, and the photos show one"),
     (r"touches the image border", "line touches the image border"),
     (r"^line partly hidden", "line partly hidden"),
     (r"^line \d+% of l0", "line longer than l0 (scale or extra marks)"),

@@ -52,6 +52,7 @@ CHUNK_COLUMNS: tuple[str, ...] = (
     "reason",
     "seconds",
     "degree",
+    "straight_end_mm",
 )
 
 

@@ -1,0 +1,102 @@
+"""A sealed end left out, or given shorter than the photos show: rows whose |psi| reads high.
+
+psi is read where the bending stops, ``sealed_end_mm`` before the tip (cap included).  Left
+out, or given short, the free end's tangent is read on the straight sealed end, fitted over a
+window that reaches back into the bending part, and |psi| reads high: customer 37's actuator
+(8 mm sealed end and cap) read 36 rows ``ok`` 5-7 deg off without it and 26 with ``4``.  A
+capped body's centre line shows its straight end where it is well bent
+(:func:`pipeline.measure.estimators.straight_end`; ``straight_end_mm`` in angles.csv, the tip's
+face included): over an actuator's photos its median is the sealed end the photos show (7.9 mm
+for customer 37's 8, 7.7 for customer 33's 7, 6.6 for customer 34's 6, 12.2 for customer 36's
+12.4, 11.2 for customer 38's 10).  Where that is longer than the one given by more than
+:data:`SEALED_END_MARGIN_MM`, every row it reads |psi| high by :data:`SEALED_END_FLAG_DEG` or
+more is flagged, naming the length the photos show.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from pipeline.measure.quality import NOTE_NO_SEALED_END
+
+#: photos of one actuator whose straight end shows, at least, for a verdict
+SEALED_END_MIN_PHOTOS = 3
+#: the straight end the photos show must exceed the one given by more than this (mm) ...
+SEALED_END_MARGIN_MM = 2.0
+#: ... and a row is flagged where that reads |psi| this much high or more (deg): about half the
+#: turning over the stretch missed, ``0.5 * |psi| / l0_mm * (shown - given)`` (customer 37, 4 mm
+#: short at psi near 220: 3-7 deg)
+SEALED_END_FLAG_DEG = 2.5
+
+
+def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
+    """Flag the rows of each actuator whose sealed end is left out or given shorter than its
+    photos show (see the module docstring).
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        angles.csv rows of one photo set: ``material``, ``actuator``, ``psi_deg``, ``l0_mm``,
+        ``status``, ``reason``, ``sealed_end_mm`` (the one given, NaN when none) and
+        ``straight_end_mm``; a table without the last is returned as it is (a video's).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy, the rows reading high ``flagged`` with the cause first in ``reason``.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"material": "M", "actuator": "A", "psi_deg": [30.0, 150, 200, 210],
+    ...     "l0_mm": 90.0, "status": "ok", "reason": "", "sealed_end_mm": 4.0,
+    ...     "straight_end_mm": [np.nan, 7.8, 8.0, 7.9]})
+    >>> out = check_sealed_ends(rows)
+    >>> out["status"].tolist()
+    ['ok', 'flagged', 'flagged', 'flagged']
+    >>> print(out["reason"][2])  # doctest: +NORMALIZE_WHITESPACE
+    sealed end shorter than the photos show: sealed_end_mm is 4 but this actuator's last 8 mm stay
+    straight in 3 of its photos, so |psi| reads high (about 4 deg here): measure it again from
+    where the chamber ends to the tip, cap included (about 8 mm)
+    >>> check_sealed_ends(rows.assign(sealed_end_mm=7.0))["status"].tolist()
+    ['ok', 'ok', 'ok', 'ok']
+    """
+    if "straight_end_mm" not in angles.columns:
+        return angles
+    out = angles.copy()
+    seen = pd.to_numeric(out["straight_end_mm"], errors="coerce")
+    given = pd.to_numeric(out["sealed_end_mm"], errors="coerce")
+    high = 0.5 * pd.to_numeric(out["psi_deg"], errors="coerce").abs() / out["l0_mm"]
+    for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
+        shown = seen[g.index].dropna()
+        if len(shown) < SEALED_END_MIN_PHOTOS:
+            continue
+        shown_mm = float(shown.median())
+        short_mm = shown_mm - given[g.index].fillna(0.0)
+        reads_high = (short_mm > SEALED_END_MARGIN_MM) & (
+            high[g.index] * short_mm >= SEALED_END_FLAG_DEG
+        )
+        for i in g.index[reads_high]:
+            read_deg = float(high[i] * short_mm[i])
+            cause = (
+                f"sealed end not given, and this actuator's last {shown_mm:.0f} mm stay straight "
+                f"in {len(shown)} of its photos: |psi| reads high (about {read_deg:.0f} deg "
+                "here): give sealed_end_mm, from where the chamber ends to the tip, cap included "
+                f"(about {shown_mm:.0f} mm)"
+                if np.isnan(given[i])
+                else f"sealed end shorter than the photos show: sealed_end_mm is {given[i]:g} but "
+                f"this actuator's last {shown_mm:.0f} mm stay straight in {len(shown)} of its "
+                f"photos, so |psi| reads high (about {read_deg:.0f} deg here): measure it again "
+                "from where the chamber ends to the tip, cap included "
+                f"(about {shown_mm:.0f} mm)"
+            )
+            # the note that a sealed end left out may read |psi| high says it less exactly
+            reason = out.at[i, "reason"]
+            before = [
+                c
+                for c in (str(reason) if pd.notna(reason) else "").split("; ")
+                if c and not c.startswith(NOTE_NO_SEALED_END)
+            ]
+            out.at[i, "status"] = "flagged"
+            out.at[i, "reason"] = "; ".join([cause, *before])
+    return out
