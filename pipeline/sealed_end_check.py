@@ -7,8 +7,8 @@ window that reaches back into the bending part, and |psi| reads high: customer 3
 capped body's centre line shows its straight end where it is well bent
 (:func:`pipeline.measure.estimators.straight_end`; ``straight_end_mm`` in angles.csv, the tip's
 face included): over an actuator's photos its median is the sealed end the photos show (7.9 mm
-for customer 37's 8, 7.7 for customer 33's 7, 6.6 for customer 34's 6, 12.2 for customer 36's
-12.4, 11.2 for customer 38's 10).  Where that is longer than the one given by more than
+for customer 37's 8, 7.7 for customer 33's 7, 6.8 for customer 34's 6, 12.2 for customer 36's
+12.4, 10.4 for customer 38's 10).  Where that is longer than the one given by more than
 :data:`SEALED_END_MARGIN_MM`, every row it reads |psi| high by :data:`SEALED_END_FLAG_DEG` or
 more is flagged, naming the length the photos show.
 """
