@@ -13,11 +13,12 @@ import contextlib
 import io
 import os
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from matplotlib.backends import backend_pdf
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
@@ -153,6 +154,43 @@ def contents(figures: list[Figure]) -> list[tuple[str, int]]:
     return out
 
 
+def model_curve_warnings(
+    materials: Sequence[str], model_curves: pd.DataFrame, rms: pd.DataFrame
+) -> list[str]:
+    """Why a material's plot has no dashed model line: the model has no such material (one
+    warning for all such, customer 38's three chamber materials gave three), or ``--model-curves``
+    holds none for it.
+
+    Examples
+    --------
+    >>> curves = pd.DataFrame({"material": ["DS20"]})
+    >>> rms = pd.DataFrame({"material": ["G1", "G2", "DS30"],
+    ...                     "note": ["the model has no material G1", "... has no material G2", ""]})
+    >>> for w in model_curve_warnings(["DS20", "DS30", "G1", "G2"], curves, rms):
+    ...     print(w[:w.index(" (")] if " (" in w else w)
+    DS30: no model curve in --model-curves; its plot has no dashed model line
+    G1, G2: the model has no such material, so there is no model line, RMS or fitted k_P
+    """
+    out, unknown = [], []
+    for m in materials:
+        if (model_curves["material"].astype(str) == m).any():
+            continue
+        if "note" in rms.columns and rms.loc[
+            rms["material"].astype(str) == m, "note"
+        ].astype(str).str.contains("has no material").any():
+            unknown.append(m)
+        else:
+            out.append(f"{m}: no model curve in --model-curves; its plot has no dashed model line")
+    if unknown:
+        out.append(
+            f"{', '.join(unknown)}: the model has no such material, so there is no model line, "
+            "RMS or fitted k_P (to compare, add "
+            + ("it" if len(unknown) == 1 else "them")
+            + " to a materials file named in config.yaml: model.materials_file)"
+        )
+    return out
+
+
 def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
     """Every page in order, and the warnings printed on the summary page."""
     warnings: list[str] = []
@@ -185,18 +223,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
         extra += figs
         infos.append(f"{len(figs)} page(s) of {SOURCE_WORDS[name]} from {folder}")
     if data.inputs.model_curves:
-        for m in data.materials:
-            if not (data.model_curves["material"].astype(str) == m).any():
-                unmodelled = "note" in data.rms.columns and data.rms.loc[
-                    data.rms["material"].astype(str) == m, "note"
-                ].astype(str).str.contains("has no material").any()
-                warnings.append(
-                    f"{m}: the model has no such material, so there is no model line, RMS or "
-                    "fitted k_P (to compare, add it to a materials file named in config.yaml: "
-                    "model.materials_file)"
-                    if unmodelled
-                    else f"{m}: no model curve in --model-curves; its plot has no dashed model line"
-                )
+        warnings += model_curve_warnings(data.materials, data.model_curves, data.rms)
     for m in data.materials:
         if not (data.rms["material"].astype(str) == m).any():
             warnings.append(f"{m}: no row in --rms; its comparison values show n/a")
