@@ -206,7 +206,8 @@ def measure_photoset(
     if ramp_check:
         out = check_ramps(out)
     if not ps.is_video:
-        out = check_sealed_ends(note_uneven_light(ps, out))
+        out = note_uneven_light(ps, out)
+    out = check_sealed_ends(out)
     if "calibration_px" in out.columns:
         out = flag_doubtful_calibration(out)
     if odir is not None:

@@ -60,3 +60,23 @@ def test_the_sealed_end_the_photos_show_given_flags_nothing(ramp):
     assert not out["reason"].fillna("").str.contains("sealed end").any()
     assert out.loc[out["status"] == "ok", "error_deg"].max() < 1.5
     assert (out["sealed_end_mm"] == 25.0).all()
+
+
+def test_a_videos_frames_are_checked_against_the_sealed_end_too(tmp_path):
+    # customer 35's step responses are videos: their frames go through the same check
+    from pipeline.synth.video import render_video
+    from pipeline.video.profile import PressureProfile
+
+    folder = tmp_path / "video"
+    truth = render_video(
+        folder, "DS20", profile=PressureProfile("steps", max_kpa=160, step_kpa=80, hold_s=0.5),
+        fps=4, rest_s=0.3, scene="grey_dots",
+        scene_overrides={"width": 1280, "height": 960, "sealed_end_mm": 25.0}, seed=3,
+    )
+    assert "sealed_end_mm" not in (folder / "photoset.yaml").read_text()
+    out = measure_photoset(folder, jobs=2).merge(truth, on=["image", "frame"], suffixes=("", "_t"))
+    said = out["reason"].fillna("").str.startswith("sealed end not given, and this actuator's")
+    assert said.sum() >= 3 and (out.loc[said, "status"] == "flagged").all()
+    error = (out["psi_deg"] - out["psi_image_deg"]).abs()
+    assert not ((out["status"] == "ok") & (error > 5.0)).any(), out.loc[error > 5.0, "reason"]
+    assert np.nanmedian(out["straight_end_mm"]) == pytest.approx(25.0, abs=1.5)

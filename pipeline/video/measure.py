@@ -200,6 +200,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
     df["l0_mm"] = np.nan if settings is None else settings.l0_mm
     df["fixed_direction_deg"] = np.nan if settings is None else settings.base_given_deg
     df["positive_turn"] = None if settings is None else settings.positive_turn
+    df["sealed_end_mm"] = np.nan if settings is None else settings.sealed_end_mm
     df["calibration_px"], df["calibration_mm"] = (
         (np.nan, np.nan) if settings is None else settings.calibration_rms
     )
