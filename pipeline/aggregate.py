@@ -431,11 +431,13 @@ def opposite_bending(
     ...     for a, p, psi in rows])
     >>> opposite_bending(angles)[["actuator", "rise_deg"]].to_numpy().tolist()
     [['2', -50.0], ['3', 5.0], ['1', 100.0]]
-    >>> opposite_bending(angles[angles["actuator"] != "2"]).empty
-    True
+    >>> same_way = angles[angles["actuator"] != "2"]
+    >>> opposite_bending(same_way).empty, opposite_bending(angles[:0]).empty
+    (True, True)
     """
     curves = aggregate_per_actuator(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
-    rising = curves[(curves["direction"] == "up") & np.isfinite(curves["psi_mean_deg"])]
+    mean = pd.to_numeric(curves["psi_mean_deg"], errors="coerce")  # an empty table's: object
+    rising = curves[(curves["direction"] == "up") & mean.notna()]
     rows = []
     for (material, actuator), g in rising.groupby(["material", "actuator"], sort=True):
         if len(g) >= 2:

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from pipeline.photoset_measure import measure_photoset
+from pipeline.sealed_end_check import check_sealed_ends
 from pipeline.synth.photoset_writer import render_photoset
 
 
@@ -53,6 +54,30 @@ def test_a_sealed_end_shorter_than_the_photos_show_flags_the_rows_it_reads_high(
     assert not out.loc[said, "reason"].str.contains("no sealed_end_mm").any()
     # what the photos show, in angles.csv
     assert np.nanmedian(out["straight_end_mm"]) == pytest.approx(25.0, abs=1.5)
+
+
+def test_without_a_scale_the_straight_end_is_measured_against_l0_alone(ramp):
+    # the body's length without mm_per_px is l0 plus the straight end: against l0 alone the
+    # 25 mm read 21 (and a user giving 21 would then pass the check 4 mm short)
+    folder, settings, _ = ramp
+    unscaled = "".join(s for s in settings.splitlines(keepends=True) if "mm_per_px" not in s)
+    out = _measured((folder, unscaled, ramp[2]), "")
+    assert np.nanmedian(out["straight_end_mm"]) == pytest.approx(25.0, abs=2.0)
+    assert out["reason"].fillna("").str.startswith("sealed end not given").sum() >= 6
+
+
+def test_a_few_stray_photos_are_no_verdict():
+    # 3 of an actuator's 40 photos (20 bent 90 deg or more) read a straight end 3 mm longer than
+    # the one given: its high rows were flagged with advice to give the wrong length
+    psi = np.r_[np.linspace(0.0, 220.0, 20), np.linspace(220.0, 0.0, 20)]
+    seen = np.full(40, np.nan)
+    seen[[10, 11, 29]] = 10.0
+    rows = pd.DataFrame({"material": "M", "actuator": "A", "psi_deg": psi, "l0_mm": 100.0,
+                         "status": "ok", "reason": "", "sealed_end_mm": 7.0,
+                         "straight_end_mm": seen})
+    assert (check_sealed_ends(rows)["status"] == "ok").all()
+    seen[[1, 5, 15, 25, 32]] = 10.5  # 8 of 20: the photos do show it
+    assert (check_sealed_ends(rows.assign(straight_end_mm=seen))["status"] == "flagged").any()
 
 
 def test_the_sealed_end_the_photos_show_given_flags_nothing(ramp):

@@ -462,7 +462,17 @@ def measure_body(
     # the straight end seen on the centre line, and the tip's face beyond it (mm): checked
     # against sealed_end_mm over the actuator's photos (pipeline.sealed_end_check)
     straight_px = straight_end(pts) if settings.free_end == "capped" else float("nan")
-    straight_end_mm = (straight_px + body.tip_face_px * per_image_px) * mm_per_work_px
+    straight_px += body.tip_face_px * per_image_px
+    straight_end_mm = straight_px * (
+        mm_per_work_px
+        if settings.mm_per_px or settings.sealed_end_mm is not None
+        else length_scale_mm_per_px(  # l0_mm is the body's length less the straight end
+            float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
+            + body.tip_face_px * per_image_px
+            - straight_px,
+            settings.l0_mm,
+        )
+    )
     sealed_px = 0.0  # the known sealed end, image px
     if settings.sealed_end_mm is not None:
         sealed_px = settings.sealed_end_mm / mm_per_work_px / per_image_px
@@ -575,7 +585,7 @@ def measure_body(
         base_side_split_deg=base_side_split_deg(
             line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION
         ),
-        straight_end_mm=straight_end_mm,
+        straight_end_mm=straight_end_mm if measured.status != "failed" else float("nan"),
     )
     if est is not tip:
         return measured

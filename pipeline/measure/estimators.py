@@ -609,12 +609,13 @@ def straight_end(points: np.ndarray, window_fraction: float = STRAIGHT_END_WINDO
     """Length of a straight stretch ending the line (its units), where the line bends up to it: a
     sealed end seen on the centre line; NaN where none shows.
 
-    Over the last ``window_fraction``, the tangent angle against arc length is fitted with two
-    joined straight pieces; the stretch after the join counts as straight when it turns at most
-    :data:`STRAIGHT_END_TURN_RATIO` of the rate before it, at least one and a half chunks
-    long (:func:`chunk_means`), and the two pieces fit much better than one
-    (:data:`STRAIGHT_END_FIT_RATIO`).  A line bending to its end, or one whose end is too
-    little bent for a join to show, gives NaN.
+    Over the last ``window_fraction`` (its last chord left out), the tangent angle against arc
+    length is fitted with two joined straight pieces; the stretch after the join counts as
+    straight when it turns at most :data:`STRAIGHT_END_TURN_RATIO` of the rate before it and the
+    two pieces fit much better than one (:data:`STRAIGHT_END_FIT_RATIO`).  The join is sought
+    up to three chunks (:func:`chunk_means`, about 3/64 of the line) before the end, so a
+    shorter straight end does not show, however many pixels the photo has.  A line bending to
+    its end, or one whose end is too little bent for a join to show, gives NaN.
 
     Examples
     --------
@@ -651,7 +652,6 @@ def straight_end(points: np.ndarray, window_fraction: float = STRAIGHT_END_WINDO
     straight = (
         abs(after) <= STRAIGHT_END_TURN_RATIO * abs(before)
         and misfit <= STRAIGHT_END_FIT_RATIO * misfit_one
-        and total - join >= 1.5 * piece
     )
     return float(total - join) if straight else float("nan")
 

@@ -489,17 +489,17 @@ def assess_body(
             "depend on it)"
         )
     if expected_length_px and length_px < 0.8 * expected_length_px:
+        seen = f"{100 * length_px / expected_length_px:.0f}% of l0"
         # a tip in view says nothing is cut off: a body bending out of the photo's plane looks
-        # short (customer 38's chambers bending 120 deg round from it: "69% of l0 visible")
+        # short (customer 38's chambers bending 120 deg round from it: "69% of l0 visible"), and
+        # its psi changes smoothly along the ramp, so this is no cosmetic flag the ramp check
+        # may lift
         flags.append(
-            f"body partly hidden: {100 * length_px / expected_length_px:.0f}% of l0 visible"
-            + (
-                ""
-                if line.touches_border or tip_at_region_edge
-                else " with its tip in view: it may bend out of the photo's plane (towards or "
-                "away from the camera: psi is then the angle as seen, less than its bending "
-                "angle), or mm_per_px is off"
-            )
+            f"body partly hidden: {seen} visible"
+            if line.touches_border or tip_at_region_edge
+            else f"body short of l0 with its tip in view ({seen}): it may bend out of the "
+            "photo's plane (towards or away from the camera: psi is then the angle as seen, "
+            "less than its bending angle), or mm_per_px is off"
         )
     # psi taken against the direction given is angles.csv's fixed_direction_deg column; a note
     # saying so on every row hid the rows that matter (customer 29)

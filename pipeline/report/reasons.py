@@ -49,6 +49,7 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^curvature fit failed", "curvature fit failed"),
     (r"^internal error", "internal error (please report)"),
     (r"^body touches the image border", "body's tip at the image border"),
+    (r"^body short of l0 with its tip in view", "body short of l0, tip in view (out of plane?)"),
     (r"^sealed end shorter than the photos show", "sealed_end_mm shorter than the photos show"),
     (r"^sealed end not given, and", "no sealed_end_mm, and the photos show one"),
     (r"touches the image border", "line touches the image border"),

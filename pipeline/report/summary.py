@@ -285,7 +285,8 @@ def opposite_bending_warnings(
             f"{material}: its actuators bend opposite ways as the pressure rises ({span}): {each}; "
             "its mean curve, range and P at ψ = 0 are none of theirs.  Give each actuator or "
             "chamber that bends its own way its own material (the manifest's material column, "
-            "or photoset init --pattern 'chamber{material}/...')"
+            "or photoset init --pattern 'chamber{material}/...'); one mounted or photographed "
+            "mirrored, its rows positive_turn: cw"
         )
     return out
 
