@@ -435,7 +435,14 @@ def opposite_bending(
     >>> opposite_bending(same_way).empty, opposite_bending(angles[:0]).empty
     (True, True)
     """
-    curves = aggregate_per_actuator(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
+    return opposite_rises(
+        aggregate_per_actuator(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
+    )
+
+
+def opposite_rises(curves: pd.DataFrame) -> pd.DataFrame:
+    """:func:`opposite_bending` of per-actuator curves already made
+    (:func:`aggregate_per_actuator`'s table, e.g. the report's, of the rows it plots)."""
     mean = pd.to_numeric(curves["psi_mean_deg"], errors="coerce")  # an empty table's: object
     rising = curves[(curves["direction"] == "up") & mean.notna()]
     rows = []

@@ -1049,6 +1049,19 @@ def test_actuators_of_one_material_bending_opposite_ways_are_warned_on_page_one(
     assert "DS20: its actuators bend opposite ways" in " ".join(pdf_text(out, 0).split())
 
 
+def test_a_synthetic_set_left_out_beside_real_photos_is_not_among_the_opposite_ways(tmp_path):
+    # real photos of DS20 beside the default synthetic DS20 ramps: the plots show the real ones
+    # only, so the synthetic actuators bending the other way are no cause for the warning
+    real = make_dataset(tmp_path, "DS20", name="real", actuators=1, trials=1, overlays=False)
+    angles = pd.read_csv(real.angles_csv)
+    angles["psi_deg"] = 420.0 - angles["psi_deg"]  # from 210 deg, up
+    angles.to_csv(real.angles_csv, index=False)
+    synthetic = make_dataset(tmp_path, "DS20", name="synthetic", actuators=2, trials=1,
+                             synthetic=True, overlays=False)
+    res = build_report(ReportInputs(datasets=(real, synthetic)), tmp_path / "r.pdf")
+    assert not [w for w in res.warnings if "opposite ways" in w], res.warnings
+
+
 def test_a_set_of_several_long_material_names_stays_on_page_one(tmp_path):
     # customer 38's three chambers, a material each, in one photo set: the data-quality table's
     # material cell ran the top reasons off the page's right edge

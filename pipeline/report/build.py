@@ -30,7 +30,6 @@ from pipeline.layout.style import FOOTER_PT, material_colors, report_style
 from pipeline.report.data import (
     ReportData,
     ReportInputs,
-    aggregate_options,
     force_inputs,
     load_report_data,
     modelled_materials,
@@ -233,7 +232,7 @@ def report_figures(data: ReportData) -> tuple[list[Figure], list[str]]:
                 warnings.append(f"{d.name}: {label} folder {folder} does not exist")
     for info in data.datasets:
         warnings += info.doubts
-    warnings += opposite_bending_warnings(data.angles, aggregate_options(data.run_config))
+    warnings += opposite_bending_warnings(data.per_actuator)
     body = (
         [overview_page(data)]
         + [material_page(data, m) for m in data.materials]

@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from pipeline.aggregate import (
     aggregate_hysteresis,
     is_used,
-    opposite_bending,
+    opposite_rises,
     pressure_levels,
     settled_frames,
 )
@@ -251,11 +251,11 @@ def coarse_crossing_notes(
     return out
 
 
-def opposite_bending_warnings(
-    angles: pd.DataFrame, options: Mapping[str, Any] | None = None
-) -> list[str]:
+def opposite_bending_warnings(per_actuator: pd.DataFrame) -> list[str]:
     """A warning per material whose actuators bend opposite ways as the pressure rises
-    (:func:`~pipeline.aggregate.opposite_bending`): its mean curve is none of theirs.
+    (:func:`~pipeline.aggregate.opposite_bending`), from the per-actuator curves the report
+    plots (a synthetic set left out beside real photos of its material is not among them): its
+    mean curve is none of theirs.
 
     Examples
     --------
@@ -263,13 +263,14 @@ def opposite_bending_warnings(
     >>> angles = pd.DataFrame([{"image": f"{a}_{p}.jpg", "material": "SIL", "actuator": a,
     ...     "trial": 1, "direction": "up", "pressure_kpa": p, "psi_deg": psi, "status": "ok"}
     ...     for a, p, psi in rows])
-    >>> (text,) = opposite_bending_warnings(angles)
+    >>> from pipeline.aggregate import aggregate_per_actuator
+    >>> (text,) = opposite_bending_warnings(aggregate_per_actuator(angles))
     >>> print(text[:text.index(":", 5)])
     SIL: its actuators bend opposite ways as the pressure rises (ψ from 0 to 50 kPa rising)
     >>> print(text[text.index("actuator 2"):text.index(";")])
     actuator 2 -50 deg, actuator 1 +100 deg
     """
-    found = opposite_bending(angles, **dict(options or {}))
+    found = opposite_rises(per_actuator)
     out = []
     for material, g in found.groupby("material", sort=True):
         spans = {(f, t) for f, t in zip(g["from_kpa"], g["to_kpa"], strict=True)}
