@@ -400,9 +400,7 @@ def aggregate_per_actuator(
 OPPOSITE_BEND_DEG = 30.0
 
 
-def opposite_bending(
-    angles: pd.DataFrame, *, bin_kpa: float | None = None, include_flagged: bool = False
-) -> pd.DataFrame:
+def opposite_bending(curves: pd.DataFrame) -> pd.DataFrame:
     """Materials whose actuators bend opposite ways as the pressure rises.
 
     An actuator's rise is the change of its mean psi from its lowest to its highest pressure on
@@ -414,8 +412,9 @@ def opposite_bending(
 
     Parameters
     ----------
-    angles, bin_kpa, include_flagged
-        As in :func:`aggregate_hysteresis`.
+    curves : pandas.DataFrame
+        Per-actuator curves (:func:`aggregate_per_actuator`; the report's are of the rows it
+        plots).
 
     Returns
     -------
@@ -429,20 +428,14 @@ def opposite_bending(
     >>> angles = pd.DataFrame([{"image": f"{a}_{p}.jpg", "material": "SIL", "actuator": a,
     ...     "trial": 1, "direction": "up", "pressure_kpa": p, "psi_deg": psi, "status": "ok"}
     ...     for a, p, psi in rows])
-    >>> opposite_bending(angles)[["actuator", "rise_deg"]].to_numpy().tolist()
+    >>> found = opposite_bending(aggregate_per_actuator(angles))
+    >>> found[["actuator", "rise_deg"]].to_numpy().tolist()
     [['2', -50.0], ['3', 5.0], ['1', 100.0]]
-    >>> same_way = angles[angles["actuator"] != "2"]
-    >>> opposite_bending(same_way).empty, opposite_bending(angles[:0]).empty
+    >>> same_way = aggregate_per_actuator(angles[angles["actuator"] != "2"])
+    >>> none = aggregate_per_actuator(angles[:0])
+    >>> opposite_bending(same_way).empty, opposite_bending(none).empty
     (True, True)
     """
-    return opposite_rises(
-        aggregate_per_actuator(angles, bin_kpa=bin_kpa, include_flagged=include_flagged)
-    )
-
-
-def opposite_rises(curves: pd.DataFrame) -> pd.DataFrame:
-    """:func:`opposite_bending` of per-actuator curves already made
-    (:func:`aggregate_per_actuator`'s table, e.g. the report's, of the rows it plots)."""
     mean = pd.to_numeric(curves["psi_mean_deg"], errors="coerce")  # an empty table's: object
     rising = curves[(curves["direction"] == "up") & mean.notna()]
     rows = []

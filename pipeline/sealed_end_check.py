@@ -75,10 +75,11 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
     out = angles.copy()
     seen = pd.to_numeric(out["straight_end_mm"], errors="coerce")
     given = pd.to_numeric(out["sealed_end_mm"], errors="coerce")
-    high = 0.5 * pd.to_numeric(out["psi_deg"], errors="coerce").abs() / out["l0_mm"]
+    psi_abs = pd.to_numeric(out["psi_deg"], errors="coerce").abs()
+    high = 0.5 * psi_abs / out["l0_mm"]  # deg read high per mm of the end missed
     for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
         shown = seen[g.index].dropna()
-        bent = int((2.0 * high[g.index] * g["l0_mm"] >= 90.0).sum())  # |psi| >= 90 deg
+        bent = int((psi_abs[g.index] >= 90.0).sum())
         if len(shown) < SEALED_END_MIN_PHOTOS or len(shown) <= SEALED_END_MIN_SHARE * bent:
             continue
         shown_mm = float(shown.median())

@@ -455,9 +455,11 @@ def measure_body(
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
     per_image_px = _work_per_image_px(line, pts)
+    # the body from the fixed end to its tip's face, in the units of pts
+    seen_work_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
+    body_work_px = seen_work_px + body.tip_face_px * per_image_px
     mm_per_work_px = settings.mm_per_px or length_scale_mm_per_px(
-        float(np.sum(np.hypot(*np.diff(pts, axis=0).T))) + body.tip_face_px * per_image_px,
-        settings.l0_mm + (settings.sealed_end_mm or 0.0),
+        body_work_px, settings.l0_mm + (settings.sealed_end_mm or 0.0)
     )
     # the straight end seen on the centre line, and the tip's face beyond it (mm): checked
     # against sealed_end_mm over the actuator's photos (pipeline.sealed_end_check)
@@ -466,12 +468,8 @@ def measure_body(
     straight_end_mm = straight_px * (
         mm_per_work_px
         if settings.mm_per_px or settings.sealed_end_mm is not None
-        else length_scale_mm_per_px(  # l0_mm is the body's length less the straight end
-            float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
-            + body.tip_face_px * per_image_px
-            - straight_px,
-            settings.l0_mm,
-        )
+        # l0_mm is the body's length less the straight end
+        else length_scale_mm_per_px(body_work_px - straight_px, settings.l0_mm)
     )
     sealed_px = 0.0  # the known sealed end, image px
     if settings.sealed_end_mm is not None:
@@ -496,8 +494,7 @@ def measure_body(
         # psi is carried on over the tip the centre line stops short of (carried_on_psi_deg,
         # below): its tangent is not also carried on to where the bending stops (twice the turn)
         ends = (ends[0], min(ends[1], 0.0))
-    seen_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
-    if seen_px + ends[0] + ends[1] <= 0.0:
+    if seen_work_px + ends[0] + ends[1] <= 0.0:
         # read before a sealed end longer than the centre line found: nothing of the bending part
         # is seen, and its length read negative (customer 33's clear body: -8 px, psi -222)
         return failed(

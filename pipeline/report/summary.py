@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from pipeline.aggregate import (
     aggregate_hysteresis,
     is_used,
-    opposite_rises,
+    opposite_bending,
     pressure_levels,
     settled_frames,
 )
@@ -270,7 +270,7 @@ def opposite_bending_warnings(per_actuator: pd.DataFrame) -> list[str]:
     >>> print(text[text.index("actuator 2"):text.index(";")])
     actuator 2 -50 deg, actuator 1 +100 deg
     """
-    found = opposite_rises(per_actuator)
+    found = opposite_bending(per_actuator)
     out = []
     for material, g in found.groupby("material", sort=True):
         spans = {(f, t) for f, t in zip(g["from_kpa"], g["to_kpa"], strict=True)}
