@@ -33,7 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             "photos before the highest pressure of each ramp are 'up', after it 'down'. A "
             "pattern with '/' matches the photos' paths in DIR's subfolders, e.g. "
             "'actuator{actuator}/{step}_{pressure_kpa}kPa.jpg' (chambers of one actuator: "
-            "'chamber{material}/...', each its own curve). For videos give --pressure-log: "
+            "'chamber{material}/...', each its own curve). Photos named by a camera take their "
+            "pressures from a logger's log at their EXIF times with --pressure-log (init DIR "
+            "--pattern 'IMG_*.JPG' --pressure-log log.csv). For videos give --pressure-log: "
             "one row per video (init DIR --pattern 'GX*.MP4' --pressure-log log.csv)."
         ),
     )
@@ -59,11 +61,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument(
         "--pressure-log",
         metavar="NAME",
-        help="for videos: the pressure log (a CSV with time_s and pressure_kpa) in DIR; "
-             "'{video}' in it stands for each video's name without its ending "
-             "('{video}_pressure.csv'). Writes a video photo set, one manifest row per video "
-             "matching --pattern (e.g. 'GX*.MP4'), or one row of a frame sequence: --pattern "
-             "'frame_%%04d.jpg' names frame_0001.jpg, frame_0002.jpg, ... (with --fps)",
+        help="the pressure log (a CSV with time_s and pressure_kpa, or a logger's dated "
+             "'timestamp' column) in DIR. For photos whose names hold no pressure: each photo's "
+             "setpoint, measured pressure and direction are read from the log at the time the "
+             "camera wrote into it (EXIF). For videos ('{video}' in it stands for each video's "
+             "name without its ending, '{video}_pressure.csv'): writes a video photo set, one "
+             "manifest row per video matching --pattern (e.g. 'GX*.MP4'), or one row of a frame "
+             "sequence: --pattern 'frame_%%04d.jpg' names frame_0001.jpg, frame_0002.jpg, ... "
+             "(with --fps)",
     )
     init.add_argument(
         "--fps",
@@ -76,7 +81,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--clock-offset-s",
         type=float,
         metavar="S",
-        help="for videos: the pressure log's time at the video's first frame (s; default 0)",
+        help="with --pressure-log: the log's time at the video's first frame, or at the first "
+             "photo (s; default 0); for a log of dates and clock times, how far the logger's "
+             "clock is ahead of the camera's (s; negative when behind)",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -378,7 +385,7 @@ def _init(args: argparse.Namespace) -> int:
             )
         settings["background"] = args.background
     kept = (Path(args.folder) / photoset.SETTINGS).is_file()  # never overwritten: the user's
-    if args.pressure_log is not None:
+    if args.pressure_log is not None and photoset_init.names_videos(args.folder, args.pattern):
         df = photoset_init.init_video_photoset(
             args.folder,
             args.pattern,
@@ -395,9 +402,14 @@ def _init(args: argparse.Namespace) -> int:
         print(f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} video(s): {trials}")
         _print_next(args, kept)
         return 0
-    for option, value in (("--clock-offset-s", args.clock_offset_s), ("--fps", args.fps)):
-        if value is not None:
-            raise UserInputError(f"{option} is for videos: give their --pressure-log too")
+    if args.fps is not None:
+        raise UserInputError("--fps is for videos: give their --pressure-log too")
+    if args.clock_offset_s is not None and args.pressure_log is None:
+        raise UserInputError("--clock-offset-s places photos or videos on a pressure log: give "
+                             "--pressure-log too")
+    if args.pressure_log is not None and args.pressures_kpa is not None:
+        raise UserInputError("--pressure-log and --pressures-kpa both give the photos' "
+                             "pressures: give one of them")
     df = photoset_init.init_photoset(
         args.folder,
         args.pattern,
@@ -417,6 +429,8 @@ def _init(args: argparse.Namespace) -> int:
             if args.pressures_kpa is None
             else photoset_init.pressure_specs(args.pressures_kpa)
         ),
+        pressure_log=args.pressure_log,
+        clock_offset_s=args.clock_offset_s,
     )
     if per_actuator:
         df = _own_backgrounds(args.folder, args.background, df)
@@ -427,6 +441,24 @@ def _init(args: argparse.Namespace) -> int:
     )
     for line in photoset_init.ramp_lines(df):
         print(f"  {line}")
+    if args.pressure_log is not None:
+        t = df["log_time_s"]
+        print(
+            f"pressures read from {args.pressure_log} at the photos' EXIF times: the first at "
+            f"log time {t.min():g} s, the last at {t.max():g} s"
+            + ("" if "measured_pressure_kpa" in df else " (the log holds no measured pressure)")
+        )
+        near = photoset_init.near_step_lines(df)
+        if near:
+            print(
+                f"warning: {int(df['near_step_s'].notna().sum())} photo(s) were taken within "
+                f"{photoset_init.NEAR_STEP_S:g} s of a step of the log's setpoint, where a clock "
+                "off by a second gives the level on the other side (check --clock-offset-s, or "
+                "their pressures in the manifest):",
+                file=sys.stderr,
+            )
+            for line in near:
+                print(f"  {line}", file=sys.stderr)
     left = photoset.unlisted_photos(Path(args.folder), df["image"], "/" in args.pattern)
     if left:
         print(

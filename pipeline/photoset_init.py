@@ -12,6 +12,7 @@ import fnmatch
 import os
 import re
 from collections.abc import Mapping, Sequence
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ import pandas as pd
 from pipeline.constants import DIRECTION_WORDS, RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
+from pipeline.photo_times import exif_time
 from pipeline.photoset import (
     MANIFEST,
     SETTINGS,
@@ -31,13 +33,25 @@ from pipeline.photoset import (
     write_settings,
 )
 from pipeline.video.reader import sequence_files
-from pipeline.video.timeline import read_pressure_log
+from pipeline.video.timeline import (
+    PressureLog,
+    frame_conditions,
+    read_pressure_log,
+    span_text,
+    step_times,
+)
 
 #: file endings taken for videos (any OpenCV reads): a pattern matching only these needs
 #: ``--pressure-log``
 VIDEO_SUFFIXES: tuple[str, ...] = (
     ".avi", ".mp4", ".mov", ".mkv", ".m4v", ".wmv", ".mpg", ".mpeg", ".webm",
 )
+
+#: a photo taken closer than this to a step of a pressure log's setpoint (s) is named by ``init``:
+#: the camera's clock is kept to the second, and a clock offset a little off moves it across
+NEAR_STEP_S = 1.5
+#: columns :func:`logged_photos` gives that are no manifest's
+LOG_ONLY_COLUMNS: tuple[str, ...] = ("log_time_s", "near_step_s")
 
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
@@ -146,12 +160,13 @@ def pattern_to_regex(pattern: str, *, pressure_in_name: bool = True) -> re.Patte
         raise UserInputError(
             f"pattern {pattern!r} has no {{pressure_kpa}} field; put it where the file names hold "
             "the pressure, or (a camera's IMG_0001.JPG) give each ramp's pressures in photo order "
-            "with --pressures-kpa, e.g. 0:180:20 for 0, 20, ..., 180 and back down to 0"
+            "with --pressures-kpa, e.g. 0:180:20 for 0, 20, ..., 180 and back down to 0, or "
+            "read them from a pressure log at each photo's time with --pressure-log LOG.csv"
         )
     if not pressure_in_name and "pressure_kpa" in names:
         raise UserInputError(
-            f"pattern {pattern!r} has a {{pressure_kpa}} field and --pressures-kpa gives them too; "
-            "use one of the two"
+            f"pattern {pattern!r} has a {{pressure_kpa}} field and --pressures-kpa (or "
+            "--pressure-log) gives them too; use one of the two"
         )
     return re.compile("".join(out) + r"\Z", re.IGNORECASE)  # kPa or kpa, .jpg or .JPG
 
@@ -165,6 +180,8 @@ def init_photoset(
     overwrite: bool = False,
     pressures_kpa: Sequence[float] | Mapping[str | None, Sequence[float]] | None = None,
     leave_out: Sequence[str] = (),
+    pressure_log: str | None = None,
+    clock_offset_s: float | None = None,
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) from image file names.
 
@@ -202,25 +219,43 @@ def init_photoset(
 
     leave_out : sequence of str
         Photos in the folder that are no ramp's (each actuator's own empty scene).
+    pressure_log : str, optional
+        For file names without the pressure: a pressure log in ``folder`` (as a video's,
+        :func:`pipeline.video.timeline.read_pressure_log`), read at the time each photo was taken
+        (its EXIF time, :func:`logged_photos`).  Each photo gets the setpoint, the measured
+        pressure (when logged), the direction and its ``timestamp`` from it; the photos are taken
+        in time order, and ramps taken one after another split into trials as with one
+        ``pressures_kpa`` for them all.
+    clock_offset_s : float, optional
+        With ``pressure_log``: the log's time at the first photo (s; a log in seconds, which
+        needs it), or how far the logger's clock is ahead of the camera's (a log of dates and
+        clock times; default 0).
 
     Returns
     -------
     pandas.DataFrame
-        The manifest written.
+        The manifest written; with ``pressure_log`` also each photo's ``log_time_s`` and
+        ``near_step_s`` (:func:`logged_photos`), which the manifest does not hold.
 
     Raises
     ------
     UserInputError
-        If no file matches, a field is missing with no default, or a manifest exists.
+        If no file matches, a field is missing with no default, a manifest exists, or (with
+        ``pressure_log``) the log cannot be read, a photo holds no EXIF time or lies outside the
+        log.
     """
     folder = _new_manifest_folder(folder, overwrite)
-    videos = _matching_videos(folder, pattern)
-    if videos and not any(fnmatch_name(n, pattern) for n in photo_names(folder, "/" in pattern)):
+    if names_videos(folder, pattern):
+        videos = _matching_videos(folder, pattern)
         raise UserInputError(
-            f"{folder / videos[0]} is a video: give its pressure log with --pressure-log (a video "
-            "photo set, one row per video: README, 'Videos')"
+            (f"{folder / videos[0]} is a video" if videos else f"{pattern!r} names a video's "
+             "frames")
+            + ": give its pressure log with --pressure-log (a video photo set, one row per "
+            "video: README, 'Videos')"
         )
-    regex = pattern_to_regex(pattern, pressure_in_name=pressures_kpa is None)
+    regex = pattern_to_regex(
+        pattern, pressure_in_name=pressures_kpa is None and pressure_log is None
+    )
     defaults = {"material": None, "actuator": "A1", "trial": "1", **(defaults or {})}
     # the empty scene and calibration boards the settings name are no photos of a ramp
     named = files_named_in(folder, dict(settings or {}), pd.DataFrame()) | named_files(folder)
@@ -235,7 +270,7 @@ def init_photoset(
             continue
         fields = m.groupdict()
         row: dict[str, Any] = {"image": name, **_ramp_keys(name, fields, defaults)}
-        if pressures_kpa is None:
+        if pressures_kpa is None and pressure_log is None:
             row["pressure_kpa"] = _decimal(fields["pressure_kpa"])
         if fields.get("step") is not None:
             row["step"] = int(fields["step"])
@@ -279,14 +314,150 @@ def init_photoset(
         )
         if not trials_in_names and "direction" not in df.columns:
             df = _split_ramps(df)
+    if pressure_log is not None:
+        log, problems = read_pressure_log(folder / pressure_log)
+        if log is None:
+            raise UserInputError("--pressure-log: " + "; ".join(problems))
+        if log.clock_start is None and clock_offset_s is None:
+            raise UserInputError(
+                f"--pressure-log {pressure_log}: its times are seconds (from "
+                f"{log.read_from[0]!r}), which say nothing of when the photos were taken; give "
+                "--clock-offset-s, the log's time at the first photo (0 if the log was started "
+                "as it was taken), or log the logger's dates and clock times (a 'timestamp' "
+                "column, 2026-12-06 14:25:01.5) to place the photos by the camera's clock"
+            )
+        logged = logged_photos(folder, df["image"], log, clock_offset_s or 0.0)
+        df = df.drop(columns=["direction"], errors="ignore").merge(logged, on="image")
+        df = df.sort_values("log_time_s", kind="stable").reset_index(drop=True)
+        if not trials_in_names:
+            df = _split_ramps(df.drop(columns=["step"], errors="ignore"))
+        df["direction"] = _rising_from_the_start(df)
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
         df["step"] = df.groupby(list(RAMP_KEYS), sort=False).cumcount()
-    write_manifest(folder, df)
+    write_manifest(folder, df.drop(columns=list(LOG_ONLY_COLUMNS), errors="ignore"))
     if not (folder / SETTINGS).exists():
         write_settings(folder, {"l0_mm": None, **dict(settings or {})})
     return df
+
+
+def logged_photos(
+    folder: str | os.PathLike[str],
+    images: Sequence[str],
+    log: PressureLog,
+    clock_offset_s: float = 0.0,
+) -> pd.DataFrame:
+    """Each photo's conditions read from a pressure log at the time the photo was taken.
+
+    A photo's time is its EXIF time (:func:`pipeline.photo_times.exif_time`).  On a log in
+    seconds the first photo (in time) is at ``clock_offset_s`` and the others as many seconds
+    later as they were taken; on a log of dates and clock times (a logger's wall clock) a photo is
+    at its own time plus ``clock_offset_s`` (how far the logger's clock is ahead of the camera's).
+
+    Parameters
+    ----------
+    folder : path
+        Folder holding the photos.
+    images : sequence of str
+        The photos' names in ``folder``.
+    log : PressureLog
+        The pressure log.
+    clock_offset_s : float
+        As above (s).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per photo: ``image``, ``timestamp`` (ISO 8601, the camera's clock),
+        ``log_time_s`` (the photo's time on the log's clock), ``pressure_kpa`` (the setpoint in
+        force, :func:`pipeline.video.timeline.frame_conditions`), ``measured_pressure_kpa``
+        (when logged), ``direction``, and ``near_step_s``: how far the photo is from a step of
+        the log's setpoint when closer than :data:`NEAR_STEP_S` (NaN otherwise), where a clock a
+        little off gives it the level on the other side.
+
+    Raises
+    ------
+    UserInputError
+        Naming the photos that hold no EXIF time, or that lie outside the log, with the fix.
+    """
+    root = Path(folder)
+    times = {str(name): exif_time(root / str(name)) for name in images}
+    untimed = [name for name, when in times.items() if when is None]
+    if untimed:
+        raise UserInputError(
+            f"--pressure-log: {len(untimed)} photo(s) hold no time the camera wrote (EXIF "
+            f"DateTimeOriginal), e.g. {root / untimed[0]}; a pressure log can only be read at "
+            "photos whose time is known: give photos straight from the camera (an editor or a "
+            "converter may drop it), or give the pressures with --pressures-kpa instead"
+        )
+    stamps = pd.Series(times).astype("datetime64[ns]")
+    zero = pd.Timestamp(log.clock_start) if log.clock_start is not None else stamps.min()
+    log_time = ((stamps - zero).dt.total_seconds() + clock_offset_s).to_numpy(float)
+    conditions = frame_conditions(log, log_time)
+    outside = np.flatnonzero(~conditions["in_log"].to_numpy(bool))
+    if outside.size:
+        first = outside[0]
+        what = (
+            "the logger's clock ahead of the camera's, s; negative when behind"
+            if log.clock_start is not None
+            else "the log's time at the first photo, s"
+        )
+        raise UserInputError(
+            f"--pressure-log {Path(log.path).name}: {outside.size} of {len(stamps)} photo(s) lie "
+            f"outside the log, whose times span {span_text(log.span_s)}"
+            + (
+                f" ({log.clock_start:%Y-%m-%d %H:%M:%S} to "
+                f"{log.clock_start + timedelta(seconds=log.span_s[1]):%H:%M:%S} on its clock)"
+                if log.clock_start is not None
+                else ""
+            )
+            + ": "
+            f"{stamps.index[first]} (taken {stamps.iloc[first]:%Y-%m-%d %H:%M:%S}) is at log time "
+            f"{log_time[first]:.1f} s; give --clock-offset-s ({what}), or move photos that are "
+            "no ramp's out of the folder"
+        )
+    steps = step_times(log)
+    gap = (
+        np.min(np.abs(log_time[:, None] - steps[None, :]), axis=1)
+        if steps.size
+        else np.full(len(log_time), np.inf)
+    )
+    out = pd.DataFrame(
+        {
+            "image": stamps.index,
+            "timestamp": [f"{t:%Y-%m-%dT%H:%M:%S.%f}"[:-3] for t in stamps],
+            "log_time_s": log_time.round(3),
+            "pressure_kpa": conditions["pressure_kpa"].round(2).to_numpy(),
+        }
+    )
+    if "measured_pressure_kpa" in conditions.columns:
+        out["measured_pressure_kpa"] = conditions["measured_pressure_kpa"].round(2).to_numpy()
+    out["direction"] = conditions["direction"].to_numpy()
+    out["near_step_s"] = np.where(gap < NEAR_STEP_S, gap.round(2), np.nan)
+    return out
+
+
+def near_step_lines(logged: pd.DataFrame, limit: int = 5) -> list[str]:
+    """A warning line per photo taken near a step of the log's setpoint (``near_step_s``, as
+    :func:`logged_photos` gives it), for the user to check the clock offset.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"image": ["IMG_1.JPG", "IMG_2.JPG"], "log_time_s": [9.6, 20.0],
+    ...                    "pressure_kpa": [0.0, 10.0], "near_step_s": [0.4, float("nan")]})
+    >>> near_step_lines(df)
+    ['IMG_1.JPG at log time 9.6 s, 0.4 s from a step of the setpoint: given 0 kPa']
+    """
+    near = logged[logged["near_step_s"].notna()] if "near_step_s" in logged else logged.iloc[:0]
+    lines = [
+        f"{r.image} at log time {r.log_time_s:g} s, {r.near_step_s:g} s from a step of the "
+        f"setpoint: given {r.pressure_kpa:g} kPa"
+        for r in near.itertuples()
+    ]
+    if len(lines) > limit:
+        lines = [*lines[: limit - 1], f"... and {len(lines) - limit + 1} more"]
+    return lines
 
 
 def backgrounds_by_actuator(
@@ -448,6 +619,17 @@ def _new_manifest_folder(folder: str | os.PathLike[str], overwrite: bool) -> Pat
     if (folder / MANIFEST).exists() and not overwrite:
         raise UserInputError(f"{folder / MANIFEST} already exists; pass --overwrite to replace it")
     return folder
+
+
+def names_videos(folder: str | os.PathLike[str], pattern: str) -> bool:
+    """Whether ``pattern`` names videos in ``folder`` (and no photo), or frames cut from one
+    (``frame_%04d.jpg``): a video photo set's."""
+    root = Path(folder)
+    if sequence_files(root / pattern) is not None:
+        return True
+    return bool(_matching_videos(root, pattern)) and not any(
+        fnmatch_name(n, pattern) for n in photo_names(root, "/" in pattern)
+    )
 
 
 def _matching_videos(folder: Path, pattern: str) -> list[str]:
@@ -667,6 +849,28 @@ def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
     if len(lines) > limit:
         lines = [*lines[: limit - 1], f"... and {len(lines) - limit + 1} more ramps"]
     return lines
+
+
+def _rising_from_the_start(df: pd.DataFrame) -> pd.Series:
+    """``df``'s directions (in photo order), but ``up`` for the photos that begin a ramp at its
+    lowest pressure: held at the bottom between two ramps, the log still falls there (the last
+    photo of one ramp and the first of the next are both at 0 kPa).
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"material": "m", "actuator": "a", "trial": "2",
+    ...                    "pressure_kpa": [0, 0, 20, 0],
+    ...                    "direction": ["down", "down", "up", "down"]})
+    >>> _rising_from_the_start(df).tolist()
+    ['up', 'up', 'up', 'down']
+    """
+    out = df["direction"].copy()
+    for _, g in df.groupby(list(RAMP_KEYS), sort=False):
+        p = g["pressure_kpa"].to_numpy(float)
+        lead = int(np.argmax(p != p[0])) if (p != p[0]).any() else len(p)
+        if p[0] <= p.min():
+            out.loc[g.index[:lead]] = "up"
+    return out
 
 
 def _infer_directions(df: pd.DataFrame) -> pd.Series:

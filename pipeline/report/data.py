@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
-from PIL import Image
 
 from pipeline.aggregate import (
     aggregate_hysteresis,
@@ -33,6 +32,7 @@ from pipeline.force.grasp import EXAMPLE_LOG as GRASP_EXAMPLE
 from pipeline.force.pages import FILES as FORCE_FILES
 from pipeline.measure.quality import NOTE_RAMP_BACKGROUND
 from pipeline.measure.settings import OVERRIDE_COLUMNS
+from pipeline.photo_times import exif_time
 from pipeline.photoset import (
     MANIFEST,
     SETTINGS,
@@ -43,9 +43,6 @@ from pipeline.photoset import (
 )
 from pipeline.report.accuracy import NO_ACCURACY, AngleAccuracy, angle_accuracy
 from pipeline.study.pages import TABLES as BENCH_TABLES
-
-#: EXIF tags holding when a photo was taken (DateTimeOriginal in the Exif IFD, DateTime in IFD0)
-EXIF_IFD, EXIF_DATETIME_ORIGINAL, EXIF_DATETIME = 0x8769, 36867, 306
 
 
 @dataclass(frozen=True)
@@ -659,17 +656,10 @@ def dataset_dates(
 
 
 def exif_date(path: Path) -> str | None:
-    """``YYYY-MM-DD`` from a photo's EXIF (DateTimeOriginal, else DateTime); ``None`` if absent."""
-    try:
-        with Image.open(path) as im:
-            exif = im.getexif()
-    except OSError:
-        return None
-    value = exif.get_ifd(EXIF_IFD).get(EXIF_DATETIME_ORIGINAL) or exif.get(EXIF_DATETIME)
-    if not isinstance(value, str) or len(value) < 10:
-        return None
-    date = value[:10].replace(":", "-")
-    return date if pd.notna(pd.to_datetime(date, errors="coerce", format="%Y-%m-%d")) else None
+    """``YYYY-MM-DD`` from a photo's EXIF time (:func:`pipeline.photo_times.exif_time`);
+    ``None`` if absent."""
+    when = exif_time(path)
+    return None if when is None else when.strftime("%Y-%m-%d")
 
 
 def model_readings_note(run_config: dict[str, Any]) -> str:

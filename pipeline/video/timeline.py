@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +58,8 @@ LOG_WORDS: dict[str, tuple[str, ...]] = {
     "pressure": ("pressure", "setpoint", "set_pressure", "set", "command", "target", "p_set"),
     "measured": ("measured", "sensor", "readback", "read_back", "actual", "feedback", "p_meas"),
 }
+#: names of a time column that may hold dates and clock times (any case)
+DATED_TIME_NAMES: tuple[str, ...] = ("time", "timestamp", "datetime", "date_time", "date")
 #: seconds per unit of a time column
 SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "ms": 1e-3, "min": 60.0}
 FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
@@ -79,6 +82,9 @@ class PressureLog:
     pressure_kpa: np.ndarray
     measured_kpa: np.ndarray | None = None
     read_from: tuple[str, str, str] = ("time_s", "pressure_kpa", "")
+    #: a log whose times are dates and clock times (a logger's wall clock): the first row's, from
+    #: which ``time_s`` counts; None for a log in seconds
+    clock_start: datetime | None = None
 
     def describe_columns(self) -> str:
         """Which of the log's columns were read as what, for ``photoset check``.
@@ -222,6 +228,9 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     columns = [str(c) for c in df.columns]
     own = log_header_names(columns)
     df = _in_kpa(_in_seconds(df.rename(columns=own)))
+    df, clock_start, dated_from, dated_problems = _dated_times(df, name)
+    if dated_problems:
+        return None, dated_problems
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
         header = list(map(str, df.columns))
@@ -257,7 +266,59 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
                 )
     if problems:
         return None, problems
-    return PressureLog(str(path), t, p, m, _read_from(columns, own, m is not None)), []
+    read_from = _read_from(columns, own, m is not None)
+    if dated_from:
+        read_from = (dated_from, read_from[1], read_from[2])
+    return PressureLog(str(path), t, p, m, read_from, clock_start), []
+
+
+def _dated_times(
+    df: pd.DataFrame, name: str
+) -> tuple[pd.DataFrame, datetime | None, str, list[str]]:
+    """``df`` with ``time_s`` counted from its first row where the log has no time in seconds but
+    one column named as a time (:data:`DATED_TIME_NAMES`) holding dates and clock times
+    (``2026-12-06 14:25:01.5``, ISO 8601, any time zone dropped: the logger's wall clock).
+
+    Returns the table, the first row's date and time (None for a log in seconds), the column's
+    name ('' for none) and the problems (a cell that is no date and time, naming its line).
+
+    Examples
+    --------
+    >>> log = pd.DataFrame({"Timestamp": ["2026-12-06 14:25:01", "2026-12-06T14:25:03.5"],
+    ...                     "pressure_kpa": [0, 10]})
+    >>> out, start, column, problems = _dated_times(log, "log.csv")
+    >>> out["time_s"].tolist(), start, column, problems
+    ([0.0, 2.5], datetime.datetime(2026, 12, 6, 14, 25, 1), 'Timestamp', [])
+    >>> _dated_times(log.assign(Timestamp=["2026-12-06 14:25:01", "later"]), "log.csv")[3]
+    ["log.csv line 3: Timestamp 'later' is not a date and time (like 2026-12-06 14:25:01.5)"]
+    >>> _dated_times(log.assign(Timestamp=[0, 1]), "log.csv")[1] is None  # numbers: no dates
+    True
+    """
+    if "time_s" in df.columns:
+        return df, None, "", []
+    named = [c for c in df.columns if str(c).strip().lower() in DATED_TIME_NAMES]
+    if len(named) != 1:
+        return df, None, "", []
+    column = named[0]
+    written = df[column]
+    if np.isfinite(user_floats(written)).any():  # numbers (seconds with no unit): not dates
+        return df, None, "", []
+    stamps = pd.to_datetime(written.astype(str), errors="coerce", format="mixed")
+    if stamps.notna().sum() == 0:
+        return df, None, "", []
+    bad = np.flatnonzero(stamps.isna().to_numpy())
+    if bad.size:
+        i = int(bad[0])
+        problem = (
+            f"{name} line {i + 2}: {column} {written.iloc[i]!r} is not a date and time (like "
+            "2026-12-06 14:25:01.5)"
+        )
+        return df, None, "", [problem]
+    if getattr(stamps.dt, "tz", None) is not None:
+        stamps = stamps.dt.tz_localize(None)
+    out = df.copy()
+    out["time_s"] = (stamps - stamps.iloc[0]).dt.total_seconds().to_numpy()
+    return out, stamps.iloc[0].to_pydatetime(), str(column), []
 
 
 def _read_from(columns: list[str], own: dict[str, str], measured: bool) -> tuple[str, str, str]:
