@@ -232,7 +232,10 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     -------
     float
         Linearly interpolated pressure (kPa) between the first two consecutive points that
-        bracket the level (a point exactly on the level is returned as is); NaN if never reached.
+        bracket the level (a point exactly on the level is returned as is); NaN if never reached,
+        and NaN for a curve that starts on the level and never comes back to it: its start is its
+        rest, not a crossing (a straight-at-rest actuator's P at psi = 0 read 0 or 1 kPa by the
+        sign of the noise at rest, else n/a).
 
     Examples
     --------
@@ -242,8 +245,10 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     13.333
     >>> round(crossing_kpa([0, 10, 20, 30, 40], [0.4, -12.0, -30.0, -5.0, 15.0], 0.0), 3)
     32.5
-    >>> round(crossing_kpa([0, 10, 20], [0.4, -12.0, -30.0], 0.0), 3)  # only at its start
-    0.323
+    >>> crossing_kpa([0, 10, 20], [0.4, -12.0, -30.0], 0.0)  # only at its start: its rest
+    nan
+    >>> crossing_kpa([0, 10, 20], [-0.4, 12.0, 30.0], 0.0)
+    nan
     >>> crossing_kpa([100, 80, 60], [1.5, 20.0, 60.0], 0.0)  # never: near it is not on it
     nan
     """
@@ -254,10 +259,8 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     d = s - level_deg
     if d.size and abs(d[0]) <= START_BAND_DEG:  # it starts on the level: from where it leaves
         left = np.flatnonzero(np.abs(d) > START_BAND_DEG)
-        later = crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
-        if not math.isnan(later):
-            return later
-    for i in range(d.size):  # (else the first crossing or touch, its start's included)
+        return crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
+    for i in range(d.size):  # the first crossing or touch
         if d[i] == 0.0:
             return float(p[i])
         if i + 1 < d.size and d[i] * d[i + 1] < 0.0:

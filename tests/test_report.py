@@ -1257,3 +1257,14 @@ def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
     assert "SS40: the curve starts at ψ = -0° (straight at rest)" in notes or (
         "SS40: the curve starts at ψ = 0° (straight at rest)" in notes
     ), notes
+    # at rest a little below 0 (customer 38: "P at psi = 0" read 1 kPa, or n/a, by the sign of
+    # the noise at rest), or 1.5 deg above it ("never reaches psi = 0 (smallest mean psi 2°)"):
+    # a start on the level is no crossing
+    for rest_deg in (-0.6, 1.5):
+        a["psi_deg"] = rest_deg + 0.8 * a["pressure_kpa"]
+        a.to_csv(d.angles_csv, index=False)
+        hyst, rms = pipeline_tables(tmp_path, [d])
+        assert np.isnan(pd.read_csv(rms)["p_zero_up_kpa"]).all(), rest_deg
+        data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+        notes = " ".join(missing_notes(data))
+        assert "(straight at rest) and does not come back" in notes, (rest_deg, notes)

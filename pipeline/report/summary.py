@@ -24,7 +24,7 @@ from pipeline.aggregate import (
     pressure_levels,
     settled_frames,
 )
-from pipeline.compare import branch
+from pipeline.compare import START_BAND_DEG, branch
 from pipeline.layout.style import P_LABEL, PSI_LABEL, lighter, material_colors, text_page
 from pipeline.layout.typeset import NA, Column, Flow, Table, fmt, table_height_pt
 from pipeline.report.accuracy import ACCURACY_NOTE
@@ -356,16 +356,11 @@ def missing_notes(data: ReportData) -> list[str]:
                 "come back "
                 f"through ψ = 0 up to {top} kPa, so P at ψ = 0 (the paper's actuators are bent "
                 f"back at rest) reads n/a{paper}."
-                if abs(first) < STRAIGHT_AT_REST_DEG
+                if abs(first) <= START_BAND_DEG
                 else f"{m}: the mean curve never reaches ψ = 0 up to {top} kPa (smallest mean ψ "
                 f"{low}°), so P at ψ = 0 reads n/a{paper}."
             )
     return out
-
-
-#: a curve whose mean |psi| at its lowest pressure going up is below this (deg) starts straight:
-#: it has no P at psi = 0 to come back through
-STRAIGHT_AT_REST_DEG = 1.0
 
 
 #: a dataset with at most this many flagged or failed photos names them beside its top reasons
