@@ -414,8 +414,9 @@ def logged_photos(
             )
             + ": "
             f"{stamps.index[first]} (taken {stamps.iloc[first]:%Y-%m-%d %H:%M:%S}) is at log time "
-            f"{log_time[first]:.1f} s; give --clock-offset-s ({what}), or move photos that are "
-            "no ramp's out of the folder"
+            f"{log_time[first]:.1f} s; give --clock-offset-s ({what}; "
+            + _offsets_that_fit(log_time - clock_offset_s, log.span_s)
+            + "), or move photos that are no ramp's out of the folder"
         )
     steps = step_times(log)
     gap = (
@@ -436,6 +437,26 @@ def logged_photos(
     out["direction"] = conditions["direction"].to_numpy()
     out["near_step_s"] = np.where(gap < NEAR_STEP_S, gap.round(2), np.nan)
     return out
+
+
+def _offsets_that_fit(placed_s: np.ndarray, span_s: tuple[float, float]) -> str:
+    """The clock offsets that put photos (at ``placed_s`` on the log's clock without one) inside
+    a log spanning ``span_s``, in words.
+
+    Examples
+    --------
+    >>> _offsets_that_fit(np.array([200.0, 260.0]), (0.0, 100.0))
+    'any from -200.0 to -160.0 puts every photo inside the log'
+    >>> _offsets_that_fit(np.array([0.0, 260.0]), (0.0, 100.0))
+    'none puts every photo inside it: the photos span 260 s, the log 100 s'
+    """
+    low, high = span_s[0] - placed_s.min(), span_s[1] - placed_s.max()
+    if low > high:
+        return (
+            f"none puts every photo inside it: the photos span {np.ptp(placed_s):.0f} s, the log "
+            f"{span_s[1] - span_s[0]:.0f} s"
+        )
+    return f"any from {low:.1f} to {high:.1f} puts every photo inside the log"
 
 
 def near_step_lines(logged: pd.DataFrame, limit: int = 5) -> list[str]:

@@ -134,6 +134,7 @@ def test_a_log_in_seconds_needs_the_offset_and_photos_outside_the_log_are_refuse
     err = capsys.readouterr().err
     assert "4 of 10 photo(s) lie outside the log, whose times span -15.00-134.50 s" in err
     assert "IMG_0004.JPG (taken 2026-12-06 14:01:18) is at log time 138.4 s" in err
+    assert "any from -15.0 to 26.5 puts every photo inside the log" in err
 
 
 def test_a_photo_without_the_cameras_time_is_named_with_the_fix(logged_folder, capsys):
