@@ -448,6 +448,12 @@ def _init(args: argparse.Namespace) -> int:
             f"log time {t.min():g} s, the last at {t.max():g} s"
             + ("" if "measured_pressure_kpa" in df else " (the log holds no measured pressure)")
         )
+        if photoset_init.unheld_levels(df):
+            print(
+                "note: the setpoints at the photos are not levels held for several photos (a "
+                "continuous ramp?), so each curve point is one photo: set aggregate.bin_kpa in "
+                "config.yaml (e.g. 5) to pool the photos by pressure, within 5 kPa"
+            )
         near = photoset_init.near_step_lines(df)
         if near:
             print(

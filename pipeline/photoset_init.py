@@ -327,7 +327,8 @@ def init_photoset(
                 "column, 2026-12-06 14:25:01.5) to place the photos by the camera's clock"
             )
         logged = logged_photos(folder, df["image"], log, clock_offset_s or 0.0)
-        df = df.drop(columns=["direction"], errors="ignore").merge(logged, on="image")
+        given = [c for c in logged.columns if c != "image"]  # the log's, not the names'
+        df = df.drop(columns=given, errors="ignore").merge(logged, on="image")
         df = df.sort_values("log_time_s", kind="stable").reset_index(drop=True)
         if not trials_in_names:
             df = _split_ramps(df.drop(columns=["step"], errors="ignore"))
@@ -437,6 +438,21 @@ def logged_photos(
     out["direction"] = conditions["direction"].to_numpy()
     out["near_step_s"] = np.where(gap < NEAR_STEP_S, gap.round(2), np.nan)
     return out
+
+
+def unheld_levels(manifest: pd.DataFrame) -> bool:
+    """Whether the photos' pressures are mostly levels no other photo shares (of another trial,
+    or of the other direction): a continuous ramp, read off a log, whose curves would have a
+    point per photo.
+
+    Examples
+    --------
+    >>> stepped = pd.DataFrame({"pressure_kpa": [0, 20, 40, 20, 0] * 2})
+    >>> unheld_levels(stepped), unheld_levels(pd.DataFrame({"pressure_kpa": np.arange(10.0)}))
+    (False, True)
+    """
+    counts = manifest["pressure_kpa"].value_counts()
+    return bool((counts == 1).sum() > 0.5 * len(manifest))
 
 
 def _offsets_that_fit(placed_s: np.ndarray, span_s: tuple[float, float]) -> str:

@@ -165,3 +165,27 @@ def test_a_loggers_dated_times_are_read_on_its_own_clock(tmp_path):
     assert log.clock_start == datetime(2026, 12, 6, 14, 0, 0)
     assert log.time_s.tolist() == [0.0, 0.5, 2.25]
     assert log.describe_columns().startswith("time from 'Timestamp', setpoint from")
+
+
+def test_photos_of_a_continuous_ramp_read_the_setpoint_between_rows_and_are_told_to_bin(
+    logged_folder, capsys
+):
+    t = np.arange(0.0, 120.5, 0.5)
+    setpoint = np.interp(t, [0, 60, 120], [0, 40, 0])
+    pd.DataFrame({"time_s": t, "pressure_kpa": setpoint}).to_csv(
+        logged_folder / "log.csv", index=False
+    )
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--clock-offset-s", "0", "--trial", "1"]) == 2
+    assert "--material" in capsys.readouterr().err  # the pattern has none and none given
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--clock-offset-s", "3", "--material", "DS20"]) == 0
+    out = capsys.readouterr()
+    assert "not levels held for several photos" in out.out and "aggregate.bin_kpa" in out.out
+    assert "warning" not in out.err  # a continuous ramp has no steps
+    m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
+    taken_s = 3 + 12.0 * np.arange(10)  # the first photo at log time 3 s
+    np.testing.assert_allclose(m["pressure_kpa"], np.interp(taken_s, [0, 60, 120], [0, 40, 0]),
+                               atol=0.01)
+    assert m["direction"].tolist() == ["up"] * 5 + ["down"] * 5
+    assert "measured_pressure_kpa" not in m.columns
