@@ -6,12 +6,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from pipeline import photoset, photoset_init
 from pipeline.constants import RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.settings import FREE_ENDS, POSITIVE_TURNS
+from pipeline.photo_log import ClockSync
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -84,6 +85,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="with --pressure-log: the log's time at the video's first frame, or at the first "
              "photo (s; default 0); for a log of dates and clock times, how far the logger's "
              "clock is ahead of the camera's (s; negative when behind)",
+    )
+    init.add_argument(
+        "--log-time-at",
+        metavar="PHOTO=TIME",
+        help="with --pressure-log, for photos: the log's time when PHOTO was taken, e.g. "
+             "IMG_0001.JPG=14:00:10.1 (a clock time on a log of dates and clock times, as a photo "
+             "of the logger's screen shows it; seconds on a log in seconds); instead of "
+             "--clock-offset-s, with no sign to get wrong",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -404,36 +413,88 @@ def _init(args: argparse.Namespace) -> int:
         return 0
     if args.fps is not None:
         raise UserInputError("--fps is for videos: give their --pressure-log too")
-    if args.clock_offset_s is not None and args.pressure_log is None:
-        raise UserInputError("--clock-offset-s places photos or videos on a pressure log: give "
-                             "--pressure-log too")
+    for option, value in (("--clock-offset-s", args.clock_offset_s),
+                          ("--log-time-at", args.log_time_at)):
+        if value is not None and args.pressure_log is None:
+            raise UserInputError(f"{option} places photos on a pressure log: give --pressure-log "
+                                 "too")
     if args.pressure_log is not None and args.pressures_kpa is not None:
         raise UserInputError("--pressure-log and --pressures-kpa both give the photos' "
                              "pressures: give one of them")
+    if args.pressure_log is not None:
+        return _init_logged(args, defaults, settings, per_actuator, kept)
     df = photoset_init.init_photoset(
         args.folder,
         args.pattern,
         defaults=defaults,
         settings=settings,
         overwrite=args.overwrite,
-        leave_out=(
-            [
-                p.relative_to(args.folder).as_posix()
-                for p in Path(args.folder).glob(args.background.replace("{actuator}", "*"))
-            ]
-            if per_actuator
-            else ()
-        ),
+        leave_out=_own_empty_scenes(args, per_actuator),
         pressures_kpa=(
             None
             if args.pressures_kpa is None
             else photoset_init.pressure_specs(args.pressures_kpa)
         ),
-        pressure_log=args.pressure_log,
-        clock_offset_s=args.clock_offset_s,
     )
     if per_actuator:
         df = _own_backgrounds(args.folder, args.background, df)
+    _print_written(args, df, kept)
+    return 0
+
+
+def _own_empty_scenes(args: argparse.Namespace, per_actuator: bool) -> list[str]:
+    """Each actuator's photo of the empty scene (``--background`` with ``{actuator}``)."""
+    if not per_actuator:
+        return []
+    return [
+        p.relative_to(args.folder).as_posix()
+        for p in Path(args.folder).glob(args.background.replace("{actuator}", "*"))
+    ]
+
+
+def _init_logged(
+    args: argparse.Namespace,
+    defaults: dict[str, Any],
+    settings: dict[str, object],
+    per_actuator: bool,
+    kept: bool,
+) -> int:
+    """``init --pressure-log`` on photos: their pressures read from the log at their EXIF
+    times, and what the user should check."""
+    photo = log_time = None
+    if args.log_time_at is not None:
+        photo, sep, log_time = args.log_time_at.partition("=")
+        if not (sep and photo.strip() and log_time.strip()):
+            raise UserInputError(
+                f"--log-time-at {args.log_time_at!r}: give PHOTO=TIME, the log's time when that "
+                "photo was taken (IMG_0001.JPG=14:00:10.1)"
+            )
+        photo, log_time = photo.strip(), log_time.strip()
+    df, placement = photoset_init.init_logged_photoset(
+        args.folder,
+        args.pattern,
+        args.pressure_log,
+        ClockSync(offset_s=args.clock_offset_s, photo=photo, log_time=log_time),
+        defaults=defaults,
+        settings=settings,
+        overwrite=args.overwrite,
+        leave_out=_own_empty_scenes(args, per_actuator),
+    )
+    if per_actuator:
+        df = _own_backgrounds(args.folder, args.background, df)
+    print(f"pressures read from {args.pressure_log} at the photos' EXIF times:")
+    for note in placement.notes:
+        print(f"  {note}")
+    for line in placement.warnings:
+        print(line if line.startswith("  ") else f"warning: {line}", file=sys.stderr)
+    _print_written(args, df, kept, placement.left_out)
+    return 0
+
+
+def _print_written(
+    args: argparse.Namespace, df: pd.DataFrame, kept: bool, left_out: tuple[str, ...] = ()
+) -> None:
+    """Say what ``init`` wrote: the photos, each ramp, the photos it left out, what next."""
     n_up = int((df["direction"] == "up").sum())
     print(
         f"wrote {args.folder}/{photoset.MANIFEST}: {len(df)} photos ({n_up} up, {len(df) - n_up} "
@@ -441,31 +502,11 @@ def _init(args: argparse.Namespace) -> int:
     )
     for line in photoset_init.ramp_lines(df):
         print(f"  {line}")
-    if args.pressure_log is not None:
-        t = df["log_time_s"]
-        print(
-            f"pressures read from {args.pressure_log} at the photos' EXIF times: the first at "
-            f"log time {t.min():g} s, the last at {t.max():g} s"
-            + ("" if "measured_pressure_kpa" in df else " (the log holds no measured pressure)")
-        )
-        if photoset_init.unheld_levels(df):
-            print(
-                "note: the setpoints at the photos are not levels held for several photos (a "
-                "continuous ramp?), so each curve point is one photo: set aggregate.bin_kpa in "
-                "config.yaml (e.g. 5) to pool the photos by pressure, within 5 kPa"
-            )
-        near = photoset_init.near_step_lines(df)
-        if near:
-            print(
-                f"warning: {int(df['near_step_s'].notna().sum())} photo(s) were taken within "
-                f"{photoset_init.NEAR_STEP_S:g} s of a step of the log's setpoint, where a clock "
-                "off by a second gives the level on the other side (check --clock-offset-s, or "
-                "their pressures in the manifest):",
-                file=sys.stderr,
-            )
-            for line in near:
-                print(f"  {line}", file=sys.stderr)
-    left = photoset.unlisted_photos(Path(args.folder), df["image"], "/" in args.pattern)
+    left = [
+        name
+        for name in photoset.unlisted_photos(Path(args.folder), df["image"], "/" in args.pattern)
+        if name not in left_out
+    ]
     if left:
         print(
             f"warning: {len(left)} photo(s) do not match the pattern and are not in the manifest: "
@@ -476,7 +517,6 @@ def _init(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     _print_next(args, kept)
-    return 0
 
 
 def _print_next(args: argparse.Namespace, kept: bool) -> None:

@@ -12,7 +12,6 @@ import fnmatch
 import os
 import re
 from collections.abc import Mapping, Sequence
-from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +21,7 @@ import pandas as pd
 from pipeline.constants import DIRECTION_WORDS, RAMP_KEYS
 from pipeline.errors import UserInputError
 from pipeline.measure.formats import undecodable, unreadable_format
-from pipeline.photo_times import exif_time
+from pipeline.photo_log import PLACEMENT_ONLY_COLUMNS, ClockSync, PhotoPlacement, place_photos
 from pipeline.photoset import (
     MANIFEST,
     SETTINGS,
@@ -33,25 +32,13 @@ from pipeline.photoset import (
     write_settings,
 )
 from pipeline.video.reader import sequence_files
-from pipeline.video.timeline import (
-    PressureLog,
-    frame_conditions,
-    read_pressure_log,
-    span_text,
-    step_times,
-)
+from pipeline.video.timeline import read_pressure_log
 
 #: file endings taken for videos (any OpenCV reads): a pattern matching only these needs
 #: ``--pressure-log``
 VIDEO_SUFFIXES: tuple[str, ...] = (
     ".avi", ".mp4", ".mov", ".mkv", ".m4v", ".wmv", ".mpg", ".mpeg", ".webm",
 )
-
-#: a photo taken closer than this to a step of a pressure log's setpoint (s) is named by ``init``:
-#: the camera's clock is kept to the second, and a clock offset a little off moves it across
-NEAR_STEP_S = 1.5
-#: columns :func:`logged_photos` gives that are no manifest's
-LOG_ONLY_COLUMNS: tuple[str, ...] = ("log_time_s", "near_step_s")
 
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
@@ -180,8 +167,6 @@ def init_photoset(
     overwrite: bool = False,
     pressures_kpa: Sequence[float] | Mapping[str | None, Sequence[float]] | None = None,
     leave_out: Sequence[str] = (),
-    pressure_log: str | None = None,
-    clock_offset_s: float | None = None,
 ) -> pd.DataFrame:
     """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) from image file names.
 
@@ -219,31 +204,93 @@ def init_photoset(
 
     leave_out : sequence of str
         Photos in the folder that are no ramp's (each actuator's own empty scene).
-    pressure_log : str, optional
-        For file names without the pressure: a pressure log in ``folder`` (as a video's,
-        :func:`pipeline.video.timeline.read_pressure_log`), read at the time each photo was taken
-        (its EXIF time, :func:`logged_photos`).  Each photo gets the setpoint, the measured
-        pressure (when logged), the direction and its ``timestamp`` from it; the photos are taken
-        in time order, and ramps taken one after another split into trials as with one
-        ``pressures_kpa`` for them all.
-    clock_offset_s : float, optional
-        With ``pressure_log``: the log's time at the first photo (s; a log in seconds, which
-        needs it), or how far the logger's clock is ahead of the camera's (a log of dates and
-        clock times; default 0).
-
     Returns
     -------
     pandas.DataFrame
-        The manifest written; with ``pressure_log`` also each photo's ``log_time_s`` and
-        ``near_step_s`` (:func:`logged_photos`), which the manifest does not hold.
+        The manifest written.
 
     Raises
     ------
     UserInputError
-        If no file matches, a field is missing with no default, a manifest exists, or (with
-        ``pressure_log``) the log cannot be read, a photo holds no EXIF time or lies outside the
-        log.
+        If no file matches, a field is missing with no default, or a manifest exists.
     """
+    return _init_photoset(
+        folder,
+        pattern,
+        defaults=defaults,
+        settings=settings,
+        overwrite=overwrite,
+        pressures_kpa=pressures_kpa,
+        leave_out=leave_out,
+    )[0]
+
+
+def init_logged_photoset(
+    folder: str | os.PathLike[str],
+    pattern: str,
+    pressure_log: str,
+    sync: ClockSync,
+    *,
+    defaults: Mapping[str, Any] | None = None,
+    settings: Mapping[str, Any] | None = None,
+    overwrite: bool = False,
+    leave_out: Sequence[str] = (),
+) -> tuple[pd.DataFrame, PhotoPlacement]:
+    """Write a starter ``manifest.csv`` (and ``photoset.yaml`` if absent) of photos whose
+    pressures come from a pressure log, read at the time each photo was taken
+    (:func:`pipeline.photo_log.place_photos`).
+
+    Each photo gets the setpoint in force, the measured pressure (when logged), the direction and
+    its ``timestamp``; the photos go in the order taken, and ramps taken one after another (no
+    ``{trial}`` in the pattern) split into trials where the pressure, back at its lowest, rises
+    again.  Photos in a gap of the log are left out.
+
+    Parameters
+    ----------
+    folder, pattern, defaults, settings, overwrite, leave_out
+        As for :func:`init_photoset` (the pattern holds no ``{pressure_kpa}``).
+    pressure_log : str
+        The log's name in ``folder``.
+    sync : ClockSync
+        How the camera's clock maps onto the log's.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, PhotoPlacement)
+        The manifest written, and the placement (its lines for the user).
+
+    Raises
+    ------
+    UserInputError
+        As :func:`init_photoset` and :func:`pipeline.photo_log.place_photos`; then no manifest
+        is written.
+    """
+    df, placement = _init_photoset(
+        folder,
+        pattern,
+        defaults=defaults,
+        settings=settings,
+        overwrite=overwrite,
+        leave_out=leave_out,
+        pressure_log=(pressure_log, sync),
+    )
+    assert placement is not None
+    return df, placement
+
+
+def _init_photoset(
+    folder: str | os.PathLike[str],
+    pattern: str,
+    *,
+    defaults: Mapping[str, Any] | None,
+    settings: Mapping[str, Any] | None,
+    overwrite: bool,
+    leave_out: Sequence[str],
+    pressures_kpa: Sequence[float] | Mapping[str | None, Sequence[float]] | None = None,
+    pressure_log: tuple[str, ClockSync] | None = None,
+) -> tuple[pd.DataFrame, PhotoPlacement | None]:
+    """:func:`init_photoset` and :func:`init_logged_photoset`: the manifest written, and the
+    placement on the log (None without one)."""
     folder = _new_manifest_folder(folder, overwrite)
     if names_videos(folder, pattern):
         videos = _matching_videos(folder, pattern)
@@ -314,21 +361,17 @@ def init_photoset(
         )
         if not trials_in_names and "direction" not in df.columns:
             df = _split_ramps(df)
+    placement = None
     if pressure_log is not None:
-        log, problems = read_pressure_log(folder / pressure_log)
-        if log is None:
-            raise UserInputError("--pressure-log: " + "; ".join(problems))
-        if log.clock_start is None and clock_offset_s is None:
-            raise UserInputError(
-                f"--pressure-log {pressure_log}: its times are seconds (from "
-                f"{log.read_from[0]!r}), which say nothing of when the photos were taken; give "
-                "--clock-offset-s, the log's time at the first photo (0 if the log was started "
-                "as it was taken), or log the logger's dates and clock times (a 'timestamp' "
-                "column, 2026-12-06 14:25:01.5) to place the photos by the camera's clock"
-            )
-        logged = logged_photos(folder, df["image"], log, clock_offset_s or 0.0)
+        placement = place_photos(folder, df["image"].tolist(), *pressure_log)
+        logged = placement.table
         given = [c for c in logged.columns if c != "image"]  # the log's, not the names'
-        df = df.drop(columns=given, errors="ignore").merge(logged, on="image")
+        df = df.drop(columns=given, errors="ignore").merge(logged, on="image")  # gaps' go
+        if df.empty:
+            raise UserInputError(
+                f"--pressure-log {pressure_log[0]}: every photo lies in a gap of the log; "
+                + "; ".join(placement.warnings)
+            )
         df = df.sort_values("log_time_s", kind="stable").reset_index(drop=True)
         if not trials_in_names:
             df = _split_ramps(df.drop(columns=["step"], errors="ignore"))
@@ -337,164 +380,10 @@ def init_photoset(
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
         df["step"] = df.groupby(list(RAMP_KEYS), sort=False).cumcount()
-    write_manifest(folder, df.drop(columns=list(LOG_ONLY_COLUMNS), errors="ignore"))
+    write_manifest(folder, df.drop(columns=list(PLACEMENT_ONLY_COLUMNS), errors="ignore"))
     if not (folder / SETTINGS).exists():
         write_settings(folder, {"l0_mm": None, **dict(settings or {})})
-    return df
-
-
-def logged_photos(
-    folder: str | os.PathLike[str],
-    images: Sequence[str],
-    log: PressureLog,
-    clock_offset_s: float = 0.0,
-) -> pd.DataFrame:
-    """Each photo's conditions read from a pressure log at the time the photo was taken.
-
-    A photo's time is its EXIF time (:func:`pipeline.photo_times.exif_time`).  On a log in
-    seconds the first photo (in time) is at ``clock_offset_s`` and the others as many seconds
-    later as they were taken; on a log of dates and clock times (a logger's wall clock) a photo is
-    at its own time plus ``clock_offset_s`` (how far the logger's clock is ahead of the camera's).
-
-    Parameters
-    ----------
-    folder : path
-        Folder holding the photos.
-    images : sequence of str
-        The photos' names in ``folder``.
-    log : PressureLog
-        The pressure log.
-    clock_offset_s : float
-        As above (s).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per photo: ``image``, ``timestamp`` (ISO 8601, the camera's clock),
-        ``log_time_s`` (the photo's time on the log's clock), ``pressure_kpa`` (the setpoint in
-        force, :func:`pipeline.video.timeline.frame_conditions`), ``measured_pressure_kpa``
-        (when logged), ``direction``, and ``near_step_s``: how far the photo is from a step of
-        the log's setpoint when closer than :data:`NEAR_STEP_S` (NaN otherwise), where a clock a
-        little off gives it the level on the other side.
-
-    Raises
-    ------
-    UserInputError
-        Naming the photos that hold no EXIF time, or that lie outside the log, with the fix.
-    """
-    root = Path(folder)
-    times = {str(name): exif_time(root / str(name)) for name in images}
-    untimed = [name for name, when in times.items() if when is None]
-    if untimed:
-        raise UserInputError(
-            f"--pressure-log: {len(untimed)} photo(s) hold no time the camera wrote (EXIF "
-            f"DateTimeOriginal), e.g. {root / untimed[0]}; a pressure log can only be read at "
-            "photos whose time is known: give photos straight from the camera (an editor or a "
-            "converter may drop it), or give the pressures with --pressures-kpa instead"
-        )
-    stamps = pd.Series(times).astype("datetime64[ns]")
-    zero = pd.Timestamp(log.clock_start) if log.clock_start is not None else stamps.min()
-    log_time = ((stamps - zero).dt.total_seconds() + clock_offset_s).to_numpy(float)
-    conditions = frame_conditions(log, log_time)
-    outside = np.flatnonzero(~conditions["in_log"].to_numpy(bool))
-    if outside.size:
-        first = outside[0]
-        what = (
-            "the logger's clock ahead of the camera's, s; negative when behind"
-            if log.clock_start is not None
-            else "the log's time at the first photo, s"
-        )
-        raise UserInputError(
-            f"--pressure-log {Path(log.path).name}: {outside.size} of {len(stamps)} photo(s) lie "
-            f"outside the log, whose times span {span_text(log.span_s)}"
-            + (
-                f" ({log.clock_start:%Y-%m-%d %H:%M:%S} to "
-                f"{log.clock_start + timedelta(seconds=log.span_s[1]):%H:%M:%S} on its clock)"
-                if log.clock_start is not None
-                else ""
-            )
-            + ": "
-            f"{stamps.index[first]} (taken {stamps.iloc[first]:%Y-%m-%d %H:%M:%S}) is at log time "
-            f"{log_time[first]:.1f} s; give --clock-offset-s ({what}; "
-            + _offsets_that_fit(log_time - clock_offset_s, log.span_s)
-            + "), or move photos that are no ramp's out of the folder"
-        )
-    steps = step_times(log)
-    gap = (
-        np.min(np.abs(log_time[:, None] - steps[None, :]), axis=1)
-        if steps.size
-        else np.full(len(log_time), np.inf)
-    )
-    out = pd.DataFrame(
-        {
-            "image": stamps.index,
-            "timestamp": [f"{t:%Y-%m-%dT%H:%M:%S.%f}"[:-3] for t in stamps],
-            "log_time_s": log_time.round(3),
-            "pressure_kpa": conditions["pressure_kpa"].round(2).to_numpy(),
-        }
-    )
-    if "measured_pressure_kpa" in conditions.columns:
-        out["measured_pressure_kpa"] = conditions["measured_pressure_kpa"].round(2).to_numpy()
-    out["direction"] = conditions["direction"].to_numpy()
-    out["near_step_s"] = np.where(gap < NEAR_STEP_S, gap.round(2), np.nan)
-    return out
-
-
-def unheld_levels(manifest: pd.DataFrame) -> bool:
-    """Whether the photos' pressures are mostly levels no other photo shares (of another trial,
-    or of the other direction): a continuous ramp, read off a log, whose curves would have a
-    point per photo.
-
-    Examples
-    --------
-    >>> stepped = pd.DataFrame({"pressure_kpa": [0, 20, 40, 20, 0] * 2})
-    >>> unheld_levels(stepped), unheld_levels(pd.DataFrame({"pressure_kpa": np.arange(10.0)}))
-    (False, True)
-    """
-    counts = manifest["pressure_kpa"].value_counts()
-    return bool((counts == 1).sum() > 0.5 * len(manifest))
-
-
-def _offsets_that_fit(placed_s: np.ndarray, span_s: tuple[float, float]) -> str:
-    """The clock offsets that put photos (at ``placed_s`` on the log's clock without one) inside
-    a log spanning ``span_s``, in words.
-
-    Examples
-    --------
-    >>> _offsets_that_fit(np.array([200.0, 260.0]), (0.0, 100.0))
-    'any from -200.0 to -160.0 puts every photo inside the log'
-    >>> _offsets_that_fit(np.array([0.0, 260.0]), (0.0, 100.0))
-    'none puts every photo inside it: the photos span 260 s, the log 100 s'
-    """
-    low, high = span_s[0] - placed_s.min(), span_s[1] - placed_s.max()
-    if low > high:
-        return (
-            f"none puts every photo inside it: the photos span {np.ptp(placed_s):.0f} s, the log "
-            f"{span_s[1] - span_s[0]:.0f} s"
-        )
-    return f"any from {low:.1f} to {high:.1f} puts every photo inside the log"
-
-
-def near_step_lines(logged: pd.DataFrame, limit: int = 5) -> list[str]:
-    """A warning line per photo taken near a step of the log's setpoint (``near_step_s``, as
-    :func:`logged_photos` gives it), for the user to check the clock offset.
-
-    Examples
-    --------
-    >>> df = pd.DataFrame({"image": ["IMG_1.JPG", "IMG_2.JPG"], "log_time_s": [9.6, 20.0],
-    ...                    "pressure_kpa": [0.0, 10.0], "near_step_s": [0.4, float("nan")]})
-    >>> near_step_lines(df)
-    ['IMG_1.JPG at log time 9.6 s, 0.4 s from a step of the setpoint: given 0 kPa']
-    """
-    near = logged[logged["near_step_s"].notna()] if "near_step_s" in logged else logged.iloc[:0]
-    lines = [
-        f"{r.image} at log time {r.log_time_s:g} s, {r.near_step_s:g} s from a step of the "
-        f"setpoint: given {r.pressure_kpa:g} kPa"
-        for r in near.itertuples()
-    ]
-    if len(lines) > limit:
-        lines = [*lines[: limit - 1], f"... and {len(lines) - limit + 1} more"]
-    return lines
+    return df, placement
 
 
 def backgrounds_by_actuator(

@@ -55,18 +55,23 @@ def _log_rows(logger_ahead_s: float = 0.0) -> pd.DataFrame:
     )
 
 
-@pytest.fixture
-def logged_folder(tmp_path: Path) -> Path:
-    """Ten photos named by the camera's counter, taken mid-hold, and the logger's dated log (its
-    clock 5.5 s ahead of the camera's), in the order a counter that rolled over names them."""
-    folder = tmp_path / "set"
+def _photo_set(folder: Path, shot_s: float = SHOT_S, logger_ahead_s: float = 5.5) -> Path:
+    """Ten photos named by the camera's counter, each ``shot_s`` into its hold, and the logger's
+    dated log (its clock ``logger_ahead_s`` ahead of the camera's), in the order a counter that
+    rolled over names them."""
     folder.mkdir()
     for i in range(len(LEVELS_KPA)):
         # the counter rolled over after the third photo: name order is not time order
         number = 9997 + i if i < 3 else i - 2
-        _photo(folder / f"IMG_{number:04d}.JPG", START + timedelta(seconds=HOLD_S * i + SHOT_S))
-    _log_rows(logger_ahead_s=5.5).drop(columns="camera_s").to_csv(folder / "log.csv", index=False)
+        _photo(folder / f"IMG_{number:04d}.JPG", START + timedelta(seconds=HOLD_S * i + shot_s))
+    _log_rows(logger_ahead_s).drop(columns="camera_s").to_csv(folder / "log.csv", index=False)
     return folder
+
+
+@pytest.fixture
+def logged_folder(tmp_path: Path) -> Path:
+    """:func:`_photo_set`: photos 6.4 s into their holds, the logger 5.5 s ahead."""
+    return _photo_set(tmp_path / "set")
 
 
 def _taken(manifest: pd.DataFrame) -> pd.DataFrame:
@@ -124,7 +129,8 @@ def test_a_log_in_seconds_needs_the_offset_and_photos_outside_the_log_are_refuse
             "log.csv", "--material", "DS20"]
     assert main(args) == 2
     err = capsys.readouterr().err
-    assert "its times are seconds (from 't (s)')" in err and "give --clock-offset-s" in err
+    assert "its times are seconds (from 't (s)')" in err and "or --clock-offset-s" in err
+    assert "give --log-time-at PHOTO=SECONDS" in err
     assert not (logged_folder / "manifest.csv").exists()
     assert main([*args, "--clock-offset-s", "6.4"]) == 0
     m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
@@ -189,3 +195,72 @@ def test_photos_of_a_continuous_ramp_read_the_setpoint_between_rows_and_are_told
                                atol=0.01)
     assert m["direction"].tolist() == ["up"] * 5 + ["down"] * 5
     assert "measured_pressure_kpa" not in m.columns
+
+
+def test_a_clock_offset_of_the_wrong_sign_is_named_and_a_photo_of_the_loggers_clock_has_none(
+    tmp_path, capsys
+):
+    """The logger 2 s ahead, photos 3 s into their holds: -2 (behind, the sign mistaken) puts the
+    eight photos after a step 1 s before it, reading the level before; the warning says the
+    opposite sign puts none there.  The log's time at one photo gives the offset with no sign."""
+    folder = _photo_set(tmp_path / "set", shot_s=3.0, logger_ahead_s=2.0)
+    args = ["photoset", "init", str(folder), "--pattern", "IMG_*.JPG", "--pressure-log",
+            "log.csv", "--material", "DS20", "--overwrite"]
+    assert main([*args, "--clock-offset-s", "-2"]) == 0
+    err = capsys.readouterr().err
+    assert "8 photo(s) were taken within 1.5 s of a step" in err
+    assert "with --clock-offset-s 2 (the opposite sign) 0 photo(s), not 8, would be near" in err
+    assert main([*args, "--clock-offset-s", "2"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    # IMG_9997.JPG was taken at 14:00:03 by the camera, 14:00:05 by the logger's clock
+    assert main([*args, "--log-time-at", "IMG_9997.JPG=14:00:05"]) == 0
+    out = capsys.readouterr()
+    assert "the logger's clock taken as 2 s ahead of the camera's" in out.out
+    assert "warning" not in out.err
+    assert _taken(pd.read_csv(folder / "manifest.csv"))["pressure_kpa"].tolist() == LEVELS_KPA
+    assert main([*args, "--log-time-at", "IMG_9997.JPG"]) == 2
+    assert "give PHOTO=TIME" in capsys.readouterr().err
+    # on a log in seconds, the log's time (s) at that photo
+    rows = _log_rows(2.0)
+    rows.assign(time_s=rows["camera_s"] + 2.0)[["time_s", "Setpoint (kPa)"]].to_csv(
+        folder / "log.csv", index=False
+    )
+    assert main([*args, "--log-time-at", "IMG_0001.JPG=41"]) == 0  # its fourth photo, at 39 s
+    assert _taken(pd.read_csv(folder / "manifest.csv"))["pressure_kpa"].tolist() == LEVELS_KPA
+
+
+def test_photos_in_a_gap_of_the_log_are_left_out_and_named(logged_folder, capsys):
+    """A logger that stopped writing for 24 s (a USB hiccup): the two photos taken then have no
+    known pressure; they were given the last level logged, and measured ok."""
+    rows = _log_rows(5.5)
+    gap = (rows["camera_s"] >= 3 * HOLD_S) & (rows["camera_s"] < 5 * HOLD_S)
+    rows[~gap].drop(columns="camera_s").to_csv(logged_folder / "log.csv", index=False)
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s", "5.5",
+                 "--l0-mm", "100"]) == 0
+    err = capsys.readouterr().err
+    assert "2 photo(s) (IMG_0001.JPG, IMG_0002.JPG) were taken in a gap of the log: no row for " \
+        "24.5 s" in err
+    assert "left out of the manifest" in err and "do not match the pattern" not in err
+    m = pd.read_csv(logged_folder / "manifest.csv")
+    assert len(m) == 8 and not m["image"].isin(["IMG_0001.JPG", "IMG_0002.JPG"]).any()
+    assert main(["photoset", "check", str(logged_folder)]) == 0
+    assert "2 photos in the folder are not in manifest.csv" in capsys.readouterr().err
+
+
+def test_a_logs_dates_that_read_either_way_are_read_as_the_photos_dates_say(
+    logged_folder, capsys
+):
+    """A logger writing day first, 06/12/2026 (read month first, 12 June, every photo lay
+    outside the log, and the error pointed at the clock offset)."""
+    rows = _log_rows(5.5)
+    stamps = pd.to_datetime(rows["Timestamp"], format="ISO8601")
+    rows.assign(Timestamp=stamps.dt.strftime("%d/%m/%Y %H:%M:%S.%f").str[:-3]).drop(
+        columns="camera_s"
+    ).to_csv(logged_folder / "log.csv", index=False)
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
+                 "5.5"]) == 0
+    assert "read as 2026-12-06, as the photos' own dates are" in capsys.readouterr().out
+    m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
+    assert m["pressure_kpa"].tolist() == LEVELS_KPA

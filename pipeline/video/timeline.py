@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -85,6 +86,9 @@ class PressureLog:
     #: a log whose times are dates and clock times (a logger's wall clock): the first row's, from
     #: which ``time_s`` counts; None for a log in seconds
     clock_start: datetime | None = None
+    #: a dated log whose dates read either way (``05/12/2026``): the first row read day first
+    #: (``clock_start`` is it read month first); None where the dates are plain
+    clock_start_dayfirst: datetime | None = None
 
     def describe_columns(self) -> str:
         """Which of the log's columns were read as what, for ``photoset check``.
@@ -228,7 +232,7 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     columns = [str(c) for c in df.columns]
     own = log_header_names(columns)
     df = _in_kpa(_in_seconds(df.rename(columns=own)))
-    df, clock_start, dated_from, dated_problems = _dated_times(df, name)
+    df, clock_starts, dated_from, dated_problems = _dated_times(df, name)
     if dated_problems:
         return None, dated_problems
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
@@ -269,18 +273,20 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     read_from = _read_from(columns, own, m is not None)
     if dated_from:
         read_from = (dated_from, read_from[1], read_from[2])
-    return PressureLog(str(path), t, p, m, read_from, clock_start), []
+    return PressureLog(str(path), t, p, m, read_from, *clock_starts), []
 
 
 def _dated_times(
     df: pd.DataFrame, name: str
-) -> tuple[pd.DataFrame, datetime | None, str, list[str]]:
+) -> tuple[pd.DataFrame, tuple[datetime | None, datetime | None], str, list[str]]:
     """``df`` with ``time_s`` counted from its first row where the log has no time in seconds but
     one column named as a time (:data:`DATED_TIME_NAMES`) holding dates and clock times
     (``2026-12-06 14:25:01.5``, ISO 8601, any time zone dropped: the logger's wall clock).
 
-    Returns the table, the first row's date and time (None for a log in seconds), the column's
-    name ('' for none) and the problems (a cell that is no date and time, naming its line).
+    Returns the table, the first row's date and time (None for a log in seconds) and, for dates
+    that read either way (``05/12/2026``: day or month first, the same times of day), the first
+    row read day first (else None), the column's name ('' for none) and the problems (a cell
+    that is no date and time, naming its line).
 
     Examples
     --------
@@ -288,24 +294,28 @@ def _dated_times(
     ...                     "pressure_kpa": [0, 10]})
     >>> out, start, column, problems = _dated_times(log, "log.csv")
     >>> out["time_s"].tolist(), start, column, problems
-    ([0.0, 2.5], datetime.datetime(2026, 12, 6, 14, 25, 1), 'Timestamp', [])
+    ([0.0, 2.5], (datetime.datetime(2026, 12, 6, 14, 25, 1), None), 'Timestamp', [])
+    >>> _dated_times(log.assign(Timestamp=["05/12/2026 14:25:01", "05/12/2026 14:25:03.5"]),
+    ...              "log.csv")[1]  # 12 May or 5 December
+    (datetime.datetime(2026, 5, 12, 14, 25, 1), datetime.datetime(2026, 12, 5, 14, 25, 1))
     >>> _dated_times(log.assign(Timestamp=["2026-12-06 14:25:01", "later"]), "log.csv")[3]
     ["log.csv line 3: Timestamp 'later' is not a date and time (like 2026-12-06 14:25:01.5)"]
-    >>> _dated_times(log.assign(Timestamp=[0, 1]), "log.csv")[1] is None  # numbers: no dates
-    True
+    >>> _dated_times(log.assign(Timestamp=[0, 1]), "log.csv")[1]  # numbers: no dates
+    (None, None)
     """
+    none: tuple[datetime | None, datetime | None] = (None, None)
     if "time_s" in df.columns:
-        return df, None, "", []
+        return df, none, "", []
     named = [c for c in df.columns if str(c).strip().lower() in DATED_TIME_NAMES]
     if len(named) != 1:
-        return df, None, "", []
+        return df, none, "", []
     column = named[0]
     written = df[column]
     if np.isfinite(user_floats(written)).any():  # numbers (seconds with no unit): not dates
-        return df, None, "", []
+        return df, none, "", []
     stamps = pd.to_datetime(written.astype(str), errors="coerce", format="mixed")
     if stamps.notna().sum() == 0:
-        return df, None, "", []
+        return df, none, "", []
     bad = np.flatnonzero(stamps.isna().to_numpy())
     if bad.size:
         i = int(bad[0])
@@ -313,12 +323,22 @@ def _dated_times(
             f"{name} line {i + 2}: {column} {written.iloc[i]!r} is not a date and time (like "
             "2026-12-06 14:25:01.5)"
         )
-        return df, None, "", [problem]
+        return df, none, "", [problem]
     if getattr(stamps.dt, "tz", None) is not None:
         stamps = stamps.dt.tz_localize(None)
     out = df.copy()
     out["time_s"] = (stamps - stamps.iloc[0]).dt.total_seconds().to_numpy()
-    return out, stamps.iloc[0].to_pydatetime(), str(column), []
+    dayfirst = None
+    if re.match(r"\s*\d{1,2}[./]\d{1,2}[./]\d{2,4}", str(written.iloc[0])):
+        other = pd.to_datetime(written.astype(str), errors="coerce", format="mixed", dayfirst=True)
+        if getattr(other.dt, "tz", None) is not None:
+            other = other.dt.tz_localize(None)
+        same_times = other.notna().all() and (
+            (other - other.iloc[0]).dt.total_seconds().to_numpy() == out["time_s"].to_numpy()
+        ).all()
+        if same_times and other.iloc[0] != stamps.iloc[0]:
+            dayfirst = other.iloc[0].to_pydatetime()
+    return out, (stamps.iloc[0].to_pydatetime(), dayfirst), str(column), []
 
 
 def _read_from(columns: list[str], own: dict[str, str], measured: bool) -> tuple[str, str, str]:

@@ -1,0 +1,430 @@
+"""Photos placed on a pressure log by the time their camera wrote into them.
+
+``photoset init DIR --pattern 'IMG_*.JPG' --pressure-log log.csv`` gives each photo the setpoint
+in force when it was taken, the measured pressure and the direction, read from the log at its
+EXIF time (:func:`pipeline.photo_times.exif_time`).  The camera's clock and the logger's are two
+clocks; :class:`ClockSync` says how they relate, either as an offset or, with no sign to get
+wrong, as the log's time at one photo (a photo of the logger's screen).
+
+:func:`place_photos` also says what a person should check: photos taken within
+:data:`NEAR_STEP_S` of a step of the setpoint; an offset whose opposite sign would put clearly
+fewer photos near a step; photos that fall in a gap of the log (a logger that stopped writing
+for a while), which are left out, since their pressure is not known; a log whose dates read
+either way (``05/12/2026``), read as the photos' own dates say.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from datetime import datetime, timedelta
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline.errors import UserInputError
+from pipeline.photo_times import exif_time
+from pipeline.video.timeline import (
+    PressureLog,
+    frame_conditions,
+    read_pressure_log,
+    span_text,
+    step_times,
+)
+
+#: a photo taken closer than this to a step of the log's setpoint (s) is named: the camera's
+#: clock is kept to the second, and a clock offset a little off moves it across
+NEAR_STEP_S = 1.5
+#: a stretch between two log rows longer than this many times the log's usual row interval (and
+#: than GAP_MIN_S) is a gap: the logger stopped writing, and a photo in it has no known pressure
+GAP_ROWS = 5.0
+GAP_MIN_S = 1.0
+#: the opposite sign of an offset is suggested when it leaves at most this share of the photos
+#: near a step that the offset given leaves (and at least 3 fewer)
+SIGN_CHECK_SHARE = 0.5
+#: columns of :attr:`PhotoPlacement.table` that are no manifest's
+PLACEMENT_ONLY_COLUMNS: tuple[str, ...] = ("log_time_s", "near_step_s")
+
+
+@dataclass(frozen=True)
+class ClockSync:
+    """How the camera's clock maps onto the log's.
+
+    ``offset_s``: on a log of dates and clock times, how far the logger's clock is ahead of the
+    camera's (negative when behind; None: 0, the clocks agree); on a log in seconds, the log's
+    time at the first photo.  Or ``photo`` and ``log_time``: the log's time when that photo was
+    taken, as written (a clock time ``14:00:10.1``, a date and time, or seconds on a log in
+    seconds), from which the offset follows.
+    """
+
+    offset_s: float | None = None
+    photo: str | None = None
+    log_time: str | None = None
+
+
+@dataclass(frozen=True)
+class PhotoPlacement:
+    """Photos placed on a pressure log (:func:`place_photos`).
+
+    ``table`` has one row per photo placed, in the order taken: ``image``, ``timestamp``
+    (ISO 8601, the camera's clock), ``log_time_s``, ``pressure_kpa`` (the setpoint in force),
+    ``measured_pressure_kpa`` (when logged), ``direction`` and ``near_step_s`` (how far from a
+    step of the setpoint, when within :data:`NEAR_STEP_S`; else NaN).  ``left_out`` are the
+    photos in a gap of the log; ``notes`` and ``warnings`` are lines for the user.
+    """
+
+    table: pd.DataFrame
+    offset_s: float
+    left_out: tuple[str, ...]
+    notes: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def place_photos(
+    folder: str | os.PathLike[str],
+    images: list[str],
+    log_name: str,
+    sync: ClockSync,
+) -> PhotoPlacement:
+    """Place photos on a pressure log by their EXIF times and read each one's conditions.
+
+    Parameters
+    ----------
+    folder : path
+        Folder holding the photos and the log.
+    images : list of str
+        The photos' names in ``folder``.
+    log_name : str
+        The pressure log's name in ``folder``
+        (:func:`pipeline.video.timeline.read_pressure_log`).
+    sync : ClockSync
+        How the camera's clock maps onto the log's.
+
+    Returns
+    -------
+    PhotoPlacement
+
+    Raises
+    ------
+    UserInputError
+        When the log cannot be read, a photo holds no EXIF time, the clocks' relation is not
+        given for a log in seconds (or given twice, or names a photo not among them), or photos
+        lie outside the log (with the offsets that would fit them all).
+    """
+    root = Path(folder)
+    log, problems = read_pressure_log(root / log_name)
+    if log is None:
+        raise UserInputError("--pressure-log: " + "; ".join(problems))
+    stamps = _camera_times(root, images)
+    notes: list[str] = []
+    if log.clock_start is not None and log.clock_start_dayfirst is not None:
+        log, note = _date_reading(log, stamps)
+        notes.append(note)
+    offset_s, placed_note = _offset(log, log_name, stamps, sync)
+    notes.append(placed_note)
+    camera_s = _camera_seconds(log, stamps)
+    log_time = camera_s + offset_s
+    _refuse_outside(log, log_name, stamps, log_time, camera_s)
+    in_gap, gap_lines = _gaps(log, stamps, log_time)
+    keep = ~in_gap
+    conditions = frame_conditions(log, log_time[keep])
+    steps = step_times(log)
+    near = _near_step(log_time[keep], steps)
+    table = pd.DataFrame(
+        {
+            "image": stamps.index[keep],
+            "timestamp": [f"{t:%Y-%m-%dT%H:%M:%S.%f}"[:-3] for t in stamps[keep]],
+            "log_time_s": log_time[keep].round(3),
+            "pressure_kpa": conditions["pressure_kpa"].round(2).to_numpy(),
+        }
+    )
+    if "measured_pressure_kpa" in conditions.columns:
+        table["measured_pressure_kpa"] = conditions["measured_pressure_kpa"].round(2).to_numpy()
+    table["direction"] = conditions["direction"].to_numpy()
+    table["near_step_s"] = np.where(near < NEAR_STEP_S, near.round(2), np.nan)
+    table = table.sort_values("log_time_s", kind="stable").reset_index(drop=True)
+    if log.measured_kpa is None:
+        notes.append("the log holds no measured pressure: the manifest has the setpoints alone")
+    if unheld_levels(table):
+        notes.append(
+            "the setpoints at the photos are not levels held for several photos (a continuous "
+            "ramp?), so each curve point is one photo: set aggregate.bin_kpa in config.yaml "
+            "(e.g. 5) to pool the photos by pressure, within 5 kPa"
+        )
+    warnings = gap_lines + _near_step_lines(table)
+    if log.clock_start is not None and sync.photo is None:  # a sign to get wrong
+        flipped = _opposite_sign_line(
+            offset_s, camera_s[keep], steps, int(table["near_step_s"].notna().sum())
+        )
+        warnings += [flipped] if flipped else []
+    return PhotoPlacement(
+        table, offset_s, tuple(stamps.index[in_gap]), tuple(notes), tuple(warnings)
+    )
+
+
+def _camera_times(root: Path, images: list[str]) -> pd.Series:
+    """Each photo's EXIF time (a datetime Series indexed by name), or the error naming those
+    without one."""
+    times = {str(name): exif_time(root / str(name)) for name in images}
+    untimed = [name for name, when in times.items() if when is None]
+    if untimed:
+        raise UserInputError(
+            f"--pressure-log: {len(untimed)} photo(s) hold no time the camera wrote (EXIF "
+            f"DateTimeOriginal), e.g. {root / untimed[0]}; a pressure log can only be read at "
+            "photos whose time is known: give photos straight from the camera (an editor or a "
+            "converter may drop it), or give the pressures with --pressures-kpa instead"
+        )
+    return pd.Series(times).astype("datetime64[ns]")
+
+
+def _camera_seconds(log: PressureLog, stamps: pd.Series) -> np.ndarray:
+    """The photos' times in seconds on the log's clock before any offset: from the log's first
+    row (a dated log), else from the first photo."""
+    zero = pd.Timestamp(log.clock_start) if log.clock_start is not None else stamps.min()
+    return (stamps - zero).dt.total_seconds().to_numpy(float)
+
+
+def _date_reading(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str]:
+    """A log whose dates read either way (``05/12/2026``): the reading whose dates the photos'
+    own (EXIF, year-month-day) fall on, else month first; with a note saying which."""
+    assert log.clock_start is not None and log.clock_start_dayfirst is not None
+    first, other = log.clock_start, log.clock_start_dayfirst
+    days = set(stamps.dt.date)
+
+    def fits(start: datetime) -> bool:
+        end = start + timedelta(seconds=log.span_s[1])
+        return any(start.date() <= d <= end.date() for d in days)
+
+    chosen = other if fits(other) and not fits(first) else first
+    log = PressureLog(
+        log.path, log.time_s, log.pressure_kpa, log.measured_kpa, log.read_from, chosen
+    )
+    why = "as the photos' own dates are" if fits(chosen) else "no reading matches the photos' dates"
+    return log, (
+        f"the log's dates read either way (day or month first): read as {chosen:%Y-%m-%d}, {why}"
+    )
+
+
+def _offset(
+    log: PressureLog, log_name: str, stamps: pd.Series, sync: ClockSync
+) -> tuple[float, str]:
+    """The offset (s) the sync gives, and a line saying where that places the photos."""
+    dated = log.clock_start is not None
+    if sync.photo is not None and sync.offset_s is not None:
+        raise UserInputError(
+            "--clock-offset-s and --log-time-at both relate the clocks: give one of them"
+        )
+    if sync.photo is not None:
+        if sync.photo not in stamps.index:
+            raise UserInputError(
+                f"--log-time-at {sync.photo}={sync.log_time}: {sync.photo} is not one of the "
+                f"photos placed on the log (e.g. {stamps.index[0]}); give one of them"
+            )
+        taken = stamps[sync.photo].to_pydatetime()
+        offset = _offset_at(log, stamps, sync.photo, taken, str(sync.log_time))
+    elif sync.offset_s is not None:
+        offset = float(sync.offset_s)
+    elif dated:
+        offset = 0.0
+    else:
+        raise UserInputError(
+            f"--pressure-log {log_name}: its times are seconds (from {log.read_from[0]!r}), which "
+            "say nothing of when the photos were taken; give --log-time-at PHOTO=SECONDS (the "
+            "log's time when that photo was taken) or --clock-offset-s (the log's time at the "
+            "first photo; 0 if the log was started as it was taken), or log the logger's dates "
+            "and clock times (a 'timestamp' column, 2026-12-06 14:25:01.5)"
+        )
+    first = stamps.idxmin()
+    if dated:
+        assert log.clock_start is not None
+        ahead = "ahead of" if offset >= 0 else "behind"
+        at = stamps[first].to_pydatetime() + timedelta(seconds=offset)
+        line = (
+            f"the logger's clock taken as {abs(offset):g} s {ahead} the camera's: the first photo, "
+            f"{first}, taken at {stamps[first]:%H:%M:%S.%f}"[:-3]
+            + f" by the camera, is at {at:%H:%M:%S.%f}"[:-3]
+            + " on the log"
+        )
+    else:
+        line = f"the first photo, {first}, taken at log time {offset:g} s"
+    return offset, line
+
+
+def _offset_at(
+    log: PressureLog, stamps: pd.Series, photo: str, taken: datetime, written: str
+) -> float:
+    """The offset that puts ``photo`` (taken at ``taken`` by the camera) at the log time
+    ``written``: a clock time or date and time on a dated log, seconds on a log in seconds."""
+    fix = (
+        f"--log-time-at {photo}={written}: give the log's time when {photo} was taken, "
+        + (
+            "as a clock time (14:00:10.1) or a date and time"
+            if log.clock_start is not None
+            else "in seconds on the log's clock (its time column)"
+        )
+    )
+    if log.clock_start is None:
+        try:
+            seconds = float(written)
+        except ValueError:
+            raise UserInputError(fix) from None
+        return seconds - float((taken - stamps.min()).total_seconds())
+    try:
+        clock = pd.Timestamp(written)
+    except ValueError:
+        raise UserInputError(fix) from None
+    if clock.tzinfo is not None:
+        clock = clock.tz_localize(None)
+    if re.fullmatch(r"\s*\d{1,2}:\d{2}(:\d{2}(\.\d*)?)?\s*", written):
+        # a clock time alone: on the day that puts it nearest the photo's own time
+        day = datetime.combine(taken.date(), clock.time())
+        clock = pd.Timestamp(min((day + timedelta(days=k) for k in (-1, 0, 1)),
+                                 key=lambda c: abs((c - taken).total_seconds())))
+    return float((clock.to_pydatetime() - taken).total_seconds())
+
+
+def _refuse_outside(
+    log: PressureLog, log_name: str, stamps: pd.Series, log_time: np.ndarray, camera_s: np.ndarray
+) -> None:
+    """The error naming the photos that lie outside the log and the offsets that would fit."""
+    lo, hi = log.span_s
+    outside = np.flatnonzero(~((log_time >= lo) & (log_time <= hi)))
+    if not outside.size:
+        return
+    first = outside[np.argmin(log_time[outside])] if (log_time[outside] < lo).any() else outside[0]
+    what = (
+        "the logger's clock ahead of the camera's, s; negative when behind"
+        if log.clock_start is not None
+        else "the log's time at the first photo, s"
+    )
+    clock = (
+        f" ({log.clock_start:%Y-%m-%d %H:%M:%S} to "
+        f"{log.clock_start + timedelta(seconds=hi):%H:%M:%S} on its clock)"
+        if log.clock_start is not None
+        else ""
+    )
+    raise UserInputError(
+        f"--pressure-log {log_name}: {outside.size} of {len(stamps)} photo(s) lie outside the "
+        f"log, whose times span {span_text(log.span_s)}{clock}: {stamps.index[first]} (taken "
+        f"{stamps.iloc[first]:%Y-%m-%d %H:%M:%S}) is at log time {log_time[first]:.1f} s; give "
+        f"--clock-offset-s ({what}; {offsets_that_fit(camera_s, log.span_s)}) or "
+        "--log-time-at PHOTO=TIME, or move photos that are no ramp's out of the folder"
+    )
+
+
+def offsets_that_fit(placed_s: np.ndarray, span_s: tuple[float, float]) -> str:
+    """The clock offsets that put photos (at ``placed_s`` on the log's clock without one) inside
+    a log spanning ``span_s``, in words.
+
+    Examples
+    --------
+    >>> offsets_that_fit(np.array([200.0, 260.0]), (0.0, 100.0))
+    'any from -200.0 to -160.0 puts every photo inside the log'
+    >>> offsets_that_fit(np.array([0.0, 260.0]), (0.0, 100.0))
+    'none puts every photo inside it: the photos span 260 s, the log 100 s'
+    """
+    low, high = span_s[0] - placed_s.min(), span_s[1] - placed_s.max()
+    if low > high:
+        return (
+            f"none puts every photo inside it: the photos span {np.ptp(placed_s):.0f} s, the log "
+            f"{span_s[1] - span_s[0]:.0f} s"
+        )
+    return f"any from {low:.1f} to {high:.1f} puts every photo inside the log"
+
+
+def _gaps(
+    log: PressureLog, stamps: pd.Series, log_time: np.ndarray
+) -> tuple[np.ndarray, list[str]]:
+    """Which photos lie in a gap of the log (:data:`GAP_ROWS`), and a warning line per gap."""
+    t = log.time_s
+    step = np.diff(t)
+    limit = max(GAP_MIN_S, GAP_ROWS * float(np.median(step)))
+    after = np.clip(np.searchsorted(t, log_time, side="right"), 1, len(t) - 1)
+    width = t[after] - t[after - 1]
+    in_gap = (width > limit) & (log_time > t[0]) & (log_time < t[-1])
+    lines = []
+    for row in np.unique(after[in_gap]):
+        names = list(stamps.index[in_gap & (after == row)])
+        lines.append(
+            f"{len(names)} photo(s) ({', '.join(names[:4])}{', ...' if len(names) > 4 else ''}) "
+            f"were taken in a gap of the log: no row for {t[row] - t[row - 1]:.1f} s, from log "
+            f"time {t[row - 1]:g} to {t[row]:g} s; their pressure is not known, so they are "
+            "left out of the manifest (add their rows by hand if you know it)"
+        )
+    return in_gap, lines
+
+
+def _near_step(log_time: np.ndarray, steps: np.ndarray) -> np.ndarray:
+    """Each time's distance (s) to the nearest step time (inf without steps)."""
+    if not steps.size:
+        return np.full(len(log_time), np.inf)
+    return np.min(np.abs(log_time[:, None] - steps[None, :]), axis=1)
+
+
+def _near_step_lines(table: pd.DataFrame, limit: int = 12) -> list[str]:
+    """A warning and a line per photo taken near a step of the log's setpoint."""
+    near = table[table["near_step_s"].notna()]
+    if near.empty:
+        return []
+    lines = [
+        f"  {r.image} at log time {r.log_time_s:g} s, {r.near_step_s:g} s from a step of the "
+        f"setpoint: given {r.pressure_kpa:g} kPa"
+        for r in near.itertuples()
+    ]
+    if len(lines) > limit:
+        more = (
+            f"  ... and {len(lines) - limit + 1} more (the manifest's timestamp column has every "
+            "photo's time)"
+        )
+        lines = [*lines[: limit - 1], more]
+    head = (
+        f"{len(near)} photo(s) were taken within {NEAR_STEP_S:g} s of a step of the log's "
+        "setpoint, where a clock off by a second gives the level on the other side, and the "
+        "actuator may still be moving (check the clocks, and these photos' pressures):"
+    )
+    return [head, *lines]
+
+
+def _opposite_sign_line(
+    offset_s: float, camera_s: np.ndarray, steps: np.ndarray, n_near: int
+) -> str:
+    """A warning when the offset with its sign flipped would put clearly fewer photos near a step
+    (a sign mistaken: the logger behind taken for ahead); '' otherwise.
+
+    Examples
+    --------
+    >>> steps = np.arange(0.0, 100.0, 10.0)
+    >>> camera_s = np.arange(10) * 10.0 + 2.5  # taken 2.5 s after each step by the camera
+    >>> _opposite_sign_line(-3.0, camera_s, steps, 10)[:48]
+    'with --clock-offset-s 3 (the opposite sign) 0 ph'
+    >>> _opposite_sign_line(3.0, camera_s, steps, 0)
+    ''
+    """
+    if offset_s == 0 or not steps.size:
+        return ""
+    flipped = int((_near_step(camera_s - offset_s, steps) < NEAR_STEP_S).sum())
+    if flipped > SIGN_CHECK_SHARE * n_near or flipped > n_near - 3:
+        return ""
+    return (
+        f"with --clock-offset-s {-offset_s:g} (the opposite sign) {flipped} photo(s), not "
+        f"{n_near}, would be near a step of the setpoint: check the sign (positive when the "
+        "logger's clock is ahead of the camera's), or give --log-time-at PHOTO=TIME, the log's "
+        "time when one photo was taken, which has no sign to get wrong"
+    )
+
+
+def unheld_levels(manifest: pd.DataFrame) -> bool:
+    """Whether the photos' pressures are mostly levels no other photo shares (of another trial,
+    or of the other direction): a continuous ramp, read off a log, whose curves would have a
+    point per photo.
+
+    Examples
+    --------
+    >>> stepped = pd.DataFrame({"pressure_kpa": [0, 20, 40, 20, 0] * 2})
+    >>> unheld_levels(stepped), unheld_levels(pd.DataFrame({"pressure_kpa": np.arange(10.0)}))
+    (False, True)
+    """
+    counts = manifest["pressure_kpa"].value_counts()
+    return bool((counts == 1).sum() > 0.5 * len(manifest))
