@@ -62,6 +62,8 @@ class ClockSync:
     offset_s: float | None = None
     photo: str | None = None
     log_time: str | None = None
+    #: (``photo`` is a photo of the logger's screen, its clock in view: ``init`` leaves it out of
+    #: the ramps)
 
 
 @dataclass(frozen=True)
@@ -122,7 +124,7 @@ def place_photos(
     if log.clock_start is not None and log.clock_start_dayfirst is not None:
         log, note = _date_reading(log, stamps)
         notes.append(note)
-    offset_s, placed_note = _offset(log, log_name, stamps, sync)
+    offset_s, placed_note = _offset(log, log_name, stamps, sync, root)
     notes.append(placed_note)
     camera_s = _camera_seconds(log, stamps)
     log_time = camera_s + offset_s
@@ -208,22 +210,33 @@ def _date_reading(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str
 
 
 def _offset(
-    log: PressureLog, log_name: str, stamps: pd.Series, sync: ClockSync
+    log: PressureLog, log_name: str, stamps: pd.Series, sync: ClockSync, root: Path
 ) -> tuple[float, str]:
-    """The offset (s) the sync gives, and a line saying where that places the photos."""
+    """The offset (s) the sync gives, and a line saying where that places the photos (the
+    sync's photo, of the logger's clock, in ``root``: one of them or not)."""
     dated = log.clock_start is not None
     if sync.photo is not None and sync.offset_s is not None:
         raise UserInputError(
             "--clock-offset-s and --log-time-at both relate the clocks: give one of them"
         )
     if sync.photo is not None:
-        if sync.photo not in stamps.index:
+        when = (
+            stamps[sync.photo].to_pydatetime()
+            if sync.photo in stamps.index
+            else exif_time(root / sync.photo)
+        )
+        if when is None:
             raise UserInputError(
-                f"--log-time-at {sync.photo}={sync.log_time}: {sync.photo} is not one of the "
-                f"photos placed on the log (e.g. {stamps.index[0]}); give one of them"
+                f"--log-time-at {sync.photo}={sync.log_time}: "
+                + (
+                    f"{root / sync.photo} holds no time the camera wrote (EXIF "
+                    "DateTimeOriginal); give a photo straight from the camera"
+                    if (root / sync.photo).is_file()
+                    else f"no photo {sync.photo} in {root}; give the photo of the logger's clock "
+                    "by its name in the folder"
+                )
             )
-        taken = stamps[sync.photo].to_pydatetime()
-        offset = _offset_at(log, stamps, sync.photo, taken, str(sync.log_time))
+        offset = _offset_at(log, stamps, sync.photo, when, str(sync.log_time))
     elif sync.offset_s is not None:
         offset = float(sync.offset_s)
     elif dated:

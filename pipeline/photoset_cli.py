@@ -89,10 +89,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument(
         "--log-time-at",
         metavar="PHOTO=TIME",
-        help="with --pressure-log, for photos: the log's time when PHOTO was taken, e.g. "
-             "IMG_0001.JPG=14:00:10.1 (a clock time on a log of dates and clock times, as a photo "
-             "of the logger's screen shows it; seconds on a log in seconds); instead of "
-             "--clock-offset-s, with no sign to get wrong",
+        help="with --pressure-log, for photos: PHOTO, a photo of the logger's screen with its "
+             "clock in view, and the log's TIME it shows, e.g. clock.JPG=14:00:10.1 (seconds on a "
+             "log in seconds); relates the camera's clock to the logger's instead of "
+             "--clock-offset-s, with no sign to get wrong; PHOTO is left out of the ramps",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -478,16 +478,19 @@ def _init_logged(
         defaults=defaults,
         settings=settings,
         overwrite=args.overwrite,
-        leave_out=_own_empty_scenes(args, per_actuator),
+        # the photo of the logger's clock is no ramp's
+        leave_out=[*_own_empty_scenes(args, per_actuator), *([photo] if photo else [])],
     )
     if per_actuator:
         df = _own_backgrounds(args.folder, args.background, df)
     print(f"pressures read from {args.pressure_log} at the photos' EXIF times:")
+    if photo:
+        print(f"  {photo}, the photo of the logger's clock, is left out of the ramps")
     for note in placement.notes:
         print(f"  {note}")
     for line in placement.warnings:
         print(line if line.startswith("  ") else f"warning: {line}", file=sys.stderr)
-    _print_written(args, df, kept, placement.left_out)
+    _print_written(args, df, kept, (*placement.left_out, *([photo] if photo else [])))
     return 0
 
 

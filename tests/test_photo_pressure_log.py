@@ -212,20 +212,26 @@ def test_a_clock_offset_of_the_wrong_sign_is_named_and_a_photo_of_the_loggers_cl
     assert "with --clock-offset-s 2 (the opposite sign) 0 photo(s), not 8, would be near" in err
     assert main([*args, "--clock-offset-s", "2"]) == 0
     assert "warning" not in capsys.readouterr().err
-    # IMG_9997.JPG was taken at 14:00:03 by the camera, 14:00:05 by the logger's clock
-    assert main([*args, "--log-time-at", "IMG_9997.JPG=14:00:05"]) == 0
+    # a photo of the logger's screen, taken at 13:59:50.2 by the camera, shows 13:59:52.2 (a
+    # camera file name too: it is left out of the ramps)
+    _photo(folder / "IMG_9996.JPG", START - timedelta(seconds=9.8))
+    assert main([*args, "--log-time-at", "IMG_9996.JPG=13:59:52.2"]) == 0
     out = capsys.readouterr()
     assert "the logger's clock taken as 2 s ahead of the camera's" in out.out
+    assert "IMG_9996.JPG, the photo of the logger's clock, is left out of the ramps" in out.out
     assert "warning" not in out.err
-    assert _taken(pd.read_csv(folder / "manifest.csv"))["pressure_kpa"].tolist() == LEVELS_KPA
-    assert main([*args, "--log-time-at", "IMG_9997.JPG"]) == 2
+    m = _taken(pd.read_csv(folder / "manifest.csv"))
+    assert m["pressure_kpa"].tolist() == LEVELS_KPA and "IMG_9996.JPG" not in set(m["image"])
+    assert main([*args, "--log-time-at", "IMG_9996.JPG"]) == 2
     assert "give PHOTO=TIME" in capsys.readouterr().err
+    assert main([*args, "--log-time-at", "clock.JPG=13:59:52.2"]) == 2
+    assert "no photo clock.JPG in" in capsys.readouterr().err
     # on a log in seconds, the log's time (s) at that photo
     rows = _log_rows(2.0)
     rows.assign(time_s=rows["camera_s"] + 2.0)[["time_s", "Setpoint (kPa)"]].to_csv(
         folder / "log.csv", index=False
     )
-    assert main([*args, "--log-time-at", "IMG_0001.JPG=41"]) == 0  # its fourth photo, at 39 s
+    assert main([*args, "--log-time-at", "IMG_9996.JPG=-7.8"]) == 0  # the first at 3 s + 2
     assert _taken(pd.read_csv(folder / "manifest.csv"))["pressure_kpa"].tolist() == LEVELS_KPA
 
 
