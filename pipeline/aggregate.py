@@ -11,6 +11,8 @@ bin and direction are first averaged, so a video trial counts once per level as 
 (``n`` counts trials there, not frames; :mod:`pipeline.video.continuous` has the per-cycle loops,
 settling curves and step responses).  Of a video stepped through held pressures only the frames at
 the end of each hold count (:func:`settled_frames`): those between are the step's response.
+Likewise a trial photographed more than once at one level and direction counts once there, with
+the mean of its photos (:func:`_collapse_repeats`).
 
 Rows whose ``status`` is not ``ok`` (``flagged`` or ``failed``) or whose psi is not finite are
 excluded by default and counted in ``n_excluded``; a level whose rows are all excluded is still
@@ -284,7 +286,38 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
     df["_ramp"] = df["actuator"] + "\x1f" + df["trial"]
     if "frame" in df.columns and df["frame"].notna().any():
         df = _collapse_frames(df)
-    return df
+    return _collapse_repeats(df)
+
+
+def _collapse_repeats(df: pd.DataFrame) -> pd.DataFrame:
+    """One row for the included photos of a trial photographed more than once at one level and
+    direction: their mean, so the trial counts once there, as every other trial does (customer
+    39's repeated 60 kPa photo weighed its trial double in the mean and the sd).  Rows not
+    included are kept as they are, counted in ``n_excluded``.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"material": "m", "actuator": "a", "trial": ["1", "1", "2"],
+    ...                    "direction": "up", "_level": 60.0, "psi_deg": [100.0, 102.0, 90.0],
+    ...                    "_pressure": 60.0, "_included": True, "status": "ok"})
+    >>> df["_ramp"] = df["actuator"] + "/" + df["trial"]
+    >>> _collapse_repeats(df).sort_values("trial")[["trial", "psi_deg"]].to_numpy().tolist()
+    [['1', 101.0], ['2', 90.0]]
+    """
+    keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
+    inc = df[df["_included"]]
+    repeated = inc.duplicated(keys, keep=False)
+    if not repeated.any():
+        return df
+    means = (
+        inc[repeated]
+        .groupby(keys, sort=False)
+        .agg(psi_deg=("psi_deg", "mean"), _pressure=("_pressure", "mean"))
+        .reset_index()
+        .assign(_included=True, status="ok")
+    )
+    rest = df.drop(index=inc.index[repeated])
+    return pd.concat([rest, means], ignore_index=True)
 
 
 def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:

@@ -186,3 +186,24 @@ def test_pooling_two_datasets_equals_aggregating_their_union(crafted):
     assert r["n_actuators"] == 4  # "first/1", "first/2", "second/1", "second/2"
     values = np.r_[200.0, 210.0, 220.0, 103.0, 108.0, 113.0]
     assert r["psi_sd_deg"] == pytest.approx(values.std(ddof=1))
+
+
+def test_a_level_photographed_twice_in_one_trial_counts_once_for_that_trial():
+    """Customer 39 photographed 60 kPa twice in trial 2: the trial weighed double in the mean
+    (n 3) and its repeat shrank the sd; a flagged repeat is still counted as excluded."""
+    rows = pd.DataFrame(
+        {
+            "image": ["a", "b", "c", "d"],
+            "psi_deg": [100.0, 104.0, 90.0, 150.0],
+            "status": ["ok", "ok", "ok", "flagged"],
+            "pressure_kpa": 60.0,
+            "direction": "up",
+            "material": "DS20",
+            "actuator": "A1",
+            "trial": [2, 2, 1, 2],
+        }
+    )
+    h = aggregate_hysteresis(rows).iloc[0]
+    assert h["psi_mean_deg"] == pytest.approx((102.0 + 90.0) / 2)
+    assert h["psi_sd_deg"] == pytest.approx(np.std([102.0, 90.0], ddof=1))
+    assert (h["n"], h["n_trials"], h["n_excluded"]) == (2, 2, 1)
