@@ -241,7 +241,8 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, [
             (
                 f"pressure log {name} lacks column(s) {missing} (its header is {header}); it "
-                "needs time_s (s) and pressure_kpa (kPa; or pressure_bar, pressure_mbar, "
+                "needs time_s (s; or a 'timestamp' column of dates and clock times) and "
+                "pressure_kpa (kPa; or pressure_bar, pressure_mbar, "
                 "pressure_psi or pressure_mpa), optionally measured_kpa (or measured_bar, ...); "
                 "a logger's own names are read with their unit in brackets ('t (s)', "
                 "'Setpoint (kPa)', 'Sensor [bar]')"
