@@ -290,10 +290,12 @@ def _prepare(angles: pd.DataFrame, bin_kpa: float | None, include_flagged: bool)
 
 
 def _collapse_repeats(df: pd.DataFrame) -> pd.DataFrame:
-    """One row for the included photos of a trial photographed more than once at one level and
-    direction: their mean, so the trial counts once there, as every other trial does (customer
-    39's repeated 60 kPa photo weighed its trial double in the mean and the sd).  Rows not
-    included are kept as they are, counted in ``n_excluded``.
+    """One row for the included photos of a trial photographed more than once in a row at one
+    level and direction: their mean, so the trial counts once there, as every other trial does
+    (customer 39's repeated 60 kPa photo weighed its trial double in the mean and the sd).
+    Photos at one level that are not next to each other in the trial (by ``step``, else in row
+    order: several ramps labelled one trial) stay apart.  Rows not included are kept as they
+    are, counted in ``n_excluded``.
 
     Examples
     --------
@@ -303,21 +305,29 @@ def _collapse_repeats(df: pd.DataFrame) -> pd.DataFrame:
     >>> df["_ramp"] = df["actuator"] + "/" + df["trial"]
     >>> _collapse_repeats(df).sort_values("trial")[["trial", "psi_deg"]].to_numpy().tolist()
     [['1', 101.0], ['2', 90.0]]
+    >>> _collapse_repeats(df.assign(_level=[60.0, 40.0, 60.0], trial="1", _ramp="a/1")).shape[0]
+    3
     """
     keys = ["material", "actuator", "trial", "_ramp", "direction", "_level"]
+    order = df.sort_values(["_ramp", "step"], kind="stable") if "step" in df else df
+    ordered = order.sort_values("_ramp", kind="stable")  # each trial's photos in their order
+    # a run: photos next to each other in their trial, at one level and direction
+    changed = (ordered[keys] != ordered[keys].shift()).any(axis=1)
+    run = changed.cumsum().rename("_run")
+    df = df.join(run)
     inc = df[df["_included"]]
-    repeated = inc.duplicated(keys, keep=False)
+    repeated = inc.duplicated("_run", keep=False)
     if not repeated.any():
-        return df
+        return df.drop(columns="_run")
     means = (
         inc[repeated]
-        .groupby(keys, sort=False)
+        .groupby([*keys, "_run"], sort=False)
         .agg(psi_deg=("psi_deg", "mean"), _pressure=("_pressure", "mean"))
         .reset_index()
         .assign(_included=True, status="ok")
     )
     rest = df.drop(index=inc.index[repeated])
-    return pd.concat([rest, means], ignore_index=True)
+    return pd.concat([rest, means], ignore_index=True).drop(columns="_run")
 
 
 def _collapse_frames(df: pd.DataFrame) -> pd.DataFrame:

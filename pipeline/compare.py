@@ -216,7 +216,9 @@ def rms_deg(psi_measured: np.ndarray, psi_model: np.ndarray) -> tuple[float, int
 START_BAND_DEG = 2.0
 
 
-def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float) -> float:
+def crossing_kpa(
+    pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float, *, from_rest: bool = True
+) -> float:
     """Pressure where a curve, walked in the given order, first reaches ``level_deg``, not
     counting its start where it starts on the level (within :data:`START_BAND_DEG`).
 
@@ -227,15 +229,19 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
         non-finite psi points are dropped.
     level_deg : float
         Angle to cross (deg).
+    from_rest : bool
+        The walk starts at the actuator's rest (the loading branch, from its lowest pressure):
+        a start on the level is its rest, not a crossing.  False for a walk from the top of the
+        ramp (the unloading branch): its start on the level is a crossing where no later one is.
 
     Returns
     -------
     float
         Linearly interpolated pressure (kPa) between the first two consecutive points that
         bracket the level (a point exactly on the level is returned as is); NaN if never reached,
-        and NaN for a curve that starts on the level and never comes back to it: its start is its
-        rest, not a crossing (a straight-at-rest actuator's P at psi = 0 read 0 or 1 kPa by the
-        sign of the noise at rest, else n/a).
+        and, ``from_rest``, NaN for a curve that starts on the level and never comes back to it:
+        its start is its rest, not a crossing (a straight-at-rest actuator's P at psi = 0 read 0
+        or 1 kPa by the sign of the noise at rest, else n/a).
 
     Examples
     --------
@@ -251,6 +257,8 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     nan
     >>> crossing_kpa([100, 80, 60], [1.5, 20.0, 60.0], 0.0)  # never: near it is not on it
     nan
+    >>> round(crossing_kpa([700, 600, 500], [-1.0, 20.0, 60.0], 0.0, from_rest=False), 1)
+    695.2
     """
     p = np.asarray(pressure_kpa, dtype=float)
     s = np.asarray(psi_deg, dtype=float)
@@ -259,8 +267,10 @@ def crossing_kpa(pressure_kpa: np.ndarray, psi_deg: np.ndarray, level_deg: float
     d = s - level_deg
     if d.size and abs(d[0]) <= START_BAND_DEG:  # it starts on the level: from where it leaves
         left = np.flatnonzero(np.abs(d) > START_BAND_DEG)
-        return crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
-    for i in range(d.size):  # the first crossing or touch
+        later = crossing_kpa(p[left[0] :], d[left[0] :], 0.0) if left.size else math.nan
+        if from_rest or not math.isnan(later):
+            return later
+    for i in range(d.size):  # the first crossing or touch (the start's, off rest, included)
         if d[i] == 0.0:
             return float(p[i])
         if i + 1 < d.size and d[i] * d[i + 1] < 0.0:
@@ -463,8 +473,9 @@ def compare_material(
         out["model_p_minus_psi0_kpa"] = model_crossing_kpa(model_psi, material, -psi0_deg)
     for direction in DIRECTIONS:
         p_b, s_b = branch(h, direction)
-        out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0)
-        out[f"p_minus_psi0_{direction}_kpa"] = crossing_kpa(p_b, s_b, -psi0_deg)
+        up = direction == "up"  # the loading branch walks from rest
+        out[f"p_zero_{direction}_kpa"] = crossing_kpa(p_b, s_b, 0.0, from_rest=up)
+        out[f"p_minus_psi0_{direction}_kpa"] = crossing_kpa(p_b, s_b, -psi0_deg, from_rest=up)
     finite = h[np.isfinite(h["psi_mean_deg"].to_numpy(float))]
     if len(finite):
         out["psi_max_deg"] = float(finite["psi_mean_deg"].max())

@@ -27,11 +27,11 @@ import pandas as pd
 from pipeline.errors import UserInputError
 from pipeline.photo_times import exif_time
 from pipeline.video.timeline import (
+    STEP_MIN_KPA,
     PressureLog,
     frame_conditions,
     read_pressure_log,
     span_text,
-    step_times,
 )
 
 #: a photo taken closer than this to a step of the log's setpoint (s) is named: the camera's
@@ -56,14 +56,13 @@ class ClockSync:
     camera's (negative when behind; None: 0, the clocks agree); on a log in seconds, the log's
     time at the first photo.  Or ``photo`` and ``log_time``: the log's time when that photo was
     taken, as written (a clock time ``14:00:10.1``, a date and time, or seconds on a log in
-    seconds), from which the offset follows.
+    seconds, whatever its unit), from which the offset follows: best a photo of the logger's
+    screen, its clock in view, kept out of the ramps' photos (a subfolder).
     """
 
     offset_s: float | None = None
     photo: str | None = None
     log_time: str | None = None
-    #: (``photo`` is a photo of the logger's screen, its clock in view: ``init`` leaves it out of
-    #: the ramps)
 
 
 @dataclass(frozen=True)
@@ -78,7 +77,6 @@ class PhotoPlacement:
     """
 
     table: pd.DataFrame
-    offset_s: float
     left_out: tuple[str, ...]
     notes: tuple[str, ...]
     warnings: tuple[str, ...]
@@ -124,15 +122,34 @@ def place_photos(
     if log.clock_start is not None and log.clock_start_dayfirst is not None:
         log, note = _date_reading(log, stamps)
         notes.append(note)
+    if log.clock_start is not None and not log.clock_dated:
+        log, note = _photos_day(log, stamps)
+        notes.append(note)
     offset_s, placed_note = _offset(log, log_name, stamps, sync, root)
     notes.append(placed_note)
     camera_s = _camera_seconds(log, stamps)
     log_time = camera_s + offset_s
     _refuse_outside(log, log_name, stamps, log_time, camera_s)
     in_gap, gap_lines = _gaps(log, stamps, log_time)
+    if in_gap.all():
+        raise UserInputError(
+            f"--pressure-log {log_name}: every photo was taken in a gap of the log, where it has "
+            "no rows, so no photo's pressure is known: "
+            + "; ".join(line.split("; their pressure")[0] for line in gap_lines)
+            + "; give the log that covers them, or check the clocks (--clock-offset-s, "
+            "--log-time-at)"
+        )
     keep = ~in_gap
-    conditions = frame_conditions(log, log_time[keep])
-    steps = step_times(log)
+    # the setpoint in force: that of the log's last row at or before the photo (a setpoint is
+    # a command, held until the next: a logger writing one row per setpoint gave photos values
+    # between two levels); its direction, that row's; the measured pressure at the photo's time
+    in_force = log.time_s[np.searchsorted(log.time_s, log_time[keep], side="right") - 1]
+    conditions = frame_conditions(log, in_force)
+    if log.measured_kpa is not None:
+        conditions["measured_pressure_kpa"] = np.interp(
+            log_time[keep], log.time_s, log.measured_kpa
+        )
+    steps = jump_times(log)
     near = _near_step(log_time[keep], steps)
     table = pd.DataFrame(
         {
@@ -161,15 +178,46 @@ def place_photos(
             offset_s, camera_s[keep], steps, int(table["near_step_s"].notna().sum())
         )
         warnings += [flipped] if flipped else []
-    return PhotoPlacement(
-        table, offset_s, tuple(stamps.index[in_gap]), tuple(notes), tuple(warnings)
+    return PhotoPlacement(table, tuple(stamps.index[in_gap]), tuple(notes), tuple(warnings))
+
+
+def jump_times(log: PressureLog) -> np.ndarray:
+    """The times of the log's rows where its setpoint jumps (by
+    :data:`pipeline.video.timeline.STEP_MIN_KPA` or more from the row before): the steps a photo
+    taken near would read on either side of, in a dense log or one written a row per setpoint.
+
+    Examples
+    --------
+    >>> log = PressureLog("l.csv", np.array([0.0, 12, 24, 36]), np.array([0.0, 20, 40, 39.5]))
+    >>> jump_times(log).tolist()
+    [12.0, 24.0]
+    """
+    jumps = np.flatnonzero(np.abs(np.diff(log.pressure_kpa)) >= STEP_MIN_KPA) + 1
+    return log.time_s[jumps]
+
+
+def _photos_day(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str]:
+    """A log of clock times alone, on the day that puts its span nearest the photos' (the day
+    before, of or after the first photo), with a note saying so."""
+    assert log.clock_start is not None
+    middle = stamps.min() + (stamps.max() - stamps.min()) / 2
+    first_day = stamps.min().to_pydatetime().date()
+    starts = [
+        datetime.combine(first_day + timedelta(days=k), log.clock_start.time()) for k in (-1, 0, 1)
+    ]
+    start = min(
+        starts,
+        key=lambda s: abs((s + timedelta(seconds=log.span_s[1] / 2) - middle).total_seconds()),
     )
+    dated = PressureLog(log.path, log.time_s, log.pressure_kpa, log.measured_kpa, log.read_from,
+                        start)
+    return dated, f"the log's clock times have no date: taken as {start:%Y-%m-%d}, the photos' day"
 
 
 def _camera_times(root: Path, images: list[str]) -> pd.Series:
     """Each photo's EXIF time (a datetime Series indexed by name), or the error naming those
     without one."""
-    times = {str(name): exif_time(root / str(name)) for name in images}
+    times = {str(name): exif_time(root / str(name), original_only=True) for name in images}
     untimed = [name for name, when in times.items() if when is None]
     if untimed:
         raise UserInputError(
@@ -223,7 +271,7 @@ def _offset(
         when = (
             stamps[sync.photo].to_pydatetime()
             if sync.photo in stamps.index
-            else exif_time(root / sync.photo)
+            else exif_time(root / sync.photo, original_only=True)
         )
         if when is None:
             raise UserInputError(
@@ -410,8 +458,8 @@ def _opposite_sign_line(
     --------
     >>> steps = np.arange(0.0, 100.0, 10.0)
     >>> camera_s = np.arange(10) * 10.0 + 2.5  # taken 2.5 s after each step by the camera
-    >>> _opposite_sign_line(-3.0, camera_s, steps, 10)[:48]
-    'with --clock-offset-s 3 (the opposite sign) 0 ph'
+    >>> _opposite_sign_line(-3.0, camera_s, steps, 10)[:46]
+    'is the sign of --clock-offset-s -3 right? With'
     >>> _opposite_sign_line(3.0, camera_s, steps, 0)
     ''
     """
@@ -421,10 +469,13 @@ def _opposite_sign_line(
     if flipped > SIGN_CHECK_SHARE * n_near or flipped > n_near - 3:
         return ""
     return (
-        f"with --clock-offset-s {-offset_s:g} (the opposite sign) {flipped} photo(s), not "
-        f"{n_near}, would be near a step of the setpoint: check the sign (positive when the "
-        "logger's clock is ahead of the camera's), or give --log-time-at PHOTO=TIME, the log's "
-        "time when one photo was taken, which has no sign to get wrong"
+        f"is the sign of --clock-offset-s {offset_s:g} right? With {-offset_s:g} (the opposite "
+        f"sign: positive when the logger's clock is ahead of the camera's) {flipped} photo(s), "
+        f"not {n_near}, would lie near a step of the setpoint, and those near a step would read "
+        "the level on its other side. Photos taken mid-hold point to the opposite sign; photos "
+        "taken just before each step (at the end of its hold) would look like this with the "
+        "right one. Settle it with --log-time-at PHOTO=TIME: a photo of the logger's screen and "
+        "the time it shows, with no sign to get wrong"
     )
 
 
@@ -440,4 +491,4 @@ def unheld_levels(manifest: pd.DataFrame) -> bool:
     (False, True)
     """
     counts = manifest["pressure_kpa"].value_counts()
-    return bool((counts == 1).sum() > 0.5 * len(manifest))
+    return len(manifest) >= 4 and bool((counts == 1).sum() > 0.5 * len(manifest))

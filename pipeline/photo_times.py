@@ -34,7 +34,7 @@ EXIF_DATETIME_ORIGINAL, EXIF_SUBSEC_ORIGINAL = 36867, 37521
 EXIF_DATETIME, EXIF_SUBSEC = 306, 37520
 
 
-def exif_time(path: str | os.PathLike[str]) -> datetime | None:
+def exif_time(path: str | os.PathLike[str], *, original_only: bool = False) -> datetime | None:
     """The time the camera took a photo (``DateTimeOriginal`` with its ``SubSecTimeOriginal``,
     else ``DateTime`` with ``SubSecTime``), as the camera's clock read it, with no time zone.
 
@@ -42,6 +42,9 @@ def exif_time(path: str | os.PathLike[str]) -> datetime | None:
     ----------
     path : path
         The photo.
+    original_only : bool
+        Only ``DateTimeOriginal``: ``DateTime`` is the time the file was last written, which an
+        editor sets to when it saved the photo (fine for a date, not for a time to the second).
 
     Returns
     -------
@@ -53,10 +56,10 @@ def exif_time(path: str | os.PathLike[str]) -> datetime | None:
             exif = im.getexif()
     except OSError:
         return None
-    for ifd, (time_tag, subsec_tag) in (
-        (exif.get_ifd(EXIF_IFD), (EXIF_DATETIME_ORIGINAL, EXIF_SUBSEC_ORIGINAL)),
-        (exif, (EXIF_DATETIME, EXIF_SUBSEC)),
-    ):
+    sources = [(exif.get_ifd(EXIF_IFD), (EXIF_DATETIME_ORIGINAL, EXIF_SUBSEC_ORIGINAL))]
+    if not original_only:
+        sources.append((exif, (EXIF_DATETIME, EXIF_SUBSEC)))
+    for ifd, (time_tag, subsec_tag) in sources:
         value = ifd.get(time_tag)
         if not isinstance(value, str):
             continue

@@ -82,17 +82,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--clock-offset-s",
         type=float,
         metavar="S",
-        help="with --pressure-log: the log's time at the video's first frame, or at the first "
-             "photo (s; default 0); for a log of dates and clock times, how far the logger's "
-             "clock is ahead of the camera's (s; negative when behind)",
+        help="with --pressure-log, in seconds whatever the log's unit. Videos: the log's time "
+             "at the video's first frame (default 0; a log of dates counts from its first row). "
+             "Photos: on a log of dates and clock times, how far the logger's clock is ahead of "
+             "the camera's (negative when behind; default 0, the clocks agree); on a log in "
+             "seconds, the log's time at the first photo (needed, or --log-time-at)",
     )
     init.add_argument(
         "--log-time-at",
         metavar="PHOTO=TIME",
         help="with --pressure-log, for photos: PHOTO, a photo of the logger's screen with its "
-             "clock in view, and the log's TIME it shows, e.g. clock.JPG=14:00:10.1 (seconds on a "
-             "log in seconds); relates the camera's clock to the logger's instead of "
-             "--clock-offset-s, with no sign to get wrong; PHOTO is left out of the ramps",
+             "clock in view (kept in a subfolder, out of the ramps' photos), and the log's TIME it "
+             "shows, e.g. clock/IMG_0001.JPG=14:00:10.1 (on a log in seconds, its time in "
+             "seconds); relates the camera's clock to the logger's instead of --clock-offset-s, "
+             "with no sign to get wrong",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -395,6 +398,11 @@ def _init(args: argparse.Namespace) -> int:
         settings["background"] = args.background
     kept = (Path(args.folder) / photoset.SETTINGS).is_file()  # never overwritten: the user's
     if args.pressure_log is not None and photoset_init.names_videos(args.folder, args.pattern):
+        if args.log_time_at is not None:
+            raise UserInputError(
+                "--log-time-at is for photos; a video's clock is placed on its log with "
+                "--clock-offset-s (the log's time at its first frame)"
+            )
         df = photoset_init.init_video_photoset(
             args.folder,
             args.pattern,
@@ -412,7 +420,10 @@ def _init(args: argparse.Namespace) -> int:
         _print_next(args, kept)
         return 0
     if args.fps is not None:
-        raise UserInputError("--fps is for videos: give their --pressure-log too")
+        raise UserInputError(
+            "--fps is for videos (or frames cut from one, --pattern 'frame_%04d.jpg') with their "
+            f"--pressure-log; --pattern {args.pattern!r} names photos"
+        )
     for option, value in (("--clock-offset-s", args.clock_offset_s),
                           ("--log-time-at", args.log_time_at)):
         if value is not None and args.pressure_log is None:
@@ -478,19 +489,23 @@ def _init_logged(
         defaults=defaults,
         settings=settings,
         overwrite=args.overwrite,
-        # the photo of the logger's clock is no ramp's
-        leave_out=[*_own_empty_scenes(args, per_actuator), *([photo] if photo else [])],
+        leave_out=_own_empty_scenes(args, per_actuator),
     )
     if per_actuator:
         df = _own_backgrounds(args.folder, args.background, df)
     print(f"pressures read from {args.pressure_log} at the photos' EXIF times:")
-    if photo:
-        print(f"  {photo}, the photo of the logger's clock, is left out of the ramps")
     for note in placement.notes:
         print(f"  {note}")
-    for line in placement.warnings:
+    warnings = list(placement.warnings)
+    if photo and photo in set(df["image"]):
+        warnings.append(
+            f"{photo}, named by --log-time-at, is one of the ramps' photos and is measured as "
+            f"one: if it shows the logger's clock, move it into a subfolder (clock/{photo}) and "
+            "give that path"
+        )
+    for line in warnings:
         print(line if line.startswith("  ") else f"warning: {line}", file=sys.stderr)
-    _print_written(args, df, kept, (*placement.left_out, *([photo] if photo else [])))
+    _print_written(args, df, kept, placement.left_out)
     return 0
 
 

@@ -207,3 +207,25 @@ def test_a_level_photographed_twice_in_one_trial_counts_once_for_that_trial():
     assert h["psi_mean_deg"] == pytest.approx((102.0 + 90.0) / 2)
     assert h["psi_sd_deg"] == pytest.approx(np.std([102.0, 90.0], ddof=1))
     assert (h["n"], h["n_trials"], h["n_excluded"]) == (2, 2, 1)
+
+
+def test_ramps_labelled_one_trial_are_not_merged_as_repeats():
+    """Three 0 -> 40 -> 0 ramps all labelled trial 1 (review): their photos at one level are not
+    next to each other, so each counts (n 3 at 40 kPa up, its sd over the three)."""
+    psi = {0.0: 0.0, 20.0: 50.0, 40.0: 100.0}
+    pressures = [0.0, 20.0, 40.0, 20.0, 0.0] * 3
+    rows = pd.DataFrame(
+        {
+            "image": [f"p{i}" for i in range(15)],
+            "psi_deg": [psi[p] + 10.0 * (i // 5) for i, p in enumerate(pressures)],
+            "status": "ok",
+            "pressure_kpa": pressures,
+            "direction": ["up", "up", "up", "down", "down"] * 3,
+            "material": "DS20",
+            "actuator": "A1",
+            "trial": 1,
+            "step": range(15),
+        }
+    )
+    top = aggregate_hysteresis(rows).set_index(["direction", "pressure_kpa"]).loc[("up", 40.0)]
+    assert top["n"] == 3 and top["psi_sd_deg"] == pytest.approx(10.0)

@@ -209,29 +209,36 @@ def test_a_clock_offset_of_the_wrong_sign_is_named_and_a_photo_of_the_loggers_cl
     assert main([*args, "--clock-offset-s", "-2"]) == 0
     err = capsys.readouterr().err
     assert "8 photo(s) were taken within 1.5 s of a step" in err
-    assert "with --clock-offset-s 2 (the opposite sign) 0 photo(s), not 8, would be near" in err
+    assert "is the sign of --clock-offset-s -2 right? With 2 (the opposite sign" in err
+    assert "0 photo(s), not 8, would lie near a step" in err
     assert main([*args, "--clock-offset-s", "2"]) == 0
     assert "warning" not in capsys.readouterr().err
-    # a photo of the logger's screen, taken at 13:59:50.2 by the camera, shows 13:59:52.2 (a
-    # camera file name too: it is left out of the ramps)
-    _photo(folder / "IMG_9996.JPG", START - timedelta(seconds=9.8))
-    assert main([*args, "--log-time-at", "IMG_9996.JPG=13:59:52.2"]) == 0
+    # a photo of the logger's screen, taken at 13:59:50.2 by the camera, shows 13:59:52.2; kept
+    # in a subfolder, it is none of the ramps' photos
+    (folder / "clock").mkdir()
+    _photo(folder / "clock" / "IMG_9996.JPG", START - timedelta(seconds=9.8))
+    assert main([*args, "--log-time-at", "clock/IMG_9996.JPG=13:59:52.2"]) == 0
     out = capsys.readouterr()
     assert "the logger's clock taken as 2 s ahead of the camera's" in out.out
-    assert "IMG_9996.JPG, the photo of the logger's clock, is left out of the ramps" in out.out
     assert "warning" not in out.err
     m = _taken(pd.read_csv(folder / "manifest.csv"))
-    assert m["pressure_kpa"].tolist() == LEVELS_KPA and "IMG_9996.JPG" not in set(m["image"])
-    assert main([*args, "--log-time-at", "IMG_9996.JPG"]) == 2
+    assert m["pressure_kpa"].tolist() == LEVELS_KPA
+    assert main([*args, "--log-time-at", "clock/IMG_9996.JPG"]) == 2
     assert "give PHOTO=TIME" in capsys.readouterr().err
     assert main([*args, "--log-time-at", "clock.JPG=13:59:52.2"]) == 2
     assert "no photo clock.JPG in" in capsys.readouterr().err
+    # one of the ramps' photos named: measured as one, and said so
+    assert main([*args, "--log-time-at", "IMG_9997.JPG=14:00:05"]) == 0
+    assert "IMG_9997.JPG, named by --log-time-at, is one of the ramps' photos" in (
+        capsys.readouterr().err
+    )
+    assert len(pd.read_csv(folder / "manifest.csv")) == len(LEVELS_KPA)
     # on a log in seconds, the log's time (s) at that photo
     rows = _log_rows(2.0)
     rows.assign(time_s=rows["camera_s"] + 2.0)[["time_s", "Setpoint (kPa)"]].to_csv(
         folder / "log.csv", index=False
     )
-    assert main([*args, "--log-time-at", "IMG_9996.JPG=-7.8"]) == 0  # the first at 3 s + 2
+    assert main([*args, "--log-time-at", "clock/IMG_9996.JPG=-7.8"]) == 0  # the first: 3 s + 2
     assert _taken(pd.read_csv(folder / "manifest.csv"))["pressure_kpa"].tolist() == LEVELS_KPA
 
 
@@ -270,3 +277,105 @@ def test_a_logs_dates_that_read_either_way_are_read_as_the_photos_dates_say(
     assert "read as 2026-12-06, as the photos' own dates are" in capsys.readouterr().out
     m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
     assert m["pressure_kpa"].tolist() == LEVELS_KPA
+
+
+def test_a_log_written_a_row_per_setpoint_gives_each_photo_the_setpoint_in_force(
+    logged_folder, capsys
+):
+    """A logger that writes one row per commanded setpoint (review): the photos read values
+    between two levels (10.67, 30.67, ...), the top one 'down', and were told to bin them."""
+    rows = _log_rows(5.5)
+    # one row a level, and one as the logger stops
+    rows = rows[rows["camera_s"].isin(HOLD_S * np.arange(len(LEVELS_KPA) + 1))]
+    rows.drop(columns="camera_s").to_csv(logged_folder / "log.csv", index=False)
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
+                 "5.5"]) == 0
+    assert "continuous ramp" not in capsys.readouterr().out
+    m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
+    assert m["pressure_kpa"].tolist() == LEVELS_KPA
+    assert m["direction"].tolist() == ["up", "up", "up", "down", "down"] * 2
+
+
+def _labview(t: pd.Timestamp, p: float, m: float, zone: str) -> str:
+    """Date and Time columns, ';' between fields, decimal commas, pressures in bar."""
+    return (f"{t:%d.%m.%Y};{t:%H:%M:%S},{t.microsecond // 1000:03d};"
+            + f"{p / 100:.3f};{m / 100:.5f}".replace(".", ","))
+
+
+def _clock_alone(t: pd.Timestamp, p: float, m: float, zone: str) -> str:
+    return f"{t:%H:%M:%S.%f},{p},{m}"
+
+
+def _zoned(t: pd.Timestamp, p: float, m: float, zone: str) -> str:
+    return f"{t:%Y-%m-%dT%H:%M:%S.%f}{zone},{p},{m}"
+
+
+@pytest.mark.parametrize(
+    "header, cell",
+    [
+        ("Date;Time;Set Pressure (bar);Measured Pressure (bar)", _labview),
+        ("Time,Setpoint (kPa),Sensor (kPa)", _clock_alone),  # the photos' day taken for theirs
+        ("timestamp,setpoint_kPa,sensor_kPa", _zoned),  # summer time starts within the log
+    ],
+    ids=["labview-date-and-time", "clock-times-alone", "zone-changes"],
+)
+def test_loggers_own_clocks_are_read(logged_folder, header, cell, capsys):
+    rows = _log_rows(5.5)
+    stamps = pd.to_datetime(rows["Timestamp"], format="ISO8601")
+    zones = ["+01:00"] * len(rows)
+    if cell is _zoned:  # after the first minute the wall clock is an hour on, the time is not
+        later = (rows["camera_s"] >= 60).to_numpy()
+        stamps = stamps.where(~later, stamps + pd.Timedelta(hours=1))
+        zones = ["+02:00" if x else "+01:00" for x in later]
+    lines = [header] + [
+        cell(t, p, m, z)
+        for t, p, m, z in zip(
+            stamps, rows["Setpoint (kPa)"], rows["Sensor (kPa)"], zones, strict=True
+        )
+    ]
+    (logged_folder / "log.csv").write_text("\n".join(lines) + "\n")
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
+                 "5.5"]) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
+    assert m["pressure_kpa"].tolist() == pytest.approx(LEVELS_KPA, abs=0.01)
+    assert np.allclose(m["measured_pressure_kpa"], LEVELS_KPA, atol=1.5)  # read, not dropped
+    if cell is _clock_alone:
+        assert "the log's clock times have no date: taken as 2026-12-06" in out
+
+
+def test_a_day_first_log_across_midnight_reads_its_dates_one_way(tmp_path):
+    """12/11/2026 23:59 then 13/11/2026 00:00 (review): read cell by cell, the first was
+    11 December and the log 'did not increase'."""
+    from pipeline.video.timeline import read_pressure_log
+
+    path = tmp_path / "log.csv"
+    path.write_text("Timestamp,pressure_kpa\n12/11/2026 23:59:59,0\n13/11/2026 00:00:01,5\n")
+    log, problems = read_pressure_log(path)
+    assert problems == [] and log is not None
+    assert log.clock_start == datetime(2026, 11, 12, 23, 59, 59) and log.time_s.tolist() == [0, 2]
+    assert log.clock_start_dayfirst is None  # 13 says day first: no other reading
+
+
+def test_a_photo_with_only_the_time_an_editor_saved_it_is_refused(logged_folder, capsys):
+    """IFD0 DateTime is when the file was last written: a photo re-saved keeps only that."""
+    exif = Image.Exif()
+    exif[306] = "2026:12:06 14:00:20"  # DateTime, no DateTimeOriginal
+    Image.new("RGB", (32, 24)).save(logged_folder / "IMG_0004.JPG", exif=exif)
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20"]) == 2
+    assert "IMG_0004.JPG" in capsys.readouterr().err
+
+
+def test_every_photo_in_a_gap_is_refused_without_a_manifest(logged_folder, capsys):
+    rows = _log_rows(5.5)
+    rows[(rows["camera_s"] < 0) | (rows["camera_s"] > 125)].drop(columns="camera_s").to_csv(
+        logged_folder / "log.csv", index=False
+    )
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20"]) == 2
+    err = capsys.readouterr().err
+    assert "every photo was taken in a gap of the log" in err and "manifest" not in err
+    assert not (logged_folder / "manifest.csv").exists()

@@ -39,9 +39,8 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +48,7 @@ import pandas as pd
 
 from pipeline.constants import DIRECTIONS, KPA_PER_UNIT, VACUUM_KPA
 from pipeline.fileio import plain_name, read_user_csv
+from pipeline.log_clock import read_log_clock
 from pipeline.measure.settings import is_missing, user_floats
 
 LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
@@ -56,11 +56,16 @@ LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 #: brackets: "t (s)", "Setpoint [bar]", "Sensor (kPa)"), by the column each stands for
 LOG_WORDS: dict[str, tuple[str, ...]] = {
     "time": ("time", "t", "elapsed", "timestamp"),
-    "pressure": ("pressure", "setpoint", "set_pressure", "set", "command", "target", "p_set"),
-    "measured": ("measured", "sensor", "readback", "read_back", "actual", "feedback", "p_meas"),
+    "pressure": (
+        "pressure", "setpoint", "set_pressure", "set", "command", "target", "p_set",
+        "pressure_setpoint", "setpoint_pressure", "target_pressure", "commanded_pressure",
+    ),
+    "measured": (
+        "measured", "sensor", "readback", "read_back", "actual", "feedback", "p_meas",
+        "measured_pressure", "pressure_measured", "actual_pressure", "sensor_pressure",
+        "pressure_sensor", "p_measured",
+    ),
 }
-#: names of a time column that may hold dates and clock times (any case)
-DATED_TIME_NAMES: tuple[str, ...] = ("time", "timestamp", "datetime", "date_time", "date")
 #: seconds per unit of a time column
 SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "ms": 1e-3, "min": 60.0}
 FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
@@ -89,6 +94,9 @@ class PressureLog:
     #: a dated log whose dates read either way (``05/12/2026``): the first row read day first
     #: (``clock_start`` is it read month first); None where the dates are plain
     clock_start_dayfirst: datetime | None = None
+    #: False for clock times alone (``clock_start`` then on :data:`pipeline.log_clock.UNDATED_DAY`:
+    #: the photos' dates give the day)
+    clock_dated: bool = True
 
     def describe_columns(self) -> str:
         """Which of the log's columns were read as what, for ``photoset check``.
@@ -125,6 +133,8 @@ def log_header_names(columns: list[str]) -> dict[str, str]:
     {'t (s)': 'time_s', 'setpoint (kPa)': 'pressure_kpa', 'sensor (kPa)': 'measured_kpa'}
     >>> log_header_names(["Time [ms]", "P set (bar)", "Sensor (kPa)"])
     {'Time [ms]': 'time_ms', 'P set (bar)': 'pressure_bar', 'Sensor (kPa)': 'measured_kpa'}
+    >>> log_header_names(["Set Pressure (bar)", "Measured Pressure (bar)"])  # LabVIEW's
+    {'Set Pressure (bar)': 'pressure_bar', 'Measured Pressure (bar)': 'measured_bar'}
     >>> log_header_names(["time", "setpoint"])  # no unit: none is guessed
     {}
     >>> log_header_names(["time_s", "pressure_kpa"])
@@ -232,12 +242,14 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     columns = [str(c) for c in df.columns]
     own = log_header_names(columns)
     df = _in_kpa(_in_seconds(df.rename(columns=own)))
-    df, clock_starts, dated_from, dated_problems = _dated_times(df, name)
-    if dated_problems:
-        return None, dated_problems
+    clock, clock_problems = read_log_clock(df, name) if "time_s" not in df.columns else (None, [])
+    if clock_problems:
+        return None, clock_problems
+    if clock is not None:
+        df = df.assign(time_s=clock.time_s)
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
-        header = list(map(str, df.columns))
+        header = columns  # as the file writes it
         return None, [
             (
                 f"pressure log {name} lacks column(s) {missing} (its header is {header}); it "
@@ -260,8 +272,26 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         back = np.flatnonzero(np.diff(t) <= 0)
         if back.size:
             i = int(back[0]) + 1
-            problems.append(f"{name} line {i + 2}: time_s {t[i]:g} does not increase (previous row "
-                            f"{t[i - 1]:g}); sort the log by time or drop the repeated row")
+            if clock is None:
+                problems.append(
+                    f"{name} line {i + 2}: time_s {t[i]:g} does not increase (previous row "
+                    f"{t[i - 1]:g}); sort the log by time or drop the repeated row"
+                )
+            else:
+                def at(k: int) -> str:
+                    return f"{clock.start + timedelta(seconds=float(t[k])):%H:%M:%S.%f}"[:-3]
+
+                problems.append(
+                    f"{name} line {i + 2}: {clock.column} {at(i)} does not increase (previous "
+                    f"row {at(i - 1)}); sort the log by time or drop the repeated row"
+                    + (
+                        f" ({back.size} rows repeat the time before them: a logger writing its "
+                        "clock to the whole second more often than once a second; write its times "
+                        "with their fraction of a second)"
+                        if back.size > 2
+                        else ""
+                    )
+                )
         for column, values in (("pressure_kpa", p), ("measured_kpa", m)):
             if values is not None and (values < VACUUM_KPA).any():
                 i = int(np.flatnonzero(values < VACUUM_KPA)[0])
@@ -272,74 +302,18 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
     if problems:
         return None, problems
     read_from = _read_from(columns, own, m is not None)
-    if dated_from:
-        read_from = (dated_from, read_from[1], read_from[2])
-    return PressureLog(str(path), t, p, m, read_from, *clock_starts), []
-
-
-def _dated_times(
-    df: pd.DataFrame, name: str
-) -> tuple[pd.DataFrame, tuple[datetime | None, datetime | None], str, list[str]]:
-    """``df`` with ``time_s`` counted from its first row where the log has no time in seconds but
-    one column named as a time (:data:`DATED_TIME_NAMES`) holding dates and clock times
-    (``2026-12-06 14:25:01.5``, ISO 8601, any time zone dropped: the logger's wall clock).
-
-    Returns the table, the first row's date and time (None for a log in seconds) and, for dates
-    that read either way (``05/12/2026``: day or month first, the same times of day), the first
-    row read day first (else None), the column's name ('' for none) and the problems (a cell
-    that is no date and time, naming its line).
-
-    Examples
-    --------
-    >>> log = pd.DataFrame({"Timestamp": ["2026-12-06 14:25:01", "2026-12-06T14:25:03.5"],
-    ...                     "pressure_kpa": [0, 10]})
-    >>> out, start, column, problems = _dated_times(log, "log.csv")
-    >>> out["time_s"].tolist(), start, column, problems
-    ([0.0, 2.5], (datetime.datetime(2026, 12, 6, 14, 25, 1), None), 'Timestamp', [])
-    >>> _dated_times(log.assign(Timestamp=["05/12/2026 14:25:01", "05/12/2026 14:25:03.5"]),
-    ...              "log.csv")[1]  # 12 May or 5 December
-    (datetime.datetime(2026, 5, 12, 14, 25, 1), datetime.datetime(2026, 12, 5, 14, 25, 1))
-    >>> _dated_times(log.assign(Timestamp=["2026-12-06 14:25:01", "later"]), "log.csv")[3]
-    ["log.csv line 3: Timestamp 'later' is not a date and time (like 2026-12-06 14:25:01.5)"]
-    >>> _dated_times(log.assign(Timestamp=[0, 1]), "log.csv")[1]  # numbers: no dates
-    (None, None)
-    """
-    none: tuple[datetime | None, datetime | None] = (None, None)
-    if "time_s" in df.columns:
-        return df, none, "", []
-    named = [c for c in df.columns if str(c).strip().lower() in DATED_TIME_NAMES]
-    if len(named) != 1:
-        return df, none, "", []
-    column = named[0]
-    written = df[column]
-    if np.isfinite(user_floats(written)).any():  # numbers (seconds with no unit): not dates
-        return df, none, "", []
-    stamps = pd.to_datetime(written.astype(str), errors="coerce", format="mixed")
-    if stamps.notna().sum() == 0:
-        return df, none, "", []
-    bad = np.flatnonzero(stamps.isna().to_numpy())
-    if bad.size:
-        i = int(bad[0])
-        problem = (
-            f"{name} line {i + 2}: {column} {written.iloc[i]!r} is not a date and time (like "
-            "2026-12-06 14:25:01.5)"
-        )
-        return df, none, "", [problem]
-    if getattr(stamps.dt, "tz", None) is not None:
-        stamps = stamps.dt.tz_localize(None)
-    out = df.copy()
-    out["time_s"] = (stamps - stamps.iloc[0]).dt.total_seconds().to_numpy()
-    dayfirst = None
-    if re.match(r"\s*\d{1,2}[./]\d{1,2}[./]\d{2,4}", str(written.iloc[0])):
-        other = pd.to_datetime(written.astype(str), errors="coerce", format="mixed", dayfirst=True)
-        if getattr(other.dt, "tz", None) is not None:
-            other = other.dt.tz_localize(None)
-        same_times = other.notna().all() and (
-            (other - other.iloc[0]).dt.total_seconds().to_numpy() == out["time_s"].to_numpy()
-        ).all()
-        if same_times and other.iloc[0] != stamps.iloc[0]:
-            dayfirst = other.iloc[0].to_pydatetime()
-    return out, (stamps.iloc[0].to_pydatetime(), dayfirst), str(column), []
+    if clock is None:
+        return PressureLog(str(path), t, p, m, read_from), []
+    return PressureLog(
+        str(path),
+        t,
+        p,
+        m,
+        (clock.column, read_from[1], read_from[2]),
+        clock.start,
+        clock.start_dayfirst,
+        clock.dated,
+    ), []
 
 
 def _read_from(columns: list[str], own: dict[str, str], measured: bool) -> tuple[str, str, str]:
