@@ -34,14 +34,17 @@ from datetime import datetime, timedelta
 import numpy as np
 import pandas as pd
 
+from pipeline.fileio import plain_name
 from pipeline.measure.settings import user_floats
 
 #: names of a column that may hold dates and clock times (any case)
 DATED_TIME_NAMES: tuple[str, ...] = ("time", "timestamp", "datetime", "date_time", "date")
-#: a date written day.month.year or with slashes (either order), the rest of the cell after it
-_NUMERIC_DATE = re.compile(r"\s*(\d{1,2})([./])(\d{1,2})\2(\d{4}|\d{2})(?!\d)(.*)")
-#: a clock time alone
-_CLOCK_TIME = re.compile(r"\s*(\d{1,2}):(\d{2})(?::(\d{2}(?:\.\d*)?))?\s*")
+#: a date written day.month.year, or with slashes or dashes (either order), the rest after it
+_NUMERIC_DATE = re.compile(r"\s*(\d{1,2})([./-])(\d{1,2})\2(\d{4}|\d{2})(?!\d)(.*)")
+#: a clock time alone (``14:25:01.5``, ``2:25:01 PM``)
+_CLOCK_TIME = re.compile(
+    r"\s*(\d{1,2}):(\d{2})(?::(\d{2}(?:\.\d*)?))?\s*([AaPp]\.?[Mm]\.?)?\s*"
+)
 #: a time zone at a cell's end
 _ZONE = re.compile(r"(Z|[+-]\d{2}:?\d{2})\s*$")
 #: the day used for clock times alone until the photos give theirs
@@ -65,6 +68,43 @@ class LogClock:
     dated: bool = True
 
 
+def _hours(hour: int, half: str | None) -> int:
+    """A clock's hour in 24: ``12 AM`` is 0, ``2 PM`` is 14."""
+    if not half:
+        return hour
+    return hour % 12 + (12 if half[0].lower() == "p" else 0)
+
+
+def _in_24_hours(text: str) -> str:
+    """A cell's clock time written in 24 hours (``2:00:01 PM`` -> ``14:00:01``)."""
+
+    def clock(m: re.Match[str]) -> str:
+        return f"{_hours(int(m[1]), m[4]):02d}:{m[2]}" + (f":{m[3]}" if m[3] else "")
+
+    return re.sub(
+        r"(\d{1,2}):(\d{2})(?::(\d{2}(?:\.\d*)?))?\s*([AaPp]\.?[Mm]\.?)(?![A-Za-z])",
+        clock,
+        text,
+    )
+
+
+def read_clock_text(text: str) -> tuple[datetime, bool] | None:
+    """One date and time, or clock time alone, read as a log's cells are (``--log-time-at``):
+    the time and whether it has a date; None when it is neither.
+
+    Examples
+    --------
+    >>> read_clock_text("06.12.2026 14:00:08,5")
+    (datetime.datetime(2026, 12, 6, 14, 0, 8, 500000), True)
+    >>> read_clock_text("2:00:01 PM")[0].time(), read_clock_text("lunch")
+    (datetime.time(14, 0, 1), None)
+    """
+    clock, problems = read_log_clock(pd.DataFrame({"timestamp": [text]}), "")
+    if clock is None or problems:
+        return None
+    return clock.start, clock.dated
+
+
 def read_log_clock(df: pd.DataFrame, name: str) -> tuple[LogClock | None, list[str]]:
     """The log's clock from its time column(s), or None where it has none (its time is in
     seconds, or no column is named as a time), with the problems in words (a cell that is no
@@ -80,7 +120,7 @@ def read_log_clock(df: pd.DataFrame, name: str) -> tuple[LogClock | None, list[s
     values, column = _clock_cells(df)
     if values is None or np.isfinite(user_floats(values)).any():  # seconds with no unit
         return None, []
-    cells = [re.sub(r"(\d:\d{2}),(\d)", r"\1.\2", str(v).strip()) for v in values]
+    cells = [_in_24_hours(re.sub(r"(\d:\d{2}),(\d)", r"\1.\2", str(v).strip())) for v in values]
     if all(_CLOCK_TIME.fullmatch(c) for c in cells):
         return _clock_times(cells, column), []
     readings = _numeric_date_readings(cells)
@@ -88,17 +128,28 @@ def read_log_clock(df: pd.DataFrame, name: str) -> tuple[LogClock | None, list[s
     if stamps is None:
         return None, problems
     other = None
-    if readings and len(readings) > 1:
+    if readings and len(readings) > 1:  # either way: both read, the likelier kept
         alt, alt_start, _ = _parse(readings[1], values, column, name)
         if alt is not None and np.array_equal(alt, stamps):
-            other = alt_start
+            other = alt_start  # the same times: the photos' dates decide
+        elif alt is not None and _likelier(alt, stamps):
+            stamps, start = alt, alt_start  # (a day-first log across midnight: 1 day, not 30)
     return LogClock(stamps, start, column, other), []
+
+
+def _likelier(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether times ``a`` are a likelier reading of a log than ``b``: increasing where ``b`` is
+    not, else over a shorter span."""
+    a_up, b_up = bool(np.all(np.diff(a) >= 0)), bool(np.all(np.diff(b) >= 0))
+    if a_up != b_up:
+        return a_up
+    return float(np.ptp(a)) < float(np.ptp(b))
 
 
 def _clock_cells(df: pd.DataFrame) -> tuple[pd.Series | None, str]:
     """The cells holding the log's clock: a Date and a Time column joined, else the one column
     named as a time."""
-    plain = {str(c).strip().lower(): c for c in df.columns}
+    plain = {plain_name(str(c)): c for c in df.columns}
     if "date" in plain and "time" in plain:
         joined = df[plain["date"]].astype(str) + " " + df[plain["time"]].astype(str)
         return joined, f"{plain['date']} + {plain['time']}"
@@ -115,7 +166,7 @@ def _clock_times(cells: list[str], column: str) -> LogClock:
     for c in cells:
         m = _CLOCK_TIME.fullmatch(c)
         assert m is not None
-        seconds.append(int(m[1]) * 3600 + int(m[2]) * 60 + float(m[3] or 0))
+        seconds.append(_hours(int(m[1]), m[4]) * 3600 + int(m[2]) * 60 + float(m[3] or 0))
     s = np.asarray(seconds, float)
     s = s + 86400.0 * np.concatenate([[0], np.cumsum(np.diff(s) < -43200)])
     return LogClock(s - s[0], UNDATED_DAY + timedelta(seconds=float(s[0])), column, dated=False)

@@ -16,7 +16,6 @@ either way (``05/12/2026``), read as the photos' own dates say.
 from __future__ import annotations
 
 import os
-import re
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 from pathlib import Path
@@ -25,9 +24,12 @@ import numpy as np
 import pandas as pd
 
 from pipeline.errors import UserInputError
+from pipeline.log_clock import read_clock_text
+from pipeline.measure.settings import user_float
 from pipeline.photo_times import exif_time
 from pipeline.video.timeline import (
     STEP_MIN_KPA,
+    TREND_DEADBAND_KPA,
     PressureLog,
     frame_conditions,
     read_pressure_log,
@@ -44,6 +46,18 @@ GAP_MIN_S = 1.0
 #: the opposite sign of an offset is suggested when it leaves at most this share of the photos
 #: near a step that the offset given leaves (and at least 3 fewer)
 SIGN_CHECK_SHARE = 0.5
+#: a log's trend turns once its pressure leaves an extreme by this many times its row-to-row
+#: noise (and by TREND_DEADBAND_KPA at least): a sensor's reading logged alone turned at every
+#: wobble, and its photos' directions with it
+NOISE_DEADBANDS = 6.0
+#: ... and its extreme lasts as long as its pressure stays within this many times its noise
+NOISE_BAND = 3.0
+#: a log whose one pressure column varies by more than this (kPa, :func:`noise_kpa`) holds a
+#: sensor's reading, not a setpoint
+NOISY_KPA = 0.3
+#: a log where more than this share of the rows change the setpoint is written a row per
+#: setpoint: a long hold there is no gap, and its last setpoint holds for a row's interval more
+ROW_PER_SETPOINT_SHARE = 0.5
 #: columns of :attr:`PhotoPlacement.table` that are no manifest's
 PLACEMENT_ONLY_COLUMNS: tuple[str, ...] = ("log_time_s", "near_step_s")
 
@@ -78,6 +92,9 @@ class PhotoPlacement:
 
     table: pd.DataFrame
     left_out: tuple[str, ...]
+    #: the log's one pressure column is a sensor's noisy reading: no two photos share a level,
+    #: and the ramps are told apart by the log's trend (``direction``), not the levels
+    sensor_only: bool
     notes: tuple[str, ...]
     warnings: tuple[str, ...]
 
@@ -140,15 +157,18 @@ def place_photos(
             "--log-time-at)"
         )
     keep = ~in_gap
-    # the setpoint in force: that of the log's last row at or before the photo (a setpoint is
-    # a command, held until the next: a logger writing one row per setpoint gave photos values
-    # between two levels); its direction, that row's; the measured pressure at the photo's time
+    # the log's last row at or before the photo: its setpoint is the one in force (a setpoint
+    # is a command, held until the next: a logger writing one row per setpoint gave photos
+    # values between two levels), its measured pressure the last read, its direction that row's
+    # (against the log's trend, beyond its noise)
     in_force = log.time_s[np.searchsorted(log.time_s, log_time[keep], side="right") - 1]
-    conditions = frame_conditions(log, in_force)
-    if log.measured_kpa is not None:
-        conditions["measured_pressure_kpa"] = np.interp(
-            log_time[keep], log.time_s, log.measured_kpa
-        )
+    noise = 0.0 if row_per_setpoint(log) else noise_kpa(log.pressure_kpa)
+    conditions = frame_conditions(
+        log,
+        in_force,
+        deadband_kpa=max(TREND_DEADBAND_KPA, NOISE_DEADBANDS * noise),
+        band_kpa=NOISE_BAND * noise,
+    )
     steps = jump_times(log)
     near = _near_step(log_time[keep], steps)
     table = pd.DataFrame(
@@ -164,9 +184,17 @@ def place_photos(
     table["direction"] = conditions["direction"].to_numpy()
     table["near_step_s"] = np.where(near < NEAR_STEP_S, near.round(2), np.nan)
     table = table.sort_values("log_time_s", kind="stable").reset_index(drop=True)
-    if log.measured_kpa is None:
+    if log.measured_kpa is None and noise > NOISY_KPA:
+        notes.append(
+            f"the log's one pressure column ({log.read_from[1]!r}) varies by about {noise:.1f} "
+            "kPa from row to row: a sensor's reading, not a setpoint, so each photo's pressure is "
+            "the reading at its time, and no two photos share a level exactly; set "
+            "aggregate.bin_kpa in config.yaml to pool them, and check the ramps below (log the "
+            "setpoint too, as its own column, for levels)"
+        )
+    elif log.measured_kpa is None:
         notes.append("the log holds no measured pressure: the manifest has the setpoints alone")
-    if unheld_levels(table):
+    if unheld_levels(table) and not (log.measured_kpa is None and noise > NOISY_KPA):
         notes.append(
             "the setpoints at the photos are not levels held for several photos (a continuous "
             "ramp?), so each curve point is one photo: set aggregate.bin_kpa in config.yaml "
@@ -178,7 +206,46 @@ def place_photos(
             offset_s, camera_s[keep], steps, int(table["near_step_s"].notna().sum())
         )
         warnings += [flipped] if flipped else []
-    return PhotoPlacement(table, tuple(stamps.index[in_gap]), tuple(notes), tuple(warnings))
+    return PhotoPlacement(
+        table,
+        tuple(stamps.index[in_gap]),
+        log.measured_kpa is None and noise > NOISY_KPA,
+        tuple(notes),
+        tuple(warnings),
+    )
+
+
+def noise_kpa(pressure_kpa: np.ndarray) -> float:
+    """The row-to-row noise of a logged pressure (kPa, a standard deviation, from the median
+    absolute deviation of its second differences, which steps and ramps leave at 0 but at their
+    corners): 0 for a setpoint, held, stepped or ramped.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)
+    1.5
+    >>> ramp = np.concatenate([np.linspace(0, 100, 50), np.linspace(100, 0, 50)])
+    >>> noise_kpa(np.repeat([0.0, 20, 40], 500)), round(noise_kpa(ramp), 6)
+    (0.0, 0.0)
+    """
+    d2 = np.diff(np.asarray(pressure_kpa, float), 2)
+    if d2.size < 2:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
+
+
+def row_per_setpoint(log: PressureLog) -> bool:
+    """Whether the log is written a row per setpoint (most rows change it) rather than at a
+    steady rate.
+
+    Examples
+    --------
+    >>> row_per_setpoint(PressureLog("l.csv", np.arange(5.0), np.array([0.0, 20, 40, 20, 0])))
+    True
+    """
+    jumps = np.abs(np.diff(log.pressure_kpa)) >= STEP_MIN_KPA
+    return bool(jumps.size) and float(jumps.mean()) > ROW_PER_SETPOINT_SHARE
 
 
 def jump_times(log: PressureLog) -> np.ndarray:
@@ -211,7 +278,10 @@ def _photos_day(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str]:
     )
     dated = PressureLog(log.path, log.time_s, log.pressure_kpa, log.measured_kpa, log.read_from,
                         start)
-    return dated, f"the log's clock times have no date: taken as {start:%Y-%m-%d}, the photos' day"
+    return dated, (
+        f"the log's clock times have no date: its first row taken as {start:%Y-%m-%d %H:%M:%S}, "
+        "the day that puts the log beside the photos"
+    )
 
 
 def _camera_times(root: Path, images: list[str]) -> pd.Series:
@@ -327,30 +397,30 @@ def _offset_at(
         )
     )
     if log.clock_start is None:
-        try:
-            seconds = float(written)
-        except ValueError:
-            raise UserInputError(fix) from None
+        seconds = user_float(written)
+        if not np.isfinite(seconds):
+            raise UserInputError(fix)
         return seconds - float((taken - stamps.min()).total_seconds())
-    try:
-        clock = pd.Timestamp(written)
-    except ValueError:
-        raise UserInputError(fix) from None
-    if clock.tzinfo is not None:
-        clock = clock.tz_localize(None)
-    if re.fullmatch(r"\s*\d{1,2}:\d{2}(:\d{2}(\.\d*)?)?\s*", written):
-        # a clock time alone: on the day that puts it nearest the photo's own time
+    read = read_clock_text(written)  # as the log's own cells are read
+    if read is None:
+        raise UserInputError(fix)
+    clock, dated = read
+    if not dated:  # a clock time alone: on the day that puts it nearest the photo's own time
         day = datetime.combine(taken.date(), clock.time())
-        clock = pd.Timestamp(min((day + timedelta(days=k) for k in (-1, 0, 1)),
-                                 key=lambda c: abs((c - taken).total_seconds())))
-    return float((clock.to_pydatetime() - taken).total_seconds())
+        clock = min((day + timedelta(days=k) for k in (-1, 0, 1)),
+                    key=lambda c: abs((c - taken).total_seconds()))
+    return float((clock - taken).total_seconds())
 
 
 def _refuse_outside(
     log: PressureLog, log_name: str, stamps: pd.Series, log_time: np.ndarray, camera_s: np.ndarray
 ) -> None:
-    """The error naming the photos that lie outside the log and the offsets that would fit."""
+    """The error naming the photos that lie outside the log and the offsets that would fit (a
+    log written a row per setpoint holds its last setpoint for a row's usual interval after its
+    last row)."""
     lo, hi = log.span_s
+    if row_per_setpoint(log):
+        hi += float(np.median(np.diff(log.time_s)))
     outside = np.flatnonzero(~((log_time >= lo) & (log_time <= hi)))
     if not outside.size:
         return
@@ -370,7 +440,7 @@ def _refuse_outside(
         f"--pressure-log {log_name}: {outside.size} of {len(stamps)} photo(s) lie outside the "
         f"log, whose times span {span_text(log.span_s)}{clock}: {stamps.index[first]} (taken "
         f"{stamps.iloc[first]:%Y-%m-%d %H:%M:%S}) is at log time {log_time[first]:.1f} s; give "
-        f"--clock-offset-s ({what}; {offsets_that_fit(camera_s, log.span_s)}) or "
+        f"--clock-offset-s ({what}; {offsets_that_fit(camera_s, (lo, hi))}) or "
         "--log-time-at PHOTO=TIME, or move photos that are no ramp's out of the folder"
     )
 
@@ -398,8 +468,11 @@ def offsets_that_fit(placed_s: np.ndarray, span_s: tuple[float, float]) -> str:
 def _gaps(
     log: PressureLog, stamps: pd.Series, log_time: np.ndarray
 ) -> tuple[np.ndarray, list[str]]:
-    """Which photos lie in a gap of the log (:data:`GAP_ROWS`), and a warning line per gap."""
+    """Which photos lie in a gap of the log (:data:`GAP_ROWS`), and a warning line per gap (a
+    log written a row per setpoint has none: a long hold is one row)."""
     t = log.time_s
+    if row_per_setpoint(log):
+        return np.zeros(len(log_time), bool), []
     step = np.diff(t)
     limit = max(GAP_MIN_S, GAP_ROWS * float(np.median(step)))
     after = np.clip(np.searchsorted(t, log_time, side="right"), 1, len(t) - 1)
@@ -421,7 +494,10 @@ def _near_step(log_time: np.ndarray, steps: np.ndarray) -> np.ndarray:
     """Each time's distance (s) to the nearest step time (inf without steps)."""
     if not steps.size:
         return np.full(len(log_time), np.inf)
-    return np.min(np.abs(log_time[:, None] - steps[None, :]), axis=1)
+    k = np.searchsorted(steps, log_time)
+    before = np.abs(log_time - steps[np.clip(k - 1, 0, steps.size - 1)])
+    after = np.abs(steps[np.clip(k, 0, steps.size - 1)] - log_time)
+    return np.minimum(before, after)
 
 
 def _near_step_lines(table: pd.DataFrame, limit: int = 12) -> list[str]:

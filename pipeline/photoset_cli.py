@@ -62,8 +62,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     init.add_argument(
         "--pressure-log",
         metavar="NAME",
-        help="the pressure log (a CSV with time_s and pressure_kpa, or a logger's dated "
-             "'timestamp' column) in DIR. For photos whose names hold no pressure: each photo's "
+        help="the pressure log (a CSV with time_s and pressure_kpa; or the logger's own clock: "
+             "a 'timestamp' column of dates and times, 'Date' and 'Time' columns, or clock times "
+             "alone) in DIR. For photos whose names hold no pressure: each photo's "
              "setpoint, measured pressure and direction are read from the log at the time the "
              "camera wrote into it (EXIF). For videos ('{video}' in it stands for each video's "
              "name without its ending, '{video}_pressure.csv'): writes a video photo set, one "

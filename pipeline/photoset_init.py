@@ -374,7 +374,8 @@ def _init_photoset(
             )
         df = df.sort_values("log_time_s", kind="stable").reset_index(drop=True)
         if not trials_in_names:
-            df = _split_ramps(df.drop(columns=["step"], errors="ignore"))
+            df = df.drop(columns=["step"], errors="ignore")
+            df = _split_by_trend(df) if placement.sensor_only else _split_ramps(df)
         df["direction"] = _rising_from_the_start(df)
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
@@ -746,6 +747,30 @@ def _split_ramps(df: pd.DataFrame) -> pd.DataFrame:
         for k, (a, b) in enumerate(zip(starts, [*starts[1:], len(order)], strict=True)):
             label = str(int(trial) + k) if str(trial).isdigit() else f"{trial}-{k + 1}"
             out.loc[order.index[a:b], "trial"] = label
+    return out
+
+
+def _split_by_trend(df: pd.DataFrame) -> pd.DataFrame:
+    """Each ramp of a group (photo order) as a trial of its own, a new one where the direction
+    turns from ``down`` to ``up``: for pressures read off a sensor, whose noise hides which
+    photos share the lowest level (:func:`_split_ramps` compares them).
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"material": "m", "actuator": "a", "trial": "1",
+    ...                    "direction": ["up", "up", "down", "down", "up", "down"]})
+    >>> _split_by_trend(df)["trial"].tolist()
+    ['1', '1', '1', '1', '2', '2']
+    """
+    out = df.copy()
+    for (_, _, trial), g in df.groupby(list(RAMP_KEYS), sort=False):
+        up = (g["direction"] == "up").to_numpy()
+        k = np.concatenate([[0], np.cumsum(up[1:] & ~up[:-1])])
+        if k[-1] == 0:
+            continue
+        out.loc[g.index, "trial"] = [
+            str(int(trial) + i) if str(trial).isdigit() else f"{trial}-{i + 1}" for i in k
+        ]
     return out
 
 

@@ -14,7 +14,8 @@ from PIL import Image
 from pipeline.cli import main
 from pipeline.photo_times import EXIF_DATETIME_ORIGINAL, EXIF_IFD, EXIF_SUBSEC_ORIGINAL
 
-START = datetime(2026, 12, 6, 14, 0, 0)
+#: not the day the tests run: a time read without its date is dated to today by pandas
+START = datetime(2026, 11, 5, 14, 0, 0)
 #: two ramps 0 -> 40 -> 0 kPa, one after the other, each level held HOLD_S
 LEVELS_KPA = [0, 20, 40, 20, 0] * 2
 HOLD_S = 12.0
@@ -95,7 +96,7 @@ def test_photos_get_the_logs_setpoint_measured_pressure_direction_and_trial_at_t
     assert m["trial"].tolist() == ["1"] * 5 + ["2"] * 5  # split where the second ramp starts
     assert m["step"].tolist() == list(range(5)) * 2  # in the order taken, not by name
     assert m["image"].iloc[0] == "IMG_9997.JPG" and m["image"].iloc[3] == "IMG_0001.JPG"
-    assert m["timestamp"].iloc[1] == "2026-12-06T14:00:18.400"
+    assert m["timestamp"].iloc[1] == "2026-11-05T14:00:18.400"
     assert code == main(["photoset", "check", str(logged_folder)])
 
 
@@ -139,7 +140,7 @@ def test_a_log_in_seconds_needs_the_offset_and_photos_outside_the_log_are_refuse
     assert main([*args, "--clock-offset-s", "66.4", "--overwrite"]) == 2
     err = capsys.readouterr().err
     assert "4 of 10 photo(s) lie outside the log, whose times span -15.00-134.50 s" in err
-    assert "IMG_0004.JPG (taken 2026-12-06 14:01:18) is at log time 138.4 s" in err
+    assert "IMG_0004.JPG (taken 2026-11-05 14:01:18) is at log time 138.4 s" in err
     assert "any from -15.0 to 26.5 puts every photo inside the log" in err
 
 
@@ -264,7 +265,7 @@ def test_photos_in_a_gap_of_the_log_are_left_out_and_named(logged_folder, capsys
 def test_a_logs_dates_that_read_either_way_are_read_as_the_photos_dates_say(
     logged_folder, capsys
 ):
-    """A logger writing day first, 06/12/2026 (read month first, 12 June, every photo lay
+    """A logger writing day first, 05/11/2026 (read month first, 11 May, every photo lay
     outside the log, and the error pointed at the clock offset)."""
     rows = _log_rows(5.5)
     stamps = pd.to_datetime(rows["Timestamp"], format="ISO8601")
@@ -274,7 +275,7 @@ def test_a_logs_dates_that_read_either_way_are_read_as_the_photos_dates_say(
     assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
                  "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
                  "5.5"]) == 0
-    assert "read as 2026-12-06, as the photos' own dates are" in capsys.readouterr().out
+    assert "read as 2026-11-05, as the photos' own dates are" in capsys.readouterr().out
     m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
     assert m["pressure_kpa"].tolist() == LEVELS_KPA
 
@@ -283,18 +284,30 @@ def test_a_log_written_a_row_per_setpoint_gives_each_photo_the_setpoint_in_force
     logged_folder, capsys
 ):
     """A logger that writes one row per commanded setpoint (review): the photos read values
-    between two levels (10.67, 30.67, ...), the top one 'down', and were told to bin them."""
-    rows = _log_rows(5.5)
-    # one row a level, and one as the logger stops
-    rows = rows[rows["camera_s"].isin(HOLD_S * np.arange(len(LEVELS_KPA) + 1))]
-    rows.drop(columns="camera_s").to_csv(logged_folder / "log.csv", index=False)
+    between two levels (10.67, 30.67, ...; the measured pressure too), the top one 'down', and
+    were told to bin them; a long hold was taken for a gap, and the last level, after the last
+    row, for outside the log."""
+    # a row a setpoint; the top of the first ramp held 36 s; no row as the logger stops
+    rows_s = [0, 12, 24, 60, 72, 84, 96, 108]
+    setpoints = [0, 20, 40, 20, 0, 20, 40, 20]
+    pd.DataFrame(
+        {
+            "Timestamp": [(START + timedelta(seconds=t + 5.5)).isoformat(sep=" ") for t in rows_s],
+            "Setpoint (kPa)": setpoints,
+            "Sensor (kPa)": [v + 0.2 for v in setpoints],
+        }
+    ).to_csv(logged_folder / "log.csv", index=False)
     assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
                  "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
                  "5.5"]) == 0
-    assert "continuous ramp" not in capsys.readouterr().out
+    out = capsys.readouterr()
+    assert "continuous ramp" not in out.out and "gap" not in out.err
     m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
-    assert m["pressure_kpa"].tolist() == LEVELS_KPA
-    assert m["direction"].tolist() == ["up", "up", "up", "down", "down"] * 2
+    # each photo (12 i + 6.4 s) reads the last row before it, the last a row's interval after
+    levels = [0, 20, 40, 40, 40, 20, 0, 20, 40, 20]
+    assert m["pressure_kpa"].tolist() == levels
+    np.testing.assert_allclose(m["measured_pressure_kpa"], np.add(levels, 0.2))
+    assert m["direction"].tolist() == ["up"] * 5 + ["down"] * 2 + ["up", "up", "down"]
 
 
 def _labview(t: pd.Timestamp, p: float, m: float, zone: str) -> str:
@@ -343,7 +356,7 @@ def test_loggers_own_clocks_are_read(logged_folder, header, cell, capsys):
     assert m["pressure_kpa"].tolist() == pytest.approx(LEVELS_KPA, abs=0.01)
     assert np.allclose(m["measured_pressure_kpa"], LEVELS_KPA, atol=1.5)  # read, not dropped
     if cell is _clock_alone:
-        assert "the log's clock times have no date: taken as 2026-12-06" in out
+        assert "clock times have no date: its first row taken as 2026-11-05 13:59:50" in out
 
 
 def test_a_day_first_log_across_midnight_reads_its_dates_one_way(tmp_path):
@@ -362,7 +375,7 @@ def test_a_day_first_log_across_midnight_reads_its_dates_one_way(tmp_path):
 def test_a_photo_with_only_the_time_an_editor_saved_it_is_refused(logged_folder, capsys):
     """IFD0 DateTime is when the file was last written: a photo re-saved keeps only that."""
     exif = Image.Exif()
-    exif[306] = "2026:12:06 14:00:20"  # DateTime, no DateTimeOriginal
+    exif[306] = "2026:11:05 14:00:20"  # DateTime, no DateTimeOriginal
     Image.new("RGB", (32, 24)).save(logged_folder / "IMG_0004.JPG", exif=exif)
     assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
                  "--pressure-log", "log.csv", "--material", "DS20"]) == 2
@@ -379,3 +392,54 @@ def test_every_photo_in_a_gap_is_refused_without_a_manifest(logged_folder, capsy
     err = capsys.readouterr().err
     assert "every photo was taken in a gap of the log" in err and "manifest" not in err
     assert not (logged_folder / "manifest.csv").exists()
+
+
+def test_a_sensor_logged_alone_gives_directions_by_its_trend_not_its_noise(logged_folder, capsys):
+    """One pressure column, a sensor's reading with noise 1.5 kPa (review: half the photos of a
+    noisy log got the wrong direction: the trend turned at every wobble)."""
+    rows = _log_rows(5.5)
+    noisy = rows["Setpoint (kPa)"] + np.random.default_rng(3).normal(0, 1.5, len(rows))
+    rows.assign(**{"Pressure (kPa)": noisy.round(2)})[["Timestamp", "Pressure (kPa)"]].to_csv(
+        logged_folder / "log.csv", index=False
+    )
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
+                 "5.5"]) == 0
+    assert "a sensor's reading, not a setpoint" in capsys.readouterr().out
+    m = _taken(pd.read_csv(logged_folder / "manifest.csv"))
+    # the sixth photo, the second at the bottom between the ramps, ends one or starts the other:
+    # with no setpoint its noisy reading cannot say
+    expected = ["up", "up", "up", "down", "down"] * 2
+    assert [d for i, d in enumerate(m["direction"]) if i != 5] == expected[:5] + expected[6:]
+    assert m["trial"].nunique() == 2
+    np.testing.assert_allclose(m["pressure_kpa"], LEVELS_KPA, atol=6)
+
+
+def test_clock_texts_are_read_one_way_in_the_log_and_in_log_time_at(tmp_path, logged_folder,
+                                                                     capsys):
+    """Slashes whose every day and month is 12 or less across midnight: read day first the log
+    spans 1 day, month first 30 (review: read month first and refused); AM/PM clock times, and
+    --log-time-at with a decimal comma, are read like the log's cells (they were dated today)."""
+    from pipeline.video.timeline import read_pressure_log
+
+    path = tmp_path / "log.csv"
+    path.write_text("Timestamp,pressure_kpa\n05/11/2026 23:59:59,0\n06/11/2026 00:00:01,5\n")
+    log, _ = read_pressure_log(path)
+    assert log is not None and log.time_s.tolist() == [0, 2]
+    assert log.clock_start == datetime(2026, 11, 5, 23, 59, 59)
+    rows = _log_rows(5.5)
+    stamps = pd.to_datetime(rows["Timestamp"], format="ISO8601")
+    rows.assign(Time=stamps.dt.strftime("%I:%M:%S.%f %p"))[["Time", "Setpoint (kPa)"]].to_csv(
+        logged_folder / "log.csv", index=False
+    )
+    (logged_folder / "clock").mkdir()
+    _photo(logged_folder / "clock" / "IMG_9996.JPG", START - timedelta(seconds=9.8))
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--material", "DS20",
+                 "--log-time-at", "clock/IMG_9996.JPG=1:59:55,7 PM"]) == 0, (
+        capsys.readouterr().err
+    )
+    assert "5.5 s ahead of the camera's" in capsys.readouterr().out
+    assert _taken(pd.read_csv(logged_folder / "manifest.csv"))["pressure_kpa"].tolist() == (
+        LEVELS_KPA
+    )

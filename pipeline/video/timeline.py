@@ -366,14 +366,18 @@ def read_frame_times(path: str | os.PathLike[str]) -> tuple[np.ndarray | None, l
 
 
 def turning_points(
-    pressure_kpa: np.ndarray, deadband_kpa: float = TREND_DEADBAND_KPA
+    pressure_kpa: np.ndarray, deadband_kpa: float = TREND_DEADBAND_KPA, band_kpa: float = 0.0
 ) -> np.ndarray:
-    """Indices of the confirmed extremes of a pressure series (the last sample of each extreme).
+    """Indices of the confirmed extremes of a pressure series (the last sample of each extreme,
+    or, with ``band_kpa``, the last sample within that of it before the pressure left it: a
+    noisy hold at the top of a ramp is its top to its end, not to its highest sample).
 
     Examples
     --------
     >>> turning_points(np.array([0.0, 5, 10, 10, 9.5, 10, 5, 0, 0.3, 4]))
     array([5, 7])
+    >>> turning_points(np.array([0.0, 10, 11, 10, 10.5, 0]), 3.0, band_kpa=1.0)
+    array([4])
     """
     p = np.asarray(pressure_kpa, float)
     out: list[int] = []
@@ -384,13 +388,13 @@ def turning_points(
             if p[i] >= p[ext]:
                 ext = i
             elif p[ext] - p[i] > deadband_kpa:
-                out.append(ext)
+                out.append(max(j for j in range(ext, i) if p[j] >= p[ext] - band_kpa))
                 rising, ext = False, i
         else:
             if p[i] <= p[ext]:
                 ext = i
             elif p[i] - p[ext] > deadband_kpa:
-                out.append(ext)
+                out.append(max(j for j in range(ext, i) if p[j] <= p[ext] + band_kpa))
                 rising, ext = True, i
     return np.array(out, dtype=int)
 
@@ -426,8 +430,15 @@ def step_rows(log: PressureLog) -> np.ndarray:
     return np.array(out, dtype=int)
 
 
-def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
-    """Pressure, direction and step of frames at ``time_s`` (log clock), one row per frame.
+def frame_conditions(
+    log: PressureLog,
+    time_s: np.ndarray,
+    deadband_kpa: float = TREND_DEADBAND_KPA,
+    band_kpa: float = 0.0,
+) -> pd.DataFrame:
+    """Pressure, direction and step of frames at ``time_s`` (log clock), one row per frame;
+    the trend turns where the pressure leaves an extreme by ``deadband_kpa``
+    (:func:`turning_points`, with ``band_kpa``).
 
     Returns
     -------
@@ -450,7 +461,7 @@ def frame_conditions(log: PressureLog, time_s: np.ndarray) -> pd.DataFrame:
         out["measured_pressure_kpa"] = np.where(
             inside, np.interp(t, log.time_s, log.measured_kpa), np.nan
         )
-    tp = turning_points(log.pressure_kpa)
+    tp = turning_points(log.pressure_kpa, deadband_kpa, band_kpa)
     # direction of each log interval: up until the first turning point, then alternating
     edges = log.time_s[tp]
     # a frame at a peak's own time is still rising, and so is one that holds the peak's setpoint
