@@ -50,6 +50,8 @@ SIGN_CHECK_SHARE = 0.5
 #: noise (and by TREND_DEADBAND_KPA at least): a sensor's reading logged alone turned at every
 #: wobble, and its photos' directions with it
 NOISE_DEADBANDS = 6.0
+#: rows over which a log's noise is taken at a time (:func:`noise_kpa`)
+NOISE_WINDOW_ROWS = 50
 #: ... and its extreme lasts as long as its pressure stays within this many times its noise
 NOISE_BAND = 3.0
 #: a log whose one pressure column varies by more than this (kPa, :func:`noise_kpa`) holds a
@@ -59,7 +61,11 @@ NOISY_KPA = 0.3
 #: setpoint: a long hold there is no gap, and its last setpoint holds for a row's interval more
 ROW_PER_SETPOINT_SHARE = 0.5
 #: columns of :attr:`PhotoPlacement.table` that are no manifest's
-PLACEMENT_ONLY_COLUMNS: tuple[str, ...] = ("log_time_s", "near_step_s")
+PLACEMENT_ONLY_COLUMNS: tuple[str, ...] = ("near_step_s",)
+#: the manifest's record of photos placed on a pressure log (``init`` writes them): the log's
+#: name, and each photo's time on the log's clock; ``check`` reads the log again by them
+#: (:func:`logged_row_doubts`)
+LOG_RECORD_COLUMNS: tuple[str, ...] = ("pressure_log", "log_time_s")
 
 
 @dataclass(frozen=True)
@@ -216,15 +222,21 @@ def place_photos(
 
 
 def noise_kpa(pressure_kpa: np.ndarray) -> float:
-    """The row-to-row noise of a logged pressure (kPa, a standard deviation, from the median
-    absolute deviation of its second differences, which steps and ramps leave at 0 but at their
-    corners): 0 for a setpoint, held, stepped or ramped.
+    """The row-to-row noise of a logged pressure where it is largest (kPa, a standard
+    deviation): the median absolute deviation of its second differences (which steps and ramps
+    leave at 0 but at their corners) over :data:`NOISE_WINDOW_ROWS` rows at a time, its 95th
+    percentile over the log: 0 for a setpoint, held, stepped or ramped.  A sensor's noise grows
+    with its reading: customer 41's was 0.05 kPa at rest and 0.4 at the top, and one median
+    over the log (0.12) let the top holds' noise turn the trend.
 
     Examples
     --------
     >>> rng = np.random.default_rng(0)
     >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)
     1.5
+    >>> levels = np.repeat([0.0, 20, 40], 500)
+    >>> round(noise_kpa(levels + rng.normal(0, 1.0, 1500) * levels / 40), 1)  # 1 at the top
+    1.0
     >>> ramp = np.concatenate([np.linspace(0, 100, 50), np.linspace(100, 0, 50)])
     >>> noise_kpa(np.repeat([0.0, 20, 40], 500)), round(noise_kpa(ramp), 6)
     (0.0, 0.0)
@@ -232,7 +244,10 @@ def noise_kpa(pressure_kpa: np.ndarray) -> float:
     d2 = np.diff(np.asarray(pressure_kpa, float), 2)
     if d2.size < 2:
         return 0.0
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
+    deviation = pd.Series(np.abs(d2 - np.median(d2)))
+    window = min(NOISE_WINDOW_ROWS, d2.size)
+    local = deviation.rolling(window, center=True, min_periods=window // 2 + 1).median()
+    return float(1.4826 * np.nanpercentile(local.to_numpy(float), 95) / np.sqrt(6.0))
 
 
 def row_per_setpoint(log: PressureLog) -> bool:
@@ -568,3 +583,72 @@ def unheld_levels(manifest: pd.DataFrame) -> bool:
     """
     counts = manifest["pressure_kpa"].value_counts()
     return len(manifest) >= 4 and bool((counts == 1).sum() > 0.5 * len(manifest))
+
+
+def logged_row_doubts(
+    folder: str | os.PathLike[str], manifest: pd.DataFrame
+) -> list[tuple[object, str, str]]:
+    """What ``check`` says, each time, of photos ``init`` placed on a pressure log (the
+    manifest's :data:`LOG_RECORD_COLUMNS`): a pressure that is no longer the log's setpoint at
+    the photo's log time (edited, or the log changed), a photo taken near a step of the
+    setpoint, and an offset whose opposite sign would put clearly fewer photos near one.
+
+    Parameters
+    ----------
+    folder : path
+        The photo set's folder.
+    manifest : pandas.DataFrame
+        Its manifest, as loaded (``pressure_kpa`` read as numbers).
+
+    Returns
+    -------
+    list of (index, what, fix)
+        One per doubt: the manifest row's index, what is wrong, and the fix.
+    """
+    if not set(LOG_RECORD_COLUMNS) <= set(manifest.columns):
+        return []
+    out: list[tuple[object, str, str]] = []
+    rows = manifest[manifest["pressure_log"].notna()]
+    for name, g in rows.groupby(rows["pressure_log"].astype(str), sort=False):
+        log, problems = read_pressure_log(Path(folder) / name)
+        if log is None:
+            out.append((g.index[0], f"pressure_log {name}: " + "; ".join(problems),
+                        "put the log the photos were placed on back beside them"))
+            continue
+        t = pd.to_numeric(g["log_time_s"], errors="coerce").to_numpy(float)
+        known = np.isfinite(t)
+        k = np.clip(np.searchsorted(log.time_s, t[known], side="right") - 1, 0, None)
+        setpoint = np.full(len(g), np.nan)
+        setpoint[known] = log.pressure_kpa[k]
+        given = pd.to_numeric(g["pressure_kpa"], errors="coerce").to_numpy(float)
+        steps = jump_times(log)
+        near = np.full(len(g), np.inf)
+        near[known] = _near_step(t[known], steps)
+        for i, ix in enumerate(g.index):
+            if known[i] and abs(given[i] - setpoint[i]) > 0.01:
+                what = (
+                    f"pressure_kpa {given[i]:g} is not the setpoint of {name} at this photo's "
+                    f"log time, {t[i]:g} s ({setpoint[i]:g} kPa): edited, or the log changed"
+                )
+                fix = "run photoset init --pressure-log again, or correct pressure_kpa"
+                out.append((ix, what, fix))
+            if near[i] < NEAR_STEP_S:
+                what = (
+                    f"taken {near[i]:.2g} s from a step of {name}'s setpoint: a clock off by a "
+                    "second reads the level on the step's other side, and the actuator may still "
+                    "be moving"
+                )
+                fix = "check the clocks (photoset init --log-time-at) and this pressure"
+                out.append((ix, what, fix))
+        if log.clock_start is not None and "timestamp" in g.columns:
+            taken = pd.to_datetime(g["timestamp"], errors="coerce", format="ISO8601")
+            camera_s = ((taken - pd.Timestamp(log.clock_start)).dt.total_seconds()).to_numpy()
+            ok = known & np.isfinite(camera_s)
+            if ok.any():
+                offset = float(np.median(t[ok] - camera_s[ok]))
+                line = _opposite_sign_line(
+                    round(offset, 3), camera_s[ok], steps, int((near[ok] < NEAR_STEP_S).sum())
+                )
+                if line:
+                    out.append((g.index[0], line, "photoset init --log-time-at PHOTO=TIME"))
+    return out

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 
 from pipeline.model.materials import load_materials
+from pipeline.photo_log import logged_row_doubts
 from pipeline.photoset import MANIFEST, PhotoSet, Problem, file_problems, load_checked
 from pipeline.ramp_check import pressure_order_breaks
 from pipeline.video.clips import clip_problems
@@ -39,6 +40,7 @@ def check_photoset(
         problems += file_problems(ps, decode_images=decode_images, require_images=require_images)
         problems += material_problems(ps)
         problems += pressure_order_problems(ps)
+        problems += logged_pressure_problems(ps)
     return [p for p in problems if warnings or not p.warning]
 
 
@@ -61,6 +63,24 @@ def material_problems(ps: PhotoSet) -> list[Problem]:
             warning=True,
         ))
     return out
+
+
+def logged_pressure_problems(ps: PhotoSet) -> list[Problem]:
+    """Warnings for photos ``init`` placed on a pressure log, said again at each check
+    (:func:`pipeline.photo_log.logged_row_doubts`): customer 40's sign warning was said once,
+    and check said OK after it."""
+    if ps.is_video:
+        return []
+    return [
+        Problem(
+            str(ps.folder / MANIFEST),
+            int(ps.manifest.at[ix, "manifest_line"]),
+            what,
+            fix,
+            warning=True,
+        )
+        for ix, what, fix in logged_row_doubts(ps.folder, ps.manifest)
+    ]
 
 
 def pressure_order_problems(ps: PhotoSet) -> list[Problem]:

@@ -93,10 +93,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--log-time-at",
         metavar="PHOTO=TIME",
         help="with --pressure-log, for photos: PHOTO, a photo of the logger's screen with its "
-             "clock in view (kept in a subfolder, out of the ramps' photos), and the log's TIME it "
-             "shows, e.g. clock/IMG_0001.JPG=14:00:10.1 (on a log in seconds, its time in "
-             "seconds); relates the camera's clock to the logger's instead of --clock-offset-s, "
-             "with no sign to get wrong",
+             "clock in view (kept out of the set's folder, its path from it), and the log's TIME "
+             "it shows, e.g. ../clock.JPG=14:00:10.1 (on a log in seconds, its time in seconds); "
+             "relates the camera's clock to the logger's instead of --clock-offset-s, with no "
+             "sign to get wrong",
     )
     init.add_argument(
         "--material", help="material for every photo when the pattern has no {material}"
@@ -501,12 +501,12 @@ def _init_logged(
     if photo and photo in set(df["image"]):
         warnings.append(
             f"{photo}, named by --log-time-at, is one of the ramps' photos and is measured as "
-            f"one: if it shows the logger's clock, move it into a subfolder (clock/{photo}) and "
-            "give that path"
+            f"one: if it shows the logger's clock, move it out of the set's folder and give its "
+            f"path from there (../{Path(photo).name})"
         )
     for line in warnings:
         print(line if line.startswith("  ") else f"warning: {line}", file=sys.stderr)
-    _print_written(args, df, kept, placement.left_out)
+    _print_written(args, df, kept, (*placement.left_out, *([photo] if photo else [])))
     return 0
 
 

@@ -40,6 +40,10 @@ VIDEO_SUFFIXES: tuple[str, ...] = (
     ".avi", ".mp4", ".mov", ".mkv", ".m4v", ".wmv", ".mpg", ".mpeg", ".webm",
 )
 
+#: photos read off a sensor's noisy log within this (kPa) sit at one level, as far as where a
+#: ramp starts is concerned
+SENSOR_LEVEL_KPA = 1.0
+
 _FIELD_PATTERNS: dict[str, str] = {
     "pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
     "measured_pressure_kpa": r"[-+]?\d+(?:[.,p]\d+)?",
@@ -367,6 +371,7 @@ def _init_photoset(
         logged = placement.table
         given = [c for c in logged.columns if c != "image"]  # the log's, not the names'
         df = df.drop(columns=given, errors="ignore").merge(logged, on="image")  # gaps' go
+        df["pressure_log"] = pressure_log[0]  # the record check reads the log again by
         if df.empty:
             raise UserInputError(
                 f"--pressure-log {pressure_log[0]}: every photo lies in a gap of the log; "
@@ -376,7 +381,9 @@ def _init_photoset(
         if not trials_in_names:
             df = df.drop(columns=["step"], errors="ignore")
             df = _split_by_trend(df) if placement.sensor_only else _split_ramps(df)
-        df["direction"] = _rising_from_the_start(df)
+        df["direction"] = _rising_from_the_start(
+            df, SENSOR_LEVEL_KPA if placement.sensor_only else 0.0
+        )
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
@@ -757,16 +764,35 @@ def _split_by_trend(df: pd.DataFrame) -> pd.DataFrame:
 
     Examples
     --------
+    Photos ``down`` before the group's first ``up`` one (at rest, after another actuator's
+    ramps) start its first ramp; the last of two photos at the bottom between two ramps (within
+    5 % of the ramp's span of each other) starts the next, as :func:`ramp_starts` has it.
+
+    Examples
+    --------
     >>> df = pd.DataFrame({"material": "m", "actuator": "a", "trial": "1",
-    ...                    "direction": ["up", "up", "down", "down", "up", "down"]})
+    ...                    "direction": ["down", "up", "up", "down", "down", "up", "down"],
+    ...                    "pressure_kpa": [0.1, 20, 40, 20, 0.2, 20, 0]})
     >>> _split_by_trend(df)["trial"].tolist()
-    ['1', '1', '1', '1', '2', '2']
+    ['1', '1', '1', '1', '1', '2', '2']
+    >>> _split_by_trend(df.assign(pressure_kpa=[0.1, 20, 40, 0.3, 0.2, 20, 0]))["trial"].tolist()
+    ['1', '1', '1', '1', '2', '2', '2']
     """
     out = df.copy()
     for (_, _, trial), g in df.groupby(list(RAMP_KEYS), sort=False):
         up = (g["direction"] == "up").to_numpy()
-        k = np.concatenate([[0], np.cumsum(up[1:] & ~up[:-1])])
-        if k[-1] == 0:
+        p = g["pressure_kpa"].to_numpy(float)
+        starts = np.flatnonzero(up[1:] & ~up[:-1]) + 1  # a rise after a fall
+        starts = starts[starts > np.argmax(up)]  # (not the group's first rise)
+        tolerance = max(SENSOR_LEVEL_KPA, 0.05 * float(np.ptp(p)))
+        starts = np.array([
+            j - 1 if j >= 2 and not up[j - 2] and abs(p[j - 1] - p[j - 2]) <= tolerance else j
+            for j in starts
+        ], dtype=int)
+        k = np.zeros(len(g), dtype=int)
+        for j in starts:
+            k[j:] += 1
+        if not starts.size:
             continue
         out.loc[g.index, "trial"] = [
             str(int(trial) + i) if str(trial).isdigit() else f"{trial}-{i + 1}" for i in k
@@ -802,10 +828,11 @@ def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
     return lines
 
 
-def _rising_from_the_start(df: pd.DataFrame) -> pd.Series:
+def _rising_from_the_start(df: pd.DataFrame, tolerance_kpa: float = 0.0) -> pd.Series:
     """``df``'s directions (in photo order), but ``up`` for the photos that begin a ramp at its
-    lowest pressure: held at the bottom between two ramps, the log still falls there (the last
-    photo of one ramp and the first of the next are both at 0 kPa).
+    lowest pressure (within ``tolerance_kpa``: a sensor's noisy reading): held at the bottom
+    between two ramps, the log still falls there (the last photo of one ramp and the first of
+    the next are both at 0 kPa).
 
     Examples
     --------
@@ -818,8 +845,9 @@ def _rising_from_the_start(df: pd.DataFrame) -> pd.Series:
     out = df["direction"].copy()
     for _, g in df.groupby(list(RAMP_KEYS), sort=False):
         p = g["pressure_kpa"].to_numpy(float)
-        lead = int(np.argmax(p != p[0])) if (p != p[0]).any() else len(p)
-        if p[0] <= p.min():
+        other = np.abs(p - p[0]) > tolerance_kpa
+        lead = int(np.argmax(other)) if other.any() else len(p)
+        if p[0] <= p.min() + tolerance_kpa:
             out.loc[g.index[:lead]] = "up"
     return out
 

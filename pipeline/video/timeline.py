@@ -55,15 +55,16 @@ LOG_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa")
 #: the words a regulator's or logger's own header uses for the log's columns (any case, a unit in
 #: brackets: "t (s)", "Setpoint [bar]", "Sensor (kPa)"), by the column each stands for
 LOG_WORDS: dict[str, tuple[str, ...]] = {
-    "time": ("time", "t", "elapsed", "timestamp"),
+    "time": ("time", "t", "elapsed", "timestamp", "zeit"),
     "pressure": (
         "pressure", "setpoint", "set_pressure", "set", "command", "target", "p_set",
         "pressure_setpoint", "setpoint_pressure", "target_pressure", "commanded_pressure",
+        "druck", "solldruck", "sollwert", "soll",
     ),
     "measured": (
         "measured", "sensor", "readback", "read_back", "actual", "feedback", "p_meas",
         "measured_pressure", "pressure_measured", "actual_pressure", "sensor_pressure",
-        "pressure_sensor", "p_measured",
+        "pressure_sensor", "p_measured", "istdruck", "istwert", "ist",
     ),
 }
 #: seconds per unit of a time column
@@ -135,6 +136,8 @@ def log_header_names(columns: list[str]) -> dict[str, str]:
     {'Time [ms]': 'time_ms', 'P set (bar)': 'pressure_bar', 'Sensor (kPa)': 'measured_kpa'}
     >>> log_header_names(["Set Pressure (bar)", "Measured Pressure (bar)"])  # LabVIEW's
     {'Set Pressure (bar)': 'pressure_bar', 'Measured Pressure (bar)': 'measured_bar'}
+    >>> log_header_names(["Zeit [ms]", "Druck [mbar]"])
+    {'Zeit [ms]': 'time_ms', 'Druck [mbar]': 'pressure_mbar'}
     >>> log_header_names(["time", "setpoint"])  # no unit: none is guessed
     {}
     >>> log_header_names(["time_s", "pressure_kpa"])
@@ -247,6 +250,11 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, clock_problems
     if clock is not None:
         df = df.assign(time_s=clock.time_s)
+    if "pressure_kpa" not in df.columns and "measured_kpa" in df.columns:
+        # a log of the measured pressure alone: the only pressure there is
+        df = df.rename(columns={"measured_kpa": "pressure_kpa"})
+        own = {c: ("pressure_" + n.split("_", 1)[1] if n.startswith("measured_") else n)
+               for c, n in own.items()}
     missing = [c for c in LOG_COLUMNS if c not in df.columns]
     if missing:
         header = columns  # as the file writes it
