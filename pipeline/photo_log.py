@@ -225,15 +225,16 @@ def noise_kpa(pressure_kpa: np.ndarray) -> float:
     """The row-to-row noise of a logged pressure where it is largest (kPa, a standard
     deviation): the median absolute deviation of its second differences (which steps and ramps
     leave at 0 but at their corners) over :data:`NOISE_WINDOW_ROWS` rows at a time, its 95th
-    percentile over the log: 0 for a setpoint, held, stepped or ramped.  A sensor's noise grows
+    percentile over the log (so a little over an even noise's own), 0 for a setpoint, held,
+    stepped or ramped.  A sensor's noise grows
     with its reading: customer 41's was 0.05 kPa at rest and 0.4 at the top, and one median
     over the log (0.12) let the top holds' noise turn the trend.
 
     Examples
     --------
     >>> rng = np.random.default_rng(0)
-    >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)
-    1.5
+    >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)  # 1.5
+    2.0
     >>> levels = np.repeat([0.0, 20, 40], 500)
     >>> round(noise_kpa(levels + rng.normal(0, 1.0, 1500) * levels / 40), 1)  # 1 at the top
     1.0
