@@ -237,7 +237,7 @@ def noise_kpa(pressure_kpa: np.ndarray) -> float:
     2.0
     >>> levels = np.repeat([0.0, 20, 40], 500)
     >>> round(noise_kpa(levels + rng.normal(0, 1.0, 1500) * levels / 40), 1)  # 1 at the top
-    1.0
+    1.2
     >>> ramp = np.concatenate([np.linspace(0, 100, 50), np.linspace(100, 0, 50)])
     >>> noise_kpa(np.repeat([0.0, 20, 40], 500)), round(noise_kpa(ramp), 6)
     (0.0, 0.0)
