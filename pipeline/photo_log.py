@@ -29,11 +29,12 @@ from pipeline.measure.settings import user_float
 from pipeline.photo_times import exif_time
 from pipeline.video.timeline import (
     STEP_MIN_KPA,
-    TREND_DEADBAND_KPA,
     PressureLog,
     frame_conditions,
+    log_noise_kpa,
     read_pressure_log,
     span_text,
+    trend_deadband_kpa,
 )
 
 #: a photo taken closer than this to a step of the log's setpoint (s) is named: the camera's
@@ -46,14 +47,6 @@ GAP_MIN_S = 1.0
 #: the opposite sign of an offset is suggested when it leaves at most this share of the photos
 #: near a step that the offset given leaves (and at least 3 fewer)
 SIGN_CHECK_SHARE = 0.5
-#: a log's trend turns once its pressure leaves an extreme by this many times its row-to-row
-#: noise (and by TREND_DEADBAND_KPA at least): a sensor's reading logged alone turned at every
-#: wobble, and its photos' directions with it
-NOISE_DEADBANDS = 6.0
-#: rows over which a log's noise is taken at a time (:func:`noise_kpa`)
-NOISE_WINDOW_ROWS = 50
-#: ... and its extreme lasts as long as its pressure stays within this many times its noise
-NOISE_BAND = 3.0
 #: a log whose one pressure column varies by more than this (kPa, :func:`noise_kpa`) holds a
 #: sensor's reading, not a setpoint
 NOISY_KPA = 0.3
@@ -151,7 +144,7 @@ def place_photos(
     offset_s, placed_note = _offset(log, log_name, stamps, sync, root)
     notes.append(placed_note)
     camera_s = _camera_seconds(log, stamps)
-    log_time = camera_s + offset_s
+    log_time = np.round(camera_s + offset_s, 3)  # as the manifest keeps it, for check
     _refuse_outside(log, log_name, stamps, log_time, camera_s)
     in_gap, gap_lines = _gaps(log, stamps, log_time)
     if in_gap.all():
@@ -168,20 +161,15 @@ def place_photos(
     # values between two levels), its measured pressure the last read, its direction that row's
     # (against the log's trend, beyond its noise)
     in_force = log.time_s[np.searchsorted(log.time_s, log_time[keep], side="right") - 1]
-    noise = 0.0 if row_per_setpoint(log) else noise_kpa(log.pressure_kpa)
-    conditions = frame_conditions(
-        log,
-        in_force,
-        deadband_kpa=max(TREND_DEADBAND_KPA, NOISE_DEADBANDS * noise),
-        band_kpa=NOISE_BAND * noise,
-    )
-    steps = jump_times(log)
+    noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
+    conditions = frame_conditions(log, in_force, noise_kpa=noise)
+    steps = jump_times(log, trend_deadband_kpa(noise))
     near = _near_step(log_time[keep], steps)
     table = pd.DataFrame(
         {
             "image": stamps.index[keep],
             "timestamp": [f"{t:%Y-%m-%dT%H:%M:%S.%f}"[:-3] for t in stamps[keep]],
-            "log_time_s": log_time[keep].round(3),
+            "log_time_s": log_time[keep],
             "pressure_kpa": conditions["pressure_kpa"].round(2).to_numpy(),
         }
     )
@@ -190,17 +178,18 @@ def place_photos(
     table["direction"] = conditions["direction"].to_numpy()
     table["near_step_s"] = np.where(near < NEAR_STEP_S, near.round(2), np.nan)
     table = table.sort_values("log_time_s", kind="stable").reset_index(drop=True)
-    if log.measured_kpa is None and noise > NOISY_KPA:
+    sensor_only = log.measured_kpa is None and (not log.setpoint_logged or noise > NOISY_KPA)
+    if sensor_only:
         notes.append(
-            f"the log's one pressure column ({log.read_from[1]!r}) varies by about {noise:.1f} "
-            "kPa from row to row: a sensor's reading, not a setpoint, so each photo's pressure is "
+            f"the log's one pressure column ({log.read_from[1]!r}) is a sensor's reading (its "
+            f"noise about {noise:.2g} kPa), not a setpoint, so each photo's pressure is "
             "the reading at its time, and no two photos share a level exactly; set "
             "aggregate.bin_kpa in config.yaml to pool them, and check the ramps below (log the "
             "setpoint too, as its own column, for levels)"
         )
     elif log.measured_kpa is None:
         notes.append("the log holds no measured pressure: the manifest has the setpoints alone")
-    if unheld_levels(table) and not (log.measured_kpa is None and noise > NOISY_KPA):
+    if unheld_levels(table) and not sensor_only:
         notes.append(
             "the setpoints at the photos are not levels held for several photos (a continuous "
             "ramp?), so each curve point is one photo: set aggregate.bin_kpa in config.yaml "
@@ -215,40 +204,10 @@ def place_photos(
     return PhotoPlacement(
         table,
         tuple(stamps.index[in_gap]),
-        log.measured_kpa is None and noise > NOISY_KPA,
+        sensor_only,
         tuple(notes),
         tuple(warnings),
     )
-
-
-def noise_kpa(pressure_kpa: np.ndarray) -> float:
-    """The row-to-row noise of a logged pressure where it is largest (kPa, a standard
-    deviation): the median absolute deviation of its second differences (which steps and ramps
-    leave at 0 but at their corners) over :data:`NOISE_WINDOW_ROWS` rows at a time, its 95th
-    percentile over the log (so a little over an even noise's own), 0 for a setpoint, held,
-    stepped or ramped.  A sensor's noise grows
-    with its reading: customer 41's was 0.05 kPa at rest and 0.4 at the top, and one median
-    over the log (0.12) let the top holds' noise turn the trend.
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(0)
-    >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)  # 1.5
-    2.0
-    >>> levels = np.repeat([0.0, 20, 40], 500)
-    >>> round(noise_kpa(levels + rng.normal(0, 1.0, 1500) * levels / 40), 1)  # 1 at the top
-    1.2
-    >>> ramp = np.concatenate([np.linspace(0, 100, 50), np.linspace(100, 0, 50)])
-    >>> noise_kpa(np.repeat([0.0, 20, 40], 500)), round(noise_kpa(ramp), 6)
-    (0.0, 0.0)
-    """
-    d2 = np.diff(np.asarray(pressure_kpa, float), 2)
-    if d2.size < 2:
-        return 0.0
-    deviation = pd.Series(np.abs(d2 - np.median(d2)))
-    window = min(NOISE_WINDOW_ROWS, d2.size)
-    local = deviation.rolling(window, center=True, min_periods=window // 2 + 1).median()
-    return float(1.4826 * np.nanpercentile(local.to_numpy(float), 95) / np.sqrt(6.0))
 
 
 def row_per_setpoint(log: PressureLog) -> bool:
@@ -264,10 +223,10 @@ def row_per_setpoint(log: PressureLog) -> bool:
     return bool(jumps.size) and float(jumps.mean()) > ROW_PER_SETPOINT_SHARE
 
 
-def jump_times(log: PressureLog) -> np.ndarray:
-    """The times of the log's rows where its setpoint jumps (by
-    :data:`pipeline.video.timeline.STEP_MIN_KPA` or more from the row before): the steps a photo
-    taken near would read on either side of, in a dense log or one written a row per setpoint.
+def jump_times(log: PressureLog, least_kpa: float = STEP_MIN_KPA) -> np.ndarray:
+    """The times of the log's rows where its setpoint jumps (by ``least_kpa`` or more from the
+    row before; a noisy sensor's, beyond its noise): the steps a photo taken near would read on
+    either side of, in a dense log or one written a row per setpoint.
 
     Examples
     --------
@@ -275,8 +234,8 @@ def jump_times(log: PressureLog) -> np.ndarray:
     >>> jump_times(log).tolist()
     [12.0, 24.0]
     """
-    jumps = np.flatnonzero(np.abs(np.diff(log.pressure_kpa)) >= STEP_MIN_KPA) + 1
-    return log.time_s[jumps]
+    jumps = np.flatnonzero(np.abs(np.diff(log.pressure_kpa)) >= max(least_kpa, STEP_MIN_KPA))
+    return log.time_s[jumps + 1]
 
 
 def _photos_day(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str]:
@@ -591,8 +550,9 @@ def logged_row_doubts(
 ) -> list[tuple[object, str, str]]:
     """What ``check`` says, each time, of photos ``init`` placed on a pressure log (the
     manifest's :data:`LOG_RECORD_COLUMNS`): a pressure that is no longer the log's setpoint at
-    the photo's log time (edited, or the log changed), a photo taken near a step of the
-    setpoint, and an offset whose opposite sign would put clearly fewer photos near one.
+    the photo's log time (edited, or the log changed), a log time outside the log, and a photo
+    taken near a step of the setpoint.  (The question of an offset's sign is ``init``'s: the
+    manifest does not say how the clocks were related.)
 
     Parameters
     ----------
@@ -622,16 +582,26 @@ def logged_row_doubts(
         setpoint = np.full(len(g), np.nan)
         setpoint[known] = log.pressure_kpa[k]
         given = pd.to_numeric(g["pressure_kpa"], errors="coerce").to_numpy(float)
-        steps = jump_times(log)
+        noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
+        steps = jump_times(log, trend_deadband_kpa(noise))
         near = np.full(len(g), np.inf)
         near[known] = _near_step(t[known], steps)
+        lo, hi = log.span_s
+        hi += float(np.median(np.diff(log.time_s))) if row_per_setpoint(log) else 0.0
         for i, ix in enumerate(g.index):
+            if known[i] and not lo <= t[i] <= hi:
+                what = f"log_time_s {t[i]:g} lies outside {name} ({span_text(log.span_s)})"
+                out.append((ix, what, "run photoset init --pressure-log again"))
+                continue
             if known[i] and abs(given[i] - setpoint[i]) > 0.01:
                 what = (
                     f"pressure_kpa {given[i]:g} is not the setpoint of {name} at this photo's "
                     f"log time, {t[i]:g} s ({setpoint[i]:g} kPa): edited, or the log changed"
                 )
-                fix = "run photoset init --pressure-log again, or correct pressure_kpa"
+                fix = (
+                    "run photoset init --pressure-log again, or correct pressure_kpa (to keep an "
+                    "edit made on purpose, empty this row's pressure_log)"
+                )
                 out.append((ix, what, fix))
             if near[i] < NEAR_STEP_S:
                 what = (
@@ -641,15 +611,4 @@ def logged_row_doubts(
                 )
                 fix = "check the clocks (photoset init --log-time-at) and this pressure"
                 out.append((ix, what, fix))
-        if log.clock_start is not None and "timestamp" in g.columns:
-            taken = pd.to_datetime(g["timestamp"], errors="coerce", format="ISO8601")
-            camera_s = ((taken - pd.Timestamp(log.clock_start)).dt.total_seconds()).to_numpy()
-            ok = known & np.isfinite(camera_s)
-            if ok.any():
-                offset = float(np.median(t[ok] - camera_s[ok]))
-                line = _opposite_sign_line(
-                    round(offset, 3), camera_s[ok], steps, int((near[ok] < NEAR_STEP_S).sum())
-                )
-                if line:
-                    out.append((g.index[0], line, "photoset init --log-time-at PHOTO=TIME"))
     return out

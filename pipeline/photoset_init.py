@@ -381,9 +381,7 @@ def _init_photoset(
         if not trials_in_names:
             df = df.drop(columns=["step"], errors="ignore")
             df = _split_by_trend(df) if placement.sensor_only else _split_ramps(df)
-        df["direction"] = _rising_from_the_start(
-            df, SENSOR_LEVEL_KPA if placement.sensor_only else 0.0
-        )
+        df["direction"] = _rising_from_the_start(df, placement.sensor_only)
     if "direction" not in df.columns:
         df["direction"] = _infer_directions(df)
     if "step" not in df.columns:
@@ -762,11 +760,9 @@ def _split_by_trend(df: pd.DataFrame) -> pd.DataFrame:
     turns from ``down`` to ``up``: for pressures read off a sensor, whose noise hides which
     photos share the lowest level (:func:`_split_ramps` compares them).
 
-    Examples
-    --------
     Photos ``down`` before the group's first ``up`` one (at rest, after another actuator's
     ramps) start its first ramp; the last of two photos at the bottom between two ramps (within
-    5 % of the ramp's span of each other) starts the next, as :func:`ramp_starts` has it.
+    :func:`sensor_level_kpa` of each other) starts the next, as :func:`ramp_starts` has it.
 
     Examples
     --------
@@ -784,7 +780,7 @@ def _split_by_trend(df: pd.DataFrame) -> pd.DataFrame:
         p = g["pressure_kpa"].to_numpy(float)
         starts = np.flatnonzero(up[1:] & ~up[:-1]) + 1  # a rise after a fall
         starts = starts[starts > np.argmax(up)]  # (not the group's first rise)
-        tolerance = max(SENSOR_LEVEL_KPA, 0.05 * float(np.ptp(p)))
+        tolerance = sensor_level_kpa(p)
         starts = np.array([
             j - 1 if j >= 2 and not up[j - 2] and abs(p[j - 1] - p[j - 2]) <= tolerance else j
             for j in starts
@@ -828,11 +824,21 @@ def ramp_lines(manifest: pd.DataFrame, limit: int = 12) -> list[str]:
     return lines
 
 
-def _rising_from_the_start(df: pd.DataFrame, tolerance_kpa: float = 0.0) -> pd.Series:
+def sensor_level_kpa(pressure_kpa: np.ndarray) -> float:
+    """Within how much (kPa) two photos of a ramp read off a sensor's noisy log sit at one level:
+    :data:`SENSOR_LEVEL_KPA`, or 5 % of the ramp's span.
+
+    >>> sensor_level_kpa(np.array([0.0, 30.0, 60.0])), sensor_level_kpa(np.array([0.0, 5.0]))
+    (3.0, 1.0)
+    """
+    return max(SENSOR_LEVEL_KPA, 0.05 * float(np.ptp(pressure_kpa)))
+
+
+def _rising_from_the_start(df: pd.DataFrame, sensor: bool = False) -> pd.Series:
     """``df``'s directions (in photo order), but ``up`` for the photos that begin a ramp at its
-    lowest pressure (within ``tolerance_kpa``: a sensor's noisy reading): held at the bottom
-    between two ramps, the log still falls there (the last photo of one ramp and the first of
-    the next are both at 0 kPa).
+    lowest pressure (for a ``sensor``'s noisy reading, within :func:`sensor_level_kpa`): held at
+    the bottom between two ramps, the log still falls there (the last photo of one ramp and the
+    first of the next are both at 0 kPa).
 
     Examples
     --------
@@ -845,6 +851,7 @@ def _rising_from_the_start(df: pd.DataFrame, tolerance_kpa: float = 0.0) -> pd.S
     out = df["direction"].copy()
     for _, g in df.groupby(list(RAMP_KEYS), sort=False):
         p = g["pressure_kpa"].to_numpy(float)
+        tolerance_kpa = sensor_level_kpa(p) if sensor else 0.0
         other = np.abs(p - p[0]) > tolerance_kpa
         lead = int(np.argmax(other)) if other.any() else len(p)
         if p[0] <= p.min() + tolerance_kpa:

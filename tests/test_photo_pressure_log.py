@@ -220,7 +220,6 @@ def test_a_clock_offset_of_the_wrong_sign_is_named_and_a_photo_of_the_loggers_cl
     manifest.to_csv(folder / "manifest.csv", index=False)
     assert main(["photoset", "check", str(folder)]) == 0
     err = capsys.readouterr().err
-    assert "is the sign of --clock-offset-s -2 right?" in err
     assert "taken 1 s from a step of log.csv's setpoint" in err
     assert "pressure_kpa 5 is not the setpoint of log.csv at this photo's log time" in err
     assert main([*args, "--clock-offset-s", "2"]) == 0
@@ -237,8 +236,6 @@ def test_a_clock_offset_of_the_wrong_sign_is_named_and_a_photo_of_the_loggers_cl
     assert "warning" not in out.err
     m = _taken(pd.read_csv(folder / "manifest.csv"))
     assert m["pressure_kpa"].tolist() == LEVELS_KPA
-    assert main(["photoset", "check", str(folder)]) == 0
-    assert "not in manifest.csv" not in capsys.readouterr().err
     assert main([*args, "--log-time-at", "../IMG_9996.JPG"]) == 2
     assert "give PHOTO=TIME" in capsys.readouterr().err
     assert main([*args, "--log-time-at", "clock.JPG=13:59:52.2"]) == 2
@@ -409,7 +406,7 @@ def test_every_photo_in_a_gap_is_refused_without_a_manifest(logged_folder, capsy
     assert not (logged_folder / "manifest.csv").exists()
 
 
-@pytest.mark.parametrize("noise", ["1.5 kPa", "0.7 % of the reading"])
+@pytest.mark.parametrize("noise", ["1.5 kPa", "0.7 % of the reading", "0.02 kPa"])
 def test_a_sensor_logged_alone_gives_directions_by_its_trend_not_its_noise(
     logged_folder, noise, capsys
 ):
@@ -420,7 +417,7 @@ def test_a_sensor_logged_alone_gives_directions_by_its_trend_not_its_noise(
     rows = _log_rows(5.5)
     level = rows["Setpoint (kPa)"].to_numpy()
     rng = np.random.default_rng(3)
-    sd = 1.5 if noise == "1.5 kPa" else 0.007 * level + 0.05
+    sd = {"1.5 kPa": 1.5, "0.02 kPa": 0.02}.get(noise, 0.007 * level + 0.05)
     reading_mbar = 10 * (level + rng.normal(0, 1, len(rows)) * sd)
     log_ms = 1000 * (rows["camera_s"] + 20.0)  # the software started 20 s before the camera's 0
     lines = ["Zeit [ms];Sensor [mbar]"] + [
@@ -430,7 +427,7 @@ def test_a_sensor_logged_alone_gives_directions_by_its_trend_not_its_noise(
     assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
                  "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
                  str(20 + SHOT_S)]) == 0, capsys.readouterr().err
-    assert "a sensor's reading, not a setpoint" in capsys.readouterr().out
+    assert "is a sensor's reading (its noise about" in capsys.readouterr().out
     m = _taken(pd.read_csv(logged_folder / "manifest.csv", dtype={"trial": str}))
     assert m["direction"].tolist() == ["up", "up", "up", "down", "down"] * 2
     assert m["trial"].tolist() == ["1"] * 5 + ["2"] * 5  # the second photo at 0 starts trial 2
@@ -465,3 +462,28 @@ def test_clock_texts_are_read_one_way_in_the_log_and_in_log_time_at(tmp_path, lo
     assert _taken(pd.read_csv(logged_folder / "manifest.csv"))["pressure_kpa"].tolist() == (
         LEVELS_KPA
     )
+
+
+def test_a_setpoint_cycling_fast_is_no_noise_and_check_reads_the_rows_init_read(tmp_path, capsys):
+    """A log that first cycles 0/40 kPa in 2 s holds (review: its steps were taken for noise of
+    24 kPa, every photo 'up', one trial, 'a sensor's reading'); photos taken on a row's own time
+    (review: check, reading the log time rounded to the ms, found the next row and said the
+    pressure was edited)."""
+    folder = _photo_set(tmp_path / "set", shot_s=6.5, logger_ahead_s=5.5)
+    rows = _log_rows(5.5)
+    cycling = rows["camera_s"] < -5
+    rows.loc[cycling, "Setpoint (kPa)"] = np.where(
+        (rows.loc[cycling, "camera_s"] // 2) % 2 == 0, 0.0, 40.0
+    )
+    rows[["Timestamp", "Setpoint (kPa)"]].to_csv(folder / "log.csv", index=False)
+    assert main(["photoset", "init", str(folder), "--pattern", "IMG_*.JPG", "--pressure-log",
+                 "log.csv", "--material", "DS20", "--clock-offset-s", "5.5",
+                 "--l0-mm", "100"]) == 0
+    assert "sensor" not in capsys.readouterr().out
+    m = _taken(pd.read_csv(folder / "manifest.csv", dtype={"trial": str}))
+    assert m["pressure_kpa"].tolist() == LEVELS_KPA
+    assert m["direction"].tolist() == ["up", "up", "up", "down", "down"] * 2
+    assert m["trial"].tolist() == ["1"] * 5 + ["2"] * 5
+    assert main(["photoset", "check", str(folder)]) == 0
+    err = capsys.readouterr().err
+    assert "is not the setpoint" not in err and "from a step" not in err

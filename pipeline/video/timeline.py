@@ -72,6 +72,14 @@ SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "ms": 1e-3, "min": 60.0}
 FRAME_TIME_COLUMNS: tuple[str, ...] = ("frame", "time_s")
 #: a reversal of the pressure trend counts once the pressure left its extreme by this much (kPa)
 TREND_DEADBAND_KPA = 1.0
+#: a log's trend turns once its pressure leaves an extreme by this many times its row-to-row
+#: noise (and by TREND_DEADBAND_KPA at least): a sensor's reading logged alone turned at every
+#: wobble, and its photos' or frames' directions with it
+NOISE_DEADBANDS = 6.0
+#: ... and its extreme lasts as long as its pressure stays within this many times its noise
+NOISE_BAND = 3.0
+#: rows over which a log's noise is taken at a time (:func:`noise_kpa`)
+NOISE_WINDOW_ROWS = 50
 #: a jump of the logged pressure of at least this between two log rows may be a step (kPa)
 STEP_MIN_KPA = 2.0
 #: ... when the pressure then holds (within HOLD_TOLERANCE_KPA) for at least this long (s)
@@ -95,6 +103,8 @@ class PressureLog:
     #: a dated log whose dates read either way (``05/12/2026``): the first row read day first
     #: (``clock_start`` is it read month first); None where the dates are plain
     clock_start_dayfirst: datetime | None = None
+    #: False when the log's pressure is its measured pressure, logged alone (no setpoint)
+    setpoint_logged: bool = True
     #: False for clock times alone (``clock_start`` then on :data:`pipeline.log_clock.UNDATED_DAY`:
     #: the photos' dates give the day)
     clock_dated: bool = True
@@ -250,7 +260,8 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, clock_problems
     if clock is not None:
         df = df.assign(time_s=clock.time_s)
-    if "pressure_kpa" not in df.columns and "measured_kpa" in df.columns:
+    setpoint_logged = "pressure_kpa" in df.columns or "measured_kpa" not in df.columns
+    if not setpoint_logged:
         # a log of the measured pressure alone: the only pressure there is
         df = df.rename(columns={"measured_kpa": "pressure_kpa"})
         own = {c: ("pressure_" + n.split("_", 1)[1] if n.startswith("measured_") else n)
@@ -311,7 +322,7 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         return None, problems
     read_from = _read_from(columns, own, m is not None)
     if clock is None:
-        return PressureLog(str(path), t, p, m, read_from), []
+        return PressureLog(str(path), t, p, m, read_from, setpoint_logged=setpoint_logged), []
     return PressureLog(
         str(path),
         t,
@@ -320,7 +331,8 @@ def read_pressure_log(path: str | os.PathLike[str]) -> tuple[PressureLog | None,
         (clock.column, read_from[1], read_from[2]),
         clock.start,
         clock.start_dayfirst,
-        clock.dated,
+        setpoint_logged=setpoint_logged,
+        clock_dated=clock.dated,
     ), []
 
 
@@ -438,15 +450,68 @@ def step_rows(log: PressureLog) -> np.ndarray:
     return np.array(out, dtype=int)
 
 
+def noise_kpa(pressure_kpa: np.ndarray) -> float:
+    """The row-to-row noise of a logged pressure where it is largest (kPa, a standard
+    deviation): the median absolute deviation of its second differences (which steps and ramps
+    leave at 0 but at their corners) over :data:`NOISE_WINDOW_ROWS` rows at a time, its 95th
+    percentile over the log (so a little over an even noise's own), 0 for a setpoint, held,
+    stepped or ramped.  A sensor's noise grows
+    with its reading: customer 41's was 0.05 kPa at rest and 0.4 at the top, and one median
+    over the log (0.12) let the top holds' noise turn the trend.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> round(noise_kpa(np.repeat([0.0, 20, 40], 500) + rng.normal(0, 1.5, 1500)), 1)  # 1.5
+    2.0
+    >>> levels = np.repeat([0.0, 20, 40], 500)
+    >>> round(noise_kpa(levels + rng.normal(0, 1.0, 1500) * levels / 40), 1)  # 1 at the top
+    1.0
+    >>> ramp = np.concatenate([np.linspace(0, 100, 50), np.linspace(100, 0, 50)])
+    >>> noise_kpa(np.repeat([0.0, 20, 40], 500)), round(noise_kpa(ramp), 6)
+    (0.0, 0.0)
+    """
+    p = np.asarray(pressure_kpa, float)
+    d1 = np.diff(p)
+    d2 = np.diff(p, 2)
+    if d2.size < 2:
+        return 0.0
+    deviation = np.abs(d2 - np.median(d2))
+    # a setpoint's steps are no noise (a log cycling 0/40 kPa in 2 s holds read 24 kPa): the
+    # second differences beside a jump beyond the log's overall noise are left out
+    overall = 1.4826 * float(np.median(deviation)) / np.sqrt(6.0)
+    jump = np.abs(d1) >= max(STEP_MIN_KPA, 8.0 * overall)
+    deviation = pd.Series(np.where(jump[1:] | jump[:-1], np.nan, deviation))
+    window = min(NOISE_WINDOW_ROWS, d2.size)
+    local = deviation.rolling(window, center=True, min_periods=window // 2 + 1).median()
+    if not np.isfinite(local.to_numpy(float)).any():
+        return 0.0
+    return float(1.4826 * np.nanpercentile(local.to_numpy(float), 95) / np.sqrt(6.0))
+
+
+def log_noise_kpa(log: PressureLog) -> float:
+    """The noise of a log's pressure column (:func:`noise_kpa`): 0 where the log has a measured
+    pressure of its own, its pressure column then being a setpoint."""
+    return 0.0 if log.measured_kpa is not None else noise_kpa(log.pressure_kpa)
+
+
+def trend_deadband_kpa(noise_kpa: float) -> float:
+    """How far a log's pressure must leave an extreme for its trend to turn (kPa): at least
+    :data:`TREND_DEADBAND_KPA`, and :data:`NOISE_DEADBANDS` times its noise.
+
+    >>> trend_deadband_kpa(0.0), trend_deadband_kpa(0.5)
+    (1.0, 3.0)
+    """
+    return max(TREND_DEADBAND_KPA, NOISE_DEADBANDS * noise_kpa)
+
+
 def frame_conditions(
-    log: PressureLog,
-    time_s: np.ndarray,
-    deadband_kpa: float = TREND_DEADBAND_KPA,
-    band_kpa: float = 0.0,
+    log: PressureLog, time_s: np.ndarray, noise_kpa: float | None = None
 ) -> pd.DataFrame:
     """Pressure, direction and step of frames at ``time_s`` (log clock), one row per frame;
-    the trend turns where the pressure leaves an extreme by ``deadband_kpa``
-    (:func:`turning_points`, with ``band_kpa``).
+    the trend turns where the pressure leaves an extreme beyond the log's noise
+    (:func:`turning_points` with :func:`trend_deadband_kpa` and :data:`NOISE_BAND` times the
+    noise; ``noise_kpa`` by :func:`log_noise_kpa` when not given).
 
     Returns
     -------
@@ -469,7 +534,8 @@ def frame_conditions(
         out["measured_pressure_kpa"] = np.where(
             inside, np.interp(t, log.time_s, log.measured_kpa), np.nan
         )
-    tp = turning_points(log.pressure_kpa, deadband_kpa, band_kpa)
+    noise = log_noise_kpa(log) if noise_kpa is None else noise_kpa
+    tp = turning_points(log.pressure_kpa, trend_deadband_kpa(noise), NOISE_BAND * noise)
     # direction of each log interval: up until the first turning point, then alternating
     edges = log.time_s[tp]
     # a frame at a peak's own time is still rising, and so is one that holds the peak's setpoint
