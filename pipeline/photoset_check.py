@@ -71,16 +71,16 @@ def logged_pressure_problems(ps: PhotoSet) -> list[Problem]:
     and check said OK after it."""
     if ps.is_video:
         return []
-    return [
-        Problem(
-            str(ps.folder / MANIFEST),
-            int(ps.manifest.at[ix, "manifest_line"]),
-            what,
-            fix,
-            warning=True,
-        )
-        for ix, what, fix in logged_row_doubts(ps.folder, ps.manifest)
-    ]
+    return [_row_warning(ps, ix, what, fix) for ix, what, fix in logged_row_doubts(ps.folder,
+                                                                                  ps.manifest)]
+
+
+def _row_warning(ps: PhotoSet, ix: object, what: str, fix: str) -> Problem:
+    """A warning on the manifest line of row ``ix``."""
+    return Problem(
+        str(ps.folder / MANIFEST), int(ps.manifest.at[ix, "manifest_line"]), what, fix,
+        warning=True,
+    )
 
 
 def pressure_order_problems(ps: PhotoSet) -> list[Problem]:
@@ -91,13 +91,12 @@ def pressure_order_problems(ps: PhotoSet) -> list[Problem]:
     if ps.is_video:
         return []
     return [
-        Problem(
-            str(ps.folder / MANIFEST),
-            int(ps.manifest.at[ix, "manifest_line"]),
+        _row_warning(
+            ps,
+            ix,
             why.replace(" a typo in the manifest?", " a typo?"),
             "correct pressure_kpa (or step) on this line; until then measure flags the photo and "
             "leaves it out of the curves",
-            warning=True,
         )
         for ix, why in pressure_order_breaks(ps.manifest).items()
     ]
