@@ -16,7 +16,7 @@ either way (``05/12/2026``), read as the photos' own dates say.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime, timedelta
 from pathlib import Path
 
@@ -70,7 +70,7 @@ class ClockSync:
     time at the first photo.  Or ``photo`` and ``log_time``: the log's time when that photo was
     taken, as written (a clock time ``14:00:10.1``, a date and time, or seconds on a log in
     seconds, whatever its unit), from which the offset follows: best a photo of the logger's
-    screen, its clock in view, kept out of the ramps' photos (a subfolder).
+    screen, its clock in view, kept beside the set's folder, out of its ramps.
     """
 
     offset_s: float | None = None
@@ -160,10 +160,9 @@ def place_photos(
     # is a command, held until the next: a logger writing one row per setpoint gave photos
     # values between two levels), its measured pressure the last read, its direction that row's
     # (against the log's trend, beyond its noise)
-    in_force = log.time_s[np.searchsorted(log.time_s, log_time[keep], side="right") - 1]
-    noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
+    in_force = log.time_s[_rows_in_force(log, log_time[keep])]
+    noise, steps = _noise_and_steps(log)
     conditions = frame_conditions(log, in_force, noise_kpa=noise)
-    steps = jump_times(log, trend_deadband_kpa(noise))
     near = _near_step(log_time[keep], steps)
     table = pd.DataFrame(
         {
@@ -210,6 +209,28 @@ def place_photos(
     )
 
 
+def _rows_in_force(log: PressureLog, log_time: np.ndarray) -> np.ndarray:
+    """The index of the log's last row at or before each time: its setpoint is the one in force
+    (a setpoint is a command, held until the next)."""
+    return np.clip(np.searchsorted(log.time_s, log_time, side="right") - 1, 0, None)
+
+
+def _noise_and_steps(log: PressureLog) -> tuple[float, np.ndarray]:
+    """The log's noise (kPa; 0 for one written a row per setpoint) and the times of its steps
+    beyond that noise."""
+    noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
+    return noise, jump_times(log, trend_deadband_kpa(noise))
+
+
+def _held_span(log: PressureLog) -> tuple[float, float]:
+    """The log times a photo may take (s): its span, and for a log written a row per setpoint a
+    row's usual interval after its last row, where its last setpoint still holds."""
+    lo, hi = log.span_s
+    if row_per_setpoint(log):
+        hi += float(np.median(np.diff(log.time_s)))
+    return lo, hi
+
+
 def row_per_setpoint(log: PressureLog) -> bool:
     """Whether the log is written a row per setpoint (most rows change it) rather than at a
     steady rate.
@@ -251,9 +272,7 @@ def _photos_day(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str]:
         starts,
         key=lambda s: abs((s + timedelta(seconds=log.span_s[1] / 2) - middle).total_seconds()),
     )
-    dated = PressureLog(log.path, log.time_s, log.pressure_kpa, log.measured_kpa, log.read_from,
-                        start)
-    return dated, (
+    return replace(log, clock_start=start, clock_dated=True), (
         f"the log's clock times have no date: its first row taken as {start:%Y-%m-%d %H:%M:%S}, "
         "the day that puts the log beside the photos"
     )
@@ -293,9 +312,7 @@ def _date_reading(log: PressureLog, stamps: pd.Series) -> tuple[PressureLog, str
         return any(start.date() <= d <= end.date() for d in days)
 
     chosen = other if fits(other) and not fits(first) else first
-    log = PressureLog(
-        log.path, log.time_s, log.pressure_kpa, log.measured_kpa, log.read_from, chosen
-    )
+    log = replace(log, clock_start=chosen, clock_start_dayfirst=None)
     why = "as the photos' own dates are" if fits(chosen) else "no reading matches the photos' dates"
     return log, (
         f"the log's dates read either way (day or month first): read as {chosen:%Y-%m-%d}, {why}"
@@ -325,8 +342,8 @@ def _offset(
                     f"{root / sync.photo} holds no time the camera wrote (EXIF "
                     "DateTimeOriginal); give a photo straight from the camera"
                     if (root / sync.photo).is_file()
-                    else f"no photo {sync.photo} in {root}; give the photo of the logger's clock "
-                    "by its name in the folder"
+                    else f"no photo {root / sync.photo}; give the photo of the logger's clock "
+                    "by its path from the set's folder (../clock.JPG beside it)"
                 )
             )
         offset = _offset_at(log, stamps, sync.photo, when, str(sync.log_time))
@@ -393,9 +410,7 @@ def _refuse_outside(
     """The error naming the photos that lie outside the log and the offsets that would fit (a
     log written a row per setpoint holds its last setpoint for a row's usual interval after its
     last row)."""
-    lo, hi = log.span_s
-    if row_per_setpoint(log):
-        hi += float(np.median(np.diff(log.time_s)))
+    lo, hi = _held_span(log)
     outside = np.flatnonzero(~((log_time >= lo) & (log_time <= hi)))
     if not outside.size:
         return
@@ -578,16 +593,13 @@ def logged_row_doubts(
             continue
         t = pd.to_numeric(g["log_time_s"], errors="coerce").to_numpy(float)
         known = np.isfinite(t)
-        k = np.clip(np.searchsorted(log.time_s, t[known], side="right") - 1, 0, None)
         setpoint = np.full(len(g), np.nan)
-        setpoint[known] = log.pressure_kpa[k]
+        setpoint[known] = log.pressure_kpa[_rows_in_force(log, t[known])]
         given = pd.to_numeric(g["pressure_kpa"], errors="coerce").to_numpy(float)
-        noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
-        steps = jump_times(log, trend_deadband_kpa(noise))
+        steps = _noise_and_steps(log)[1]
         near = np.full(len(g), np.inf)
         near[known] = _near_step(t[known], steps)
-        lo, hi = log.span_s
-        hi += float(np.median(np.diff(log.time_s))) if row_per_setpoint(log) else 0.0
+        lo, hi = _held_span(log)
         for i, ix in enumerate(g.index):
             if known[i] and not lo <= t[i] <= hi:
                 what = f"log_time_s {t[i]:g} lies outside {name} ({span_text(log.span_s)})"

@@ -372,11 +372,6 @@ def _init_photoset(
         given = [c for c in logged.columns if c != "image"]  # the log's, not the names'
         df = df.drop(columns=given, errors="ignore").merge(logged, on="image")  # gaps' go
         df["pressure_log"] = pressure_log[0]  # the record check reads the log again by
-        if df.empty:
-            raise UserInputError(
-                f"--pressure-log {pressure_log[0]}: every photo lies in a gap of the log; "
-                + "; ".join(placement.warnings)
-            )
         df = df.sort_values("log_time_s", kind="stable").reset_index(drop=True)
         if not trials_in_names:
             df = df.drop(columns=["step"], errors="ignore")
