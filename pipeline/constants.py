@@ -20,6 +20,12 @@ STATUSES: tuple[str, ...] = ("ok", "flagged", "failed")
 #: how a row whose pressure breaks its ramp's order (a manifest typo) says so in its reason: its
 #: psi never enters a curve, flagged rows included (its pressure, not psi, is in doubt)
 PRESSURE_OUT_OF_ORDER = "is out of its ramp's order"
+#: a photo taken closer than this (s) to a step of its pressure log's setpoint is named by
+#: ``photoset init`` and ``check`` (the camera's clock is kept to the second, and a clock offset a
+#: little off moves it across), and one taken this soon after a step is ``flagged`` by measure:
+#: the actuator may still be moving (customer 39: 41.0 deg 0.5 s after a step to 30 kPa, 43.3
+#: settled)
+NEAR_STEP_S = 1.5
 #: rest bending angle psi0 of the paper's actuators (deg, DESIGN.md): the fallback where no material
 #: says its own (a material's is ``Material.psi0_deg``, from the materials file)
 PSI0_DEG: float = 210.0

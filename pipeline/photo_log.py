@@ -7,10 +7,12 @@ clocks; :class:`ClockSync` says how they relate, either as an offset or, with no
 wrong, as the log's time at one photo (a photo of the logger's screen).
 
 :func:`place_photos` also says what a person should check: photos taken within
-:data:`NEAR_STEP_S` of a step of the setpoint; an offset whose opposite sign would put clearly
-fewer photos near a step; photos that fall in a gap of the log (a logger that stopped writing
-for a while), which are left out, since their pressure is not known; a log whose dates read
-either way (``05/12/2026``), read as the photos' own dates say.
+:data:`~pipeline.constants.NEAR_STEP_S` of a step of the setpoint; an offset whose opposite
+sign would put clearly fewer photos near a step; photos that fall in a gap of the log (a
+logger that stopped writing for a while), which are left out, since their pressure is not known;
+a log whose dates read either way (``05/12/2026``), read as the photos' own dates say.  Each
+photo's ``since_step_s`` (the time since the setpoint last stepped) goes into the manifest: measure
+flags a photo taken while the actuator may still be moving.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import NEAR_STEP_S
 from pipeline.errors import UserInputError
 from pipeline.log_clock import read_clock_text
 from pipeline.measure.settings import user_float
@@ -33,13 +36,11 @@ from pipeline.video.timeline import (
     frame_conditions,
     log_noise_kpa,
     read_pressure_log,
+    since_last_step,
     span_text,
     trend_deadband_kpa,
 )
 
-#: a photo taken closer than this to a step of the log's setpoint (s) is named: the camera's
-#: clock is kept to the second, and a clock offset a little off moves it across
-NEAR_STEP_S = 1.5
 #: a stretch between two log rows longer than this many times the log's usual row interval (and
 #: than GAP_MIN_S) is a gap: the logger stopped writing, and a photo in it has no known pressure
 GAP_ROWS = 5.0
@@ -84,9 +85,12 @@ class PhotoPlacement:
 
     ``table`` has one row per photo placed, in the order taken: ``image``, ``timestamp``
     (ISO 8601, the camera's clock), ``log_time_s``, ``pressure_kpa`` (the setpoint in force),
-    ``measured_pressure_kpa`` (when logged), ``direction`` and ``near_step_s`` (how far from a
-    step of the setpoint, when within :data:`NEAR_STEP_S`; else NaN).  ``left_out`` are the
-    photos in a gap of the log; ``notes`` and ``warnings`` are lines for the user.
+    ``measured_pressure_kpa`` (when logged), ``direction``, ``near_step_s`` (how far from a
+    step of the setpoint, when within :data:`~pipeline.constants.NEAR_STEP_S`; else NaN) and
+    ``since_step_s`` (the time since the setpoint's last step, NaN before the first: measure
+    flags a photo taken while settling, :func:`pipeline.ramp_check.flag_settling`).
+    ``left_out`` are the photos in a gap of the log; ``notes`` and ``warnings`` are lines for
+    the user.
     """
 
     table: pd.DataFrame
@@ -176,6 +180,7 @@ def place_photos(
         table["measured_pressure_kpa"] = conditions["measured_pressure_kpa"].round(2).to_numpy()
     table["direction"] = conditions["direction"].to_numpy()
     table["near_step_s"] = np.where(near < NEAR_STEP_S, near.round(2), np.nan)
+    table["since_step_s"] = since_last_step(log_time[keep], steps)[1].round(2)
     table = table.sort_values("log_time_s", kind="stable").reset_index(drop=True)
     sensor_only = log.measured_kpa is None and (not log.setpoint_logged or noise > NOISY_KPA)
     if sensor_only:
@@ -509,7 +514,9 @@ def _near_step_lines(table: pd.DataFrame, limit: int = 12) -> list[str]:
     head = (
         f"{len(near)} photo(s) were taken within {NEAR_STEP_S:g} s of a step of the log's "
         "setpoint, where a clock off by a second gives the level on the other side, and the "
-        "actuator may still be moving (check the clocks, and these photos' pressures):"
+        "actuator may still be moving (check the clocks, and these photos' pressures; measure "
+        f"flags those taken less than {NEAR_STEP_S:g} s after a step, by the manifest's "
+        "since_step_s, and leaves them out of the curves):"
     )
     return [head, *lines]
 

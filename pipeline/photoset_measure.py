@@ -41,7 +41,7 @@ from pipeline.photoset import (
     photo_names,
 )
 from pipeline.pool import map_photos
-from pipeline.ramp_check import check_ramps
+from pipeline.ramp_check import check_ramps, flag_settling
 from pipeline.result_cache import cached_tasks, check_cache_dir, prune, run_cached
 from pipeline.sealed_end_check import check_sealed_ends
 
@@ -206,7 +206,7 @@ def measure_photoset(
     if ramp_check:
         out = check_ramps(out)
     if not ps.is_video:
-        out = note_uneven_light(ps, out)
+        out = flag_settling(note_uneven_light(ps, out))
     out = check_sealed_ends(out)
     if "calibration_px" in out.columns:
         out = flag_doubtful_calibration(out)

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from pipeline.constants import DIRECTIONS, PRESSURE_OUT_OF_ORDER, RAMP_KEYS
+from pipeline.constants import DIRECTIONS, NEAR_STEP_S, PRESSURE_OUT_OF_ORDER, RAMP_KEYS
 from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
@@ -254,6 +254,44 @@ def _is_cosmetic(reason: str) -> bool:
 
 def _join(*parts: str) -> str:
     return "; ".join(p for p in parts if p)
+
+
+def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
+    """Flag each measured photo taken less than :data:`~pipeline.constants.NEAR_STEP_S` after a
+    step of its pressure log's setpoint (the manifest's ``since_step_s``, which
+    ``photoset init --pressure-log`` writes): the actuator may still have been moving, so its
+    psi is not yet its level's, and a curve averaging it in is off (customer 39's 30 kPa mean,
+    1 deg under the settled value).  A video's frames are left alone: the ends of their holds
+    count (:func:`pipeline.aggregate.settled_frames`).
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"status": ["ok", "ok", "failed"], "reason": ["", "", "x"],
+    ...                    "since_step_s": [0.5, 4.0, 0.2]})
+    >>> out = flag_settling(df)
+    >>> out["status"].tolist()
+    ['flagged', 'ok', 'failed']
+    >>> out["reason"].iloc[0].split(",")[0]
+    "taken 0.5 s after a step of its pressure log's setpoint"
+    """
+    if "since_step_s" not in angles.columns:
+        return angles
+    since = pd.to_numeric(angles["since_step_s"], errors="coerce")
+    settling = (since < NEAR_STEP_S) & (angles["status"] != "failed")
+    if "frame" in angles.columns:
+        settling &= angles["frame"].isna()
+    out = angles.copy()
+    out.loc[settling, "status"] = "flagged"
+    out.loc[settling, "reason"] = [
+        _join(
+            str(why) if isinstance(why, str) else "",
+            f"taken {s:.2g} s after a step of its pressure log's setpoint, so the actuator may "
+            "still have been moving: not in the curves (to keep it, empty since_step_s in its "
+            "manifest row)",
+        )
+        for why, s in zip(out.loc[settling, "reason"], since[settling])
+    ]
+    return out
 
 
 def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
@@ -778,17 +816,34 @@ def _same_pressure(leg: pd.DataFrame, others: pd.DataFrame) -> list[np.ndarray]:
     return [other_psi[np.abs(other_p - p) <= near] for p in pressure]
 
 
-def _allowed_in_leg(
-    psi: np.ndarray, i: int, same_pressure: np.ndarray
-) -> tuple[float, float, float]:
-    """(how far outside, lo, hi): photo ``i`` against its neighbours' range [lo, hi], or for an
-    end photo against the nearest ``ok`` photo of another leg at its pressure, if that is nearer.
+def _allowed_in_leg(psi: np.ndarray, i: int, same_pressure: np.ndarray) -> tuple[float, str]:
+    """(how far outside, what its neighbours allow, in words): photo ``i`` against its
+    neighbours' range, or for an end photo against the nearest ``ok`` photo of another leg at its
+    pressure, if that is nearer.
+
+    Examples
+    --------
+    >>> _allowed_in_leg(np.array([0.0, 30.0, 60.0]), 1, np.array([]))[1]
+    'where its neighbours allow +0 to +60'
+    >>> _allowed_in_leg(np.array([300.0, 192.0, 546.0]), 0, np.array([]))[1]
+    "at its leg's start, back past its neighbour's +192 (the leg goes +192 -> +546)"
+    >>> _allowed_in_leg(np.array([0.0, 10.0, 20.0, 200.0]), 3, np.array([]))[1]
+    "at its leg's end, more than 4 steps beyond its neighbour's +20 (the leg goes +10 -> +20)"
     """
     lo, hi = _allowed(psi, i)
     off = _outside(psi[i], lo, hi)
     if i in (0, len(psi) - 1) and same_pressure.size:
         off = min(off, float(np.min(np.abs(same_pressure - psi[i]))))
-    return off, lo, hi
+    if 0 < i < len(psi) - 1:
+        return off, f"where its neighbours allow {lo:+.0f} to {hi:+.0f}"
+    # an end: its range runs from its neighbour out by END_STEPS of the leg's next step, which
+    # as two numbers read like nonsense (customer 40: "allow +192 to +1608")
+    j, k = (1, 2) if i == 0 else (len(psi) - 2, len(psi) - 3)
+    end = "start" if i == 0 else "end"
+    runs = f"{psi[j]:+.0f} -> {psi[k]:+.0f}" if i == 0 else f"{psi[k]:+.0f} -> {psi[j]:+.0f}"
+    back = (psi[i] - psi[j]) * (psi[j] - psi[k]) < 0  # on the wrong side of its neighbour
+    where = "back past" if back else f"more than {END_STEPS:g} steps beyond"
+    return off, f"at its leg's {end}, {where} its neighbour's {psi[j]:+.0f} (the leg goes {runs})"
 
 
 def _check_leg(
@@ -813,25 +868,21 @@ def _check_leg(
         breaking = []
         for i in range(len(keep)):
             if i in rank:
-                off, lo, hi = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
+                off, allowed = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
             else:
-                off, lo, hi = _allowed_in_leg(psi, i, same_pressure[keep[i]])
+                off, allowed = _allowed_in_leg(psi, i, same_pressure[keep[i]])
             if off > SLACK_DEG:
-                breaking.append((off, i, lo, hi))
+                breaking.append((off, i, allowed))
         if not breaking:
             break
         # a photo already doubtful on its own is blamed before one that is not (two photos that
         # disagree break each other's range alike); then the worst
-        _, i, lo, hi = max(
+        _, i, allowed = max(
             [b for b in breaking if doubtful[keep[b[1]]]] or breaking
         )
         k = position[leg.index[keep[i]]]
         status[k] = "flagged"
-        reason[k] = _join(
-            f"breaks its ramp: psi {psi[i]:+.0f} deg where its neighbours allow {lo:+.0f} to "
-            f"{hi:+.0f}",
-            reason[k],
-        )
+        reason[k] = _join(f"breaks its ramp: psi {psi[i]:+.0f} deg {allowed}", reason[k])
         del keep[i]
     if len(keep) < 3:
         return

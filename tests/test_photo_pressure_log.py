@@ -111,6 +111,9 @@ def test_a_camera_clock_off_by_a_hold_is_named_or_placed_where_the_offset_says(
     err = capsys.readouterr().err
     assert "8 photo(s) were taken within 1.5 s of a step of the log's setpoint" in err
     assert "IMG_9998.JPG at log time 27.9 s, 0.9 s from a step of the setpoint" in err
+    since = _taken(pd.read_csv(logged_folder / "manifest.csv"))["since_step_s"]
+    # since the setpoint last stepped (the second ramp's rest photo: 0 kPa held 24.9 s)
+    assert np.allclose(since, [np.nan, *[0.9] * 4, 12.9, *[0.9] * 4], equal_nan=True)
     assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
                  "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s", "-6.5",
                  "--overwrite"]) == 0
@@ -502,3 +505,30 @@ def test_a_quiet_sensor_logged_alone_with_clock_times_stays_a_sensor(logged_fold
                  "--pressure-log", "log.csv", "--material", "DS20", "--clock-offset-s",
                  "5.5"]) == 0
     assert "is a sensor's reading" in capsys.readouterr().out
+
+
+def test_a_photo_taken_while_settling_is_measured_flagged_and_kept_out_of_the_curve(
+    tmp_path, repo
+):
+    """A photo taken 0.4 s after its setpoint stepped (the manifest's ``since_step_s``, as
+    ``init`` writes it) is measured, flagged with the reason, and not averaged into its level;
+    one taken 1.6 s after, or whose since_step_s was emptied, counts."""
+    from pipeline.aggregate import aggregate_hysteresis
+    from pipeline.report.reasons import words
+
+    folder = tmp_path / "set"
+    folder.mkdir()
+    rows = pd.read_csv(repo / "sample_images" / "manifest.csv").head(6)
+    for name in [*rows["image"], "photoset.yaml"]:
+        (folder / name).write_bytes((repo / "sample_images" / name).read_bytes())
+    rows["since_step_s"] = [np.nan, 5.0, 0.4, 1.6, np.nan, 6.0]
+    rows.to_csv(folder / "manifest.csv", index=False)
+    assert main(["measure", str(folder), "--out", str(tmp_path / "angles.csv")]) == 0
+    angles = pd.read_csv(tmp_path / "angles.csv")
+    assert angles["status"].tolist() == ["ok", "ok", "flagged", "ok", "ok", "ok"]
+    reason = angles["reason"].iloc[2]
+    assert reason.startswith("taken 0.4 s after a step of its pressure log's setpoint")
+    assert words(reason) == "taken while settling after a step"
+    curve = aggregate_hysteresis(angles).set_index("pressure_kpa")
+    assert curve.loc[20.0, "n"] == 0 and curve.loc[20.0, "n_excluded"] == 1
+    assert curve.loc[30.0, "n"] == 1

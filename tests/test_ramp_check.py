@@ -70,6 +70,22 @@ def test_a_photo_off_its_ramp_is_flagged(k, wrong):
     assert (out.drop(index=k)["status"] == "ok").all()
 
 
+def test_an_end_photo_off_its_ramp_says_where_it_lies_against_its_neighbour():
+    """An end photo's range runs out END_STEPS steps from its neighbour: said as two numbers it
+    read like nonsense ("its neighbours allow +192 to +1608")."""
+    psi = _ds20_like()
+    first, last = psi[0] + 200.0, psi[-1] + 300.0  # beyond the leg, back against it
+    out = check_ramps(_ramp([first, *psi[1:-1], last]))
+    assert out.loc[0, "reason"] == (
+        f"breaks its ramp: psi {first:+.0f} deg at its leg's start, more than 4 steps beyond its "
+        f"neighbour's {psi[1]:+.0f} (the leg goes {psi[1]:+.0f} -> {psi[2]:+.0f})"
+    )
+    assert out.iloc[-1]["reason"] == (
+        f"breaks its ramp: psi {last:+.0f} deg at its leg's end, back past its neighbour's "
+        f"{psi[-2]:+.0f} (the leg goes {psi[-3]:+.0f} -> {psi[-2]:+.0f})"
+    )
+
+
 def test_a_partial_line_is_flagged_by_its_length():
     df = _ramp(_ds20_like())
     df.loc[4, "length_px"] = 600.0

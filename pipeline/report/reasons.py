@@ -68,6 +68,7 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^pressure [-+\d.e]+ kPa is out of its ramp's order",
      "pressure out of its ramp's order (a manifest typo?)"),
     (r"^image .*does not exist", "photo missing from the folder"),
+    (r"^taken [\d.e+-]+ s after a step of its pressure log", "taken while settling after a step"),
     (r"^the body's two sides diverge", "body's sides diverge at the clamp (a faint side?)"),
     # a body's causes
     (r"^the free end's direction is uncertain", "free end's direction uncertain"),

@@ -419,6 +419,22 @@ def turning_points(
     return np.array(out, dtype=int)
 
 
+def since_last_step(time_s: np.ndarray, steps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How many of the step times ``steps`` (sorted) lie at or before each of ``time_s``, and
+    the time (s) since the last of them (NaN before the first).
+
+    Examples
+    --------
+    >>> k, since = since_last_step(np.array([0.5, 2.0, 3.5]), np.array([1.0, 3.0]))
+    >>> k.tolist(), since.tolist()
+    ([0, 1, 2], [nan, 1.0, 0.5])
+    """
+    t = np.asarray(time_s, float)
+    k = np.searchsorted(steps, t, side="right")
+    since = t - steps[np.maximum(k - 1, 0)] if steps.size else np.full(t.shape, np.nan)
+    return k.astype(int), np.where(k > 0, since, np.nan)
+
+
 def step_times(log: PressureLog) -> np.ndarray:
     """Times (s, log clock) at which ``pressure_kpa`` steps (see the module docstring)."""
     return log.time_s[step_rows(log)]
@@ -543,12 +559,7 @@ def frame_conditions(
     # of a stepped ramp's top hold was 'down' at the peak's level)
     n_turns = np.searchsorted(edges, np.where(held, log.time_s[np.maximum(after - 1, 0)], t))
     out["direction"] = np.where(n_turns % 2 == 0, *DIRECTIONS)
-    steps = step_times(log)
-    k = np.searchsorted(steps, t, side="right")
-    out["step"] = k.astype(int)
-    out["since_step_s"] = np.where(
-        k > 0, t - steps[np.maximum(k - 1, 0)] if steps.size else np.nan, np.nan
-    )
+    out["step"], out["since_step_s"] = since_last_step(t, step_times(log))
     out["in_log"] = inside
     return out
 
