@@ -218,6 +218,40 @@ class Problem:
         return f"{where}: {'warning: ' if self.warning else ''}{self.message} (fix: {self.fix})"
 
 
+def problem_lines(problems: Sequence[Problem]) -> list[str]:
+    """The problems as lines for a person, the same problem on several rows of one file said
+    once with its lines (an empty scene of another shape than the 26 photos of a set was said
+    26 times).
+
+    Examples
+    --------
+    >>> same = [Problem("m.csv", n, "too dark", "relight") for n in (2, 3, 4, 7)]
+    >>> for line in problem_lines([*same, Problem("m.csv", 5, "no image", "copy it in")]):
+    ...     print(line)
+    m.csv lines 2-4, 7 (4 rows): too dark (fix: relight)
+    m.csv line 5: no image (fix: copy it in)
+    """
+    groups: dict[tuple[str, str, str, bool], list[int | None]] = {}
+    for p in problems:
+        groups.setdefault((p.file, p.message, p.fix, p.warning), []).append(p.line)
+    out: list[str] = []
+    for (file, message, fix, warning), lines in groups.items():
+        numbers = sorted(n for n in lines if n is not None)
+        if len(numbers) < 2 or len(numbers) != len(lines):
+            out.extend(str(Problem(file, n, message, fix, warning)) for n in lines)
+            continue
+        runs: list[list[int]] = []
+        for n in numbers:
+            if runs and n == runs[-1][-1] + 1:
+                runs[-1].append(n)
+            else:
+                runs.append([n])
+        spans = ", ".join(f"{r[0]}-{r[-1]}" if len(r) > 1 else f"{r[0]}" for r in runs)
+        where = f"{file} lines {spans} ({len(numbers)} rows)"
+        out.append(f"{where}: {'warning: ' if warning else ''}{message} (fix: {fix})")
+    return out
+
+
 @dataclass(frozen=True)
 class PhotoSet:
     """A loaded photo set.
@@ -1543,15 +1577,24 @@ def geometry_problems(
                 )
             )
         elif not same_aspect(bsize, (w, h)):
+            turned = same_aspect(bsize, (h, w))  # an orientation tag lost, or a photo turned
             out.append(
                 Problem(
                     file,
                     line,
                     f"the photo is {w}x{h} px but background photo "
                     f"{Path(s.background_path).name} is {bsize[0]}x{bsize[1]} px: it cannot be "
-                    "laid over the photo",
+                    "laid over the photo"
+                    + (
+                        " (turned by 90 deg against it: a phone's photos are stored sideways "
+                        "with an orientation tag, which an editor or a copy may have dropped or "
+                        "applied to one and not the other)"
+                        if turned
+                        else ""
+                    ),
                     "take the empty scene with the camera, resolution and orientation of the "
-                    "actuator photos",
+                    "actuator photos"
+                    + (", or save it upright as they show" if turned else ""),
                 )
             )
     if s.fixed_end_px is not None and not (

@@ -595,8 +595,8 @@ def _check(args: argparse.Namespace) -> int:
                     warning=True,
                 )
             )
-    for p in problems:
-        print(f"  {p}", file=sys.stderr)
+    for line in photoset.problem_lines(problems):
+        print(f"  {line}", file=sys.stderr)
     if errors:
         print(f"{args.folder}: {len(errors)} problem(s)", file=sys.stderr)
         return 1

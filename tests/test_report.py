@@ -641,6 +641,18 @@ def test_a_material_page_of_synthetic_photos_says_so_in_its_title(pages):
     assert spread["material DS20"].startswith("Mean ± 1 sd over the 2 ramps of one actuator")
 
 
+def test_an_actuator_with_no_photo_in_its_curves_is_not_counted_in_their_spread():
+    # customer 42: "11 actuators, 20 ramps" counted a set with no ok photo as an actuator but
+    # none of its ramps
+    from types import SimpleNamespace
+
+    from pipeline.report.pages import spread_of
+
+    per = pd.DataFrame({"material": "M", "actuator": ["a", "a", "b", "c"],
+                        "n": [2, 2, 1, 0], "n_trials": [2, 2, 1, 0]})
+    assert spread_of(SimpleNamespace(per_actuator=per), "M") == "2 actuators, 3 ramps"
+
+
 @ON_THE_DEFAULT_REPORT
 def test_the_force_pages_say_which_materials_were_rendered_and_that_the_grasp_log_is_an_example(
     default,

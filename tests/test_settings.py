@@ -301,6 +301,11 @@ def test_a_background_photo_of_another_shape_is_refused_and_its_rows_fail(photo_
     assert len(problems) == 8, text
     assert "line 2:" in text and "background photo empty.jpg is 24x32 px" in text
     assert "the photo is 32x24 px" in text and "orientation" in text
+    assert "turned by 90 deg against it" in text  # an orientation tag lost, customer 42
+    # said once for its rows (customer 42's check said it 26 times)
+    assert ps.problem_lines(problems) == [
+        str(problems[0]).replace("line 2:", "lines 2-9 (8 rows):")
+    ]
     got = measure_photoset(photo_folder, ramp_check=False)
     assert (got["status"] == "failed").all()
     assert got["reason"].str.contains("background photo empty.jpg is 24x32 px").all()

@@ -404,9 +404,11 @@ def _load_background(
         return "background photo {} cannot be decoded ({}; {})".format(name, *undecodable(name))
     bh, bw = img.shape[:2]
     if not same_aspect((bw, bh), (shape[1], shape[0])):
+        turned = same_aspect((bh, bw), (shape[1], shape[0]))
         return (
-            f"background photo {name} is {bw}x{bh} px, another shape than the photo: take the "
-            "empty scene with the camera, resolution and orientation of the photos"
+            f"background photo {name} is {bw}x{bh} px, another shape than the photo"
+            + (" (turned by 90 deg: an orientation tag lost?)" if turned else "")
+            + ": take the empty scene with the camera, resolution and orientation of the photos"
         )
     return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
 

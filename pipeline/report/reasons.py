@@ -16,6 +16,8 @@ Examples
 'manifest row: pressure_kpa is not a number'
 >>> words("manifest line 12: image 'IMG_4310.JPG' does not exist in /lab/C (fix: copy it in")
 'manifest row: photo missing from the folder'
+>>> words("background photo IMG_5000.JPG is 4032x3024 px, another shape than the photo: take")
+'empty-scene photo of another shape'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
@@ -68,6 +70,10 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^pressure [-+\d.e]+ kPa is out of its ramp's order",
      "pressure out of its ramp's order (a manifest typo?)"),
     (r"^image .*does not exist", "photo missing from the folder"),
+    (r"^background photo .* another shape than the photo \(turned",
+     "empty-scene photo turned against the photos"),
+    (r"^background photo .* another shape than the photo", "empty-scene photo of another shape"),
+    (r"^background photo .* cannot be decoded", "empty-scene photo cannot be read"),
     (r"^taken [\d.e+-]+ s after a step of its pressure log", "taken while settling after a step"),
     (r"^the body's two sides diverge", "body's sides diverge at the clamp (a faint side?)"),
     # a body's causes

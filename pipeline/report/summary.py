@@ -490,7 +490,7 @@ def nothing_ok(data: ReportData) -> list[str]:
         if not (g["status"] == "ok").any():
             out.append(
                 f"{name}: none of its {len(g)} photos was measured ok, so it adds nothing to the "
-                "curves or the comparison; the quality table below gives the reasons, and "
+                "curves or the comparison; the quality table on this page gives the reasons, and "
                 "photoset preview shows what the settings select"
             )
     return out
