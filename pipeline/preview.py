@@ -155,10 +155,12 @@ def tile_reason(
     return f"{note}: {reason}" if reason else note
 
 
-#: a body tile's psi is its own base's; measure's is its ramp's
+#: a body tile's psi is its own base's; measure's is its ramp's where the ramp's bodies agree
+#: on one (customer 42's ramps, whose own bases scattered over 26 deg, took none, as the caption
+#: had promised they would)
 OWN_BASE_NOTE = (
-    "psi from this photo's own base direction (measure takes its ramp's shared one: it may "
-    "differ by a few deg)"
+    "psi from this photo's own base direction (measure takes its ramp's shared one where the "
+    "ramp's bodies agree on it: it may differ by a few deg)"
 )
 
 
