@@ -23,8 +23,8 @@ PRESSURE_OUT_OF_ORDER = "is out of its ramp's order"
 #: a photo taken closer than this (s) to a step of its pressure log's setpoint is named by
 #: ``photoset init`` and ``check`` (the camera's clock is kept to the second, and a clock offset a
 #: little off moves it across), and one taken this soon after a step is ``flagged`` by measure:
-#: the actuator may still be moving (customer 39: 41.0 deg 0.5 s after a step to 30 kPa, 43.3
-#: settled)
+#: the actuator may still be moving (customer 39: 41.2 deg 0.4 s after its log's step to 30 kPa,
+#: 43.3 settled)
 NEAR_STEP_S = 1.5
 #: rest bending angle psi0 of the paper's actuators (deg, DESIGN.md): the fallback where no material
 #: says its own (a material's is ``Material.psi0_deg``, from the materials file)

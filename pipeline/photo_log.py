@@ -180,7 +180,8 @@ def place_photos(
         table["measured_pressure_kpa"] = conditions["measured_pressure_kpa"].round(2).to_numpy()
     table["direction"] = conditions["direction"].to_numpy()
     table["near_step_s"] = np.where(near < NEAR_STEP_S, near.round(2), np.nan)
-    table["since_step_s"] = since_last_step(log_time[keep], steps)[1].round(2)
+    held = held_steps(log, trend_deadband_kpa(noise), _held_span(log)[1])
+    table["since_step_s"] = since_last_step(log_time[keep], held)[1].round(2)
     table = table.sort_values("log_time_s", kind="stable").reset_index(drop=True)
     sensor_only = log.measured_kpa is None and (not log.setpoint_logged or noise > NOISY_KPA)
     if sensor_only:
@@ -225,6 +226,36 @@ def _noise_and_steps(log: PressureLog) -> tuple[float, np.ndarray]:
     beyond that noise."""
     noise = 0.0 if row_per_setpoint(log) else log_noise_kpa(log)
     return noise, jump_times(log, trend_deadband_kpa(noise))
+
+
+def held_steps(log: PressureLog, tolerance_kpa: float, end_s: float) -> np.ndarray:
+    """When the log's pressure reached each level it then held (s): the first row of a run of
+    rows within ``tolerance_kpa`` of it that lasts :data:`~pipeline.constants.NEAR_STEP_S` or
+    more (until the next run, the last until ``end_s``) and lies at least
+    ``max(tolerance_kpa, STEP_MIN_KPA)`` from the held level before it.  What a photo's
+    ``since_step_s`` counts from: a staircase of 1 s treads, a sensor's one-row glitch and the
+    rows of its rise are no levels held (the rows' own jumps made every photo of a 2.5 kPa/s
+    staircase "taken 0.4 s after a step", and a glitch 1.4 s before a mid-hold photo one).
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 10.0, 0.5)
+    >>> p = np.r_[[0.0] * 6, 9, 18, [20.0] * 8, 26, [20.0] * 3]  # a rise, then a glitch
+    >>> held_steps(PressureLog("l.csv", t, p), 1.0, 10.0).tolist()
+    [4.0]
+    """
+    t, p = log.time_s, log.pressure_kpa
+    starts = [0]
+    for i in range(1, len(p)):
+        if abs(p[i] - p[starts[-1]]) > tolerance_kpa:
+            starts.append(i)
+    first = np.array(starts)
+    lasts = np.append(t[first[1:]], max(end_s, float(t[-1])))
+    held = first[lasts - t[first] >= NEAR_STEP_S]
+    if held.size < 2:
+        return np.array([], float)
+    moved = np.abs(np.diff(p[held])) >= max(tolerance_kpa, STEP_MIN_KPA)
+    return t[held[1:][moved]]
 
 
 def _held_span(log: PressureLog) -> tuple[float, float]:
@@ -511,12 +542,18 @@ def _near_step_lines(table: pd.DataFrame, limit: int = 12) -> list[str]:
             "photo's time)"
         )
         lines = [*lines[: limit - 1], more]
+    since = pd.to_numeric(table.get("since_step_s"), errors="coerce")
+    settling = int((since < NEAR_STEP_S).sum()) if since is not None else 0
+    flags = (
+        f"; measure flags the {settling} taken less than {NEAR_STEP_S:g} s after the pressure "
+        "reached a level it held (the manifest's since_step_s)"
+        if settling
+        else ""
+    )
     head = (
         f"{len(near)} photo(s) were taken within {NEAR_STEP_S:g} s of a step of the log's "
         "setpoint, where a clock off by a second gives the level on the other side, and the "
-        "actuator may still be moving (check the clocks, and these photos' pressures; measure "
-        f"flags those taken less than {NEAR_STEP_S:g} s after a step, by the manifest's "
-        "since_step_s, and leaves them out of the curves):"
+        f"actuator may still be moving (check the clocks, and these photos' pressures{flags}):"
     )
     return [head, *lines]
 
@@ -607,6 +644,7 @@ def logged_row_doubts(
         near = np.full(len(g), np.inf)
         near[known] = _near_step(t[known], steps)
         lo, hi = _held_span(log)
+        since = pd.to_numeric(g.get("since_step_s"), errors="coerce")
         for i, ix in enumerate(g.index):
             if known[i] and not lo <= t[i] <= hi:
                 what = f"log_time_s {t[i]:g} lies outside {name} ({span_text(log.span_s)})"
@@ -628,6 +666,8 @@ def logged_row_doubts(
                     "second reads the level on the step's other side, and the actuator may still "
                     "be moving"
                 )
+                if since is not None and since.iloc[i] < NEAR_STEP_S:
+                    what += f" (measure flags it: its since_step_s is {since.iloc[i]:g})"
                 fix = "check the clocks (photoset init --log-time-at) and this pressure"
                 out.append((ix, what, fix))
     return out

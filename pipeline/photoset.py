@@ -236,8 +236,8 @@ def problem_lines(problems: Sequence[Problem]) -> list[str]:
         groups.setdefault((p.file, p.message, p.fix, p.warning), []).append(p.line)
     out: list[str] = []
     for (file, message, fix, warning), lines in groups.items():
-        numbers = sorted(n for n in lines if n is not None)
-        if len(numbers) < 2 or len(numbers) != len(lines):
+        numbers = sorted({n for n in lines if n is not None})
+        if len(numbers) < 2 or None in lines:
             out.extend(str(Problem(file, n, message, fix, warning)) for n in lines)
             continue
         runs: list[list[int]] = []
@@ -1577,7 +1577,8 @@ def geometry_problems(
                 )
             )
         elif not same_aspect(bsize, (w, h)):
-            turned = same_aspect(bsize, (h, w))  # an orientation tag lost, or a photo turned
+            # an orientation tag lost, or a photo turned (a near-square one says nothing)
+            turned = same_aspect(bsize, (h, w)) and not same_aspect((w, h), (h, w), 0.04)
             out.append(
                 Problem(
                     file,

@@ -266,18 +266,18 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
 
     Examples
     --------
-    >>> df = pd.DataFrame({"status": ["ok", "ok", "failed"], "reason": ["", "", "x"],
-    ...                    "since_step_s": [0.5, 4.0, 0.2]})
+    >>> df = pd.DataFrame({"status": ["ok", "ok", "failed", "ok", "ok"], "reason": "",
+    ...                    "since_step_s": [0.5, 4.0, 0.2, -0.3, "1,2"]})  # typed in by hand
     >>> out = flag_settling(df)
     >>> out["status"].tolist()
-    ['flagged', 'ok', 'failed']
+    ['flagged', 'ok', 'failed', 'ok', 'ok']
     >>> out["reason"].iloc[0].split(",")[0]
     "taken 0.5 s after a step of its pressure log's setpoint"
     """
     if "since_step_s" not in angles.columns:
         return angles
     since = pd.to_numeric(angles["since_step_s"], errors="coerce")
-    settling = (since < NEAR_STEP_S) & (angles["status"] != "failed")
+    settling = (since >= 0) & (since < NEAR_STEP_S) & (angles["status"] != "failed")
     if "frame" in angles.columns:
         settling &= angles["frame"].isna()
     out = angles.copy()
@@ -285,9 +285,9 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
     out.loc[settling, "reason"] = [
         _join(
             str(why) if isinstance(why, str) else "",
-            f"taken {s:.2g} s after a step of its pressure log's setpoint, so the actuator may "
-            "still have been moving: not in the curves (to keep it, empty since_step_s in its "
-            "manifest row)",
+            f"taken {s:g} s after a step of its pressure log's setpoint, so the actuator may "
+            "still have been moving: left out of the curves with the flagged photos (to keep "
+            "it, empty since_step_s in its manifest row)",
         )
         for why, s in zip(out.loc[settling, "reason"], since[settling])
     ]
@@ -827,6 +827,8 @@ def _allowed_in_leg(psi: np.ndarray, i: int, same_pressure: np.ndarray) -> tuple
     'where its neighbours allow +0 to +60'
     >>> _allowed_in_leg(np.array([300.0, 192.0, 546.0]), 0, np.array([]))[1]
     "at its leg's start, back past its neighbour's +192 (the leg goes +192 -> +546)"
+    >>> _allowed_in_leg(np.array([100.0, 100.0, 100.0, 140.0]), 3, np.array([]))[1]
+    "at its leg's end, away from its neighbour's +100 (the leg goes +100 -> +100)"
     >>> _allowed_in_leg(np.array([0.0, 10.0, 20.0, 200.0]), 3, np.array([]))[1]
     "at its leg's end, more than 4 steps beyond its neighbour's +20 (the leg goes +10 -> +20)"
     """
@@ -842,7 +844,9 @@ def _allowed_in_leg(psi: np.ndarray, i: int, same_pressure: np.ndarray) -> tuple
     end = "start" if i == 0 else "end"
     runs = f"{psi[j]:+.0f} -> {psi[k]:+.0f}" if i == 0 else f"{psi[k]:+.0f} -> {psi[j]:+.0f}"
     back = (psi[i] - psi[j]) * (psi[j] - psi[k]) < 0  # on the wrong side of its neighbour
-    where = "back past" if back else f"more than {END_STEPS:g} steps beyond"
+    flat = abs(psi[j] - psi[k]) < 1.0  # steps of nothing: "4 steps beyond" says nothing
+    beyond = "away from" if flat else f"more than {END_STEPS:g} steps beyond"
+    where = "back past" if back else beyond
     return off, f"at its leg's {end}, {where} its neighbour's {psi[j]:+.0f} (the leg goes {runs})"
 
 

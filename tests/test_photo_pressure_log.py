@@ -532,3 +532,31 @@ def test_a_photo_taken_while_settling_is_measured_flagged_and_kept_out_of_the_cu
     curve = aggregate_hysteresis(angles).set_index("pressure_kpa")
     assert curve.loc[20.0, "n"] == 0 and curve.loc[20.0, "n_excluded"] == 1
     assert curve.loc[30.0, "n"] == 1
+
+
+def test_only_levels_held_count_as_steps_for_since_step_s(tmp_path):
+    """Review: a staircase of 1 s treads logged a row per setpoint (2.5 kPa a row) made every
+    photo "taken 0.4 s after a step", and a sensor's one-row glitch 1.4 s before a mid-hold
+    photo made it one; the level the pressure reached and held is what since_step_s counts
+    from."""
+    from pipeline.photo_log import ClockSync, place_photos
+
+    def since(folder: Path, log: pd.DataFrame) -> np.ndarray:
+        log.to_csv(folder / "log.csv", index=False)
+        photos = sorted(p.name for p in folder.glob("IMG_*.JPG"))
+        return place_photos(folder, photos, "log.csv", ClockSync(offset_s=5.5)).table[
+            "since_step_s"
+        ].to_numpy()
+
+    folder = _photo_set(tmp_path / "stairs")
+    t = np.arange(-15.0, 135.0, 1.0)
+    stairs = pd.DataFrame({
+        "Timestamp": [(START + timedelta(seconds=x + 5.5)).isoformat(sep=" ") for x in t],
+        "Setpoint (kPa)": np.interp(t, [0, 60, 120], [0, 150, 0]),
+    })
+    assert np.isnan(since(folder, stairs)).all()
+    rows = _log_rows(5.5)
+    reading = rows["Setpoint (kPa)"].to_numpy() + np.random.default_rng(3).normal(0, 0.2, len(rows))
+    reading[np.searchsorted(rows["camera_s"].to_numpy(), 100.5)] += 4.0  # 1.4 s before a photo
+    got = since(folder, pd.DataFrame({"Timestamp": rows["Timestamp"], "Sensor (kPa)": reading}))
+    assert np.nanmin(got) > 5.0, got  # every photo 6.4 s into its hold (the rest photos more)

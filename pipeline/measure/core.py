@@ -404,7 +404,9 @@ def _load_background(
         return "background photo {} cannot be decoded ({}; {})".format(name, *undecodable(name))
     bh, bw = img.shape[:2]
     if not same_aspect((bw, bh), (shape[1], shape[0])):
-        turned = same_aspect((bh, bw), (shape[1], shape[0]))
+        turned = same_aspect((bh, bw), (shape[1], shape[0])) and not same_aspect(
+            (bw, bh), (bh, bw), 0.04
+        )  # turned by 90 deg (a near-square photo says nothing)
         return (
             f"background photo {name} is {bw}x{bh} px, another shape than the photo"
             + (" (turned by 90 deg: an orientation tag lost?)" if turned else "")

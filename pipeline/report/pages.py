@@ -284,6 +284,8 @@ def spread_of(data: ReportData, material: str) -> str:
     2 ramps of one actuator"`` (the plotted photos: a lab's own beside synthetic ones)."""
     per = data.per_actuator[data.per_actuator["material"] == material]
     per = per[per["n"] > 0]  # an actuator none of whose photos is in a curve is no part of it
+    if per.empty:
+        return "no photo measured ok"
     n_act = int(per["actuator"].nunique())
     n_ramps = int(per.groupby("actuator")["n_trials"].max().sum()) if len(per) else 0
     ramps = f"{n_ramps} ramp{'s' if n_ramps != 1 else ''}"

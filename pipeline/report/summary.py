@@ -311,7 +311,7 @@ def _left_out_between(
     frames = "frame" in out.columns and out["frame"].notna().any()
     since = pd.to_numeric(out.get("since_step_s", pd.Series(np.nan, index=out.index)),
                           errors="coerce")
-    if frames and np.isfinite(since).any():  # a stepped video: the ends of its holds count
+    if frames and np.isfinite(since[out["frame"].notna()]).any():  # a stepped video's holds
         n_holds = len(out.groupby([c for c in ("image", "step") if c in out.columns]))
         what = f"{len(out)} frame{'s' if many else ''} ending the hold{'s' if n_holds > 1 else ''}"
     else:
