@@ -720,6 +720,26 @@ def _row_problems(df: pd.DataFrame, mpath: str) -> list[Problem]:
                         "cell empty (the setpoint pressure_kpa is then used)",
                     )
                 )
+        if "since_step_s" in df.columns:  # what measure flags a settling photo by
+            since = df["since_step_s"].iloc[i]
+            seconds = np.nan if is_missing(since) else user_float(since)
+            if not is_missing(since) and not (np.isfinite(seconds) and seconds >= 0):
+                doubt = number_doubt(since)
+                out.append(
+                    Problem(
+                        mpath,
+                        line,
+                        f"since_step_s {since!r} "
+                        + (
+                            f"could be either number: {doubt}"
+                            if doubt
+                            else "is negative" if np.isfinite(seconds) else "is not a number"
+                        ),
+                        "write the seconds since the pressure reached its level with a decimal "
+                        "point, or leave the cell empty (the photo is then not flagged as taken "
+                        "while settling)",
+                    )
+                )
         if direction not in DIRECTIONS:
             out.append(
                 Problem(

@@ -51,6 +51,7 @@ import pandas as pd
 
 from pipeline.constants import DIRECTIONS, NEAR_STEP_S, PRESSURE_OUT_OF_ORDER, RAMP_KEYS
 from pipeline.measure.quality import BASE_MISMATCH_DEG, COSMETIC_FLAGS, NOTE_GIVEN_OFF
+from pipeline.measure.settings import user_floats
 
 #: a photo this far (deg) outside the range its neighbours allow breaks its ramp
 SLACK_DEG = 12.0
@@ -270,13 +271,13 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
     ...                    "since_step_s": [0.5, 4.0, 0.2, -0.3, "1,2"]})  # typed in by hand
     >>> out = flag_settling(df)
     >>> out["status"].tolist()
-    ['flagged', 'ok', 'failed', 'ok', 'ok']
+    ['flagged', 'ok', 'failed', 'ok', 'flagged']
     >>> out["reason"].iloc[0].split(",")[0]
     "taken 0.5 s after a step of its pressure log's setpoint"
     """
     if "since_step_s" not in angles.columns:
         return angles
-    since = pd.to_numeric(angles["since_step_s"], errors="coerce")
+    since = user_floats(angles["since_step_s"])  # as check reads it: "1,2" is 1.2
     settling = (since >= 0) & (since < NEAR_STEP_S) & (angles["status"] != "failed")
     if "frame" in angles.columns:
         settling &= angles["frame"].isna()

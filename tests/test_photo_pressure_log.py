@@ -560,3 +560,20 @@ def test_only_levels_held_count_as_steps_for_since_step_s(tmp_path):
     reading[np.searchsorted(rows["camera_s"].to_numpy(), 100.5)] += 4.0  # 1.4 s before a photo
     got = since(folder, pd.DataFrame({"Timestamp": rows["Timestamp"], "Sensor (kPa)": reading}))
     assert np.nanmin(got) > 5.0, got  # every photo 6.4 s into its hold (the rest photos more)
+
+
+def test_a_since_step_s_typed_by_hand_that_is_no_time_is_named_by_check(logged_folder, capsys):
+    # review: "abc" or "-0.3" were taken silently (a settling photo kept, a settled one flagged)
+    assert main(["photoset", "init", str(logged_folder), "--pattern", "IMG_*.JPG",
+                 "--pressure-log", "log.csv", "--clock-offset-s", "5.5", "--material", "DS20",
+                 "--l0-mm", "100"]) == 0
+    m = pd.read_csv(logged_folder / "manifest.csv", dtype={"since_step_s": str})
+    m.loc[1, "since_step_s"], m.loc[2, "since_step_s"] = "abc", "-0.3"
+    m.loc[3, "since_step_s"] = "1,2"  # a decimal comma: read as 1.2, as measure reads it
+    m.to_csv(logged_folder / "manifest.csv", index=False)
+    capsys.readouterr()
+    assert main(["photoset", "check", str(logged_folder)]) == 1
+    err = capsys.readouterr().err
+    assert "manifest.csv line 3: since_step_s 'abc' is not a number" in err
+    assert "manifest.csv line 4: since_step_s '-0.3' is negative" in err
+    assert "line 5: since_step_s" not in err
