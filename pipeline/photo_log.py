@@ -11,8 +11,9 @@ wrong, as the log's time at one photo (a photo of the logger's screen).
 sign would put clearly fewer photos near a step; photos that fall in a gap of the log (a
 logger that stopped writing for a while), which are left out, since their pressure is not known;
 a log whose dates read either way (``05/12/2026``), read as the photos' own dates say.  Each
-photo's ``since_step_s`` (the time since the setpoint last stepped) goes into the manifest: measure
-flags a photo taken while the actuator may still be moving.
+photo's ``since_step_s`` (the time since the pressure reached the level it then held,
+:func:`held_steps`) goes into the manifest: measure flags a photo taken while the actuator may
+still be moving.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from pipeline.errors import UserInputError
 from pipeline.log_clock import read_clock_text
 from pipeline.measure.settings import user_float
 from pipeline.photo_times import exif_time
+from pipeline.ramp_check import settling
 from pipeline.video.timeline import (
     STEP_MIN_KPA,
     PressureLog,
@@ -87,8 +89,9 @@ class PhotoPlacement:
     (ISO 8601, the camera's clock), ``log_time_s``, ``pressure_kpa`` (the setpoint in force),
     ``measured_pressure_kpa`` (when logged), ``direction``, ``near_step_s`` (how far from a
     step of the setpoint, when within :data:`~pipeline.constants.NEAR_STEP_S`; else NaN) and
-    ``since_step_s`` (the time since the setpoint's last step, NaN before the first: measure
-    flags a photo taken while settling, :func:`pipeline.ramp_check.flag_settling`).
+    ``since_step_s`` (the time since the pressure reached the level it then held,
+    :func:`held_steps`; NaN before the first: measure flags a photo taken while settling,
+    :func:`pipeline.ramp_check.flag_settling`).
     ``left_out`` are the photos in a gap of the log; ``notes`` and ``warnings`` are lines for
     the user.
     """
@@ -542,12 +545,11 @@ def _near_step_lines(table: pd.DataFrame, limit: int = 12) -> list[str]:
             "photo's time)"
         )
         lines = [*lines[: limit - 1], more]
-    since = pd.to_numeric(table.get("since_step_s"), errors="coerce")
-    settling = int((since < NEAR_STEP_S).sum()) if since is not None else 0
+    n_flagged = int(settling(table["since_step_s"]).sum())
     flags = (
-        f"; measure flags the {settling} taken less than {NEAR_STEP_S:g} s after the pressure "
+        f"; measure flags the {n_flagged} taken less than {NEAR_STEP_S:g} s after the pressure "
         "reached a level it held (the manifest's since_step_s)"
-        if settling
+        if n_flagged
         else ""
     )
     head = (
@@ -644,7 +646,9 @@ def logged_row_doubts(
         near = np.full(len(g), np.inf)
         near[known] = _near_step(t[known], steps)
         lo, hi = _held_span(log)
-        since = pd.to_numeric(g.get("since_step_s"), errors="coerce")
+        flagged = (
+            settling(g["since_step_s"]) if "since_step_s" in g else np.zeros(len(g), bool)
+        )
         for i, ix in enumerate(g.index):
             if known[i] and not lo <= t[i] <= hi:
                 what = f"log_time_s {t[i]:g} lies outside {name} ({span_text(log.span_s)})"
@@ -666,8 +670,8 @@ def logged_row_doubts(
                     "second reads the level on the step's other side, and the actuator may still "
                     "be moving"
                 )
-                if since is not None and since.iloc[i] < NEAR_STEP_S:
-                    what += f" (measure flags it: its since_step_s is {since.iloc[i]:g})"
+                if flagged[i]:
+                    what += f" (measure flags it: its since_step_s is {g['since_step_s'].iloc[i]})"
                 fix = "check the clocks (photoset init --log-time-at) and this pressure"
                 out.append((ix, what, fix))
     return out

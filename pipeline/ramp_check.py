@@ -257,13 +257,27 @@ def _join(*parts: str) -> str:
     return "; ".join(p for p in parts if p)
 
 
+def settling(since_step_s: pd.Series) -> np.ndarray:
+    """Which photos were taken while the actuator may still have been moving: a manifest's
+    ``since_step_s`` from 0 up to :data:`~pipeline.constants.NEAR_STEP_S` (read as ``check``
+    reads it: ``"1,2"`` is 1.2 s; text or a negative time, which check names, is no such photo).
+
+    Examples
+    --------
+    >>> settling(pd.Series([0.5, 4.0, -0.3, "1,2", None, "abc"])).tolist()
+    [True, False, False, True, False, False]
+    """
+    since = user_floats(since_step_s)
+    return (since >= 0) & (since < NEAR_STEP_S)
+
+
 def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
-    """Flag each measured photo taken less than :data:`~pipeline.constants.NEAR_STEP_S` after a
-    step of its pressure log's setpoint (the manifest's ``since_step_s``, which
-    ``photoset init --pressure-log`` writes): the actuator may still have been moving, so its
-    psi is not yet its level's, and a curve averaging it in is off (customer 39's 30 kPa mean,
-    1 deg under the settled value).  A video's frames are left alone: the ends of their holds
-    count (:func:`pipeline.aggregate.settled_frames`).
+    """Flag each measured photo taken less than :data:`~pipeline.constants.NEAR_STEP_S` after
+    the logged pressure reached the level it then held (:func:`settling`, by the manifest's
+    ``since_step_s``, which ``photoset init --pressure-log`` writes): the actuator may still
+    have been moving, so its psi is not yet its level's, and a curve averaging it in is off
+    (customer 39's 30 kPa mean, 1 deg under the settled value).  A video's frames are left
+    alone: the ends of their holds count (:func:`pipeline.aggregate.settled_frames`).
 
     Examples
     --------
@@ -277,20 +291,20 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
     """
     if "since_step_s" not in angles.columns:
         return angles
-    since = user_floats(angles["since_step_s"])  # as check reads it: "1,2" is 1.2
-    settling = (since >= 0) & (since < NEAR_STEP_S) & (angles["status"] != "failed")
+    since = user_floats(angles["since_step_s"])
+    moving = settling(angles["since_step_s"]) & (angles["status"] != "failed")
     if "frame" in angles.columns:
-        settling &= angles["frame"].isna()
+        moving &= angles["frame"].isna()
     out = angles.copy()
-    out.loc[settling, "status"] = "flagged"
-    out.loc[settling, "reason"] = [
+    out.loc[moving, "status"] = "flagged"
+    out.loc[moving, "reason"] = [
         _join(
             str(why) if isinstance(why, str) else "",
             f"taken {s:g} s after a step of its pressure log's setpoint, so the actuator may "
             "still have been moving: left out of the curves with the flagged photos (to keep "
             "it, empty since_step_s in its manifest row)",
         )
-        for why, s in zip(out.loc[settling, "reason"], since[settling])
+        for why, s in zip(out.loc[moving, "reason"], since[moving])
     ]
     return out
 
