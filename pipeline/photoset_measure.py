@@ -204,7 +204,7 @@ def measure_photoset(
     cached_seconds = float(out.attrs.get("cached_seconds", 0.0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
     if ramp_check:
-        out = check_ramps(out)
+        out = check_ramps(out, clamped=() if ps.is_video else clamped_ramps(ps, out))
     if not ps.is_video:
         out = flag_settling(note_uneven_light(ps, out))
     out = check_sealed_ends(out)
@@ -216,6 +216,30 @@ def measure_photoset(
         write_contact_sheets(out, odir)
     out.attrs["from_cache"] = from_cache
     out.attrs["cached_seconds"] = cached_seconds
+    return out
+
+
+def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
+    """The ramps (their :data:`~pipeline.constants.RAMP_KEYS` values in ``angles``, one row per
+    manifest row of ``ps``) whose rows all name one fixed end: a clamp holds their bodies in one
+    direction.  Free strips name one per row; a guessed fixed end (``auto``) names none.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> ps = S(rows=[S(fixed_end_px=(10.0, 5.0))] * 2 + [S(fixed_end_px=(10.0, 5.0)),
+    ...                                                   S(fixed_end_px=(40.0, 5.0))])
+    >>> df = pd.DataFrame({"material": "M", "actuator": "A1", "trial": [1, 1, 2, 2]})
+    >>> clamped_ramps(ps, df)
+    {('M', 'A1', 1)}
+    """
+    if not set(RAMP_KEYS) <= set(angles.columns):
+        return set()
+    out = set()
+    for key, ramp in angles.groupby(list(RAMP_KEYS), sort=False):
+        ends = {None if r is None else r.fixed_end_px for r in (ps.rows[i] for i in ramp.index)}
+        if len(ends) == 1 and None not in ends:
+            out.add(key)
     return out
 
 

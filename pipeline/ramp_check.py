@@ -44,6 +44,7 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from typing import Any
 
 import numpy as np
@@ -309,7 +310,9 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
+def check_ramps(
+    angles: pd.DataFrame, clamped: Collection[tuple[Any, ...]] = ()
+) -> pd.DataFrame:
     """Measure a ramp's bodies from its shared base direction, flag photos that break their
     ramp's trend and trust cosmetically flagged ones that follow it.
 
@@ -318,13 +321,15 @@ def check_ramps(angles: pd.DataFrame) -> pd.DataFrame:
     angles : pandas.DataFrame
         The angles.csv table (``psi_deg``, ``status``, ``reason``, ``pressure_kpa``,
         ``direction``, the ramp keys, optionally ``step`` and ``length_px``).
+    clamped : collection of tuple
+        See :func:`share_base_direction`.
 
     Returns
     -------
     pandas.DataFrame
         A copy with ``status`` and ``reason`` updated (rows in the same order).
     """
-    out = share_base_direction(angles)
+    out = share_base_direction(angles, clamped=clamped)
     if out.empty or not set(RAMP_KEYS) <= set(out.columns):
         return out
     status, reason = (
@@ -459,7 +464,9 @@ def _wrap_deg(angle: np.ndarray) -> np.ndarray:
 
 
 def share_base_direction(
-    angles: pd.DataFrame, keys: tuple[str, ...] = RAMP_KEYS
+    angles: pd.DataFrame,
+    keys: tuple[str, ...] = RAMP_KEYS,
+    clamped: Collection[tuple[Any, ...]] = (),
 ) -> pd.DataFrame:
     """Measure every body of a ramp from the ramp's one base direction, where the clamp holds it.
 
@@ -475,7 +482,9 @@ def share_base_direction(
     the base direction jumps part-way through the ramp (in step order) and stays there, the
     camera or the clamp moved: each run of photos (:func:`base_runs`) is measured from its own
     direction (a run of fewer than :data:`BASE_MIN_PHOTOS`, each photo from its own) and the
-    photos after the move say so.
+    photos after the move say so.  Where the bodies of a run held by one clamp (``clamped``)
+    scatter by more than :data:`BASE_SPREAD_DEG`, their base cannot be read and its rows are
+    flagged (:func:`_flag_unsteady_base`); free strips scatter, and each keeps its own.
 
     Parameters
     ----------
@@ -484,6 +493,9 @@ def share_base_direction(
         ``keys``; ``kappa_per_mm`` and ``l0_mm`` are kept consistent when present).
     keys : tuple of str
         The columns naming one ramp (one clamping of one actuator).
+    clamped : collection of tuple
+        The ``keys`` values of the ramps whose rows name one fixed end (a clamp holds them;
+        per-row fixed ends are free strips').
 
     Returns
     -------
@@ -509,7 +521,7 @@ def share_base_direction(
     if out.empty or "base_direction_deg" not in out.columns or not set(keys) <= set(out.columns):
         return out
     order = [c for c in ("step", "time_s") if c in out.columns]  # as the photos were taken
-    for _, whole in out.groupby(list(keys), sort=False):
+    for key, whole in out.groupby(list(keys), sort=False):
         ramp = whole.sort_values(order, kind="stable") if order else whole
         # each body's own base as the ramp's first photo sees it: a camera held by hand turned
         # between photos (customer 34: psi off by each photo's turn, 14 rows ok 5-7 deg off)
@@ -532,6 +544,7 @@ def share_base_direction(
         first = float(np.median(own_all[used][runs[0]]))
         for number, run in enumerate(runs):
             _share_run(out, ramp[used].iloc[run], first_base_deg=first if number else None,
+                       clamped=key in clamped,
                        turn=turn[used][run])
     return out
 
@@ -713,7 +726,11 @@ def _turn_given(out: pd.DataFrame, ramp: pd.DataFrame, turn: np.ndarray, given: 
 
 
 def _share_run(
-    out: pd.DataFrame, run: pd.DataFrame, first_base_deg: float | None, turn: np.ndarray
+    out: pd.DataFrame,
+    run: pd.DataFrame,
+    first_base_deg: float | None,
+    turn: np.ndarray,
+    clamped: bool = False,
 ) -> None:
     """Measure the bodies of one run of a ramp (one setting of camera and clamp) from their
     shared base direction, in place in ``out``.
@@ -728,7 +745,8 @@ def _share_run(
     shared = float(own[0] + np.median(_wrap_deg(own - own[0])))
     moved = _wrap_deg(own - shared)
     run_base = shared  # the run's direction, for the note (one outlying photo does not set it)
-    if n < BASE_MIN_PHOTOS or float(np.median(np.abs(moved))) > BASE_SPREAD_DEG:
+    scatter = float(np.median(np.abs(moved)))
+    if n < BASE_MIN_PHOTOS or scatter > BASE_SPREAD_DEG:
         # too few to share, or they scatter (free strips, a clamp that let go): each its own
         shared, moved = float("nan"), np.zeros(n)
     reasons = out.loc[rows, "reason"].fillna("").astype(str).to_numpy()
@@ -766,6 +784,43 @@ def _share_run(
         )
         for before, p, o, b, m in zip(reasons, psi, old, own, moved, strict=True)
     ]
+    if clamped and n >= BASE_MIN_PHOTOS and scatter > BASE_SPREAD_DEG:
+        _flag_unsteady_base(out, rows, scatter)
+
+
+def _flag_unsteady_base(out: pd.DataFrame, rows: pd.Index, scatter_deg: float) -> None:
+    """Flag ``rows`` (in place in ``out``), bodies held by one clamp whose own base directions
+    scatter by ``scatter_deg`` (median absolute deviation, over :data:`BASE_SPREAD_DEG`): each
+    psi is measured from its own base, which may be that far off.
+
+    One clamp holds every body of the ramp in one direction, so a scatter is the base's reading,
+    not the bodies: customer 42's grey-blue body lit from one side, against its empty scene, lost
+    its shaded side at the clamp as shadow in some photos, and its ramps' bases scattered by
+    3.1-3.6 deg, from 77 to 104 (the clamp's 88): 17 of 37 ``ok`` rows more than 3 deg off, 6
+    more than 5.  Over 15 other customer sets and the rendered ramps no clamped ramp's bases
+    scattered by more than 3.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"status": ["ok", "failed"], "reason": ["", "unreadable image"]})
+    >>> _flag_unsteady_base(df, df.index, 3.6)
+    >>> df["status"].tolist(), df["reason"].iloc[0][:59]
+    (['flagged', 'failed'], 'the bodies of this ramp leave its one fixed_end in directio')
+    """
+    why = (
+        f"the bodies of this ramp leave its one fixed_end in directions that scatter by "
+        f"{scatter_deg:.1f} deg (median absolute deviation; one clamp holds them in one): psi is "
+        "measured from each body's own, which may be as far off. Give fixed_direction_deg, the "
+        "clamp's direction; check with photoset preview where the base is read (a pale body's "
+        "shaded side at the clamp taken for shadow or backdrop? Then measure without the empty "
+        "scene too and compare)"
+    )
+    for ix in rows:
+        if out.at[ix, "status"] == "failed":
+            continue
+        reason = out.at[ix, "reason"]
+        out.at[ix, "reason"] = _join(why, reason if isinstance(reason, str) else "")
+        out.at[ix, "status"] = "flagged"
 
 
 def layer_lengths(measured: pd.DataFrame) -> np.ndarray:

@@ -819,6 +819,31 @@ def test_check_warns_of_a_pressure_out_of_its_ramps_order_naming_the_line(photo_
     assert warning.fix.startswith("correct pressure_kpa (or step) on this line")
 
 
+@pytest.mark.parametrize(("empty_bgr", "warned"), [((200, 200, 200), False),
+                                                   ((205, 196, 200), False),
+                                                   ((140, 140, 140), True),
+                                                   ((200, 200, 160), True)])
+def test_check_warns_of_an_empty_scene_taken_at_another_exposure(photo_folder, empty_bgr, warned):
+    # customer 42's empty scene at 0.72 of the photos' exposure and another white balance: 5 rows
+    # of its grey-blue body `ok` and 7-10 deg off, and check said OK
+    from pipeline.photoset_check import check_photoset
+
+    cv2.imwrite(str(photo_folder / "empty.png"), np.full((24, 32, 3), empty_bgr, np.uint8))
+    photoset_init.init_photoset(
+        photo_folder, PATTERN, settings={"l0_mm": 150.0, "target": "body",
+                                         "background": "empty.png", "fixed_end": [2, 12]}
+    )
+    got = [p for p in check_photoset(photo_folder, warnings=True) if "exposure" in p.message]
+    assert [p.line for p in got] == ([2, 7] if warned else []), got  # each ramp's first row
+    if warned:
+        assert got[0].warning and got[0].message.startswith(
+            "background photo empty.png was taken at another exposure or white balance than "
+            "this ramp's first photo"
+        )
+        assert "lock" in got[0].fix
+    assert not check_photoset(photo_folder)  # a warning, not an error
+
+
 def test_check_warns_that_a_fixed_end_left_auto_is_guessed(photo_folder):
     # customer 25 left fixed_end out: check said OK, and measure then flagged all 36 bodies
     # "fixed end guessed; set fixed_end" (the README said check would say so)

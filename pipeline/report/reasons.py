@@ -18,6 +18,10 @@ Examples
 'manifest row: photo missing from the folder'
 >>> words("background photo IMG_5000.JPG is 4032x3024 px, another shape than the photo: take")
 'empty-scene photo of another shape'
+>>> words("the selection runs on from the body's free end to the image border, 199% of l0 long")
+'something joins the body at its free end (a hand?)'
+>>> words("the bodies of this ramp leave its one fixed_end in directions that scatter by 3.6")
+'bodies leave one clamp in scattered directions (base unreadable)'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
@@ -51,6 +55,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^curvature fit failed", "curvature fit failed"),
     (r"^internal error", "internal error (please report)"),
     (r"^body touches the image border", "body's tip at the image border"),
+    (r"^the selection runs on from the body's free end to the image border",
+     "something joins the body at its free end (a hand?)"),
     (r"^body short of l0 with its tip in view", "body short of l0, tip in view (out of plane?)"),
     (r"^sealed end shorter than the photos show", "sealed_end_mm shorter than the photos show"),
     (r"^sealed end not given, and", "no sealed_end_mm, and the photos show one"),
@@ -76,6 +82,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^background photo .* cannot be decoded", "empty-scene photo cannot be read"),
     (r"^taken [\d.e+-]+ s after a step of its pressure log", "taken while settling after a step"),
     (r"^the body's two sides diverge", "body's sides diverge at the clamp (a faint side?)"),
+    (r"^the bodies of this ramp leave its one fixed_end in directions that scatter",
+     "bodies leave one clamp in scattered directions (base unreadable)"),
     # a body's causes
     (r"^the free end's direction is uncertain", "free end's direction uncertain"),
     (r"^the centre line stops \d+ px short of the body's free end where the body still turns",
