@@ -45,7 +45,7 @@ def check_photoset(
         problems += material_problems(ps)
         problems += pressure_order_problems(ps)
         problems += logged_pressure_problems(ps)
-        if decode_images:
+        if decode_images and warnings:
             problems += background_exposure_problems(ps)
     return [p for p in problems if warnings or not p.warning]
 
@@ -108,78 +108,101 @@ def pressure_order_problems(ps: PhotoSet) -> list[Problem]:
     ]
 
 
-#: an empty scene whose brightness differs from its ramp's first photo by more than this share
-#: (the three channels' median ratio) ...
+#: an empty scene more than this share brighter or darker than its ramp's first photo (the mean
+#: of its channels' median ratios) ...
 BACKGROUND_EXPOSURE_OFF = 0.2
-#: ... or whose three channels' ratios to it spread by more than this share (white balance)
+#: ... or whose channels' ratios to it spread by more than this share (white balance)
 BACKGROUND_BALANCE_OFF = 0.1
+#: channels whose medians lie outside these levels in either photo are not compared: too dark
+#: for a ratio (a blue backdrop's red), or clipped
+CHANNEL_LEVELS = (32.0, 250.0)
 
 
-def exposure_offset(photo_bgr: np.ndarray, background_bgr: np.ndarray) -> tuple[float, float]:
-    """How the photo's light differs from the empty scene's: the mean of the three channels'
-    ratios of their medians (1 for the same exposure) and their spread (max - min over the
-    mean: 0 for the same white balance).  The body, a small part of the photo, barely moves
-    the medians.
+def exposure_offset(
+    photo_bgr: np.ndarray, background_bgr: np.ndarray
+) -> tuple[float, float] | None:
+    """How the empty scene's light differs from the photo's: the mean over the channels of the
+    ratios of their medians (empty scene over photo: 0.8 is 20% darker) and their spread (max -
+    min over the mean: 0 for the same white balance), over the channels both show between
+    :data:`CHANNEL_LEVELS`; None when fewer than two do.  The body, a small part of the photo,
+    barely moves the medians (at most 10% for a body over 40% of a vignetted photo).
 
     Examples
     --------
     >>> bg = np.full((4, 4, 3), 200, np.uint8)
-    >>> [round(v, 2) for v in exposure_offset((bg * 0.7).astype(np.uint8), bg)]
-    [0.71, 0.0]
-    >>> [round(v, 2) for v in exposure_offset((bg * [1.0, 1.0, 0.8]).astype(np.uint8), bg)]
+    >>> [round(v, 2) for v in exposure_offset(bg, (bg * 0.8).astype(np.uint8))]
+    [0.8, 0.0]
+    >>> [round(v, 2) for v in exposure_offset(bg, (bg * [1.0, 1.0, 0.8]).astype(np.uint8))]
     [0.93, 0.21]
+    >>> exposure_offset(np.full((4, 4, 3), 255, np.uint8), bg) is None  # clipped white
+    True
     """
-    ratio = (np.median(photo_bgr.reshape(-1, 3), axis=0) + 4.0) / (
-        np.median(background_bgr.reshape(-1, 3), axis=0) + 4.0
-    )
+    photo = np.median(photo_bgr.reshape(-1, 3), axis=0)
+    empty = np.median(background_bgr.reshape(-1, 3), axis=0)
+    lo, hi = CHANNEL_LEVELS
+    seen = (np.minimum(photo, empty) >= lo) & (np.maximum(photo, empty) < hi)
+    if seen.sum() < 2:
+        return None
+    ratio = empty[seen] / photo[seen]
     mean = float(ratio.mean())
     return mean, float((ratio.max() - ratio.min()) / mean)
 
 
 def background_exposure_problems(ps: PhotoSet) -> list[Problem]:
-    """A warning on the first row of each ramp whose empty scene (``background``) was taken at
-    another exposure or white balance than the ramp's first photo (:func:`exposure_offset`,
-    beyond :data:`BACKGROUND_EXPOSURE_OFF` or :data:`BACKGROUND_BALANCE_OFF`).
+    """A warning on the first row of each ramp (by step) whose empty scene (``background``) was
+    taken at another exposure or white balance than the ramp's first readable photo
+    (:func:`exposure_offset`, beyond :data:`BACKGROUND_EXPOSURE_OFF` or
+    :data:`BACKGROUND_BALANCE_OFF`).
 
     ``measure`` matches the empty scene's light to each photo, but not perfectly: customer 42's
     empty scene taken at 0.72 of the photos' exposure and another white balance read 5 rows of
     its grey-blue body ``ok`` and 7-10 deg off (1 with the empty scene taken with the photos),
     and ``check`` said nothing.
     """
-    import cv2
-
     from pipeline.measure.core import decode_for_work
+
+    def decoded(path: Path) -> np.ndarray | None:
+        try:
+            data = np.fromfile(str(path), np.uint8)
+        except OSError:  # the format's problems say so
+            return None
+        img = decode_for_work(data)[0] if data.size else None
+        return img if img is not None and img.ndim == 3 else None
 
     if ps.is_video or not set(RAMP_KEYS) <= set(ps.manifest.columns):
         return []
+    order = [c for c in ("step",) if c in ps.manifest.columns]
+    empties: dict[str, np.ndarray | None] = {}
     out: list[Problem] = []
     for _, ramp in ps.manifest.groupby(list(RAMP_KEYS), sort=False):
-        first = next((i for i in ramp.index if ps.rows[i] is not None), None)
-        settings = None if first is None else ps.rows[first]
+        rows = ramp.sort_values(order, kind="stable").index if order else ramp.index
+        read = [i for i in rows if ps.rows[i] is not None]
+        settings = ps.rows[read[0]] if read else None
         if settings is None or settings.background_path is None:
             continue
-        images = []
-        for path in (ps.image_path(str(ps.manifest.at[first, "image"])),
-                     Path(settings.background_path)):
-            try:
-                data = np.fromfile(str(path), np.uint8)
-            except OSError:  # the format's problems say so
-                data = np.zeros(0, np.uint8)
-            images.append(decode_for_work(data)[0] if data.size else None)
-        photo, empty = images
-        if photo is None or empty is None or photo.ndim != 3 or empty.ndim != 3:
+        path = settings.background_path
+        if path not in empties:
+            empties[path] = decoded(Path(path))
+        empty = empties[path]
+        first, photo = next(
+            ((i, img) for i in read
+             if (img := decoded(ps.image_path(str(ps.manifest.at[i, "image"])))) is not None),
+            (None, None),
+        )
+        if empty is None or photo is None:
             continue
-        empty = cv2.resize(empty, (photo.shape[1], photo.shape[0]), interpolation=cv2.INTER_AREA)
-        brightness, balance = exposure_offset(photo, empty)
+        offset = exposure_offset(photo, empty)
+        if offset is None:
+            continue
+        brightness, balance = offset
         if abs(brightness - 1.0) <= BACKGROUND_EXPOSURE_OFF and balance <= BACKGROUND_BALANCE_OFF:
             continue
-        name = Path(settings.background_path).name
         out.append(_row_warning(
             ps,
             first,
-            f"background photo {name} was taken at another exposure or white balance than this "
-            f"ramp's first photo: {abs(1.0 / brightness - 1.0) * 100:.0f}% "
-            + ("brighter" if brightness < 1.0 else "darker")
+            f"background photo {Path(path).name} was taken at another exposure or white balance "
+            f"than this ramp's first photo: {abs(brightness - 1.0) * 100:.0f}% "
+            + ("darker" if brightness < 1.0 else "brighter")
             + f", its colour channels {100 * balance:.0f}% apart; measure matches its light to "
             "each photo, but a faint or shaded part of the body may then pass for backdrop or "
             "shadow",

@@ -219,26 +219,44 @@ def measure_photoset(
     return out
 
 
+#: the rows of a ramp whose fixed ends lie this close (px, or half its bodies' median width where
+#: that is more) name one clamp (:func:`clamped_ramps`)
+SAME_CLAMP_PX = 5.0
+
+
 def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
     """The ramps (their :data:`~pipeline.constants.RAMP_KEYS` values in ``angles``, one row per
-    manifest row of ``ps``) whose rows all name one fixed end: a clamp holds their bodies in one
-    direction.  Free strips name one per row; a guessed fixed end (``auto``) names none.
+    manifest row of ``ps``) whose rows name one fixed end: a clamp holds their bodies in one
+    direction.  Fixed ends given per row count as one when they lie within
+    :data:`SAME_CLAMP_PX` (or half the ramp's median ``width_px``) of their median; rows that
+    could not be read (a typo: ``ps.rows`` None) are passed over.  Free strips name one per row,
+    farther apart; a guessed fixed end (``auto``) names none.
 
     Examples
     --------
     >>> from types import SimpleNamespace as S
-    >>> ps = S(rows=[S(fixed_end_px=(10.0, 5.0))] * 2 + [S(fixed_end_px=(10.0, 5.0)),
-    ...                                                   S(fixed_end_px=(40.0, 5.0))])
-    >>> df = pd.DataFrame({"material": "M", "actuator": "A1", "trial": [1, 1, 2, 2]})
+    >>> ps = S(rows=[S(fixed_end_px=(10.0, 5.0)), None, S(fixed_end_px=(10.3, 5.0)),
+    ...              S(fixed_end_px=(10.0, 5.0)), S(fixed_end_px=(40.0, 5.0))])
+    >>> df = pd.DataFrame({"material": "M", "actuator": "A1", "trial": [1, 1, 1, 2, 2]})
     >>> clamped_ramps(ps, df)
     {('M', 'A1', 1)}
+    >>> sorted(clamped_ramps(ps, df.assign(width_px=70.0)))  # 30 px apart: in half a width
+    [('M', 'A1', 1), ('M', 'A1', 2)]
     """
     if not set(RAMP_KEYS) <= set(angles.columns):
         return set()
+    widths = pd.to_numeric(
+        angles.get("width_px", pd.Series(np.nan, index=angles.index)), errors="coerce"
+    )
     out = set()
     for key, ramp in angles.groupby(list(RAMP_KEYS), sort=False):
-        ends = {None if r is None else r.fixed_end_px for r in (ps.rows[i] for i in ramp.index)}
-        if len(ends) == 1 and None not in ends:
+        read = [r for r in (ps.rows[i] for i in ramp.index) if r is not None]
+        if not read or any(r.fixed_end_px is None for r in read):
+            continue
+        ends = np.array([r.fixed_end_px for r in read], float)
+        spread = float(np.hypot(*(ends - np.median(ends, axis=0)).T).max())
+        width = float(widths[ramp.index].median()) if widths[ramp.index].notna().any() else 0.0
+        if spread <= max(SAME_CLAMP_PX, 0.5 * width):
             out.add(key)
     return out
 

@@ -516,6 +516,18 @@ def share_base_direction(
     True
     >>> reason.endswith("the median of 5 photos; -193.0 from its own, -7.0)")
     True
+
+    Held by one clamp (``clamped``), bodies whose own directions scatter are flagged; one read
+    half a turn off is flagged alone:
+
+    >>> df = df.assign(base_direction_deg=[90.0, -90.0, -91.0, -89.0, -92.0])
+    >>> out = share_base_direction(df, clamped={("DS20", "A1", "1")})
+    >>> out["status"].tolist(), out["psi_deg"].round(1).tolist()
+    (['flagged', 'ok', 'ok', 'ok', 'ok'], [21.0, 101.0, 0.0, -98.0, -194.0])
+    >>> out = share_base_direction(df.assign(base_direction_deg=[0.0, 6.0, -5.0, 7.0, -6.0]),
+    ...                            clamped={("DS20", "A1", "1")})
+    >>> out["status"].unique().tolist(), out["reason"].iloc[0][:47]
+    (['flagged'], 'the bodies of this ramp leave its one fixed_end')
     """
     out = angles.copy()
     if out.empty or "base_direction_deg" not in out.columns or not set(keys) <= set(out.columns):
@@ -742,7 +754,10 @@ def _share_run(
     """
     own = run["base_direction_deg"].to_numpy(float) - turn
     rows, n = run.index, len(own)
-    shared = float(own[0] + np.median(_wrap_deg(own - own[0])))
+    # measured round the photo nearest the others (a first photo read half a turn off, a hook,
+    # put the rest on both sides of +-180 deg and the median between them)
+    ref = own[int(np.argmin(np.abs(_wrap_deg(own[:, None] - own[None, :])).sum(axis=1)))]
+    shared = float(ref + np.median(_wrap_deg(own - ref)))
     moved = _wrap_deg(own - shared)
     run_base = shared  # the run's direction, for the note (one outlying photo does not set it)
     scatter = float(np.median(np.abs(moved)))

@@ -819,16 +819,32 @@ def test_check_warns_of_a_pressure_out_of_its_ramps_order_naming_the_line(photo_
     assert warning.fix.startswith("correct pressure_kpa (or step) on this line")
 
 
-@pytest.mark.parametrize(("empty_bgr", "warned"), [((200, 200, 200), False),
-                                                   ((205, 196, 200), False),
-                                                   ((140, 140, 140), True),
-                                                   ((200, 200, 160), True)])
-def test_check_warns_of_an_empty_scene_taken_at_another_exposure(photo_folder, empty_bgr, warned):
+@pytest.mark.parametrize(
+    ("backdrop", "gain", "warned"),
+    [
+        ((200, 200, 200), (1.0, 1.0, 1.0), ""),
+        ((200, 200, 200), (1.02, 0.97, 1.0), ""),  # a little drift
+        ((200, 200, 200), (0.7, 0.7, 0.7), "30% darker"),
+        ((150, 150, 150), (1.22, 1.22, 1.22), "22% brighter"),  # the other way
+        ((200, 200, 200), (1.0, 1.0, 0.8), "channels 21% apart"),  # white balance
+        ((200, 90, 20), (1.0, 1.0, 0.6), ""),  # a blue card's red is too dark for a ratio
+        ((20, 22, 18), (0.7, 0.7, 0.7), ""),  # a black backdrop: levels too low to compare
+        ((255, 255, 255), (0.9, 0.9, 0.9), ""),  # a clipped white backdrop says nothing
+    ],
+)
+def test_check_warns_of_an_empty_scene_taken_at_another_exposure(
+    photo_folder, backdrop, gain, warned
+):
     # customer 42's empty scene at 0.72 of the photos' exposure and another white balance: 5 rows
     # of its grey-blue body `ok` and 7-10 deg off, and check said OK
     from pipeline.photoset_check import check_photoset
 
-    cv2.imwrite(str(photo_folder / "empty.png"), np.full((24, 32, 3), empty_bgr, np.uint8))
+    photo = np.full((60, 80, 3), backdrop, np.uint8)
+    photo[10:40, 20:60] = (60, 120, 220)  # a body over a quarter of the photo
+    for path in photo_folder.glob("*.jpg"):
+        cv2.imwrite(str(path), photo)
+    empty = np.clip(np.full((60, 80, 3), backdrop, float) * gain, 0, 255).astype(np.uint8)
+    cv2.imwrite(str(photo_folder / "empty.png"), empty)
     photoset_init.init_photoset(
         photo_folder, PATTERN, settings={"l0_mm": 150.0, "target": "body",
                                          "background": "empty.png", "fixed_end": [2, 12]}
@@ -840,7 +856,7 @@ def test_check_warns_of_an_empty_scene_taken_at_another_exposure(photo_folder, e
             "background photo empty.png was taken at another exposure or white balance than "
             "this ramp's first photo"
         )
-        assert "lock" in got[0].fix
+        assert warned in got[0].message and "lock" in got[0].fix
     assert not check_photoset(photo_folder)  # a warning, not an error
 
 

@@ -570,6 +570,9 @@ def measure_body(
         excluded=bool(settings.exclude),
         hollow_outline=body.hollow_outline,
         sealed_end_unknown=settings.sealed_end_mm is None and settings.free_end == "capped",
+        sealed_end_px=(settings.sealed_end_mm or 0.0) / settings.mm_per_px
+        if settings.mm_per_px
+        else 0.0,
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along

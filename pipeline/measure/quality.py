@@ -225,8 +225,8 @@ def tip_turn_deg(
 
 #: a measured base direction this far (deg) from ``fixed_direction_deg`` is doubtful
 BASE_MISMATCH_DEG = 20.0
-#: a body's line touching the image border and this many times l0 long has something joined at
-#: its free end, its tip in view
+#: a body's line touching the image border and this many times the body long (l0 and the sealed
+#: end) may have something joined at its free end, its tip in view
 JOINED_AT_TIP = 1.3
 #: the notes a body's ``reason`` may hold beside its flags, saying how psi was taken (an ``ok``
 #: row's reason holds only these): how each begins
@@ -311,10 +311,13 @@ def assess_body(
     fixed_direction_deg: float | None = None,
     hollow_outline: bool = False,
     sealed_end_unknown: bool = False,
+    sealed_end_px: float = 0.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
-    Flagged when the free end reaches the image border (a side along it is a note); several
+    Flagged when the free end reaches the image border (a side along it is a note; a selection
+    reaching it more than :data:`JOINED_AT_TIP` times the body's length, ``expected_length_px``
+    plus ``sealed_end_px``, may have something joined at its tip); several
     bodies compete; the fixed end is not reached or guessed; the outline is uneven (the
     segmentation leaked into the backdrop, or lost part of the body); the free end's direction
     depends on how much of the end is fitted (a hooked or ragged tip), or either end's direction
@@ -339,15 +342,17 @@ def assess_body(
 
     flags: list[str] = []
     notes: list[str] = []
-    of_l0 = length_px / expected_length_px if expected_length_px else 0.0
-    if line.touches_border and of_l0 > JOINED_AT_TIP:
+    of_body = length_px / (expected_length_px + sealed_end_px) if expected_length_px else 0.0
+    if line.touches_border and of_body > JOINED_AT_TIP:
         # a hand near the tip joined the selection and ran it to the border (customer 42's
-        # finger photo read "the tip may be outside", with the tip well in view)
+        # finger photo read "the tip may be outside", with the tip well in view; customer 43's
+        # feed tube swung past the tip)
         flags.append(
             "the selection runs on from the body's free end to the image border, "
-            f"{100 * of_l0:.0f}% of l0 long: something there joins the "
-            "body (a hand, a tube, a cable?) and is read with it; exclude it (a box over it) or "
-            "retake the photo; check with photoset preview"
+            f"{100 * of_body:.0f}% as long as the body (l0_mm, sealed_end_mm and mm_per_px say): "
+            "something there may join it (a hand, a tube, a cable?), or those settings are off, "
+            "or the tip is outside the photo; exclude what joins it (a box over it) or retake "
+            "the photo; check with photoset preview"
         )
     elif line.touches_border:
         flags.append("body touches the image border at its free end: the tip may be outside")

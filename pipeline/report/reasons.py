@@ -18,7 +18,7 @@ Examples
 'manifest row: photo missing from the folder'
 >>> words("background photo IMG_5000.JPG is 4032x3024 px, another shape than the photo: take")
 'empty-scene photo of another shape'
->>> words("the selection runs on from the body's free end to the image border, 199% of l0 long")
+>>> words("the selection runs on from the body's free end to the image border, 199% as long")
 'something joins the body at its free end (a hand?)'
 >>> words("the bodies of this ramp leave its one fixed_end in directions that scatter by 3.6")
 'bodies leave one clamp in scattered directions (base unreadable)'
