@@ -158,14 +158,15 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
 
     Along a leg (a run of one ``direction`` of a ramp, in ``step`` order) the pressure rises
     (``up``) or falls (``down``).  A pressure that does not (by more than
-    :data:`PRESSURE_SLACK_STEPS` of the leg's median step) is doubtful: the one farthest from
-    the middle of its two neighbours goes first, and the leg is checked again without it, so a
-    typo never blames its neighbours (a customer's 100 kPa typed as 1000 went into the curves:
-    a level at 1000 kPa); then a leg's first or last pressure whose step is more than
-    :data:`PRESSURE_END_STEPS` times the step beside it (a typo at a ramp's top).  Nothing is
-    said without a ``step`` column (the rows' order is then
-    not the order taken), for a video's frames (their pressures come from its log, not typed)
-    or for a leg of fewer than 3 pressures.
+    :data:`PRESSURE_SLACK_STEPS` of the leg's median step) is doubtful: the fewest rows that,
+    left out, put the leg in order are blamed (:func:`in_order`), so a typo never blames its
+    neighbours (a customer's 100 kPa typed as 1000 went into the curves: a level at 1000 kPa;
+    customer 44's retake of 30 kPa added at the end of a leg blamed the three correct rows
+    before it, and they left the curves); then a leg's first or last pressure whose step is
+    more than :data:`PRESSURE_END_STEPS` times the step beside it (a typo at a ramp's top).
+    Nothing is said without a ``step`` column (the rows' order is then not the order taken),
+    for a video's frames (their pressures come from its log, not typed) or for a leg of fewer
+    than 3 pressures.
 
     Returns
     -------
@@ -200,27 +201,16 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
                 PRESSURE_SLACK_MIN_KPA,
                 PRESSURE_SLACK_STEPS * float(np.median(steps[steps > 0])) if steps.any() else 0.0,
             )
-            while len(keep) >= 3:
-                q = p[keep]
-                worst: tuple[float, int] | None = None
-                for i in range(len(q)):
-                    before = q[i - 1] - q[i] if i > 0 else 0.0  # it falls below the one before
-                    after = q[i] - q[i + 1] if i + 1 < len(q) else 0.0  # or rises past the next
-                    if max(before, after) <= slack:
-                        continue
-                    near = [q[j] for j in (i - 1, i + 1) if 0 <= j < len(q)]
-                    off = abs(q[i] - float(np.mean(near)))
-                    if worst is None or off > worst[0]:
-                        worst = (off, i)
-                if worst is None:
-                    break
-                i = worst[1]
-                shown = [f"{sign * q[j]:g}" for j in (i - 1, i, i + 1) if 0 <= j < len(q)]
-                out[leg.index[keep[i]]] = (
-                    f"pressure {sign * q[i]:g} kPa {PRESSURE_OUT_OF_ORDER} "
+            keep = in_order(p, slack) if len(p) >= 3 else keep
+            for doubt in sorted(set(range(len(p))) - set(keep)):
+                # between the kept pressures before and after it (not the other doubtful ones)
+                kept_before = [k for k in keep if k < doubt][-1:]
+                kept_after = [k for k in keep if k > doubt][:1]
+                shown = [f"{sign * p[k]:g}" for k in (*kept_before, doubt, *kept_after)]
+                out[leg.index[doubt]] = (
+                    f"pressure {sign * p[doubt]:g} kPa {PRESSURE_OUT_OF_ORDER} "
                     f"({' -> '.join(shown)} kPa by step): a typo in the manifest?"
                 )
-                del keep[i]
             if len(keep) >= 3:  # a typo that overshoots at a leg's end keeps it in order
                 q = p[keep]
                 for i, j, k in ((len(q) - 1, len(q) - 2, len(q) - 3), (0, 1, 2)):
@@ -233,6 +223,36 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
                             "times the step beside it): a typo in the manifest?"
                         )
     return out
+
+
+def in_order(p: np.ndarray, slack: float) -> list[int]:
+    """The indices of the longest subsequence of ``p`` (in order) in which no value falls below
+    the one before it by more than ``slack``; of several as long, the smoothest (least sum of
+    squared steps).
+
+    Examples
+    --------
+    >>> in_order(np.array([-60.0, -50, -40, -30, -20, -10, 0, -30, -20]), 5.0)  # a retake after
+    [0, 1, 2, 3, 4, 5, 6]
+    >>> in_order(np.array([0.0, 20, 40, 60, 1000, 120, 140]), 10.0)
+    [0, 1, 2, 3, 5, 6]
+    >>> in_order(np.array([0.0, 10, 5, 20]), 2.0)
+    [0, 1, 3]
+    """
+    n = len(p)
+    length, cost, prev = [1] * n, [0.0] * n, [-1] * n
+    for j in range(n):
+        for i in range(j):
+            if p[j] - p[i] >= -slack:
+                c = cost[i] + float(p[j] - p[i]) ** 2
+                if length[i] + 1 > length[j] or (length[i] + 1 == length[j] and c < cost[j]):
+                    length[j], cost[j], prev[j] = length[i] + 1, c, i
+    end = max(range(n), key=lambda j: (length[j], -cost[j]))
+    chain = []
+    while end >= 0:
+        chain.append(end)
+        end = prev[end]
+    return chain[::-1]
 
 
 def _allowed(psi: np.ndarray, i: int) -> tuple[float, float]:
@@ -337,14 +357,17 @@ def check_ramps(
         out["reason"].fillna("").astype(str).to_numpy(copy=True),
     )
     position = {ix: k for k, ix in enumerate(out.index)}
-    for ix, why in pressure_order_breaks(out).items():
+    off_order = pressure_order_breaks(out)
+    for ix, why in off_order.items():
         k = position[ix]
         if status[k] != "failed":  # its pressure is in doubt, not psi: kept out of the curves
             status[k], reason[k] = "flagged", _join(why, reason[k])
     keys = [c for c in ("step", "time_s") if c in out.columns]  # frames of a video: over time
     order = out.sort_values(keys, kind="stable").index if keys else out.index
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
-        measured = ramp[ramp["status"] != "failed"]
+        # a photo whose pressure is in doubt is no neighbour of the others (customer 44's retake
+        # of 30 kPa at a leg's end flagged the three right photos before it as breaking the ramp)
+        measured = ramp[(ramp["status"] != "failed") & ~ramp.index.isin(list(off_order))]
         if "length_px" in measured.columns and len(measured) >= 3:
             lengths = layer_lengths(measured)
             med = float(np.nanmedian(lengths)) if np.isfinite(lengths).any() else np.nan

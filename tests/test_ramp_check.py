@@ -407,6 +407,26 @@ def test_a_pressure_out_of_its_legs_order_is_flagged_and_kept_out_of_the_curves(
     assert words(out.loc[k, "reason"]) == "pressure out of its ramp's order (a manifest typo?)"
 
 
+@pytest.mark.parametrize("retakes", [[3], [3, 2]])
+def test_a_photo_retaken_at_the_end_of_a_leg_is_blamed_not_the_right_ones_before_it(retakes):
+    # customer 44 added a retake of 30 kPa (and one of 20) after its falling leg's 0 kPa, as
+    # steps 13 and 14: check blamed the three right rows before them ("pressure 0 kPa is out of
+    # its ramp's order (10 -> 0 -> 30 kPa)"), and measure flagged those three as breaking the
+    # ramp, their neighbour the retake: three right photos left the curves
+    up = list(2.0 + 3.0 * UP[:12])  # its body bent 3 deg more each kPa
+    df = _ramp(up, up[::-1])
+    for n, k in enumerate(retakes):  # a level of the falling leg photographed again
+        row = df.iloc[[len(up) + (len(up) - 1 - k)]].assign(step=len(df), image=f"r{n}.jpg")
+        df = pd.concat([df, row], ignore_index=True)
+    out = check_ramps(df)
+    retaken = out.index[len(up) * 2:]
+    assert (out.loc[retaken, "status"] == "flagged").all()
+    assert out.loc[retaken, "reason"].str.startswith(
+        f"pressure {UP[retakes[0]]:g} kPa is out of its ramp's order (0 -> {UP[retakes[0]]:g}"
+    ).iloc[0], out.loc[retaken, "reason"].tolist()
+    assert (out.drop(index=retaken)["status"] == "ok").all(), out[["pressure_kpa", "reason"]]
+
+
 def test_pressures_that_repeat_or_wobble_like_a_gauge_are_in_order():
     df = _ramp(_ds20_like(), _ds20_like()[::-1])
     df["pressure_kpa"] += np.random.default_rng(0).normal(0.0, 1.0, len(df))  # a gauge's reading

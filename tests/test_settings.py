@@ -387,6 +387,13 @@ def test_each_kind_of_bad_row_fails_alone_and_the_rest_is_measured(small_set, tm
     assert "vacuum" in angles.loc[6, "reason"] and "twice" in angles.loc[9, "reason"]
     assert (angles.loc[[0, 5, 7, 8], "status"] == "ok").all()
     assert angles.loc[7, "pressure_kpa"] == -40.0
+    # the stages after measure take the set as it is, its failed rows out of the curves: the
+    # failed 'sideways' row stopped aggregate, and customer 44's run kept the report before it
+    from pipeline.aggregate import aggregate_hysteresis, read_angles
+
+    angles.to_csv(tmp_path / "angles.csv", index=False)
+    curves = aggregate_hysteresis(read_angles([tmp_path / "angles.csv"]))
+    assert curves["n"].sum() == 4 and set(curves["direction"]) == {"up"}, curves
 
 
 @pytest.mark.parametrize(
