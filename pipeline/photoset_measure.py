@@ -642,10 +642,10 @@ def write_angles(angles: pd.DataFrame, out: str | os.PathLike[str]) -> None:
     write_table(angles, out)
 
 
-def summary(angles: pd.DataFrame) -> str:
-    """One-line summary of a measured set: its counts and the seconds the photos took to measure
-    in this run (not those read back from a cache: customer 33 read "17.4 s of work" for a run
-    that measured nothing).
+def summary(angles: pd.DataFrame, seconds: bool = True) -> str:
+    """One-line summary of a measured set: its counts and (``seconds``) the seconds the photos
+    took to measure in this run (not those read back from a cache: customer 33 read "17.4 s of
+    work" for a run that measured nothing).
 
     Examples
     --------
@@ -661,8 +661,8 @@ def summary(angles: pd.DataFrame) -> str:
     unit = "frames" if "frame" in angles.columns else "photos"
     return (
         f"measured {len(angles)} {unit}: {counts.get('ok', 0)} ok, {counts.get('flagged', 0)} "
-        "flagged, "
-        f"{counts.get('failed', 0)} failed ({max(sec, 0.0):.1f} s of work)"
+        f"flagged, {counts.get('failed', 0)} failed"
+        + (f" ({max(sec, 0.0):.1f} s of work)" if seconds else "")
     )
 
 
@@ -672,14 +672,16 @@ def run_summaries(angles_paths: dict[str, Path]) -> list[str]:
 
     Snakemake writes each job's output to its log, so a run ended with exit status 0 and nothing
     on the console about a failed row (customer 30).  ``angles_paths`` maps a dataset's name to
-    its angles.csv; a missing file is skipped.
+    its angles.csv; a missing file is skipped.  The seconds of work are not said: angles.csv
+    holds those of photos measured in earlier runs too (customer 44 read "12.3 s of work" for
+    a run that measured one photo in 0.9 s); each measure job's log says its own.
     """
     lines = []
     for name, path in angles_paths.items():
         if not Path(path).is_file():
             continue
         angles = pd.read_csv(path, usecols=lambda c: c in {"status", "seconds", "frame"})
-        line = f"{name}: {summary(angles)}"
+        line = f"{name}: {summary(angles, seconds=False)}"
         if (angles["status"] != "ok").any():
             line += f"; why: the 'reason' column of {path}"
         lines.append(line)
