@@ -222,15 +222,17 @@ def measure_photoset(
 #: the rows of a ramp whose fixed ends lie this close (px, or half its bodies' median width where
 #: that is more) name one clamp (:func:`clamped_ramps`)
 SAME_CLAMP_PX = 5.0
+#: ... for at least this share of its rows (one fixed end mistyped is no free strip)
+SAME_CLAMP_SHARE = 0.8
 
 
 def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
     """The ramps (their :data:`~pipeline.constants.RAMP_KEYS` values in ``angles``, one row per
     manifest row of ``ps``) whose rows name one fixed end: a clamp holds their bodies in one
-    direction.  Fixed ends given per row count as one when they lie within
-    :data:`SAME_CLAMP_PX` (or half the ramp's median ``width_px``) of their median; rows that
-    could not be read (a typo: ``ps.rows`` None) are passed over.  Free strips name one per row,
-    farther apart; a guessed fixed end (``auto``) names none.
+    direction.  Fixed ends given per row count as one when :data:`SAME_CLAMP_SHARE` of them lie
+    within :data:`SAME_CLAMP_PX` (or half the ramp's median ``width_px``) of their median; rows
+    that could not be read (a typo: ``ps.rows`` None) are passed over.  Free strips name one per
+    row, farther apart; a guessed fixed end (``auto``) names none.
 
     Examples
     --------
@@ -242,6 +244,9 @@ def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
     {('M', 'A1', 1)}
     >>> sorted(clamped_ramps(ps, df.assign(width_px=70.0)))  # 30 px apart: in half a width
     [('M', 'A1', 1), ('M', 'A1', 2)]
+    >>> ps = S(rows=[S(fixed_end_px=(10.0, 5.0))] * 5 + [S(fixed_end_px=(1000.0, 5.0))])
+    >>> clamped_ramps(ps, pd.DataFrame({"material": "M", "actuator": "A1", "trial": [1] * 6}))
+    {('M', 'A1', 1)}
     """
     if not set(RAMP_KEYS) <= set(angles.columns):
         return set()
@@ -254,9 +259,9 @@ def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
         if not read or any(r.fixed_end_px is None for r in read):
             continue
         ends = np.array([r.fixed_end_px for r in read], float)
-        spread = float(np.hypot(*(ends - np.median(ends, axis=0)).T).max())
+        off = np.hypot(*(ends - np.median(ends, axis=0)).T)
         width = float(widths[ramp.index].median()) if widths[ramp.index].notna().any() else 0.0
-        if spread <= max(SAME_CLAMP_PX, 0.5 * width):
+        if np.mean(off <= max(SAME_CLAMP_PX, 0.5 * width)) >= SAME_CLAMP_SHARE:
             out.add(key)
     return out
 

@@ -147,6 +147,9 @@ def base_runs(own_deg: np.ndarray) -> list[np.ndarray]:
 #: a pressure out of its leg's order by more than this share of the leg's median step (and at
 #: least PRESSURE_SLACK_MIN_KPA) is a typo: a gauge's own reading wobbles far less
 PRESSURE_SLACK_STEPS, PRESSURE_SLACK_MIN_KPA = 0.5, 1.0
+#: the leg's step is the median of its steps over this share of its span (from its tenth to its
+#: ninetieth percentile: photos of one level differ by less)
+LEVEL_STEP_SHARE = 0.05
 #: ... and so is a leg's first or last pressure whose step is more than this many times the step
 #: beside it (a typo at the top of a ramp keeps its leg in order: 90 -> 1100; a ramp that doubles
 #: its steps, 40 -> 80 -> 160, is no typo)
@@ -188,7 +191,9 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
     ):
         return {}
     p_all = pd.to_numeric(rows["pressure_kpa"], errors="coerce")
-    ordered = rows[p_all.notna()].sort_values("step", kind="stable")
+    # a failed row of no known direction ('upp') would split its leg in two, each too short
+    known = p_all.notna() & rows["direction"].isin(DIRECTIONS)
+    ordered = rows[known].sort_values("step", kind="stable")
     out: dict[Any, str] = {}
     for _, ramp in ordered.groupby(list(RAMP_KEYS), sort=False):
         legs = (ramp["direction"] != ramp["direction"].shift()).cumsum()
@@ -197,11 +202,16 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
             p = sign * p_all[leg.index].to_numpy(float)
             keep = list(range(len(p)))
             steps = np.abs(np.diff(p))
-            slack = max(
-                PRESSURE_SLACK_MIN_KPA,
-                PRESSURE_SLACK_STEPS * float(np.median(steps[steps > 0])) if steps.any() else 0.0,
-            )
-            keep = in_order(p, slack) if len(p) >= 3 else keep
+            # the step between levels: not the wobble between photos of one level (two or three
+            # photos a level read by a gauge, +-0.5 kPa, set the slack to 1 kPa and half their
+            # rows were typos)
+            span = float(np.percentile(p, 90) - np.percentile(p, 10)) if len(p) else 0.0
+            between = steps[steps > LEVEL_STEP_SHARE * span]  # (a typo widens no such span)
+            typical = float(np.median(between)) if between.size else 0.0
+            slack = max(PRESSURE_SLACK_MIN_KPA, PRESSURE_SLACK_STEPS * typical)
+            # ties are broken by the steps nearest the typical one where enough steps say what
+            # it is, else by the smoothest (in 0 -> 100 -> 20 kPa the typo sets the median)
+            keep = in_order(p, slack, typical if len(p) >= 5 else 0.0) if len(p) >= 3 else keep
             for doubt in sorted(set(range(len(p))) - set(keep)):
                 # between the kept pressures before and after it (not the other doubtful ones)
                 kept_before = [k for k in keep if k < doubt][-1:]
@@ -225,10 +235,11 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
     return out
 
 
-def in_order(p: np.ndarray, slack: float) -> list[int]:
+def in_order(p: np.ndarray, slack: float, typical: float = 0.0) -> list[int]:
     """The indices of the longest subsequence of ``p`` (in order) in which no value falls below
-    the one before it by more than ``slack``; of several as long, the smoothest (least sum of
-    squared steps).
+    the one before it by more than ``slack``; of several as long, the one whose steps lie
+    nearest the ``typical`` step (least sum of squared differences), then the one that keeps
+    the earlier values.
 
     Examples
     --------
@@ -236,15 +247,17 @@ def in_order(p: np.ndarray, slack: float) -> list[int]:
     [0, 1, 2, 3, 4, 5, 6]
     >>> in_order(np.array([0.0, 20, 40, 60, 1000, 120, 140]), 10.0)
     [0, 1, 2, 3, 5, 6]
-    >>> in_order(np.array([0.0, 10, 5, 20]), 2.0)
+    >>> in_order(np.array([0.0, 10, 5, 20]), 2.0, 10.0)
     [0, 1, 3]
+    >>> in_order(np.array([-30.0, -20, -10, 0, -10]), 5.0, 10.0)  # a retake of the level before
+    [0, 1, 2, 3]
     """
     n = len(p)
     length, cost, prev = [1] * n, [0.0] * n, [-1] * n
     for j in range(n):
         for i in range(j):
             if p[j] - p[i] >= -slack:
-                c = cost[i] + float(p[j] - p[i]) ** 2
+                c = cost[i] + (abs(float(p[j] - p[i])) - typical) ** 2
                 if length[i] + 1 > length[j] or (length[i] + 1 == length[j] and c < cost[j]):
                     length[j], cost[j], prev[j] = length[i] + 1, c, i
     end = max(range(n), key=lambda j: (length[j], -cost[j]))
@@ -777,10 +790,10 @@ def _share_run(
     """
     own = run["base_direction_deg"].to_numpy(float) - turn
     rows, n = run.index, len(own)
-    # measured round the photo nearest the others (a first photo read half a turn off, a hook,
-    # put the rest on both sides of +-180 deg and the median between them)
-    ref = own[int(np.argmin(np.abs(_wrap_deg(own[:, None] - own[None, :])).sum(axis=1)))]
-    shared = float(ref + np.median(_wrap_deg(own - ref)))
+    # measured round their circular mean (round the first photo, one read half a turn off, a
+    # hook, put the rest on both sides of +-180 deg and the median between them)
+    ref = float(np.rad2deg(np.angle(np.mean(np.exp(1j * np.deg2rad(own))))))
+    shared = round(float(ref + np.median(_wrap_deg(own - ref))), 9) + 0.0  # no "-0.0 deg"
     moved = _wrap_deg(own - shared)
     run_base = shared  # the run's direction, for the note (one outlying photo does not set it)
     scatter = float(np.median(np.abs(moved)))

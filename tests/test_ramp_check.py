@@ -407,7 +407,7 @@ def test_a_pressure_out_of_its_legs_order_is_flagged_and_kept_out_of_the_curves(
     assert words(out.loc[k, "reason"]) == "pressure out of its ramp's order (a manifest typo?)"
 
 
-@pytest.mark.parametrize("retakes", [[3], [3, 2]])
+@pytest.mark.parametrize("retakes", [[3], [3, 2], [1]])
 def test_a_photo_retaken_at_the_end_of_a_leg_is_blamed_not_the_right_ones_before_it(retakes):
     # customer 44 added a retake of 30 kPa (and one of 20) after its falling leg's 0 kPa, as
     # steps 13 and 14: check blamed the three right rows before them ("pressure 0 kPa is out of
@@ -425,6 +425,27 @@ def test_a_photo_retaken_at_the_end_of_a_leg_is_blamed_not_the_right_ones_before
         f"pressure {UP[retakes[0]]:g} kPa is out of its ramp's order (0 -> {UP[retakes[0]]:g}"
     ).iloc[0], out.loc[retaken, "reason"].tolist()
     assert (out.drop(index=retaken)["status"] == "ok").all(), out[["pressure_kpa", "reason"]]
+
+
+def test_two_photos_a_level_read_off_a_gauge_are_in_order():
+    # the review: with two photos a level differing by a gauge's wobble, the median step was the
+    # wobble, the slack 1 kPa, and 12 of 24 rows were "a typo in the manifest?"
+    up = list(2.0 + 3.0 * np.repeat(UP[:12], 2))
+    df = pd.DataFrame({"psi_deg": up, "status": "ok", "reason": "", "direction": "up",
+                       "pressure_kpa": np.repeat(UP[:12], 2) + np.tile([0.5, -0.8], 12),
+                       "material": "DS20", "actuator": "A1", "trial": "1", "step": range(24)})
+    assert (check_ramps(df)["status"] == "ok").all()
+    df.loc[9, "pressure_kpa"] = 400.0  # and a typo among them is still found
+    assert check_ramps(df)["status"].eq("flagged").tolist() == [k == 9 for k in range(24)]
+
+
+def test_a_failed_row_of_no_known_direction_does_not_hide_a_typo_after_it():
+    # the review: a failed 'upp' row split its leg in two, and the typo in the short half passed
+    df = _ramp(_ds20_like())
+    df.loc[9, ["direction", "status"]] = ["upp", "failed"]
+    df.loc[10, "pressure_kpa"] = 1000.0
+    out = check_ramps(df)
+    assert out.loc[10, "status"] == "flagged" and "out of its ramp's order" in out.loc[10, "reason"]
 
 
 def test_pressures_that_repeat_or_wobble_like_a_gauge_are_in_order():
