@@ -45,6 +45,7 @@ def check_photoset(
         problems += material_problems(ps)
         problems += pressure_order_problems(ps)
         problems += logged_pressure_problems(ps)
+        problems += background_photo_problems(ps)
         if decode_images and warnings:
             problems += background_exposure_problems(ps)
     return [p for p in problems if warnings or not p.warning]
@@ -209,4 +210,59 @@ def background_exposure_problems(ps: PhotoSet) -> list[Problem]:
             "take the empty scene with the camera's exposure and white balance locked as for the "
             "photos (a phone: lock AE/AWB, or its manual mode), just before or after the ramp",
         ))
+    return out
+
+
+def background_photo_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning on the first row of each empty scene (``background``) that is one of the set's
+    own photos: the same file, or a copy of it byte for byte.
+
+    An empty scene shows the clamp and the backdrop with the actuator taken out; a ramp's
+    0 kPa photo named as one (customer 44 tried it) makes every body a difference from a body:
+    0 of 26 photos ``ok``, and ``check`` warned only of the ramp whose first photo it was.
+    """
+    if ps.is_video:
+        return []
+    sizes: dict[int, list[tuple[int, Path]]] = {}
+    for i, name in zip(ps.manifest.index, ps.manifest["image"].astype(str), strict=True):
+        path = ps.image_path(name)
+        try:
+            sizes.setdefault(path.stat().st_size, []).append((i, path))
+        except OSError:  # a missing photo is the format's problem
+            continue
+    out: list[Problem] = []
+    seen: set[str] = set()
+    for i in ps.manifest.index:
+        settings = ps.rows[i]
+        if settings is None or settings.background_path is None:
+            continue
+        background = Path(settings.background_path)
+        if str(background) in seen:
+            continue
+        seen.add(str(background))
+        try:
+            same_size = sizes.get(background.stat().st_size, [])
+            data = background.read_bytes() if same_size else b""
+        except OSError:
+            continue
+        match = next(
+            (path for _, path in same_size
+             if path.resolve() == background.resolve() or path.read_bytes() == data),
+            None,
+        )
+        if match is not None:
+            out.append(_row_warning(
+                ps,
+                i,
+                f"background photo {background.name} is "
+                + (
+                    "one of this set's photos of the actuator"
+                    if match.resolve() == background.resolve()
+                    else f"a copy of {match.name}, one of this set's photos of the actuator"
+                )
+                + ": an empty scene shows the clamp and backdrop with the actuator taken out, "
+                "and measured against this one every body is told from a body",
+                "photograph the scene with the actuator removed (camera, exposure and framing as "
+                "for the photos) and name that photo as background, or leave background out",
+            ))
     return out

@@ -860,6 +860,40 @@ def test_check_warns_of_an_empty_scene_taken_at_another_exposure(
     assert not check_photoset(photo_folder)  # a warning, not an error
 
 
+@pytest.mark.parametrize("background", ["first photo", "its copy", "an empty scene"])
+def test_check_warns_of_an_empty_scene_that_is_one_of_the_photos(photo_folder, background):
+    # customer 44 named a photo of the actuator as the empty scene: 0 of 26 ok, and check warned
+    # only of the ramp whose first photo it was
+    import shutil
+
+    from pipeline.photoset_check import check_photoset
+
+    photos = sorted(photo_folder.glob("*.jpg"))
+    for k, path in enumerate(photos):  # each photo its own bytes
+        cv2.imwrite(str(path), np.full((24, 32, 3), 100 + 10 * k, np.uint8))
+    shutil.copy(photos[0], photo_folder / "copy.jpg")
+    cv2.imwrite(str(photo_folder / "empty.png"), np.full((24, 32, 3), 90, np.uint8))
+    name = {"first photo": photos[0].name, "its copy": "copy.jpg",
+            "an empty scene": "empty.png"}[background]
+    photoset_init.init_photoset(
+        photo_folder, PATTERN, settings={"l0_mm": 150.0, "target": "body", "fixed_end": [2, 12]}
+    )
+    with open(photo_folder / ps.SETTINGS, "a") as fh:  # named by hand, after init
+        fh.write(f"background: {name}\n")
+    got = [p for p in check_photoset(photo_folder, warnings=True) if "taken out" in p.message]
+    if background == "an empty scene":
+        assert not got
+        return
+    (warning,) = got
+    assert warning.warning and warning.line == 2
+    assert warning.message.startswith(
+        f"background photo {name} is "
+        + ("a copy of " + photos[0].name + ", " if background == "its copy" else "")
+        + "one of this set's photos of the actuator"
+    ), warning.message
+    assert "with the actuator removed" in warning.fix
+
+
 def test_check_warns_that_a_fixed_end_left_auto_is_guessed(photo_folder):
     # customer 25 left fixed_end out: check said OK, and measure then flagged all 36 bodies
     # "fixed end guessed; set fixed_end" (the README said check would say so)
