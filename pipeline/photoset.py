@@ -1580,7 +1580,7 @@ def geometry_problems(
                 )
             )
     if s.background_path is not None:
-        from pipeline.measure.core import same_aspect
+        from pipeline.measure.core import same_aspect, turned_by_90
 
         try:  # keyed by the file's time too: a replaced photo is read again
             bsize = _background_size(s.background_path, os.stat(s.background_path).st_mtime_ns)
@@ -1597,8 +1597,7 @@ def geometry_problems(
                 )
             )
         elif not same_aspect(bsize, (w, h)):
-            # an orientation tag lost, or a photo turned (a near-square one says nothing)
-            turned = same_aspect(bsize, (h, w)) and not same_aspect((w, h), (h, w), 0.04)
+            turned = turned_by_90(bsize, (w, h))
             out.append(
                 Problem(
                     file,

@@ -245,9 +245,10 @@ def background_photo_problems(ps: PhotoSet) -> list[Problem]:
             data = background.read_bytes() if same_size else b""
         except OSError:
             continue
+        resolved = background.resolve()
         match = next(
             (path for _, path in same_size
-             if path.resolve() == background.resolve() or path.read_bytes() == data),
+             if path.resolve() == resolved or path.read_bytes() == data),
             None,
         )
         if match is not None:
@@ -257,7 +258,7 @@ def background_photo_problems(ps: PhotoSet) -> list[Problem]:
                 f"background photo {background.name} is "
                 + (
                     "one of this set's photos of the actuator"
-                    if match.resolve() == background.resolve()
+                    if match.resolve() == resolved
                     else f"a copy of {match.name}, one of this set's photos of the actuator"
                 )
                 + ": an empty scene shows the clamp and backdrop with the actuator taken out, "

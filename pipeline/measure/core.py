@@ -404,15 +404,31 @@ def _load_background(
         return "background photo {} cannot be decoded ({}; {})".format(name, *undecodable(name))
     bh, bw = img.shape[:2]
     if not same_aspect((bw, bh), (shape[1], shape[0])):
-        turned = same_aspect((bh, bw), (shape[1], shape[0])) and not same_aspect(
-            (bw, bh), (bh, bw), 0.04
-        )  # turned by 90 deg (a near-square photo says nothing)
         return (
             f"background photo {name} is {bw}x{bh} px, another shape than the photo"
-            + (" (turned by 90 deg: an orientation tag lost?)" if turned else "")
+            + (
+                " (turned by 90 deg: an orientation tag lost?)"
+                if turned_by_90((bw, bh), (shape[1], shape[0]))
+                else ""
+            )
             + ": take the empty scene with the camera, resolution and orientation of the photos"
         )
     return cv2.resize(img, (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+
+
+def turned_by_90(size_a: Sequence[int], size_b: Sequence[int]) -> bool:
+    """Whether an image (width, height) ``size_a`` has the shape of ``size_b`` turned by 90 deg
+    (an orientation tag lost, or applied to one and not the other); a near-square one says
+    nothing.
+
+    Examples
+    --------
+    >>> turned_by_90((3024, 4032), (4032, 3024)), turned_by_90((1000, 990), (990, 1000))
+    (True, False)
+    """
+    return same_aspect((size_a[1], size_a[0]), size_b) and not same_aspect(
+        size_a, (size_a[1], size_a[0]), 0.04
+    )
 
 
 def same_aspect(size_a: Sequence[int], size_b: Sequence[int], tolerance: float = 0.02) -> bool:
