@@ -1325,3 +1325,31 @@ def test_a_selection_shorter_than_the_sealed_end_is_a_failed_row_not_a_negative_
     assert "shorter than the sealed end (sealed_end_mm)" in res.reason
     ok = measure_image(img, settings_for(fe, mm_per_px=0.3, sealed_end_mm=5.0))
     assert ok.status == "ok" and ok.length_px > 0
+
+
+@pytest.mark.parametrize("method", ["hyper", "paper_corrected"])
+def test_a_circle_fit_on_a_body_that_is_not_an_arc_is_flagged_not_an_ok_psi(method):
+    # a body is rarely an arc: asked for with `method:`, a circle fit read the rendered bulged
+    # lab body (psi 175.6) as 216, ok, and 61 of 109 ok rows of the realscenes analogues more
+    # than 5 deg off; the tip angle reads it right, and the circle fit where it agrees with it
+    from pipeline.synth import render_with_background, scene_from
+
+    scene = scene_from("lab", line_contrast=0.0, body_translucency=0.0, body_bgr=(90, 140, 200))
+    for psi, bulge in ((175.6, 0.4), (56.7, 0.0)):
+        r, _ = render_with_background(psi, 270.0, scene, seed=31, bulge=bulge)
+        img = cv2.imdecode(np.frombuffer(r.jpeg_bytes, np.uint8), cv2.IMREAD_COLOR)
+        fe = [float(v) for v in r.fixed_end_px]
+        tip = measure_image(img, resolve_settings(l0_mm=270.0, target="body", fixed_end=fe))
+        assert tip.status == "ok", tip.reason
+        assert tip.psi_deg == pytest.approx(r.psi_image_deg, abs=3.0)
+        arc = measure_image(
+            img, resolve_settings(l0_mm=270.0, target="body", fixed_end=fe, method=method)
+        )
+        assert arc.method == method
+        if bulge:  # the circle fit is far off, and says why
+            assert abs(arc.psi_deg - r.psi_image_deg) > 10.0
+            assert arc.status == "flagged"
+            assert "the body is not an arc" in arc.reason and "leave method out" in arc.reason
+        else:  # a body bent as an arc: the circle fit agrees with the tip angle
+            assert arc.psi_deg == pytest.approx(tip.psi_deg, abs=3.0)
+            assert "not an arc" not in arc.reason

@@ -589,6 +589,8 @@ def measure_body(
         sealed_end_px=(settings.sealed_end_mm or 0.0) / settings.mm_per_px
         if settings.mm_per_px
         else 0.0,
+        method=method,
+        psi_tip_deg=None if est is tip else float(np.rad2deg(sign * tip.turning_rad)),
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along

@@ -312,6 +312,8 @@ def assess_body(
     hollow_outline: bool = False,
     sealed_end_unknown: bool = False,
     sealed_end_px: float = 0.0,
+    method: str = "tangents",
+    psi_tip_deg: float | None = None,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -336,7 +338,9 @@ def assess_body(
     than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
     how psi was taken, and that a capped body bent :data:`NO_SEALED_END_PSI_DEG` or more was
-    read without its sealed end's length (``sealed_end_unknown``): its |psi| reads high.
+    read without its sealed end's length (``sealed_end_unknown``): its |psi| reads high.  With
+    another ``method`` than the tip angle, psi further than :data:`DISAGREE_DEG` from the tip
+    angle (``psi_tip_deg``) is flagged: a body is rarely an arc.
     """
     import numpy as np
 
@@ -404,6 +408,14 @@ def assess_body(
                 f"uneven outline (width {lo:.0f}-{hi:.0f} px): check line_color / roi / exclude in "
                 "photoset preview"
             )
+    if psi_tip_deg is not None and abs(psi_deg - psi_tip_deg) > DISAGREE_DEG:
+        # a circle fit on a body that is not an arc (rendered analogues, method hyper: 61 of 109
+        # rows ok more than 5 deg off, none flagged for it)
+        flags.append(
+            f"{method} reads psi {abs(psi_deg - psi_tip_deg):.0f} deg from the tip angle (the end "
+            f"tangents, {psi_tip_deg:+.1f} deg): the body is not an arc, and its psi is the tip "
+            "angle; leave method out (the tip angle is a body's default)"
+        )
     if abs(psi_check_deg - psi_deg) > TIP_UNSTABLE_DEG:
         flags.append(
             f"end direction unstable ({psi_deg:+.0f} vs {psi_check_deg:+.0f} deg over a longer end)"

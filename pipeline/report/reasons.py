@@ -22,6 +22,8 @@ Examples
 'something joins the body at its free end (a hand?)'
 >>> words("the bodies of this ramp leave its one fixed_end in directions that scatter by 3.6")
 'bodies leave one clamp in scattered directions (base unreadable)'
+>>> words("hyper reads psi 41 deg from the tip angle (the end tangents, +175.2 deg): the body")
+'method reads a body as an arc, which it is not'
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
@@ -68,6 +70,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^no line reaches fixed_end", "no line reaches the fixed end"),
     (r"^non-constant curvature", "curvature not constant"),
     (r"differs from the arc and turning fits", "angle methods disagree"),
+    (r"^\w+ reads psi [\d.]+ deg from the tip angle",
+     "method reads a body as an arc, which it is not"),
     (r"closes on itself or branches", "line closes on itself or branches"),
     (r"^ends almost touching", "ends almost touching"),
     (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
