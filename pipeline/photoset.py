@@ -460,7 +460,8 @@ def files_named_in(folder: Path, settings: Any, manifest: pd.DataFrame) -> froze
 def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
     """Files outside ``folder`` that its settings name: a ``background`` photo or calibration
     board photos given as ``../...`` or an absolute path, in ``photoset.yaml`` or a
-    ``manifest.csv`` column.
+    ``manifest.csv`` column, and the manifest's own photos or videos given so (``image`` or
+    ``video``: one folder of photos shared by the sets of several actuators in one view).
 
     The workflow digests them with the folder, so replacing such a file re-measures the set
     (results are never stale).  Read leniently: a set whose files cannot be parsed names nothing
@@ -476,9 +477,30 @@ def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
     ...     "background: ../empty.jpg\\ncalibration: {board: [board.jpg], square_mm: 5}\\n")
     >>> [p.name for p in referenced_files(root / "set")]
     ['empty.jpg']
+    >>> _ = (root / "set" / MANIFEST).write_text("image\\n../shared.jpg\\nboard.jpg\\n")
+    >>> _ = (root / "shared.jpg").write_bytes(b"x")
+    >>> [p.name for p in referenced_files(root / "set")]
+    ['empty.jpg', 'shared.jpg']
     """
-    inside = Path(folder).resolve()
-    return tuple(sorted(p for p in named_files(folder) if not p.is_relative_to(inside)))
+    folder = Path(folder)
+    inside = folder.resolve()
+    try:
+        manifest = read_user_csv(folder / MANIFEST, dtype=str)
+        manifest = manifest.rename(columns=header_names(manifest.columns))
+    except (OSError, ValueError, pd.errors.ParserError):
+        manifest = pd.DataFrame()
+    media = {
+        path.resolve()
+        for column in ("image", "video")
+        if column in manifest.columns
+        for name in manifest[column].dropna().unique()
+        if isinstance(name, str) and name.strip()
+        for path in [user_path(name.strip(), folder)]
+        if path.is_file()
+    }
+    return tuple(
+        sorted(p for p in named_files(folder) | media if not p.is_relative_to(inside))
+    )
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
@@ -1119,14 +1141,11 @@ def file_problems(
             )
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
-    own_fixed_end = (
-        {int(line) for line, v in zip(ps.manifest["manifest_line"], ps.manifest["fixed_end"])
-         if not is_missing(v)}
-        if "fixed_end" in ps.manifest.columns
-        else set()
-    )
     problems += size_problems(
-        mpath, [(line, image) for line, image in images if int(line) not in own_fixed_end], sizes
+        mpath,
+        [(line, image) for line, image in images if int(line) not in _own_framing(ps)],
+        sizes,
+        framing_keys(ps.settings),
     )
     problems += _calibration_problems(ps)
     problems += newer_spreadsheet_problems(ps.folder)
@@ -1373,15 +1392,45 @@ def unlisted_problems(ps: PhotoSet) -> list[Problem]:
     ]
 
 
+#: settings in pixels of one framing (a photo of another size needs its own)
+FRAMING_KEYS: tuple[str, ...] = ("fixed_end", "mm_per_px", "roi", "exclude", "background")
+
+
+def framing_keys(settings: Any) -> tuple[str, ...]:
+    """The :data:`FRAMING_KEYS` a set's ``photoset.yaml`` gives (``fixed_end`` always: ``auto``
+    is guessed per photo, but a row of its own says where its clamp is).
+
+    >>> framing_keys({"l0_mm": 90, "roi": [0, 0, 10, 10], "fixed_end": [3, 4]})
+    ('fixed_end', 'roi')
+    """
+    given = settings if isinstance(settings, dict) else {}
+    return tuple(k for k in FRAMING_KEYS if k == "fixed_end" or given.get(k) is not None)
+
+
+def _own_framing(ps: PhotoSet) -> set[int]:
+    """Manifest lines that give their own value of each of the set's :func:`framing_keys`
+    (``fixed_end`` as one column or as ``fixed_end_x``)."""
+    manifest = ps.manifest
+    own = pd.Series(True, index=manifest.index)
+    for key in framing_keys(ps.settings):
+        given = pd.Series(False, index=manifest.index)
+        for column in (key, f"{key}_x"):
+            if column in manifest.columns:
+                given |= ~manifest[column].map(is_missing).astype(bool)
+        own &= given
+    return {int(line) for line in manifest.loc[own, "manifest_line"]}
+
+
 def size_problems(
     manifest: str,
     images: Sequence[tuple[int, str]],
     sizes: Mapping[str, tuple[int, int] | None],
+    keys: Sequence[str] = ("fixed_end", "mm_per_px"),
 ) -> list[Problem]:
     """A warning for each photo whose size differs from that of most of its set's photos (more
     than half): ``fixed_end``, ``roi``, ``exclude``, the background photo and ``mm_per_px`` are
-    pixels of one framing. Pass the rows without a ``fixed_end`` of their own (a set of crops,
-    each with its own, is not warned of).
+    pixels of one framing. Pass the rows that do not give their own of each of the set's
+    ``keys`` (:func:`framing_keys`; a set of crops, each with its own, is not warned of).
 
     Examples
     --------
@@ -1407,8 +1456,8 @@ def size_problems(
             f"image {image!r} is {size[0]}x{size[1]} px where {n} photos of the set are {w}x{h}: "
             "fixed_end, roi, exclude, the background photo and mm_per_px are pixels of one "
             "framing (a cropped or resized photo, or a phone turned to portrait?)",
-            f"use the photo as taken, at {w}x{h}, or give this row its own fixed_end (and "
-            "mm_per_px) in manifest.csv",
+            f"use the photo as taken, at {w}x{h}, or give this row its own "
+            + ", ".join(keys) + " in manifest.csv",
             warning=True,
         )
         for line, image, size in known

@@ -894,13 +894,25 @@ def layer_lengths(measured: pd.DataFrame) -> np.ndarray:
     [900.0, 900.0, 900.0, 900.0]
     >>> np.round(layer_lengths(body.assign(length_px=900.0)), 1).tolist()  # a drawn line
     [900.0, 900.0, 900.0, 900.0]
+
+    Where every photo has a scale (``length_mm``), in mm: a photo of the ramp taken at another
+    scale (a phone turned to portrait, its row given its own ``mm_per_px``) is no partial line.
+
+    >>> scaled = body.assign(length_mm=0.3 * body["length_px"])
+    >>> scaled.loc[1, ["length_px", "width_px"]] = scaled.loc[1, ["length_px", "width_px"]] / 2
+    >>> np.round(layer_lengths(scaled), 1).tolist()
+    [270.0, 270.0, 270.0, 270.0]
     """
     lengths = measured["length_px"].to_numpy(float)
-    if "width_px" not in measured.columns:
+    widths = measured["width_px"].to_numpy(float) if "width_px" in measured.columns else None
+    if "length_mm" in measured.columns:
+        lengths_mm = measured["length_mm"].to_numpy(float)
+        if np.isfinite(lengths_mm).all() and (lengths > 0).all():
+            widths = None if widths is None else widths * lengths_mm / lengths
+            lengths = lengths_mm
+    if widths is None:
         return lengths
-    shift = 0.5 * measured["width_px"].to_numpy(float) * np.deg2rad(
-        measured["psi_deg"].to_numpy(float)
-    )
+    shift = 0.5 * widths * np.deg2rad(measured["psi_deg"].to_numpy(float))
     if not np.isfinite(shift).any():
         return lengths
     best, spread = lengths, np.inf

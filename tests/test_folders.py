@@ -94,6 +94,23 @@ def test_digest_covers_the_files_outside_the_folder_that_the_set_names(tmp_path)
     assert update_folder_digest(folder, digest, referenced_files(folder)).read_text() != before
 
 
+def test_digest_covers_photos_shared_from_a_folder_outside_the_set(tmp_path):
+    # customer 45: three actuators in one view, one set each, the photos in one shared folder
+    # named as ../photos/x.jpg: a photo re-taken there left "Nothing to be done" and a stale psi
+    from pipeline.photoset import referenced_files
+
+    folder = _photos(tmp_path / "A1")
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "photos" / "t1.jpg").write_bytes(b"photo 1")
+    (folder / "photoset.yaml").write_text("l0_mm: 200\n")
+    (folder / "manifest.csv").write_text("image\n../photos/t1.jpg\na.jpg\n../photos/gone.jpg\n")
+    assert referenced_files(folder) == ((tmp_path / "photos" / "t1.jpg").resolve(),)
+    digest = update_folder_digest(folder, tmp_path / "d" / "A1.sha256", referenced_files(folder))
+    before = digest.read_text()
+    (tmp_path / "photos" / "t1.jpg").write_bytes(b"photo 1, re-taken")
+    assert update_folder_digest(folder, digest, referenced_files(folder)).read_text() != before
+
+
 def test_digest_is_rewritten_only_when_it_changes_and_reads_only_changed_files(
     tmp_path, monkeypatch
 ):

@@ -278,6 +278,26 @@ def test_a_photo_of_another_size_than_its_set_is_named_by_check(photo_folder):
     assert f"image {turned!r} is 24x32 px where 7 photos of the set are 32x24" in sized[0].message
     assert "manifest.csv" in sized[0].file and "32x24" in sized[0].fix
     assert ps.validate_photoset(photo_folder) == []  # a warning: the set is still measured
+    # the fix names each pixel setting the set gives; once the row gives its own of each (the
+    # fixed end as the README's fixed_end_x/_y columns) the warning goes (customer 45's stayed)
+    settings_file = photo_folder / "photoset.yaml"
+    settings_file.write_text(settings_file.read_text() + "roi: [0, 0, 30, 20]\n")
+
+    def framing():
+        found = ps.validate_photoset(photo_folder, warnings=True)
+        return [p for p in found if "framing" in p.message]
+
+    assert "give this row its own fixed_end, roi in manifest.csv" in framing()[0].fix
+    manifest = ps.read_manifest(photo_folder).drop(columns="manifest_line")
+    own = manifest["image"] == turned
+    for column, value in (("fixed_end_x", 12), ("fixed_end_y", 30)):
+        manifest[column] = np.where(own, value, None)
+    manifest.to_csv(photo_folder / "manifest.csv", index=False)
+    still = framing()
+    assert len(still) == 1 and "its own fixed_end, roi" in still[0].fix  # the roi not yet its own
+    manifest["roi"] = np.where(own, "[0, 0, 20, 30]", None)
+    manifest.to_csv(photo_folder / "manifest.csv", index=False)
+    assert not framing()
 
 
 def test_photos_the_pattern_misses_are_named_by_init_and_check_not_left_out_unseen(

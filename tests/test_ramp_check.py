@@ -109,6 +109,25 @@ def test_a_body_whose_centre_line_shortens_as_it_bends_is_no_partial_line(side):
     assert (out.drop(index=4)["status"] == "ok").all()
 
 
+def test_a_photo_of_the_ramp_taken_at_another_scale_is_no_partial_line():
+    # customer 45: a phone turned to portrait, its rows given their own mm_per_px (0.47 where
+    # the others are 0.28): the body read 206 px where the others read 348, the same 97 mm, and
+    # all 9 such rows were flagged "line length 59% of its ramp's median", every one within 3 deg
+    df = _ramp(_ds20_like(), width_px=65.0, length_px=348.0)
+    df["length_mm"] = 0.28 * df["length_px"]
+    df.loc[[3, 7], ["length_px", "width_px"]] = [[206.0, 38.5]] * 2
+    out = check_ramps(df)
+    assert (out["status"] == "ok").all(), out[["length_px", "length_mm", "reason"]]
+    # a partial body is still one, in mm
+    df.loc[5, ["length_px", "length_mm"]] *= 0.6
+    out = check_ramps(df)
+    assert out.loc[5, "status"] == "flagged" and "line length 60%" in out.loc[5, "reason"]
+    assert (out.drop(index=5)["status"] == "ok").all()
+    # without a scale the lengths are compared in px, as they must be
+    out = check_ramps(df.drop(columns="length_mm"))
+    assert (out.loc[[3, 7], "status"] == "flagged").all()
+
+
 def test_a_cosmetic_flag_on_a_photo_that_follows_its_ramp_is_lifted():
     df = _ramp(_ds20_like())
     df.loc[5, ["status", "reason"]] = ["flagged", "line partly hidden: gap bridged"]
