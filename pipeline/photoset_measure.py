@@ -107,12 +107,14 @@ CARRIED_FIRST: tuple[str, ...] = (
 def _tasks(ps: PhotoSet, method: str, overlays_dir: Path | None) -> list[Task]:
     tasks = []
     in_folder: list[str] | None = None  # the folder's photos, listed once if a row's is missing
-    for i, (image, pressure, direction) in enumerate(
-        zip(ps.manifest["image"], ps.manifest["pressure_kpa"], ps.manifest["direction"])
-    ):
-        image = str(image)
+    for i, m in enumerate(ps.manifest.itertuples(index=False)):
+        image = str(m.image)
         overlay = None if overlays_dir is None else str(overlays_dir / overlay_name(image))
-        title = f"{image}  {pressure:g} kPa {direction}"
+        # which actuator, as preview's tiles say: the sets of several actuators in one view show
+        # the same photos (customer 45)
+        title = (
+            f"{image}  {m.material} {m.actuator} t{m.trial}  {m.pressure_kpa:g} kPa {m.direction}"
+        )
         row = ps.rows[i]
         if row is not None and not ps.image_path(image).is_file():
             if in_folder is None:

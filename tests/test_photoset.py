@@ -34,6 +34,16 @@ def test_init_reads_fields_and_infers_direction(photo_folder):
     assert ps.validate_photoset(photo_folder) == []
 
 
+def test_each_overlay_names_its_actuator_as_the_preview_does(photo_folder):
+    # customer 45's three sets of the same photos, one per actuator, drew overlays titled alike
+    from pipeline.photoset_measure import _tasks
+
+    photoset_init.init_photoset(photo_folder, PATTERN, settings={"l0_mm": 210.0})
+    titles = [t.title for t in _tasks(ps.load_photoset(photo_folder), "auto", None)]
+    assert titles[0] == "DS30_A2_t1_s00_0kPa.jpg  DS30 A2 t1  0 kPa up", titles
+    assert titles[-1] == "DS30_A2_t2_s02_20kPa.jpg  DS30 A2 t2  20 kPa up", titles
+
+
 def test_init_refuses_to_overwrite_and_unknown_field(photo_folder):
     photoset_init.init_photoset(photo_folder, PATTERN)
     with pytest.raises(UserInputError, match="already exists"):

@@ -240,8 +240,12 @@ NOTE_RAMP_BACKGROUND = "measured against the empty scene estimated from its ramp
 #: a capped body measured without ``sealed_end_mm``, bent this much (deg) or more
 NOTE_NO_SEALED_END = "no sealed_end_mm"
 NO_SEALED_END_PSI_DEG = 100.0
+#: the sealed-end check's note where an actuator's photos show a straight end a little longer
+#: than the sealed_end_mm given (pipeline.sealed_end_check)
+NOTE_SEALED_END_LONGER = "the photos show a longer straight end"
 NOTES: tuple[str, ...] = (
     NOTE_NO_SEALED_END,
+    NOTE_SEALED_END_LONGER,
     NOTE_FIXED_DIRECTION,
     NOTE_SIDE_ON_BORDER,
     NOTE_SELECTION_COVERS,
