@@ -179,14 +179,25 @@ def near_name(name: str, names: Sequence[str]) -> str | None:
 def overlay_name(image: str) -> str:
     """The overlay file of a manifest's photo, relative to the overlays folder: the photo's own
     path in the set, as a JPEG (photos in subfolders keep them: two subfolders may hold photos of
-    the same name).
+    the same name).  Always inside the overlays folder: a photo named from outside the set
+    (``../photos/x.jpg``, an absolute path) keeps only its path's names (customer 46's overlays,
+    written to ``overlays/../photos/x.jpg``, replaced the photos themselves).
 
     Examples
     --------
     >>> overlay_name("DS20_A1_t1_0kPa.png"), overlay_name("chamber2/00_0kPa_up.jpg")
     ('DS20_A1_t1_0kPa.jpg', 'chamber2/00_0kPa_up.jpg')
+    >>> overlay_name("../photos/t1.JPG"), overlay_name("/lab/x/t2.png")
+    ('photos/t1.jpg', 'lab/x/t2.jpg')
+    >>> overlay_name("C:\\\\lab\\\\t3.jpg")
+    'lab/t3.jpg'
     """
-    return PurePosixPath(str(image).replace("\\", "/")).with_suffix(".jpg").as_posix()
+    parts = [
+        part
+        for part in PurePosixPath(str(image).replace("\\", "/")).parts
+        if part not in ("/", ".", "..", "~") and not part.endswith(":")
+    ]
+    return PurePosixPath(*parts).with_suffix(".jpg").as_posix()
 
 
 @dataclass(frozen=True)
@@ -1428,15 +1439,21 @@ def size_problems(
     keys: Sequence[str] = ("fixed_end", "mm_per_px"),
 ) -> list[Problem]:
     """A warning for each photo whose size differs from that of most of its set's photos (more
-    than half): ``fixed_end``, ``roi``, ``exclude``, the background photo and ``mm_per_px`` are
-    pixels of one framing. Pass the rows that do not give their own of each of the set's
-    ``keys`` (:func:`framing_keys`; a set of crops, each with its own, is not warned of).
+    than half; else from the first photo's): ``fixed_end``, ``roi``, ``exclude``, the
+    background photo and ``mm_per_px`` are pixels of one framing. Pass the rows that do not
+    give their own of each of the set's ``keys`` (:func:`framing_keys`; a set of crops, each
+    with its own, is not warned of).
 
     Examples
     --------
     >>> sizes = {"a.jpg": (1280, 960), "b.jpg": (960, 1280), "c.jpg": (1280, 960)}
     >>> [p.line for p in size_problems("m.csv", [(2, "a.jpg"), (3, "b.jpg"), (4, "c.jpg")], sizes)]
     [3]
+
+    Where no size is most photos' (customer 46: half of its set portrait), against the first's:
+
+    >>> [p.line for p in size_problems("m.csv", [(3, "b.jpg"), (4, "c.jpg")], sizes)]
+    [4]
     """
     known: list[tuple[int, str, tuple[int, int]]] = []
     for line, image in images:
@@ -1447,8 +1464,9 @@ def size_problems(
     if len(counts) < 2:
         return []
     (w, h), n = counts.most_common(1)[0]
-    if 2 * n <= len(known):
-        return []
+    if 2 * n <= len(known):  # no size of most photos (half portrait): the first photo's
+        (w, h) = known[0][2]
+        n = counts[(w, h)]
     return [
         Problem(
             manifest,

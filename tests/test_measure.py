@@ -597,6 +597,24 @@ def test_a_line_short_of_l0_names_the_scale_and_an_oblique_camera_as_well_as_hid
     assert ";" not in flag  # one cause: the ramp check may still trust it again as cosmetic
 
 
+@pytest.mark.parametrize("psi", [205.0, -90.0])
+def test_a_scale_a_few_percent_off_the_photos_is_flagged_not_an_ok_psi(psi):
+    # psi is the curvature times l0_mm: customer 46's camera, held by hand, took each photo at a
+    # scale up to 3 % off its ruler's mm_per_px, and 8 of 26 rows were ok 3-8 deg off; the
+    # line's own turning (its curvature times its length as seen) is right whatever the scale
+    scene = scene_from("lab")
+    r = render_actuator(psi, L0_MM, scene, seed=7)
+    right = _measure(r, scene)
+    assert right.status == "ok" and right.psi_deg == pytest.approx(psi, abs=0.6), right.reason
+    off = _measure(r, scene, mm_per_px=1.04 * scene.mm_per_px)
+    assert abs(off.psi_deg - psi) > 3.0  # psi moves with the scale ...
+    assert off.status == "flagged"  # ... and is not passed as ok
+    assert f"the line as seen is {100 * off.length_mm / L0_MM:.1f}% of l0_mm" in off.reason
+    seen = float(off.reason.split("own turning reads ")[1].split(" deg")[0])
+    assert seen == pytest.approx(psi, abs=1.0)  # the figure the reason gives is the right one
+    assert "leave mm_per_px out" in off.reason
+
+
 def test_the_preview_measures_a_black_line_as_measure_does():
     # the preview measured the colour decoding, measure the luma one: customer 32 read psi 209.9
     # on the preview and 208.7 in angles.csv for the same photo (0.5 deg apart on the sample)

@@ -233,6 +233,38 @@ def test_folder_hsv_range_fills_rows_without_their_own_colour(photo_folder):
     )
 
 
+def test_overlays_of_photos_named_from_outside_the_set_stay_in_the_overlays_folder(tmp_path):
+    # README, "Several actuators in one photo": photos shared from ../photos. Their overlays were
+    # written to overlays/../photos/x.jpg: run from the folder above, the photos themselves
+    # (customer 46's six originals replaced by 640 px overlays, without a word)
+    import cv2
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth import render_actuator, scene_from
+
+    scene = scene_from("clean", width=480, height=360)
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "A1").mkdir()
+    names = []
+    for step, (kpa, angle) in enumerate(zip((0, 20, 40), (200.0, 60.0, -100.0))):
+        r = render_actuator(angle, 200.0, scene, seed=step)
+        names.append(f"s{step}_{kpa}kPa.jpg")
+        (tmp_path / "photos" / names[-1]).write_bytes(r.jpeg_bytes)
+    before = {n: (tmp_path / "photos" / n).read_bytes() for n in names}
+    pd.DataFrame({
+        "image": [f"../photos/{n}" for n in names], "pressure_kpa": [0, 20, 40],
+        "direction": "up", "material": "DS20", "actuator": "A1", "trial": 1,
+    }).to_csv(tmp_path / "A1" / "manifest.csv", index=False)
+    (tmp_path / "A1" / "photoset.yaml").write_text("l0_mm: 200\n")
+    # the overlays folder beside the photos' folder: overlays/../photos is photos
+    angles = measure_photoset(tmp_path / "A1", overlays_dir=tmp_path / "overlays", ramp_check=False)
+    assert (angles["status"] == "ok").all(), angles[["image", "reason"]]
+    assert {n: (tmp_path / "photos" / n).read_bytes() for n in names} == before
+    for n in names:
+        overlay = cv2.imread(str(tmp_path / "overlays" / "photos" / n))
+        assert overlay is not None and overlay.shape[1] == 480
+
+
 def test_photos_in_subfolders_with_the_same_names_keep_their_own_rows_and_overlays(tmp_path):
     # a lab's three-chamber ramps, one subfolder a chamber, the same file names in each: init
     # reads a pattern with '/', and each photo gets its own overlay (they were keyed by the

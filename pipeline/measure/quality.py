@@ -136,6 +136,18 @@ def assess(
     """
     flags = line_flags(line, length_px, expected_length_px)
     notes: list[str] = []
+    ratio = length_px / expected_length_px if expected_length_px else 1.0
+    if LENGTH_LOW <= ratio <= LENGTH_HIGH and abs(psi_deg * (1.0 - ratio)) > DISAGREE_DEG:
+        # psi is the curvature times l0_mm: a scale a few % off this photo's moves it as much
+        # (customer 46, a camera held by hand, its scale +-3 %: 8 of 26 rows ok 3-8 deg off); the
+        # line's own turning, its curvature times its length as seen, does not depend on it
+        flags.append(
+            f"the line as seen is {100 * ratio:.1f}% of l0_mm at mm_per_px, so its own turning "
+            f"reads {psi_deg * ratio:+.1f} deg where its curvature times l0_mm reads "
+            f"{psi_deg:+.1f}: this photo's scale is not mm_per_px (a camera held by hand, moved "
+            "or zoomed? Then leave mm_per_px out: psi is the line's own turning), or part of the "
+            "line is missing or extra (photoset preview shows it)"
+        )
     if line.gap_bridged:
         flags.append("line partly hidden: gap bridged")
     if not line.fixed_end_found:

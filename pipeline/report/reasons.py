@@ -24,6 +24,8 @@ Examples
 'bodies leave one clamp in scattered directions (base unreadable)'
 >>> words("hyper reads psi 41 deg from the tip angle (the end tangents, +175.2 deg): the body")
 'method reads a body as an arc, which it is not'
+>>> words("the line as seen is 95.8% of l0_mm at mm_per_px, so its own turning reads +206.1")
+"line's length off l0_mm at mm_per_px (scale differs?)"
 >>> words("tilted board 12.5 (((1, 2), (3, 4)),)")
 'tilted board'
 >>> words("psi may be 5.1 deg off: it is measured from the fixed_direction_deg given (+49.0)")
@@ -70,6 +72,8 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^no line reaches fixed_end", "no line reaches the fixed end"),
     (r"^non-constant curvature", "curvature not constant"),
     (r"differs from the arc and turning fits", "angle methods disagree"),
+    (r"^the line as seen is [\d.]+% of l0_mm at mm_per_px",
+     "line's length off l0_mm at mm_per_px (scale differs?)"),
     (r"^\w+ reads psi [\d.]+ deg from the tip angle",
      "method reads a body as an arc, which it is not"),
     (r"closes on itself or branches", "line closes on itself or branches"),
