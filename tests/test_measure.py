@@ -185,6 +185,24 @@ def test_without_scale_psi_is_the_total_turning_angle() -> None:
     assert np.isnan(res.length_mm)
 
 
+@pytest.mark.parametrize("psi", [-200.0, 60.0])
+def test_a_fixed_end_given_inside_the_clamp_does_not_lengthen_the_line(psi) -> None:
+    # without a scale psi is the line's curvature times its length, carried back to fixed_end
+    # where the line's start is hidden: customer 46's one fixed end lay 100-200 px inside the
+    # clamp of photos taken by hand, and psi read up to 9 % high (15 of 35 ok rows 3-17 deg
+    # off). Not past the clamp's face.
+    scene = scene_from("lab")
+    r = render_actuator(psi, L0_MM, scene, seed=12)
+    start = np.asarray(r.centreline_px[:40], float)
+    back = start[0] - start[-1]
+    back /= np.hypot(*back)
+    length_px = L0_MM / scene.mm_per_px
+    for into in (0.0, 0.03 * length_px, 0.06 * length_px):  # -200: -6 and -12 deg off, ok
+        res = _measure(r, scene, mm_per_px=None, fixed_end_px=tuple(start[0] + into * back))
+        assert res.status == "ok", (into, res.reason)
+        assert res.psi_deg == pytest.approx(psi, abs=1.0), (into, res.psi_deg)
+
+
 def test_auto_fixed_end_finds_the_clamp() -> None:
     scene = scene_from("lab")
     r = render_actuator(150.0, L0_MM, scene, seed=9)

@@ -691,6 +691,12 @@ def extract_centreline(
         # off), also where the clamp cut removed a piece of it
         if fe is not None:
             gap_fixed = float(np.hypot(*(gpts[0] - np.asarray(fe)))) * scale
+            face = _face_distance(image_bgr, gpts, best.half_width) * scale
+            if face > 0.0:
+                # not on into the clamp: a fixed end given inside it (a camera held by hand
+                # moved the clamp 100-200 px off customer 46's one fixed end, and psi, the
+                # line's curvature times its length, read up to 9 % high, ok)
+                gap_fixed = min(gap_fixed, face)
         else:
             gap_fixed = _face_distance(image_bgr, gpts, best.half_width) * scale
         if gap_fixed < 0.15 * s_along[-1] * scale:
