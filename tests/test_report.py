@@ -1280,3 +1280,27 @@ def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
         data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
         notes = " ".join(missing_notes(data))
         assert "(straight at rest) and does not come back" in notes, (rest_deg, notes)
+
+
+def test_a_strip_of_portrait_photos_keeps_its_captions_apart():
+    # customer 46's photo strip of 3000x4000 photos, most flagged: each tile narrower than its
+    # caption, "ψ = -24° (flagged)ψ = -58° (flagged)" printed over each other on page 4
+    from pipeline.layout.style import page
+    from pipeline.layout.typeset import Flow
+    from pipeline.report.pages import draw_strip
+    from pipeline.report.strip import Strip, StripPhoto
+
+    portrait = np.full((400, 300, 3), 200, np.uint8)
+    photos = tuple(
+        StripPhoto(portrait, kpa, psi, "ok" if i % 3 == 0 else "flagged", "overlay")
+        for i, (kpa, psi) in enumerate(zip(range(0, 140, 20), (205, 128, 64, 12, -24, -58, -86)))
+    )
+    strip = Strip("SS50", "c46", "B1", "1", "up", photos, images=("a.jpg", "g.jpg"))
+    with report_style():
+        fig = page()
+        flow = Flow(fig)
+        flow.y = flow.bottom - 110.0  # the foot of a full material page, as there
+        draw_strip(fig, flow, strip)
+        texts = drawn_texts(fig)
+    assert sum("(flagged)" in t.text for t in texts) == 4, [t.text for t in texts]
+    assert overlapping_texts(texts) == [] and outside_page(texts) == []

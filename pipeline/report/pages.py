@@ -353,17 +353,29 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
         size=7.5,
     )
     flow.space(2.0)
-    caption = 2 * 7.5 * 1.32
     image, spans = strip_image(strip.photos, STRIP_PHOTO_PX, STRIP_GAP_PX)
-    # pt per px
-    scale = min(
-        flow.width / image.shape[1], max(flow.remaining_pt - caption, 20.0) / image.shape[0]
-    )
+    labels = [
+        ("ψ: none" if not math.isfinite(photo.psi_deg) else f"ψ = {photo.psi_deg:.0f}°")
+        + ("" if photo.status == "ok" else f" ({photo.status})")
+        + (", photo not found" if photo.image is None else "")
+        for photo in strip.photos
+    ]
+    lines = 2
+    for _ in range(2):
+        caption = lines * 7.5 * 1.32
+        # pt per px
+        scale = min(
+            flow.width / image.shape[1], max(flow.remaining_pt - caption, 20.0) / image.shape[0]
+        )
+        # a caption wider than its photo (narrow portrait tiles at the foot of a full page)
+        # would print over its neighbour's: the status then takes a line of its own
+        narrowest = min(scale * (x1 - x0 + STRIP_GAP_PX) for x0, x1 in spans)
+        if lines == 3 or max(len(t) for t in labels) * 0.55 * 7.5 <= narrowest:
+            break
+        lines = 3
     top = flow.y
-    for (x0, x1), photo in zip(spans, strip.photos, strict=True):
+    for (x0, x1), photo, label in zip(spans, strip.photos, labels, strict=True):
         x = flow.x + scale * (x0 + x1) / 2
-        psi = "ψ: none" if not math.isfinite(photo.psi_deg) else f"ψ = {photo.psi_deg:.0f}°"
-        flag = "" if photo.status == "ok" else f" ({photo.status})"
         fig.text(
             x,
             top,
@@ -376,7 +388,7 @@ def draw_strip(fig: Figure, flow: Flow, strip: Strip | None) -> None:
         fig.text(
             x,
             top + 7.5 * 1.32,
-            psi + flag + (", photo not found" if photo.image is None else ""),
+            label.replace(" (", "\n(", 1) if lines == 3 else label,
             transform=flow.transform,
             fontsize=7.5,
             ha="center",
