@@ -189,15 +189,15 @@ def overlay_name(image: str) -> str:
     ('DS20_A1_t1_0kPa.jpg', 'chamber2/00_0kPa_up.jpg')
     >>> overlay_name("../photos/t1.JPG"), overlay_name("/lab/x/t2.png")
     ('photos/t1.jpg', 'lab/x/t2.jpg')
-    >>> overlay_name("C:\\\\lab\\\\t3.jpg")
-    'lab/t3.jpg'
+    >>> overlay_name("C:\\\\lab\\\\t3.jpg"), overlay_name("D:photos\\\\t4.jpg")
+    ('lab/t3.jpg', 'photos/t4.jpg')
+    >>> overlay_name("\\\\\\\\server\\\\share\\\\t5.jpg")
+    'server/share/t5.jpg'
     """
-    parts = [
-        part
-        for part in PurePosixPath(str(image).replace("\\", "/")).parts
-        if part not in ("/", ".", "..", "~") and not part.endswith(":")
-    ]
-    return PurePosixPath(*parts).with_suffix(".jpg").as_posix()
+    # no root, share or drive (/lab, //server/share, C:, D:photos): only names
+    parts = re.sub(r"^[A-Za-z]:", "", str(image).replace("\\", "/")).split("/")
+    kept = [part for part in parts if part not in ("", ".", "..", "~")]
+    return PurePosixPath(*kept).with_suffix(".jpg").as_posix()
 
 
 @dataclass(frozen=True)
@@ -427,16 +427,22 @@ def named_files(folder: str | os.PathLike[str]) -> frozenset[Path]:
     photos; in ``photoset.yaml`` or a ``manifest.csv`` column), resolved, inside the folder or
     not. Read leniently: a set whose files cannot be parsed names nothing here."""
     folder = Path(folder)
+    return files_named_in(folder, *_read_leniently(folder))
+
+
+def _read_leniently(folder: Path) -> tuple[Any, pd.DataFrame]:
+    """``photoset.yaml`` as written and ``manifest.csv`` with its columns' canonical names
+    ('Background' -> background); empty where either cannot be read."""
     try:
         raw = yaml.safe_load(read_user_text(folder / SETTINGS)) or {}
     except (OSError, yaml.YAMLError):
         raw = {}
     try:
         manifest = read_user_csv(folder / MANIFEST, dtype=str)
-        manifest = manifest.rename(columns=header_names(manifest.columns))  # 'Background'
+        manifest = manifest.rename(columns=header_names(manifest.columns))
     except (OSError, ValueError, pd.errors.ParserError):
         manifest = pd.DataFrame()
-    return files_named_in(folder, raw, manifest)
+    return raw, manifest
 
 
 def files_named_in(folder: Path, settings: Any, manifest: pd.DataFrame) -> frozenset[Path]:
@@ -471,8 +477,9 @@ def files_named_in(folder: Path, settings: Any, manifest: pd.DataFrame) -> froze
 def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
     """Files outside ``folder`` that its settings name: a ``background`` photo or calibration
     board photos given as ``../...`` or an absolute path, in ``photoset.yaml`` or a
-    ``manifest.csv`` column, and the manifest's own photos or videos given so (``image`` or
-    ``video``: one folder of photos shared by the sets of several actuators in one view).
+    ``manifest.csv`` column, and the manifest's own photos, videos (a frame sequence's files),
+    pressure logs and frame times given so (one folder of photos shared by the sets of several
+    actuators in one view).
 
     The workflow digests them with the folder, so replacing such a file re-measures the set
     (results are never stale).  Read leniently: a set whose files cannot be parsed names nothing
@@ -493,25 +500,25 @@ def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
     >>> [p.name for p in referenced_files(root / "set")]
     ['empty.jpg', 'shared.jpg']
     """
+    from pipeline.video.reader import sequence_files
+
     folder = Path(folder)
+    raw, manifest = _read_leniently(folder)
+    media: set[Path] = set()
+    for column in ("image", "video", "pressure_log", "frame_times"):
+        if column not in manifest.columns:
+            continue
+        for name in manifest[column].dropna().unique():
+            if not (isinstance(name, str) and name.strip()):
+                continue
+            path = user_path(name.strip(), folder)
+            frames = sequence_files(path) if column == "video" else None  # frame_%04d.jpg
+            media |= {Path(f).resolve() for f in frames or () if f}
+            if path.is_file():
+                media.add(path.resolve())
     inside = folder.resolve()
-    try:
-        manifest = read_user_csv(folder / MANIFEST, dtype=str)
-        manifest = manifest.rename(columns=header_names(manifest.columns))
-    except (OSError, ValueError, pd.errors.ParserError):
-        manifest = pd.DataFrame()
-    media = {
-        path.resolve()
-        for column in ("image", "video")
-        if column in manifest.columns
-        for name in manifest[column].dropna().unique()
-        if isinstance(name, str) and name.strip()
-        for path in [user_path(name.strip(), folder)]
-        if path.is_file()
-    }
-    return tuple(
-        sorted(p for p in named_files(folder) | media if not p.is_relative_to(inside))
-    )
+    named = files_named_in(folder, raw, manifest) | media
+    return tuple(sorted(p for p in named if not p.is_relative_to(inside)))
 
 
 def read_manifest(folder: str | os.PathLike[str]) -> pd.DataFrame:
@@ -1152,11 +1159,13 @@ def file_problems(
             )
         elif settings_row is not None:
             problems += geometry_problems(mpath, int(line), settings_row, size)
+    own_framing = _own_framing(ps)
     problems += size_problems(
         mpath,
-        [(line, image) for line, image in images if int(line) not in _own_framing(ps)],
+        [(line, image) for line, image in images if int(line) not in own_framing],
         sizes,
         framing_keys(ps.settings),
+        pixels_given=_pixel_settings_given(ps.settings),
     )
     problems += _calibration_problems(ps)
     problems += newer_spreadsheet_problems(ps.folder)
@@ -1418,6 +1427,16 @@ def framing_keys(settings: Any) -> tuple[str, ...]:
     return tuple(k for k in FRAMING_KEYS if k == "fixed_end" or given.get(k) is not None)
 
 
+def _pixel_settings_given(settings: Any) -> bool:
+    """Whether a set's ``photoset.yaml`` gives any setting in pixels (a ``fixed_end`` other
+    than ``auto``, or another of :data:`FRAMING_KEYS`)."""
+    given = settings if isinstance(settings, dict) else {}
+    fixed = given.get("fixed_end")
+    return (fixed is not None and str(fixed).strip().lower() != "auto") or any(
+        given.get(k) is not None for k in FRAMING_KEYS if k != "fixed_end"
+    )
+
+
 def _own_framing(ps: PhotoSet) -> set[int]:
     """Manifest lines that give their own value of each of the set's :func:`framing_keys`
     (``fixed_end`` as one column or as ``fixed_end_x``)."""
@@ -1437,12 +1456,15 @@ def size_problems(
     images: Sequence[tuple[int, str]],
     sizes: Mapping[str, tuple[int, int] | None],
     keys: Sequence[str] = ("fixed_end", "mm_per_px"),
+    *,
+    pixels_given: bool = True,
 ) -> list[Problem]:
     """A warning for each photo whose size differs from that of most of its set's photos (more
     than half; else from the first photo's): ``fixed_end``, ``roi``, ``exclude``, the
     background photo and ``mm_per_px`` are pixels of one framing. Pass the rows that do not
     give their own of each of the set's ``keys`` (:func:`framing_keys`; a set of crops, each
-    with its own, is not warned of).
+    with its own, is not warned of). ``pixels_given``: whether the set gives any setting in
+    pixels; without, photos of several sizes, none of them most photos', are not warned of.
 
     Examples
     --------
@@ -1464,14 +1486,18 @@ def size_problems(
     if len(counts) < 2:
         return []
     (w, h), n = counts.most_common(1)[0]
-    if 2 * n <= len(known):  # no size of most photos (half portrait): the first photo's
+    if 2 * n <= len(known):
+        if not pixels_given:  # crops of several sizes, nothing given in pixels: nothing to say
+            return []
+        # no size of most photos (half portrait): the first photo's, for which the set's pixel
+        # settings were most likely written
         (w, h) = known[0][2]
         n = counts[(w, h)]
     return [
         Problem(
             manifest,
             int(line),
-            f"image {image!r} is {size[0]}x{size[1]} px where {n} photos of the set are {w}x{h}: "
+            f"image {image!r} is {size[0]}x{size[1]} px where {n} of the set's photos are {w}x{h}: "
             "fixed_end, roi, exclude, the background photo and mm_per_px are pixels of one "
             "framing (a cropped or resized photo, or a phone turned to portrait?)",
             f"use the photo as taken, at {w}x{h}, or give this row its own "

@@ -1350,6 +1350,15 @@ def test_a_circle_fit_on_a_body_that_is_not_an_arc_is_flagged_not_an_ok_psi(meth
             assert abs(arc.psi_deg - r.psi_image_deg) > 10.0
             assert arc.status == "flagged"
             assert "the body is not an arc" in arc.reason and "leave method out" in arc.reason
+            # one cause in the report's counts (a ';' in it made two)
+            import pandas as pd
+
+            from pipeline.report.reasons import top_reasons
+
+            table = pd.DataFrame({"dataset": ["d"], "status": ["flagged"], "reason": [arc.reason]})
+            causes = [c for c, _ in top_reasons(table, limit=10)["d"]]
+            assert "method reads a body as an arc, which it is not" in causes, causes
+            assert not [c for c in causes if "leave method out" in c], causes
         else:  # a body bent as an arc: the circle fit agrees with the tip angle
             assert arc.psi_deg == pytest.approx(tip.psi_deg, abs=3.0)
             assert "not an arc" not in arc.reason

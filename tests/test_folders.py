@@ -111,6 +111,25 @@ def test_digest_covers_photos_shared_from_a_folder_outside_the_set(tmp_path):
     assert update_folder_digest(folder, digest, referenced_files(folder)).read_text() != before
 
 
+def test_digest_covers_a_videos_log_and_frames_named_from_outside_the_set(tmp_path):
+    # a video set naming its pressure log and a frame sequence in folders beside it: only the
+    # video itself was watched (the review of the change above)
+    from pipeline.photoset import referenced_files
+
+    folder = tmp_path / "set"
+    folder.mkdir()
+    for name in ("logs/p.csv", "frames/f_0001.jpg", "frames/f_0002.jpg", "videos/v.mp4"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_bytes(name.encode())
+    (folder / "manifest.csv").write_text(
+        "video,pressure_log,material,actuator,trial\n"
+        "../frames/f_%04d.jpg,../logs/p.csv,DS20,A1,1\n../videos/v.mp4,../logs/p.csv,DS20,A1,2\n"
+    )
+    assert [p.relative_to(tmp_path).as_posix() for p in referenced_files(folder)] == [
+        "frames/f_0001.jpg", "frames/f_0002.jpg", "logs/p.csv", "videos/v.mp4"
+    ]
+
+
 def test_digest_is_rewritten_only_when_it_changes_and_reads_only_changed_files(
     tmp_path, monkeypatch
 ):

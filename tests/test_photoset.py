@@ -317,7 +317,7 @@ def test_a_photo_of_another_size_than_its_set_is_named_by_check(photo_folder):
     cv2.imwrite(str(photo_folder / turned), np.full((32, 24, 3), 200, np.uint8))
     sized = [p for p in ps.validate_photoset(photo_folder, warnings=True) if "framing" in p.message]
     assert len(sized) == 1 and sized[0].warning and sized[0].line == 4, sized
-    assert f"image {turned!r} is 24x32 px where 7 photos of the set are 32x24" in sized[0].message
+    assert f"image {turned!r} is 24x32 px where 7 of the set's photos are 32x24" in sized[0].message
     assert "manifest.csv" in sized[0].file and "32x24" in sized[0].fix
     assert ps.validate_photoset(photo_folder) == []  # a warning: the set is still measured
     # the fix names each pixel setting the set gives; once the row gives its own of each (the

@@ -430,7 +430,7 @@ def assess_body(
         flags.append(
             f"{method} reads psi {abs(psi_deg - psi_tip_deg):.0f} deg from the tip angle (the end "
             f"tangents, {psi_tip_deg:+.1f} deg): the body is not an arc, and its psi is the tip "
-            "angle; leave method out (the tip angle is a body's default)"
+            "angle (leave method out: the tip angle is a body's default)"
         )
     if abs(psi_check_deg - psi_deg) > TIP_UNSTABLE_DEG:
         flags.append(
