@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,7 @@ from typing import Any
 import cv2
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from pipeline.camera_turn import RampPhotos, ramp_turns
 from pipeline.constants import RAMP_KEYS
@@ -205,8 +207,17 @@ def measure_photoset(
     from_cache = int(out.attrs.get("from_cache", 0))
     cached_seconds = float(out.attrs.get("cached_seconds", 0.0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
+    flipped = guessed_at_the_free_end(ps, out, out.attrs.get("line_ends"))
+    for i, why in flipped.items():
+        out.loc[i, "status"] = "flagged"
+        reason = out.at[i, "reason"]
+        out.loc[i, "reason"] = "; ".join(
+            c for c in (why, str(reason) if isinstance(reason, str) else "") if c
+        )
     if ramp_check:
-        out = check_ramps(out, clamped=() if ps.is_video else clamped_ramps(ps, out))
+        out = check_ramps(
+            out, clamped=() if ps.is_video else clamped_ramps(ps, out), not_neighbours=flipped
+        )
     if not ps.is_video:
         out = flag_settling(note_uneven_light(ps, out))
     out = check_sealed_ends(out)
@@ -265,6 +276,73 @@ def clamped_ramps(ps: PhotoSet, angles: pd.DataFrame) -> set[tuple[Any, ...]]:
         width = float(widths[ramp.index].median()) if widths[ramp.index].notna().any() else 0.0
         if np.mean(off <= max(SAME_CLAMP_PX, 0.5 * width)) >= SAME_CLAMP_SHARE:
             out.add(key)
+    return out
+
+
+#: a guessed fixed end (``auto``) lies at a photo's free end where the other end of its line
+#: lies within this share of the ramp's median line length of where most of its photos' lines
+#: start (the clamp, which stays put, or moves with a camera held by hand)
+SAME_START_SHARE = 0.1
+
+
+def ramp_start(ends: NDArray[np.float64], radius_px: float) -> NDArray[np.float64] | None:
+    """Where the lines of one ramp start: the line end (``ends`` rows are ``x0, y0, x1, y1``,
+    start then end) with the most photos' lines ending within ``radius_px`` of it at either end,
+    a start before an end; None where fewer than 60 % of the photos (and 3) share one.
+
+    Examples
+    --------
+    >>> ends = np.array([[0, 0, 90, 50], [2, 1, 80, 70], [60, 95, 1, 2], [1, 0, 40, 95.0]])
+    >>> ramp_start(ends, 10.0).tolist()
+    [0.0, 0.0]
+    >>> ramp_start(ends[:2], 10.0) is None
+    True
+    """
+    points = np.r_[ends[:, :2], ends[:, 2:]]
+    near = [
+        int(np.sum(np.minimum(np.hypot(*(ends[:, :2] - p).T), np.hypot(*(ends[:, 2:] - p).T))
+                   <= radius_px))
+        for p in points
+    ]
+    best = int(np.argmax(near))  # the first of the most: a start before an end
+    if near[best] < max(3, 0.6 * len(ends)):
+        return None
+    return points[best]
+
+
+def guessed_at_the_free_end(
+    ps: PhotoSet, angles: pd.DataFrame, line_ends: Sequence[Any] | None
+) -> dict[Any, str]:
+    """The rows whose fixed end was guessed (``fixed_end: auto``) at the line's free end, each
+    with its reason: their line's other end lies where the lines of most of the ramp's photos
+    start (:func:`ramp_start`), so psi, walked from the tip, may have the wrong sign (customer
+    46's clamp beside a grey backdrop: two rows ok with psi +61 and +64 for -58 and -60, and
+    the ramp check flagged the right rows beside them as breaking it).
+
+    ``line_ends`` holds each row's line start and end (``x0, y0, x1, y1``, image px; None where
+    not measured), in the order of ``angles``' rows.
+    """
+    if line_ends is None or not set(RAMP_KEYS) <= set(angles.columns):
+        return {}
+    guessed = np.array([r is not None and r.fixed_end_px is None for r in ps.rows])
+    found = np.array([e is not None for e in line_ends]) & (angles["status"] != "failed")
+    out: dict[Any, str] = {}
+    for _, ramp in angles[guessed & found.to_numpy()].groupby(list(RAMP_KEYS), sort=False):
+        if len(ramp) < 3:
+            continue
+        ends = np.array([line_ends[i] for i in ramp.index], float)
+        radius = SAME_START_SHARE * float(np.nanmedian(angles.loc[ramp.index, "length_px"]))
+        start = ramp_start(ends, radius)
+        if start is None:
+            continue
+        for i, e in zip(ramp.index, ends, strict=True):
+            if np.hypot(*(e[2:] - start)) <= radius < np.hypot(*(e[:2] - start)):
+                out[i] = (
+                    "fixed end guessed at the free end (fixed_end auto): the line's other end "
+                    f"lies where most of its ramp's photos start, near ({start[0]:.0f}, "
+                    f"{start[1]:.0f}), so psi may have the wrong sign (set fixed_end, the pixel "
+                    "where the actuator leaves the clamp)"
+                )
     return out
 
 
@@ -413,6 +491,12 @@ def _measure_photos(
     )
     out.attrs["from_cache"] = sum(cached)
     out.attrs["cached_seconds"] = cached_s
+    out.attrs["line_ends"] = [
+        None
+        if r["status"] == "failed" or r.get("centreline_px") is None or len(r["centreline_px"]) < 2
+        else (*np.asarray(r["centreline_px"], float)[0], *np.asarray(r["centreline_px"], float)[-1])
+        for r in rows
+    ]
     return out
 
 

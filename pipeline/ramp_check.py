@@ -344,7 +344,9 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
 
 
 def check_ramps(
-    angles: pd.DataFrame, clamped: Collection[tuple[Any, ...]] = ()
+    angles: pd.DataFrame,
+    clamped: Collection[tuple[Any, ...]] = (),
+    not_neighbours: Collection[Any] = (),
 ) -> pd.DataFrame:
     """Measure a ramp's bodies from its shared base direction, flag photos that break their
     ramp's trend and trust cosmetically flagged ones that follow it.
@@ -356,6 +358,9 @@ def check_ramps(
         ``direction``, the ramp keys, optionally ``step`` and ``length_px``).
     clamped : collection of tuple
         See :func:`share_base_direction`.
+    not_neighbours : collection
+        Index labels of rows whose psi is in doubt already (a fixed end guessed at the free end:
+        its sign may be wrong): they are no neighbours in the trend and length checks.
 
     Returns
     -------
@@ -380,7 +385,10 @@ def check_ramps(
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
         # a photo whose pressure is in doubt is no neighbour of the others (customer 44's retake
         # of 30 kPa at a leg's end flagged the three right photos before it as breaking the ramp)
-        measured = ramp[(ramp["status"] != "failed") & ~ramp.index.isin(list(off_order))]
+        measured = ramp[
+            (ramp["status"] != "failed")
+            & ~ramp.index.isin([*off_order, *not_neighbours])
+        ]
         if "length_px" in measured.columns and len(measured) >= 3:
             lengths = layer_lengths(measured)
             med = float(np.nanmedian(lengths)) if np.isfinite(lengths).any() else np.nan

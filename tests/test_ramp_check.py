@@ -534,3 +534,60 @@ def test_a_direction_given_far_off_is_doubted_even_where_the_sides_diverge():
                                   base_side_split_deg=np.full(12, -3.0)))
         assert (out["status"] == "flagged").all(), (given, out["reason"].iloc[0])
         assert out["reason"].str.startswith("psi may be").all()
+
+
+def test_rows_whose_fixed_end_was_guessed_at_the_tip_are_flagged_and_no_neighbours():
+    # customer 46, fixed_end auto: in 4 photos of a ramp the guess took the tip for the clamp,
+    # psi read with the wrong sign (+61, +90, +64, +28 for -58, -85, -60, -27), two of them ok,
+    # and the ramp check flagged the right photos beside them as breaking the ramp
+    from types import SimpleNamespace
+
+    from pipeline.photoset_measure import guessed_at_the_free_end
+
+    truth = [196.0, 129.0, 71.0, 18.0, -24.0, -58.0, -85.0, -60.0, -27.0, 15.0, 66.0, 125.0]
+    flipped = {5, 6, 7}
+    df = _ramp(truth[:7], truth[7:])  # up 0-60 kPa (7 rows), down 40-0 (5 rows)
+    df["psi_deg"] = [-p if i in flipped else p for i, p in enumerate(truth)]
+    clamp, tips = np.array([100.0, 500.0]), np.array([[600.0 + 10 * i, 200.0 + 20 * i]
+                                                      for i in range(12)])
+    ends = [(*(tips[i] if i in flipped else clamp + i), *(clamp if i in flipped else tips[i]))
+            for i in range(12)]
+    ps = SimpleNamespace(rows=[SimpleNamespace(fixed_end_px=None)] * 12)
+    doubtful = guessed_at_the_free_end(ps, df, ends)
+    assert sorted(doubtful) == sorted(flipped)
+    assert all("fixed end guessed at the free end" in why and "(100, 500)" in why
+               for why in doubtful.values())
+    assert words(next(iter(doubtful.values()))) == "fixed end guessed at the tip (fixed_end auto)"
+    assert ";" not in next(iter(doubtful.values()))  # one cause in the report's counts
+    right = [i for i in range(12) if i not in flipped]
+    assert (check_ramps(df).loc[right, "status"] != "ok").any()  # as neighbours they mislead
+    out = check_ramps(df, not_neighbours=doubtful)
+    assert (out.loc[right, "status"] == "ok").all(), out.loc[right, ["psi_deg", "reason"]]
+    # with its fixed end given, or with a start no 60 % of the photos share, nothing is said
+    given = SimpleNamespace(rows=[SimpleNamespace(fixed_end_px=(100.0, 500.0))] * 12)
+    assert guessed_at_the_free_end(given, df, ends) == {}
+    scattered = [(*tips[i], *(tips[i] + 400.0)) for i in range(12)]
+    assert guessed_at_the_free_end(ps, df, scattered) == {}
+
+
+def test_a_ramp_whose_fixed_end_auto_took_the_tips_has_no_ok_row_of_the_wrong_sign(tmp_path):
+    # a black line on a body held by a white clamp: auto, with no dark clamp to start from,
+    # walked every photo from the tip, and the two at rest were ok at -209.5 and -208.5 deg for
+    # +208 and +207; every line's other end lies at the clamp, where the ramp's lines start
+    import yaml
+
+    from pipeline.photoset_measure import measure_photoset
+    from pipeline.synth.photoset_writer import render_photoset
+
+    folder = tmp_path / "s"
+    truth = render_photoset(folder, "DS20", actuators=1, trials=1, seed=3, scene="lab",
+                            step_kpa=40, scene_overrides={"width": 640, "height": 480,
+                                                          "clamp_style": "white"})
+    settings = yaml.safe_load((folder / "photoset.yaml").read_text())
+    (folder / "photoset.yaml").write_text(yaml.safe_dump({**settings, "fixed_end": "auto"}))
+    out = measure_photoset(folder)
+    wrong_sign = np.sign(out["psi_deg"]) != np.sign(out["image"].map(truth.set_index("image")
+                                                                     ["psi_deg"]))
+    assert wrong_sign.sum() >= 7  # the guess took the tip ...
+    assert not (wrong_sign & (out["status"] == "ok")).any(), out[["psi_deg", "reason"]]
+    assert out.loc[wrong_sign, "reason"].str.startswith("fixed end guessed at the free end").all()

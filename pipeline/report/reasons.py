@@ -78,6 +78,7 @@ WORDS: tuple[tuple[str, str], ...] = (
      "method reads a body as an arc, which it is not"),
     (r"closes on itself or branches", "line closes on itself or branches"),
     (r"^ends almost touching", "ends almost touching"),
+    (r"^fixed end guessed at the free end", "fixed end guessed at the tip (fixed_end auto)"),
     (r"^fixed end guessed", "fixed end guessed (no clamp seen)"),
     (r"^psi may be [\d.]+ deg off: it is measured from the fixed_direction_deg",
      "bodies leave the clamp off fixed_direction_deg"),
