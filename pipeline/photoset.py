@@ -500,8 +500,6 @@ def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
     >>> [p.name for p in referenced_files(root / "set")]
     ['empty.jpg', 'shared.jpg']
     """
-    from pipeline.video.reader import sequence_files
-
     folder = Path(folder)
     raw, manifest = _read_leniently(folder)
     media: set[Path] = set()
@@ -512,8 +510,10 @@ def referenced_files(folder: str | os.PathLike[str]) -> tuple[Path, ...]:
             if not (isinstance(name, str) and name.strip()):
                 continue
             path = user_path(name.strip(), folder)
-            frames = sequence_files(path) if column == "video" else None  # frame_%04d.jpg
-            media |= {Path(f).resolve() for f in frames or () if f}
+            if column == "video":  # a frame sequence, frame_%04d.jpg: every file it may name
+                pattern = re.sub(r"%(0\d+)?d", "*", path.name)
+                if pattern != path.name and path.parent.is_dir():
+                    media |= {f.resolve() for f in path.parent.glob(pattern) if f.is_file()}
             if path.is_file():
                 media.add(path.resolve())
     inside = folder.resolve()
