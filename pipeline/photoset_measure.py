@@ -207,16 +207,11 @@ def measure_photoset(
     from_cache = int(out.attrs.get("from_cache", 0))
     cached_seconds = float(out.attrs.get("cached_seconds", 0.0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
-    flipped = guessed_at_the_free_end(ps, out, out.attrs.get("line_ends"))
-    for i, why in flipped.items():
-        out.loc[i, "status"] = "flagged"
-        reason = out.at[i, "reason"]
-        out.loc[i, "reason"] = "; ".join(
-            c for c in (why, str(reason) if isinstance(reason, str) else "") if c
-        )
     if ramp_check:
         out = check_ramps(
-            out, clamped=() if ps.is_video else clamped_ramps(ps, out), not_neighbours=flipped
+            out,
+            clamped=() if ps.is_video else clamped_ramps(ps, out),
+            doubtful=guessed_at_the_free_end(ps, out, out.attrs.get("line_ends")),
         )
     if not ps.is_video:
         out = flag_settling(note_uneven_light(ps, out))

@@ -44,7 +44,7 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from typing import Any
 
 import numpy as np
@@ -346,7 +346,7 @@ def flag_settling(angles: pd.DataFrame) -> pd.DataFrame:
 def check_ramps(
     angles: pd.DataFrame,
     clamped: Collection[tuple[Any, ...]] = (),
-    not_neighbours: Collection[Any] = (),
+    doubtful: Mapping[Any, str] | None = None,
 ) -> pd.DataFrame:
     """Measure a ramp's bodies from its shared base direction, flag photos that break their
     ramp's trend and trust cosmetically flagged ones that follow it.
@@ -358,9 +358,10 @@ def check_ramps(
         ``direction``, the ramp keys, optionally ``step`` and ``length_px``).
     clamped : collection of tuple
         See :func:`share_base_direction`.
-    not_neighbours : collection
-        Index labels of rows whose psi is in doubt already (a fixed end guessed at the free end:
-        its sign may be wrong): they are no neighbours in the trend and length checks.
+    doubtful : mapping, optional
+        Rows found in doubt over their ramp before (index label -> reason: a fixed end guessed
+        at the free end, so psi's sign may be wrong): flagged with it and, like a row whose
+        pressure is out of its ramp's order, no neighbour in the trend and length checks.
 
     Returns
     -------
@@ -376,19 +377,20 @@ def check_ramps(
     )
     position = {ix: k for k, ix in enumerate(out.index)}
     off_order = pressure_order_breaks(out)
-    for ix, why in off_order.items():
+    given = doubtful or {}
+    in_doubt = {
+        ix: _join(given.get(ix, ""), off_order.get(ix, "")) for ix in {*given, *off_order}
+    }
+    for ix, why in in_doubt.items():
         k = position[ix]
-        if status[k] != "failed":  # its pressure is in doubt, not psi: kept out of the curves
+        if status[k] != "failed":  # its pressure or psi is in doubt: kept out of the curves
             status[k], reason[k] = "flagged", _join(why, reason[k])
     keys = [c for c in ("step", "time_s") if c in out.columns]  # frames of a video: over time
     order = out.sort_values(keys, kind="stable").index if keys else out.index
     for _, ramp in out.loc[order].groupby(list(RAMP_KEYS), sort=False):
         # a photo whose pressure is in doubt is no neighbour of the others (customer 44's retake
         # of 30 kPa at a leg's end flagged the three right photos before it as breaking the ramp)
-        measured = ramp[
-            (ramp["status"] != "failed")
-            & ~ramp.index.isin([*off_order, *not_neighbours])
-        ]
+        measured = ramp[(ramp["status"] != "failed") & ~ramp.index.isin(list(in_doubt))]
         if "length_px" in measured.columns and len(measured) >= 3:
             lengths = layer_lengths(measured)
             med = float(np.nanmedian(lengths)) if np.isfinite(lengths).any() else np.nan

@@ -561,8 +561,10 @@ def test_rows_whose_fixed_end_was_guessed_at_the_tip_are_flagged_and_no_neighbou
     assert ";" not in next(iter(doubtful.values()))  # one cause in the report's counts
     right = [i for i in range(12) if i not in flipped]
     assert (check_ramps(df).loc[right, "status"] != "ok").any()  # as neighbours they mislead
-    out = check_ramps(df, not_neighbours=doubtful)
+    out = check_ramps(df, doubtful=doubtful)
     assert (out.loc[right, "status"] == "ok").all(), out.loc[right, ["psi_deg", "reason"]]
+    assert (out.loc[sorted(flipped), "status"] == "flagged").all()
+    assert out.loc[sorted(flipped), "reason"].str.startswith("fixed end guessed at the free").all()
     # with its fixed end given, or with a start no 60 % of the photos share, nothing is said
     given = SimpleNamespace(rows=[SimpleNamespace(fixed_end_px=(100.0, 500.0))] * 12)
     assert guessed_at_the_free_end(given, df, ends) == {}
