@@ -185,7 +185,7 @@ def test_without_scale_psi_is_the_total_turning_angle() -> None:
     assert np.isnan(res.length_mm)
 
 
-@pytest.mark.parametrize("psi", [-200.0, 60.0])
+@pytest.mark.parametrize("psi", [-200.0, 60.0, 150.0, -90.0])
 def test_a_fixed_end_given_inside_the_clamp_does_not_lengthen_the_line(psi) -> None:
     # without a scale psi is the line's curvature times its length, carried back to fixed_end
     # where the line's start is hidden: customer 46's one fixed end lay 100-200 px inside the
@@ -197,7 +197,10 @@ def test_a_fixed_end_given_inside_the_clamp_does_not_lengthen_the_line(psi) -> N
     back = start[0] - start[-1]
     back /= np.hypot(*back)
     length_px = L0_MM / scene.mm_per_px
-    for into in (0.0, 0.03 * length_px, 0.06 * length_px):  # -200: -6 and -12 deg off, ok
+    # at 150 and -90 the line leaves the clamp along its lower edge, and the black-hat mask
+    # followed that edge into the clamp to the fixed end: 3 % to 12 % in were flagged 48-72 deg
+    # off, or read 98 for 150, ok. 12 % in, at -200 and 60, was flagged (no line reaches it)
+    for into in (0.0, 0.03 * length_px, 0.06 * length_px, 0.12 * length_px):
         res = _measure(r, scene, mm_per_px=None, fixed_end_px=tuple(start[0] + into * back))
         assert res.status == "ok", (into, res.reason)
         assert res.psi_deg == pytest.approx(psi, abs=1.0), (into, res.psi_deg)

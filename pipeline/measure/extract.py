@@ -37,6 +37,7 @@ from pipeline.measure.settings import Polygon
 MIN_LENGTH_PX = 25.0
 #: another component at least this fraction of the chosen line's length is a rival candidate
 RIVAL_FRACTION = 0.4
+CLAMP_DARK_V = 110  # V (max of B, G, R) at or below which a block is a dark clamp
 
 
 class NoLineFound(Exception):
@@ -418,11 +419,17 @@ def _value(image: np.ndarray) -> np.ndarray:
 
 
 def _cut_dark_blocks(
-    image: np.ndarray, cand: _Candidate, line: np.ndarray
+    image: np.ndarray,
+    cand: _Candidate,
+    line: np.ndarray,
+    at: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Cut the line where it runs into a dark block (a clamp the black-hat mask left out).
 
-    Only used with ``fixed_end: auto``, where no given fixed end truncates the line.
+    With ``fixed_end: auto`` every dark block cuts. With a given fixed end ``at`` (work px) only
+    the block holding it does: the fixed end was given inside a dark clamp, and the black-hat mask
+    follows the clamp's edge to it (a line at psi 150 with its fixed end 12 % of its length inside
+    the clamp read 98, ok).
     """
     h, w = line.shape
     pad = int(6 * cand.half_width + 8)
@@ -430,12 +437,23 @@ def _cut_dark_blocks(
     y1, x1 = min(cand.y0 + h + pad, image.shape[0]), min(cand.x0 + w + pad, image.shape[1])
     roi = image[y0:y1, x0:x1]
     v = cv2.blur(_value(roi), (5, 5))
-    dark = (v <= 110).astype(np.uint8)
+    dark = (v <= CLAMP_DARK_V).astype(np.uint8)
     radius = int(np.ceil(clamp_radius_px(cand.half_width)))
     k = 2 * radius + 1
     block = cv2.morphologyEx(
         dark, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
     )
+    if at is not None:
+        ax, ay = int(round(at[0])) - x0, int(round(at[1])) - y0  # noqa: RUF046 (numpy)
+        if not (0 <= ay < block.shape[0] and 0 <= ax < block.shape[1]) or not block[ay, ax]:
+            return line, None
+        _, blocks = cv2.connectedComponents(block, connectivity=8)
+        block = (blocks == blocks[ay, ax]).astype(np.uint8)
+        if block.sum() > 0.5 * block.size:  # a dark backdrop, not a clamp
+            return line, None
+        inside = block[cand.y0 - y0 : cand.y0 - y0 + h, cand.x0 - x0 : cand.x0 - x0 + w] & line
+        if inside.sum() <= 2.0 * cand.half_width * (radius + 2):
+            return line, None  # at the face: the cut would take more line than the clamp hides
     if not block.any():
         return line, None
     block = cv2.dilate(block, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 5,) * 2))
@@ -448,6 +466,37 @@ def _cut_dark_blocks(
     return (labels == keep).astype(np.uint8), block
 
 
+def _dark_at(image: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """Whether the photo is as dark as a clamp (V <= ``CLAMP_DARK_V``) at each point (N, 2)."""
+    h, w = image.shape[:2]
+    p = np.round(xy).astype(int)
+    xs, ys = np.clip(p[:, 0], 0, w - 1), np.clip(p[:, 1], 0, h - 1)
+    v = image[ys, xs] if image.ndim == 2 else image[ys, xs].max(axis=1)
+    return np.asarray(v <= CLAMP_DARK_V)
+
+
+def _inside_dark(image: np.ndarray, xy: tuple[float, float], radius: float) -> bool:
+    """Whether ``xy`` lies inside something dark wider than a line: at least 7 of 8 points on a
+    circle of ``radius`` around it are dark (a point on a dark line has 2, one at a clamp's face
+    about 4)."""
+    a = np.arange(8) * (np.pi / 4)
+    ring = np.asarray(xy, float) + radius * np.c_[np.cos(a), np.sin(a)]
+    return int(np.count_nonzero(_dark_at(image, ring))) >= 7
+
+
+def _back_tangent(points: np.ndarray) -> np.ndarray:
+    """Unit vector from the line's start backwards, towards the clamp (its first 5 %)."""
+    k = min(len(points) - 1, max(len(points) // 20, 3))
+    t = points[0] - points[k]
+    return np.asarray(t / max(float(np.hypot(*t)), 1e-9))
+
+
+def _dark_between(image: np.ndarray, a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether the straight path from ``a`` to ``b`` runs in the dark for 80 % of its length:
+    both lie in one dark clamp (its bolts and marks may be lighter)."""
+    return bool(np.mean(_dark_at(image, a + np.linspace(0.0, 1.0, 24)[:, None] * (b - a))) >= 0.8)
+
+
 def _face_distance(image: np.ndarray, points: np.ndarray, half_width: float) -> float:
     """Distance (work px) back from the line's first point, along its start tangent, to the face of
     the clamp that was cut off (0 when no clear face is seen).
@@ -456,9 +505,7 @@ def _face_distance(image: np.ndarray, points: np.ndarray, half_width: float) -> 
     profiles are sampled (sub-pixel) and the face is where their mean crosses halfway between
     the table's and the clamp's brightness.
     """
-    k = min(len(points) - 1, max(len(points) // 20, 3))
-    t = points[0] - points[k]
-    t = t / max(float(np.hypot(*t)), 1e-9)  # pointing back, towards the clamp
+    t = _back_tangent(points)
     nrm = np.array([-t[1], t[0]])
     steps = np.arange(0.0, 14.0 * half_width + 14.0, 0.25, dtype=np.float32)
     side = 2.0 * half_width + 3.0
@@ -618,6 +665,13 @@ def extract_centreline(
     line, thick = _cut_thick_parts(best.sub, best.half_width)
     if fe is None and thick is None:
         line, thick = _cut_dark_blocks(image_bgr, best, line)
+    elif (
+        thick is None
+        and color.dark_line
+        and fe is not None
+        and _inside_dark(image_bgr, fe, clamp_radius_px(best.half_width) + 2.0)
+    ):
+        line, _ = _cut_dark_blocks(image_bgr, best, line, at=fe)
     band = max(1.0, min(2.0, best.half_width))
     fe_sub = None if fe is None else (fe[0] - best.x0, fe[1] - best.y0)
     x0, y0 = best.x0, best.y0
@@ -706,6 +760,9 @@ def extract_centreline(
                 # moved the clamp 100-200 px off customer 46's one fixed end, and psi, the
                 # line's curvature times its length, read up to 9 % high, ok)
                 gap_fixed = min(gap_fixed, face)
+                # a line running out of the clamp that holds the fixed end reaches it
+                face_xy = gpts[0] + (face / scale + 2.0) * _back_tangent(gpts)
+                at_fixed = at_fixed or _dark_between(image_bgr, face_xy, np.asarray(fe))
         else:
             gap_fixed = _face_distance(image_bgr, gpts, best.half_width) * scale
         if gap_fixed < 0.15 * s_along[-1] * scale:
