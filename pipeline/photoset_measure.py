@@ -26,7 +26,7 @@ from pipeline.errors import UserInputError
 from pipeline.fileio import atomic_write_bytes, write_table
 from pipeline.measure.core import DEFAULT_METHOD, decode_for_work
 from pipeline.measure.estimators import METHODS
-from pipeline.measure.quality import NOTES
+from pipeline.measure.quality import NOTE_FROM_RAMP_START, NOTES
 from pipeline.measure.ramp_background import (
     RAMP_BACKGROUND_MIN_PHOTOS,
     covered,
@@ -464,6 +464,7 @@ def _measure_photos(
     cached_s = float(np.nansum([r["seconds"] for r, c in zip(rows, cached, strict=True) if c]))
     if second_look:
         rows = _on_ramp_backgrounds(ps, tasks, rows, jobs, cache_dir, used)
+    rows = _from_ramp_starts(ps, tasks, rows, jobs, cache_dir, used)
     if cache_dir is not None:
         prune(cache_dir, used)
     turns = _camera_turns(ps, tasks, rows, jobs)
@@ -486,12 +487,7 @@ def _measure_photos(
     )
     out.attrs["from_cache"] = sum(cached)
     out.attrs["cached_seconds"] = cached_s
-    out.attrs["line_ends"] = [
-        None
-        if r["status"] == "failed" or r.get("centreline_px") is None or len(r["centreline_px"]) < 2
-        else (*np.asarray(r["centreline_px"], float)[0], *np.asarray(r["centreline_px"], float)[-1])
-        for r in rows
-    ]
+    out.attrs["line_ends"] = [_line_ends(r) for r in rows]
     return out
 
 
@@ -651,6 +647,79 @@ def _on_ramp_backgrounds(
             if drawn is not None and final is not None:
                 shutil.move(drawn, final)  # the temporary folder may be on another disk
     return out
+
+
+def _from_ramp_starts(
+    ps: PhotoSet,
+    tasks: list[Task],
+    rows: list[dict[str, Any]],
+    jobs: int,
+    cache_dir: Path | None = None,
+    used: set[str] | None = None,
+) -> list[dict[str, Any]]:
+    """``rows``, where a fixed end guessed (``fixed_end: auto``) took the line's free end, with
+    the photo measured again from where its ramp's photos' lines start (:func:`ramp_start`: the
+    clamp stays put, the tip moves), when that measurement is not ``failed``; its reason says so.
+
+    A black line on a body held by a white clamp gave ``auto`` no dark clamp to start from: it
+    walked every photo of a rendered ramp from the tip, and psi had the wrong sign in each.
+    """
+    ends = [_line_ends(r) for r in rows]
+    manifest = ps.manifest
+    if not set(RAMP_KEYS) <= set(manifest.columns):
+        return rows
+    guessed = [
+        i for i, t in enumerate(tasks)
+        if t.settings is not None and t.settings.fixed_end_px is None and ends[i] is not None
+    ]
+    again: list[tuple[int, Task]] = []
+    starts: dict[int, NDArray[np.float64]] = {}
+    ramps: dict[tuple[str, ...], list[int]] = {}
+    for i in guessed:
+        ramps.setdefault(tuple(str(manifest[k].iloc[i]) for k in RAMP_KEYS), []).append(i)
+    for idx in ramps.values():
+        if len(idx) < 3:
+            continue
+        line_ends = np.array([ends[i] for i in idx], float)
+        radius = SAME_START_SHARE * float(np.nanmedian([rows[i]["length_px"] for i in idx]))
+        start = ramp_start(line_ends, radius)
+        if start is None:
+            continue
+        for i, e in zip(idx, line_ends, strict=True):
+            if np.hypot(*(e[2:] - start)) <= radius < np.hypot(*(e[:2] - start)):
+                settings = tasks[i].settings
+                assert settings is not None
+                starts[i] = start
+                again.append((i, replace(
+                    tasks[i], settings=replace(settings, fixed_end_px=(float(start[0]),
+                                                                       float(start[1])))
+                )))
+    if not again:
+        return rows
+    out = list(rows)
+    measured = _measured([t for _, t in again], jobs, cache_dir, set() if used is None else used)
+    for (i, _), row in zip(again, measured, strict=True):
+        row.pop("from_cache")
+        if row["status"] == "failed":
+            continue
+        first = rows[i]
+        note = (
+            f"{NOTE_FROM_RAMP_START} where its ramp's photos' lines start, near "
+            f"({starts[i][0]:.0f}, {starts[i][1]:.0f}) (the walk from the tip read "
+            f"{first['psi_deg']:+.1f} deg): set fixed_end, the pixel where the actuator leaves "
+            "the clamp"
+        )
+        out[i] = {**row, "reason": f"{row['reason']}; {note}" if row["reason"] else note}
+    return out
+
+
+def _line_ends(row: dict[str, Any]) -> tuple[float, float, float, float] | None:
+    """A measured row's line start and end (``x0, y0, x1, y1``, image px); None where failed."""
+    line = row.get("centreline_px")
+    if row["status"] == "failed" or line is None or len(line) < 2:
+        return None
+    a = np.asarray(line, float)
+    return (float(a[0, 0]), float(a[0, 1]), float(a[-1, 0]), float(a[-1, 1]))
 
 
 def first_cause(reason: str) -> str:
