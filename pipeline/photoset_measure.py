@@ -310,7 +310,8 @@ def guessed_at_the_free_end(
 ) -> dict[Any, str]:
     """The rows whose fixed end was guessed (``fixed_end: auto``) at the line's free end, each
     with its reason: their line's other end lies where the lines of most of the ramp's photos
-    start (:func:`ramp_start`), so psi, walked from the tip, may have the wrong sign (customer
+    start (:func:`walked_from_the_tip`), so psi, walked from the tip, may have the wrong sign;
+    after :func:`measure_photoset` measured them again from there, those it could not (customer
     46's clamp beside a grey backdrop: two rows ok with psi +61 and +64 for -58 and -60, and
     the ramp check flagged the right rows beside them as breaking it).
 
@@ -321,23 +322,50 @@ def guessed_at_the_free_end(
         return {}
     guessed = np.array([r is not None and r.fixed_end_px is None for r in ps.rows])
     found = np.array([e is not None for e in line_ends]) & (angles["status"] != "failed")
-    out: dict[Any, str] = {}
-    for _, ramp in angles[guessed & found.to_numpy()].groupby(list(RAMP_KEYS), sort=False):
-        if len(ramp) < 3:
+    ramps = [
+        list(ramp.index)
+        for _, ramp in angles[guessed & found.to_numpy()].groupby(list(RAMP_KEYS), sort=False)
+    ]
+    return {
+        i: (
+            "fixed end guessed at the free end (fixed_end auto): the line's other end "
+            f"lies where most of its ramp's photos start, near ({start[0]:.0f}, "
+            f"{start[1]:.0f}), so psi may have the wrong sign (set fixed_end, the pixel "
+            "where the actuator leaves the clamp)"
+        )
+        for i, start in walked_from_the_tip(ramps, line_ends, angles["length_px"]).items()
+    }
+
+
+def walked_from_the_tip(
+    ramps: Sequence[Sequence[int]],
+    line_ends: Sequence[Any],
+    lengths_px: Sequence[float] | pd.Series,
+) -> dict[int, NDArray[np.float64]]:
+    """The rows, of ``ramps`` (lists of row positions, each row's fixed end guessed), whose line
+    was walked from its tip, each with where its ramp's lines start (:func:`ramp_start`): its
+    line ends within :data:`SAME_START_SHARE` of the ramp's median line length of that point, and
+    starts farther from it.  ``line_ends`` holds each row's ``x0, y0, x1, y1`` (image px; None
+    where not measured) and ``lengths_px`` its line length, both by row position.
+
+    Examples
+    --------
+    >>> ends = [(0, 0, 90, 50), (1, 0, 80, 70), (2, 1, 60, 95), (40, 95, 1, 1), None]
+    >>> {i: p.tolist() for i, p in walked_from_the_tip([[0, 1, 2, 3]], ends, [100] * 5).items()}
+    {3: [0.0, 0.0]}
+    """
+    out: dict[int, NDArray[np.float64]] = {}
+    for idx in ramps:
+        if len(idx) < 3:
             continue
-        ends = np.array([line_ends[i] for i in ramp.index], float)
-        radius = SAME_START_SHARE * float(np.nanmedian(angles.loc[ramp.index, "length_px"]))
+        ends = np.array([line_ends[i] for i in idx], float)
+        radius = SAME_START_SHARE * float(np.nanmedian([lengths_px[i] for i in idx]))
         start = ramp_start(ends, radius)
         if start is None:
             continue
-        for i, e in zip(ramp.index, ends, strict=True):
+        for i, e in zip(idx, ends, strict=True):
             if np.hypot(*(e[2:] - start)) <= radius < np.hypot(*(e[:2] - start)):
-                out[i] = (
-                    "fixed end guessed at the free end (fixed_end auto): the line's other end "
-                    f"lies where most of its ramp's photos start, near ({start[0]:.0f}, "
-                    f"{start[1]:.0f}), so psi may have the wrong sign (set fixed_end, the pixel "
-                    "where the actuator leaves the clamp)"
-                )
+                out[i] = start
     return out
 
 
@@ -657,9 +685,10 @@ def _from_ramp_starts(
     cache_dir: Path | None = None,
     used: set[str] | None = None,
 ) -> list[dict[str, Any]]:
-    """``rows``, where a fixed end guessed (``fixed_end: auto``) took the line's free end, with
-    the photo measured again from where its ramp's photos' lines start (:func:`ramp_start`: the
-    clamp stays put, the tip moves), when that measurement is not ``failed``; its reason says so.
+    """``rows``, where a fixed end guessed (``fixed_end: auto``) took the line's free end
+    (:func:`walked_from_the_tip`), with the photo measured again from where its ramp's photos'
+    lines start (the clamp stays put, the tip moves), when that measurement is not ``failed``;
+    its reason says so (:data:`~pipeline.measure.quality.NOTE_FROM_RAMP_START`).
 
     A black line on a body held by a white clamp gave ``auto`` no dark clamp to start from: it
     walked every photo of a rendered ramp from the tip, and psi had the wrong sign in each.
@@ -672,28 +701,16 @@ def _from_ramp_starts(
         i for i, t in enumerate(tasks)
         if t.settings is not None and t.settings.fixed_end_px is None and ends[i] is not None
     ]
-    again: list[tuple[int, Task]] = []
-    starts: dict[int, NDArray[np.float64]] = {}
     ramps: dict[tuple[str, ...], list[int]] = {}
     for i in guessed:
         ramps.setdefault(tuple(str(manifest[k].iloc[i]) for k in RAMP_KEYS), []).append(i)
-    for idx in ramps.values():
-        if len(idx) < 3:
-            continue
-        line_ends = np.array([ends[i] for i in idx], float)
-        radius = SAME_START_SHARE * float(np.nanmedian([rows[i]["length_px"] for i in idx]))
-        start = ramp_start(line_ends, radius)
-        if start is None:
-            continue
-        for i, e in zip(idx, line_ends, strict=True):
-            if np.hypot(*(e[2:] - start)) <= radius < np.hypot(*(e[:2] - start)):
-                settings = tasks[i].settings
-                assert settings is not None
-                starts[i] = start
-                again.append((i, replace(
-                    tasks[i], settings=replace(settings, fixed_end_px=(float(start[0]),
-                                                                       float(start[1])))
-                )))
+    starts = walked_from_the_tip(list(ramps.values()), ends, [r["length_px"] for r in rows])
+    again: list[tuple[int, Task]] = []
+    for i, start in starts.items():
+        settings = tasks[i].settings
+        assert settings is not None
+        fixed_end = (float(start[0]), float(start[1]))
+        again.append((i, replace(tasks[i], settings=replace(settings, fixed_end_px=fixed_end))))
     if not again:
         return rows
     out = list(rows)
