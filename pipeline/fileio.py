@@ -311,6 +311,49 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
+def check_replaceable_table(
+    path: str | os.PathLike[str], columns: Sequence[str], option: str = "--out"
+) -> None:
+    """Refuse to write a table over a file that is not an earlier one of its kind: an existing
+    ``path`` whose first line does not name every one of ``columns`` (a photo, a hand-made
+    manifest, another program's file) is a person's data, never replaced.
+
+    Customer 47's ``measure SET --out SET/manifest.csv`` (one tab completion away from
+    ``SET/``) replaced its manifest with angles.csv, and ``--out SET/photo.jpg`` a photo,
+    without a word.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "angles.csv").write_text("image,psi_deg,status\\na.jpg,1.0,ok\\n")
+    >>> check_replaceable_table(d / "angles.csv", ["psi_deg", "status"])
+    >>> check_replaceable_table(d / "new.csv", ["psi_deg", "status"])
+    >>> _ = (d / "manifest.csv").write_text("image,pressure_kpa\\na.jpg,0\\n")
+    >>> try:
+    ...     check_replaceable_table(d / "manifest.csv", ["psi_deg", "status"])
+    ... except UserInputError as exc:
+    ...     print(str(exc).split(": ", 1)[1][:72])
+    exists and is not a table this command wrote (its first line has no psi_
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise UserInputError(f"{option} {path}: is a folder; give a file, e.g. {path / 'x.csv'}")
+    if not path.exists():
+        return
+    with open(path, "rb") as fh:
+        first = fh.read(1 << 16).split(b"\n", 1)[0].decode("utf-8", "replace").lstrip("\ufeff")
+    names = {n.strip().strip('"') for n in first.rstrip("\r").split(",")}
+    if not set(columns) <= names:
+        example = path.with_name(f"{path.stem}_angles.csv") if path.suffix == ".csv" else (
+            path.with_name("angles.csv")
+        )
+        raise UserInputError(
+            f"{option} {path}: exists and is not a table this command wrote (its first line has "
+            f"no {', '.join(columns)}), so it is not replaced: give a new file, e.g. {example}"
+        )
+
+
 def table_bytes(table: pd.DataFrame, float_format: str | None = FLOAT_FORMAT) -> bytes:
     """The CSV bytes of a table as every stage writes it (no index, ``\\n`` line ends)."""
     return table.to_csv(index=False, lineterminator="\n", float_format=float_format).encode()

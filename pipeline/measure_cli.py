@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+from pipeline.fileio import check_replaceable_table
 from pipeline.folders import staged_folder
 from pipeline.measure.core import DEFAULT_METHOD
 from pipeline.measure.estimators import METHODS
@@ -69,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
+    check_replaceable_table(args.out, ("psi_deg", "status"))  # before minutes of measuring
     ps = load_photoset(args.photoset)
     kw = {
         "method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check,

@@ -341,24 +341,58 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
         return None, [
             Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")
         ]
-    return {**SETTING_DEFAULTS, **raw}, unknown_key_problems(name, raw)
+    problems = unknown_key_problems(name, raw)
+    if any(not p.warning for p in problems):
+        return None, problems
+    return {**SETTING_DEFAULTS, **raw}, problems
 
 
-def unknown_key_problems(path: str, settings: Mapping[str, Any]) -> list[Problem]:
-    """A warning for each key of ``photoset.yaml`` that is not one: it is ignored, so a typo
-    (``sealed_end: 8``) measures as if nothing were given, with the closest key as the fix.
+#: a key or column this much like a setting's name (:func:`difflib.get_close_matches` ratio) is
+#: taken for a typo of it and refused: as it is it would be ignored, and every photo measured
+#: without it (customer 47: ``postive_turn: cw`` in the manifest gave 30 rows ok of the wrong
+#: sign, ``mm_per_pix`` in photoset.yaml moved psi 1.4 deg, every row ok)
+TYPO_RATIO = 0.8
+
+
+def typo_of(name: str, names: Sequence[str]) -> str | None:
+    """The name of ``names`` that ``name`` is a typo of (:data:`TYPO_RATIO`), or None.
 
     Examples
     --------
-    >>> [p.fix[:27] for p in unknown_key_problems("photoset.yaml", {"l0_mm": 1, "sealed_end": 8})]
-    ['did you mean sealed_end_mm?']
+    >>> typo_of("postive_turn", KEYS), typo_of("mm_per_pix", KEYS), typo_of("operator", KEYS)
+    ('positive_turn', 'mm_per_px', None)
+    """
+    close = difflib.get_close_matches(name, names, n=1, cutoff=TYPO_RATIO)
+    return close[0] if close else None
+
+
+def unknown_key_problems(path: str, settings: Mapping[str, Any]) -> list[Problem]:
+    """A problem for each key of ``photoset.yaml`` that is not one: a typo of one
+    (:func:`typo_of`: ``sealed_end: 8``) is refused, since as it is it would measure as if
+    nothing were given; any other key is a warning (ignored), with the closest key as the fix.
+
+    Examples
+    --------
+    >>> [(p.warning, p.fix[:23]) for p in unknown_key_problems(
+    ...     "photoset.yaml", {"l0_mm": 1, "sealed_end": 8, "operator": "Ann"})]
+    [(False, 'rename it sealed_end_mm'), (True, 'use only l0_mm, mm_per_')]
     """
     out = []
+    keys = ", ".join(KEYS)
     for key in settings:
         if key in KEYS:
             continue
+        typo = typo_of(str(key), [k for k in KEYS if k not in settings])
+        if typo is not None:
+            out.append(Problem(
+                path,
+                None,
+                f"unknown key {key!r}, a typo of {typo}? As it is it would be ignored, and every "
+                "photo measured without it",
+                f"rename it {typo} (a key of your own needs a name less like a setting's)",
+            ))
+            continue
         close = difflib.get_close_matches(str(key), KEYS, n=1, cutoff=0.6)
-        keys = ", ".join(KEYS)
         out.append(
             Problem(
                 path,
@@ -617,6 +651,21 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             "may follow: 'Pressure (kPa)')"
             + ("" if "video" in df.columns else f"; for videos {list(VIDEO_REQUIRED_COLUMNS)}"),
         )
+    if {"psi_deg", "status"} <= set(map(str, df.columns)):
+        # customer 47 wrote angles.csv over its manifest (measure --out SET/manifest.csv), and
+        # measure then stopped with a TypeError
+        return None, Problem(
+            str(path),
+            1,
+            "is a table of measured angles (its header has psi_deg and status, which measure "
+            "writes), not the list of the photos",
+            "put back the manifest that lists the photos (image, pressure_kpa, direction, "
+            "material, actuator, trial); 'python -m pipeline photoset init' makes one from the "
+            "photos' names",
+        )
+    typos = column_typo_problems(str(path), df.columns)
+    if typos:
+        return None, typos[0]
     if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
         df["direction"] = df["direction"].map(direction_name)
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
@@ -652,6 +701,41 @@ def header_names(columns: Iterable[Any]) -> dict[str, str]:
             continue
         if canonical not in out.values():
             out[name] = canonical
+    return out
+
+
+def column_typo_problems(path: str, columns: Iterable[Any]) -> list[Problem]:
+    """A problem for each manifest column that is a typo of one the manifest knows and does not
+    have (:func:`typo_of`): as it is it would be carried to angles.csv as a column of the user's
+    own and the setting ignored on every row.  Other columns of the user's own are fine (a
+    ``pressure_kpa_set`` beside ``pressure_kpa``).
+
+    Examples
+    --------
+    >>> [p.fix for p in column_typo_problems("m.csv", ["image", "postive_turn", "operator"])]
+    ["rename it positive_turn (a column of your own needs a name less like the manifest's)"]
+    >>> column_typo_problems("m.csv", ["fixed_end"])[0].fix[:43]
+    'give the fixed end as fixed_end_x and fixed'
+    """
+    known = (
+        *REQUIRED_COLUMNS, *OPTIONAL_COLUMNS, *VIDEO_REQUIRED_COLUMNS, *VIDEO_OPTIONAL_COLUMNS,
+        *PRESSURE_UNITS_KPA, *OVERRIDE_COLUMNS,
+    )
+    columns = [str(c) for c in columns]
+    missing = [k for k in known if k not in columns]
+    out = []
+    for column in columns:
+        typo = None if column in known else typo_of(column, missing)
+        if typo is None:
+            continue
+        out.append(Problem(
+            path,
+            1,
+            f"column {column!r}, a typo of {typo}? As it is it would be ignored on every row",
+            "give the fixed end as fixed_end_x and fixed_end_y columns (one pixel number each)"
+            if column == "fixed_end"
+            else f"rename it {typo} (a column of your own needs a name less like the manifest's)",
+        ))
     return out
 
 

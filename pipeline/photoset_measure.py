@@ -509,7 +509,12 @@ def _measure_photos(
     result["calibration_mm"] = [mm for _, mm in rms]
     drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
-    carried += [c for c in manifest.columns if c not in drop and c not in carried]
+    # a column of the manifest's own named as one measure writes ('reason', 'seconds') is
+    # left out: angles.csv would hold two columns of that name
+    carried += [
+        c for c in manifest.columns
+        if c not in drop and c not in carried and c not in RESULT_COLUMNS
+    ]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
         drop=True
     )

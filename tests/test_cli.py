@@ -95,15 +95,28 @@ def test_photoset_init_writes_a_body_sets_sealed_end(photo_folder):
     assert out.returncode == 0 and "no sealed_end_mm" not in out.stdout
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
     assert out.returncode == 0 and "no sealed_end_mm" not in out.stderr, out.stderr
-    # without it, measure says so too: every row may still come out ok (customer 14's did, 8-14
-    # deg off, and only check had said it); a typo of its key is ignored, and measure said
-    # nothing of it, only check did
+    # a typo of its key is refused: as it was, it was ignored, and measure said nothing of it,
+    # only check did (customer 47's mm_per_pix moved psi 1.4 deg, every row ok)
     written["sealed_end"] = written.pop("sealed_end_mm")
+    (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(written))
+    for command in (
+        ("photoset", "check", str(photo_folder)),
+        ("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv")),
+    ):
+        out = _run(*command)
+        said = out.stdout + out.stderr
+        assert out.returncode != 0, said
+        assert "unknown key 'sealed_end', a typo of sealed_end_mm?" in said, said
+        assert "(fix: rename it sealed_end_mm" in said, said
+    # without it, measure says so too: every row may still come out ok (customer 14's did, 8-14
+    # deg off, and only check had said it); a key far from any setting's is a warning
+    written.pop("sealed_end")
+    written["sealed_length"] = 6
     (photo_folder / "photoset.yaml").write_text(yaml.safe_dump(written))
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
     assert out.returncode == 0 and "no sealed_end_mm" in out.stderr, out.stderr
-    assert "unknown key 'sealed_end' is ignored (fix: did you mean sealed_end_mm?" in out.stderr
-    written.pop("sealed_end")
+    assert "unknown key 'sealed_length' is ignored (fix: did you mean sealed_end_mm?" in out.stderr
+    written.pop("sealed_length")
     written["sealed_end_mm"] = 6.0
     # without the scale it is turned into pixels with the body's length against l0_mm +
     # sealed_end_mm: check accepts it (and warns of the missing scale, as for any body)
@@ -212,3 +225,54 @@ def test_output_piped_into_a_reader_that_stopped_ends_without_a_traceback(photo_
     assert proc.wait(timeout=120) == 141, err
     assert "Traceback" not in err and "BrokenPipeError" not in err, err
     assert (photo_folder / "manifest.csv").is_file()  # the work was done
+
+
+def test_measure_out_never_replaces_a_photo_or_the_manifest(photo_folder):
+    # customer 47: 'measure SET --out SET/manifest.csv' (or a photo's name) exited 0 and replaced
+    # the hand-made manifest (or the photo) with angles.csv, without a word
+    out = _run("photoset", "init", str(photo_folder), "--pattern",
+               "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200")
+    assert out.returncode == 0, out.stderr
+    photo = photo_folder / "DS30_A2_t1_s01_10kPa.jpg"
+    kept = {p: p.read_bytes() for p in (photo_folder / "manifest.csv", photo)}
+    for target in kept:
+        out = _run("measure", str(photo_folder), "--out", str(target))
+        assert out.returncode != 0, out.stdout
+        assert f"--out {target}: exists and is not a table this command wrote" in out.stderr
+        assert "Traceback" not in out.stderr
+    assert {p: p.read_bytes() for p in kept} == kept
+    # its own earlier table is replaced, as before
+    angles = photo_folder.parent / "angles.csv"
+    for _ in range(2):
+        out = _run("measure", str(photo_folder), "--out", str(angles))
+        assert out.returncode == 0, out.stderr
+    # an angles.csv put where the manifest was is named as such (measure stopped in a TypeError)
+    (photo_folder / "manifest.csv").write_bytes(angles.read_bytes())
+    for command in (("photoset", "check", str(photo_folder)),
+                    ("measure", str(photo_folder), "--out", str(angles))):
+        out = _run(*command)
+        said = out.stdout + out.stderr
+        assert out.returncode != 0 and "Traceback" not in said, said
+        assert "is a table of measured angles (its header has psi_deg and status" in said, said
+
+
+def test_a_manifest_column_spelt_almost_as_a_setting_is_refused_as_a_typo(photo_folder):
+    # customer 47: a column 'postive_turn' holding cw was carried as a column of its own, and
+    # every row came out ok with the sign it had not asked for; check said OK
+    out = _run("photoset", "init", str(photo_folder), "--pattern",
+               "{material}_{actuator}_t{trial}_s{step}_{pressure_kpa}kPa.jpg", "--l0-mm", "200")
+    assert out.returncode == 0, out.stderr
+    manifest = pd.read_csv(photo_folder / "manifest.csv")
+    manifest.assign(postive_turn="cw").to_csv(photo_folder / "manifest.csv", index=False)
+    for command in (("photoset", "check", str(photo_folder)),
+                    ("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))):
+        out = _run(*command)
+        said = out.stdout + out.stderr
+        assert out.returncode != 0, said
+        assert "manifest.csv line 1: column 'postive_turn', a typo of positive_turn?" in said
+        assert "(fix: rename it positive_turn" in said
+    # a column of the user's own is carried as before
+    manifest.assign(operator="Ann").to_csv(photo_folder / "manifest.csv", index=False)
+    out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
+    assert out.returncode == 0, out.stderr
+    assert (pd.read_csv(photo_folder.parent / "a.csv")["operator"] == "Ann").all()

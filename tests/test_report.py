@@ -1030,11 +1030,12 @@ def test_a_body_set_without_its_sealed_end_or_with_a_photo_left_out_is_warned_in
         "DS20: 1 photo in the folder is not in manifest.csv and will not be measured: "
         "'DS20_late.jpg'")], res.warnings
     (d.photoset_dir / "DS20_late.jpg").unlink()
-    # a typo of the key is said as such
-    (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end: 6\n")
+    # a key that is none is said as such (one spelt almost as a setting is refused)
+    (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_length: 6\n")
     res = build_report(ReportInputs(datasets=(d,)), out)
-    assert [w for w in res.warnings if w.startswith("DS20: unknown key 'sealed_end' is ignored; "
-                                                    "did you mean sealed_end_mm?")], res.warnings
+    assert [w for w in res.warnings if w.startswith("DS20: unknown key 'sealed_length' is "
+                                                    "ignored; did you mean sealed_end_mm?")], (
+        res.warnings)
     (d.photoset_dir / "photoset.yaml").write_text(settings + "sealed_end_mm: 6\n")
     res = build_report(ReportInputs(datasets=(d,)), out)
     assert not [w for w in res.warnings if "sealed_end" in w], res.warnings
