@@ -33,9 +33,25 @@ rule all:
 onsuccess:
     import sys
 
-    from pipeline.photoset_measure import run_summaries
+    from pipeline.photoset_measure import remove_stale_report, run_summaries
 
     for line in run_summaries(
-        {name: f"{RESULTS}/datasets/{name}/angles.csv" for name in DATASETS}
+        {name: f"{RESULTS}/datasets/{name}/angles.csv" for name in DATASETS},
+        {name: log_file(f"measure/{name}") for name in DATASETS},
     ):
         print(line, file=sys.stderr)
+    remove_stale_report(Path(f"{RESULTS}/report.pdf"))
+
+
+onerror:
+    import sys
+
+    from pipeline.photoset_measure import set_aside_stale_report
+
+    stale = set_aside_stale_report(Path(f"{RESULTS}/report.pdf"))
+    if stale is not None:
+        print(
+            f"The run stopped before it made the report again: the earlier run's, which does not "
+            f"show what changed since, is now {stale}. Fix what is said above and run again.",
+            file=sys.stderr,
+        )

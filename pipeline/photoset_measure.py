@@ -843,12 +843,17 @@ def summary(angles: pd.DataFrame, seconds: bool = True) -> str:
     )
 
 
-def run_summaries(angles_paths: dict[str, Path]) -> list[str]:
+def run_summaries(
+    angles_paths: dict[str, Path], logs: dict[str, Path] | None = None, most: int = 5
+) -> list[str]:
     """What the console says at the end of a workflow run: one line per dataset measured
-    (:func:`summary`), and where a set's flagged and failed rows say why.
+    (:func:`summary`), and where a set's flagged and failed rows say why; then, indented, the
+    warnings its measure job's log holds (``logs``: dataset -> log; at most ``most``).
 
     Snakemake writes each job's output to its log, so a run ended with exit status 0 and nothing
-    on the console about a failed row (customer 30).  ``angles_paths`` maps a dataset's name to
+    on the console about a failed row (customer 30), nor of a key ignored that moved psi on every
+    ``ok`` row, or of a photo of the folder left out (customer 47).  A job not run again keeps
+    its log, whose warnings still hold for its set.  ``angles_paths`` maps a dataset's name to
     its angles.csv; a missing file is skipped.  The seconds of work are not said: angles.csv
     holds those of photos measured in earlier runs too (customer 44 read "12.3 s of work" for
     a run that measured one photo in 0.9 s); each measure job's log says its own.
@@ -862,4 +867,53 @@ def run_summaries(angles_paths: dict[str, Path]) -> list[str]:
         if (angles["status"] != "ok").any():
             line += f"; why: the 'reason' column of {path}"
         lines.append(line)
+        log = None if logs is None else Path(logs[name])
+        if log is None or not log.is_file():
+            continue
+        said = log.read_text(errors="replace").splitlines()
+        warnings = list(dict.fromkeys(w.strip() for w in said if ": warning: " in w))
+        lines += [f"  {w}" for w in warnings[:most]]
+        if len(warnings) > most:
+            lines.append(f"  ... and {len(warnings) - most} more warnings in {log}")
     return lines
+
+
+#: what an earlier run's report is renamed to when a run fails before making it again
+STALE_REPORT_SUFFIX = ".STALE.pdf"
+
+
+def set_aside_stale_report(report: Path) -> Path | None:
+    """Rename ``report`` (an earlier run's, which a failed run did not make again) to
+    ``<name>.STALE.pdf``, replacing an older one; return the new path, or None where there was
+    no report.
+
+    Customer 47's run stopped on a set's photoset.yaml, and the report of the run before, whose
+    numbers no longer matched the photos, stayed as ``results/report.pdf`` for anyone to open
+    on Monday.  A run that makes the report again removes the stale one
+    (:func:`remove_stale_report`).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> report = Path(tempfile.mkdtemp()) / "report.pdf"
+    >>> set_aside_stale_report(report) is None
+    True
+    >>> _ = report.write_bytes(b"%PDF")
+    >>> set_aside_stale_report(report).name, report.exists()
+    ('report.STALE.pdf', False)
+    >>> _ = report.write_bytes(b"%PDF"); remove_stale_report(report); report.exists()
+    True
+    >>> (report.parent / "report.STALE.pdf").exists()
+    False
+    """
+    if not report.is_file():
+        return None
+    stale = report.with_name(report.stem + STALE_REPORT_SUFFIX)
+    os.replace(report, stale)
+    return stale
+
+
+def remove_stale_report(report: Path) -> None:
+    """Remove the report :func:`set_aside_stale_report` set aside, once ``report`` is made."""
+    if report.is_file():
+        report.with_name(report.stem + STALE_REPORT_SUFFIX).unlink(missing_ok=True)
