@@ -102,8 +102,8 @@ def pressure_order_problems(ps: PhotoSet) -> list[Problem]:
             ps,
             ix,
             why.replace(" a typo in the manifest?", " a typo?"),
-            "correct pressure_kpa (or step) on this line; until then measure flags the photo and "
-            "leaves it out of the curves",
+            "correct pressure_kpa, direction or step on this line; until then measure flags the "
+            "photo and leaves it out of the curves",
         )
         for ix, why in pressure_order_breaks(ps.manifest).items()
     ]

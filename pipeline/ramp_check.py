@@ -197,6 +197,7 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
     out: dict[Any, str] = {}
     for _, ramp in ordered.groupby(list(RAMP_KEYS), sort=False):
         legs = (ramp["direction"] != ramp["direction"].shift()).cumsum()
+        out.update(direction_breaks([leg for _, leg in ramp.groupby(legs, sort=False)], p_all))
         for _, leg in ramp.groupby(legs, sort=False):
             sign = 1.0 if leg["direction"].iloc[0] == DIRECTIONS[0] else -1.0
             p = sign * p_all[leg.index].to_numpy(float)
@@ -232,6 +233,44 @@ def pressure_order_breaks(rows: pd.DataFrame) -> dict[Any, str]:
                             f"({' -> '.join(shown)} kPa by step, {step / max(before, slack):.0f} "
                             "times the step beside it): a typo in the manifest?"
                         )
+    return out
+
+
+def direction_breaks(legs: list[pd.DataFrame], pressures_kpa: pd.Series) -> dict[Any, str]:
+    """The rows of one ramp (``legs``: its runs of one ``direction``, in ``step`` order) whose
+    direction is a typo: a run of one or two rows between two longer runs of the other
+    direction, whose pressures follow those runs' order (customer 47's 'up' typed for one row
+    after the ramp's top moved the rising curve's 120 kPa level 4 deg, nothing flagged).
+
+    Examples
+    --------
+    >>> def runs(df):
+    ...     return [g for _, g in df.groupby((df.direction != df.direction.shift()).cumsum())]
+    >>> df = pd.DataFrame({"pressure_kpa": [0, 40, 80, 120, 100, 80, 60, 40, 0],
+    ...                    "direction": ["up"] * 4 + ["down"] * 2 + ["up"] + ["down"] * 2})
+    >>> print(direction_breaks(runs(df), df.pressure_kpa)[6])  # doctest: +NORMALIZE_WHITESPACE
+    direction up is out of its ramp's order (down rows before and after it by step: 80 -> 60 -> 40
+    kPa): a typo in the manifest?
+    >>> cycles = pd.DataFrame({"pressure_kpa": [0, 40, 80, 40, 0, 40, 80, 40, 0],
+    ...                        "direction": ["up"] * 3 + ["down"] * 2 + ["up"] * 2 + ["down"] * 2})
+    >>> direction_breaks(runs(cycles), cycles.pressure_kpa)  # a second cycle
+    {}
+    """
+    out: dict[Any, str] = {}
+    for before, run, after in zip(legs, legs[1:], legs[2:]):
+        direction, other = run["direction"].iloc[0], before["direction"].iloc[0]
+        if len(run) > 2 or len(before) < 2 or len(after) < 2 or after["direction"].iloc[0] != other:
+            continue
+        rows = [before.index[-1], *run.index, after.index[0]]
+        sign = 1.0 if other == DIRECTIONS[0] else -1.0
+        if (np.diff(sign * pressures_kpa[rows].to_numpy(float)) < -PRESSURE_SLACK_MIN_KPA).any():
+            continue  # its pressures do not follow the other direction's either
+        shown = " -> ".join(f"{float(pressures_kpa[ix]):g}" for ix in rows)
+        for ix in run.index:
+            out[ix] = (
+                f"direction {direction} {PRESSURE_OUT_OF_ORDER} ({other} rows before and after "
+                f"it by step: {shown} kPa): a typo in the manifest?"
+            )
     return out
 
 

@@ -878,7 +878,7 @@ def test_check_warns_of_a_pressure_out_of_its_ramps_order_naming_the_line(photo_
     assert warning.message == (
         "pressure 100 kPa is out of its ramp's order (0 -> 100 -> 20 kPa by step): a typo?"
     )
-    assert warning.fix.startswith("correct pressure_kpa (or step) on this line")
+    assert warning.fix.startswith("correct pressure_kpa, direction or step on this line")
 
 
 @pytest.mark.parametrize(

@@ -426,6 +426,28 @@ def test_a_pressure_out_of_its_legs_order_is_flagged_and_kept_out_of_the_curves(
     assert words(out.loc[k, "reason"]) == "pressure out of its ramp's order (a manifest typo?)"
 
 
+@pytest.mark.parametrize("k", [15, 16])
+def test_a_direction_typed_wrong_in_the_middle_of_a_leg_is_flagged_and_kept_out(k):
+    # customer 47 typed 'up' for one falling photo after the top: the rising curve's 120 kPa
+    # level moved from 116.0 +- 0.8 to 111.7 +- 7.5 deg, nothing flagged, check said OK
+    from pipeline.aggregate import is_used
+
+    df = _ramp(_ds20_like(), _ds20_like()[::-1])
+    df.loc[k, "direction"] = "up"
+    out = check_ramps(df)
+    assert out.loc[k, "status"] == "flagged", out.loc[k, "reason"]
+    assert out.loc[k, "reason"].startswith(
+        "direction up is out of its ramp's order (down rows before and after it by step: "
+    ), out.loc[k, "reason"]
+    assert (out.drop(index=k)["status"] == "ok").all(), out[["pressure_kpa", "reason"]]
+    assert not is_used(out, include_flagged=True)[k]
+    assert words(out.loc[k, "reason"]) == "direction out of its ramp's order (a manifest typo?)"
+    # two cycles of one trial are no typo
+    two = _ramp(_ds20_like()[:4], _ds20_like()[:4][::-1])
+    two = pd.concat([two, two.assign(step=two["step"] + len(two))], ignore_index=True)
+    assert (check_ramps(two)["status"] == "ok").all()
+
+
 @pytest.mark.parametrize("retakes", [[3], [3, 2], [1]])
 def test_a_photo_retaken_at_the_end_of_a_leg_is_blamed_not_the_right_ones_before_it(retakes):
     # customer 44 added a retake of 30 kPa (and one of 20) after its falling leg's 0 kPa, as

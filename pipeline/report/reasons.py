@@ -84,6 +84,8 @@ WORDS: tuple[tuple[str, str], ...] = (
      "bodies leave the clamp off fixed_direction_deg"),
     (r"^pressure [-+\d.e]+ kPa is out of its ramp's order",
      "pressure out of its ramp's order (a manifest typo?)"),
+    (r"^direction \w+ is out of its ramp's order",
+     "direction out of its ramp's order (a manifest typo?)"),
     (r"^image .*does not exist", "photo missing from the folder"),
     (r"^background photo .* another shape than the photo \(turned",
      "empty-scene photo turned against the photos"),
