@@ -160,7 +160,9 @@ def _semantic_errors(
     unreadable)."""
     messages = []
     names: dict[str, int] = {}
+    cased: dict[str, str] = {}
     packaged = known_materials()
+    results = (workdir / str(config.get("results_dir", "results"))).resolve()
     for section in ("datasets",):
         for i, ds in enumerate(config.get(section, [])):
             key = f"{section}[{i}]"
@@ -170,7 +172,15 @@ def _semantic_errors(
                     f"{key}.name: {name!r} is used twice (also {section}[{names[name]}]); give "
                     "each dataset a unique name"
                 )
+            elif str(name).casefold() in cased:
+                # on a Mac or Windows disk (or a share) results/datasets/syn and .../Syn are one
+                messages.append(
+                    f"{key}.name: {name!r} and {cased[str(name).casefold()]!r} differ only in "
+                    "case, and on a Mac or Windows disk their results would share one folder; "
+                    "give each dataset a name of its own"
+                )
             names.setdefault(name, i)
+            cased.setdefault(str(name).casefold(), str(name))
             source = ds.get("source")
             folder_ok = source != "folder" or (workdir / ds["path"]).is_dir()
             if not folder_ok:
@@ -178,6 +188,9 @@ def _semantic_errors(
                     f"{key}.path: photo-set folder {ds['path']!r} does not exist (relative to "
                     f"{workdir}); fix the path or copy the photo set there"
                 )
+            elif source == "folder":
+                messages += _results_problems(key, ds["path"], (workdir / ds["path"]).resolve(),
+                                              results, workdir.resolve())
             own = ds.get("materials_file")  # replaces model.materials_file for this dataset
             where, model_materials = "model.materials_file", materials
             if own:
@@ -244,6 +257,26 @@ def _semantic_errors(
             f"force.grasp_log: file {grasp!r} does not exist; fix the path or set it to null"
         )
     return messages
+
+
+def _results_problems(
+    key: str, path: str, folder: Path, results: Path, workdir: Path
+) -> list[str]:
+    """A photo set and ``results_dir`` inside one another (customer 47: results inside the set
+    failed in the measure job, naming a --cache it never typed; a set kept in results/, which
+    the README calls the run's own and yours to delete, was taken without a word)."""
+    if results == folder or results.is_relative_to(folder):
+        return [(
+            f"results_dir: {str(results)!r} lies inside the photo set {path!r} ({key}): the "
+            "run's files would join its photos; give results_dir a folder outside it"
+        )]
+    if folder.is_relative_to(results) and not workdir.is_relative_to(results):
+        return [(
+            f"{key}.path: the photo set {path!r} lies inside results_dir ({str(results)!r}), "
+            "the run's own folder, which may be deleted to run afresh; keep the photos in a "
+            "folder outside it"
+        )]
+    return []
 
 
 def known_materials(materials_file: str | Path | None = None) -> set[str]:

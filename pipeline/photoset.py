@@ -33,6 +33,7 @@ import difflib
 import functools
 import os
 import re
+import unicodedata
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -174,6 +175,29 @@ def near_name(name: str, names: Sequence[str]) -> str | None:
         if close:
             return close[0]
     return None
+
+
+def disk_name(folder: Path, name: str) -> str:
+    """``name`` as the file is named in ``folder``: the same letters may be stored in another
+    Unicode form (a Mac's disk writes ``a`` + a combining mark where a spreadsheet types ``ä``),
+    and a Linux disk tells the two apart (customer 47's 'Probe ä 3.jpg' was said both "does not
+    exist" and "not in manifest").  ``name`` itself where it exists or neither form does.
+
+    Examples
+    --------
+    >>> import tempfile, unicodedata
+    >>> root = Path(tempfile.mkdtemp())
+    >>> _ = (root / unicodedata.normalize("NFD", "Probe ä.jpg")).write_bytes(b"")
+    >>> disk_name(root, "Probe ä.jpg") == unicodedata.normalize("NFD", "Probe ä.jpg")
+    True
+    """
+    if name.isascii() or (folder / name).exists():
+        return name
+    for form in ("NFC", "NFD"):
+        other = unicodedata.normalize(form, name)
+        if other != name and (folder / other).exists():
+            return other
+    return name
 
 
 def overlay_name(image: str) -> str:
@@ -336,7 +360,7 @@ def _read_yaml(folder: Path) -> tuple[dict[str, Any] | None, list[Problem]]:
     try:
         raw = yaml.safe_load(read_user_text(path)) or {}
     except yaml.YAMLError as exc:
-        return None, [Problem(name, None, f"not valid YAML ({exc})", "fix the YAML syntax")]
+        return None, [Problem(name, None, f"not valid YAML ({exc})", yaml_fix(exc))]
     if not isinstance(raw, dict):
         return None, [
             Problem(name, None, "must be a mapping of key: value", "write e.g. 'l0_mm: 200'")
@@ -364,6 +388,25 @@ def typo_of(name: str, names: Sequence[str]) -> str | None:
     """
     close = difflib.get_close_matches(name, names, n=1, cutoff=TYPO_RATIO)
     return close[0] if close else None
+
+
+def yaml_fix(exc: yaml.YAMLError) -> str:
+    """The fix for a YAML file PyYAML could not read: a tab (which YAML never takes where
+    photoset.yaml would have one) is named with its line (customer 47 got "fix the YAML
+    syntax").
+
+    Examples
+    --------
+    >>> try:
+    ...     yaml.safe_load("l0_mm: 200\\nline_color:\\tblack\\n")
+    ... except yaml.YAMLError as exc:
+    ...     print(yaml_fix(exc))
+    replace the tab on line 2 with a space (YAML takes no tabs)
+    """
+    mark = getattr(exc, "problem_mark", None)
+    if "'\\t'" in str(exc) and mark is not None:
+        return f"replace the tab on line {mark.line + 1} with a space (YAML takes no tabs)"
+    return "fix the YAML syntax" + (f" on line {mark.line + 1}" if mark is not None else "")
 
 
 def unknown_key_problems(path: str, settings: Mapping[str, Any]) -> list[Problem]:
@@ -668,6 +711,9 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
         return None, typos[0]
     if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
         df["direction"] = df["direction"].map(direction_name)
+    for column in ("image", "video"):
+        if column in df.columns:
+            df[column] = [disk_name(folder, n) if isinstance(n, str) else n for n in df[column]]
     df["manifest_line"] = np.arange(len(df), dtype=int) + 2
     # rows with every cell empty (a blank line, or the ',,,,,' a spreadsheet leaves under its
     # data) are no photos: left out, not each one 'image name is empty'

@@ -11,6 +11,7 @@ from __future__ import annotations
 import fnmatch
 import os
 import re
+import unicodedata
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -131,6 +132,7 @@ def pattern_to_regex(pattern: str, *, pressure_in_name: bool = True) -> re.Patte
     """
     out, pos = [], 0
     names = []
+    pattern = unicodedata.normalize("NFC", pattern)  # names are matched in NFC too
     for m in re.finditer(r"\{([A-Za-z_]+)\}", pattern):
         out.append(re.escape(pattern[pos : m.start()]).replace(r"\*", ".*?"))
         name = m.group(1)
@@ -315,7 +317,7 @@ def _init_photoset(
     for name in sorted(photo_names(folder, subfolders="/" in pattern), key=natural_key):
         if (folder / name).resolve() in named:
             continue
-        m = regex.match(name)
+        m = regex.match(unicodedata.normalize("NFC", name))  # a Mac's NFD names
         if not m:
             unmatched.append(name)
             continue
@@ -498,7 +500,7 @@ def init_video_photoset(
     else:  # a frame sequence is one video
         names = [pattern] if frames else []
     for name in names:
-        m = regex.match(name)
+        m = regex.match(unicodedata.normalize("NFC", name))  # a Mac's NFD names
         if not m:
             continue
         log = pressure_log.replace("{video}", Path(name).stem)

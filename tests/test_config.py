@@ -110,6 +110,32 @@ def test_bad_config_is_refused_with_key_and_fix(tmp_path, datasets, message):
     assert "nothing was run" in str(exc.value)
 
 
+def test_a_config_that_would_mix_results_and_photos_or_share_a_folder_is_refused(tmp_path):
+    # customer 47: results_dir inside a photo set failed in the measure job, naming a --cache
+    # the Snakemake user never typed; a set kept in results/ (the run's own, to delete freely)
+    # passed; 'syn' and 'Syn' share one results folder on a Mac or Windows disk
+    (tmp_path / "set").mkdir()
+    (tmp_path / "results" / "mine").mkdir(parents=True)
+    cases = [
+        ({"results_dir": "set/out", "datasets": [{"name": "a", "source": "folder", "path": "set"}]},
+         "results_dir: "),
+        ({"datasets": [{"name": "a", "source": "folder", "path": "results/mine"}]},
+         "datasets[0].path: the photo set 'results/mine' lies inside results_dir"),
+        ({"datasets": [{"name": "syn", "source": "synthetic", "material": "DS20"},
+                       {"name": "Syn", "source": "synthetic", "material": "DS20"}]},
+         "datasets[1].name: 'Syn' and 'syn' differ only in case"),
+    ]
+    for config, message in cases:
+        with pytest.raises(UserInputError) as exc:
+            validate_config(config, workdir=tmp_path)
+        assert message in str(exc.value), str(exc.value)
+    assert "lies inside the photo set 'set'" in str(
+        pytest.raises(UserInputError, validate_config, cases[0][0], workdir=tmp_path).value
+    )
+    validate_config({"datasets": [{"name": "a", "source": "folder", "path": "set"}]},
+                    workdir=tmp_path)
+
+
 def test_unknown_key_lists_allowed_keys(tmp_path):
     with pytest.raises(UserInputError, match="allowed keys here"):
         validate_config({"measure": {"metod": "pratt"}}, workdir=tmp_path)

@@ -1032,3 +1032,29 @@ def test_init_gives_each_actuator_its_own_empty_scene(tmp_path, capsys):
     (tmp_path / "T1/empty_0102.jpg").write_bytes(b"")
     assert main([*init, "--background", "{actuator}/empty_*.jpg", "--overwrite"]) == 2
     assert "actuator T1 has 2 photos of the empty scene" in capsys.readouterr().err
+
+
+def test_a_photo_named_in_another_unicode_form_is_the_same_photo(tmp_path):
+    # customer 47: a Mac wrote 'Probe ä 3.jpg' as 'a' + a combining mark (NFD), the spreadsheet
+    # typed 'ä' (NFC): check said both "does not exist" and "not in manifest", and photoset
+    # init's pattern matched none
+    import unicodedata
+
+    from pipeline.photoset_check import check_photoset
+
+    img = np.full((24, 32, 3), 200, np.uint8)
+    for kpa in (0, 10, 20):
+        name = unicodedata.normalize("NFD", f"Probe ä_{kpa}kPa.jpg")
+        cv2.imencode(".jpg", img)[1].tofile(str(tmp_path / name))
+    typed = unicodedata.normalize("NFC", "Probe ä_{pressure_kpa}kPa.jpg")
+    manifest = photoset_init.init_photoset(
+        tmp_path, typed, settings={"l0_mm": 150.0}, defaults={"material": "DS20"}
+    )
+    assert len(manifest) == 3
+    rows = pd.read_csv(tmp_path / ps.MANIFEST)
+    rows["image"] = [unicodedata.normalize("NFC", n) for n in rows["image"]]  # as typed
+    rows.to_csv(tmp_path / ps.MANIFEST, index=False)
+    said = [str(p) for p in check_photoset(tmp_path, warnings=True)]
+    assert not [p for p in said if "does not exist" in p or "not in manifest" in p], said
+    loaded = ps.load_photoset(tmp_path)
+    assert all(loaded.image_path(n).is_file() for n in loaded.manifest["image"])
