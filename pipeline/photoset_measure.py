@@ -33,7 +33,6 @@ from pipeline.measure.ramp_background import (
     estimate_background,
     estimates_background,
 )
-from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task
 from pipeline.photoset import (
     PhotoSet,
@@ -507,13 +506,14 @@ def _measure_photos(
     rms = [(np.nan, np.nan) if r is None else r.calibration_rms for r in ps.rows]
     result["calibration_px"] = [px for px, _ in rms]
     result["calibration_mm"] = [mm for _, mm in rms]
-    drop = {"image", "manifest_line", *OVERRIDE_COLUMNS}
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
-    # a column of the manifest's own named as one measure writes ('reason', 'seconds') is
-    # left out: angles.csv would hold two columns of that name
+    # every other column of the manifest, its setting columns as given (customer 47 could not
+    # trace a row's fixed_end_x), but those angles.csv writes itself: the settings it writes as
+    # used (l0_mm, positive_turn, ...), and a column of the user's own of such a name ('reason',
+    # 'seconds': angles.csv would hold two columns of that name)
     carried += [
         c for c in manifest.columns
-        if c not in drop and c not in carried and c not in RESULT_COLUMNS
+        if c != "manifest_line" and c not in carried and c not in RESULT_COLUMNS
     ]
     out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
         drop=True
