@@ -36,7 +36,7 @@ import re
 import unicodedata
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from typing import Any
 
@@ -379,15 +379,30 @@ TYPO_RATIO = 0.8
 
 
 def typo_of(name: str, names: Sequence[str]) -> str | None:
-    """The name of ``names`` that ``name`` is a typo of (:data:`TYPO_RATIO`), or None.
+    """The name of ``names`` that ``name`` is a typo of (:data:`TYPO_RATIO`), or None: not where
+    ``name`` only adds to it (``timestamp_s``, ``steps``: another quantity) or ends in another
+    word (``l0_cm``, ``pressure_set``); a name short of its unit is one (``sealed_end``).
 
     Examples
     --------
     >>> typo_of("postive_turn", KEYS), typo_of("mm_per_pix", KEYS), typo_of("operator", KEYS)
     ('positive_turn', 'mm_per_px', None)
+    >>> typo_of("sealed_end", KEYS), typo_of("l0_cm", KEYS), typo_of("free_end_x", KEYS)
+    ('sealed_end_mm', None, None)
     """
     close = difflib.get_close_matches(name, names, n=1, cutoff=TYPO_RATIO)
-    return close[0] if close else None
+    if not close or name.startswith(close[0]):
+        return None
+    stem, _, last = name.rpartition("_")
+    known_stem, _, known_last = close[0].rpartition("_")
+    other_word = difflib.SequenceMatcher(None, last, known_last).ratio() < 0.75
+    if stem and stem == known_stem and other_word:
+        return None
+    return close[0]
+
+
+#: the last word of a column that names a unit: ``l0_cm`` is ``l0_mm`` in another unit
+UNIT_WORDS = frozenset({"m", "cm", "mm", "um", "in", "px", "deg", "rad", "s", "ms"})
 
 
 def yaml_fix(exc: yaml.YAMLError) -> str:
@@ -706,9 +721,13 @@ def _read_manifest(folder: Path) -> tuple[pd.DataFrame | None, Problem | None]:
             "material, actuator, trial); 'python -m pipeline photoset init' makes one from the "
             "photos' names",
         )
-    typos = column_typo_problems(str(path), df.columns)
+    typos = column_typo_problems(str(path), df.columns, is_video_manifest(df))
     if typos:
-        return None, typos[0]
+        more = [p.message.split(",", 1)[0].removeprefix("column ") for p in typos[1:]]
+        first = typos[0]
+        return None, replace(
+            first, message=first.message + (f" (so are {', '.join(more)})" if more else "")
+        )
     if "direction" in df.columns:  # 'Up', 'decreasing': read as meant, once, here
         df["direction"] = df["direction"].map(direction_name)
     for column in ("image", "video"):
@@ -750,37 +769,63 @@ def header_names(columns: Iterable[Any]) -> dict[str, str]:
     return out
 
 
-def column_typo_problems(path: str, columns: Iterable[Any]) -> list[Problem]:
-    """A problem for each manifest column that is a typo of one the manifest knows and does not
-    have (:func:`typo_of`): as it is it would be carried to angles.csv as a column of the user's
-    own and the setting ignored on every row.  Other columns of the user's own are fine (a
-    ``pressure_kpa_set`` beside ``pressure_kpa``).
+def column_typo_problems(
+    path: str, columns: Iterable[Any], video: bool = False
+) -> list[Problem]:
+    """A problem for each manifest column that is a typo of one a (``video``) manifest knows and
+    does not have (:func:`typo_of`; its name as :func:`plain_name` reads it), or a setting's
+    column in another unit (``l0_cm``): as it is it would be carried to angles.csv as a column
+    of the user's own and the setting ignored on every row.  Other columns of the user's own
+    are fine (``pressure_kpa_set``, ``timestamp_s``, ``notes``).
 
     Examples
     --------
-    >>> [p.fix for p in column_typo_problems("m.csv", ["image", "postive_turn", "operator"])]
+    >>> [p.fix for p in column_typo_problems("m.csv", ["image", "Postive Turn", "operator"])]
     ["rename it positive_turn (a column of your own needs a name less like the manifest's)"]
-    >>> column_typo_problems("m.csv", ["fixed_end"])[0].fix[:43]
+    >>> column_typo_problems("m.csv", ["fixed_end_px"])[0].fix[:43]
     'give the fixed end as fixed_end_x and fixed'
+    >>> column_typo_problems("m.csv", ["l0_cm"])[0].fix
+    "convert it to mm and name it l0_mm (a column of your own needs a name less like a setting's)"
+    >>> column_typo_problems("m.csv", ["timestamp_s", "steps", "pressure_set", "trial_id"])
+    []
     """
     known = (
-        *REQUIRED_COLUMNS, *OPTIONAL_COLUMNS, *VIDEO_REQUIRED_COLUMNS, *VIDEO_OPTIONAL_COLUMNS,
-        *PRESSURE_UNITS_KPA, *OVERRIDE_COLUMNS,
-    )
-    columns = [str(c) for c in columns]
-    missing = [k for k in known if k not in columns]
+        (*VIDEO_REQUIRED_COLUMNS, *VIDEO_OPTIONAL_COLUMNS) if video
+        else (*REQUIRED_COLUMNS, *OPTIONAL_COLUMNS)
+    ) + OVERRIDE_COLUMNS
+    names = {str(c): plain_name(str(c)) for c in columns}
+    missing = [k for k in known if k not in names.values()]
     out = []
-    for column in columns:
-        typo = None if column in known else typo_of(column, missing)
+    for column, name in names.items():
+        if name in known or name in PRESSURE_UNITS_KPA:
+            continue
+        stem, _, unit = name.rpartition("_")
+        other_unit = [
+            k for k in OVERRIDE_COLUMNS
+            if unit in UNIT_WORDS and k.rpartition("_")[0] == stem
+            and k.rpartition("_")[2] in UNIT_WORDS
+        ]
+        fix, typo = "", None
+        if name.startswith("fixed_end"):  # fixed_end [x, y] in one cell, fixed_end_px, ...
+            typo = "fixed_end_x"
+            fix = "give the fixed end as fixed_end_x and fixed_end_y columns (a pixel number each)"
+        elif other_unit:
+            typo = other_unit[0]
+            fix = (
+                f"convert it to {typo.rpartition('_')[2]} and name it {other_unit[0]} (a column "
+                "of your own needs a name less like a setting's)"
+            )
+        else:
+            typo = typo_of(name, missing)
         if typo is None:
             continue
         out.append(Problem(
             path,
             1,
-            f"column {column!r}, a typo of {typo}? As it is it would be ignored on every row",
-            "give the fixed end as fixed_end_x and fixed_end_y columns (one pixel number each)"
-            if column == "fixed_end"
-            else f"rename it {typo} (a column of your own needs a name less like the manifest's)",
+            f"column {column!r}, "
+            + (f"{typo} in another unit?" if other_unit else f"a typo of {typo}?")
+            + " As it is it would be ignored on every row",
+            fix or f"rename it {typo} (a column of your own needs a name less like the manifest's)",
         ))
     return out
 
