@@ -202,7 +202,7 @@ def measure_photoset(
         cache = None if cache_dir is None else Path(cache_dir)
         if cache is not None:
             check_cache_dir(cache, ps.folder)
-        out = _measure_photos(ps, method, jobs, odir, second_look, cache)
+        out = _measure_photos(ps, method, jobs, odir, second_look, cache, ramp_check)
     from_cache = int(out.attrs.get("from_cache", 0))
     cached_seconds = float(out.attrs.get("cached_seconds", 0.0))
     drawn = out[["status", "reason", "psi_deg"]].copy()
@@ -480,9 +480,12 @@ def _measure_photos(
     odir: Path | None,
     second_look: bool = True,
     cache_dir: Path | None = None,
+    from_ramp_starts: bool = True,
 ) -> pd.DataFrame:
     """The angles.csv table of a photo set of images (one row per manifest row); its ``attrs``
-    hold ``from_cache``, how many photos an earlier run had measured (with ``cache_dir``)."""
+    hold ``from_cache``, how many photos an earlier run had measured (with ``cache_dir``).
+    ``from_ramp_starts``: measure a line walked from its tip again (:func:`_from_ramp_starts`;
+    not with ``--no-ramp-check``, which measures each photo on its own)."""
     manifest = ps.manifest
     tasks = _tasks(ps, method, odir)
     used: set[str] = set()
@@ -491,7 +494,8 @@ def _measure_photos(
     cached_s = float(np.nansum([r["seconds"] for r, c in zip(rows, cached, strict=True) if c]))
     if second_look:
         rows = _on_ramp_backgrounds(ps, tasks, rows, jobs, cache_dir, used)
-    rows = _from_ramp_starts(ps, tasks, rows, jobs, cache_dir, used)
+    if from_ramp_starts:
+        rows = _from_ramp_starts(ps, tasks, rows, jobs, cache_dir, used)
     if cache_dir is not None:
         prune(cache_dir, used)
     turns = _camera_turns(ps, tasks, rows, jobs)
@@ -690,13 +694,16 @@ def _from_ramp_starts(
     cache_dir: Path | None = None,
     used: set[str] | None = None,
 ) -> list[dict[str, Any]]:
-    """``rows``, where a fixed end guessed (``fixed_end: auto``) took the line's free end
+    """``rows``, where a drawn line's fixed end guessed (``fixed_end: auto``) took its free end
     (:func:`walked_from_the_tip`), with the photo measured again from where its ramp's photos'
     lines start (the clamp stays put, the tip moves), when that measurement is not ``failed``;
-    its reason says so (:data:`~pipeline.measure.quality.NOTE_FROM_RAMP_START`).
+    its reason says so (:data:`~pipeline.measure.quality.NOTE_FROM_RAMP_START`), and its
+    overlay is the second measurement's only then.
 
     A black line on a body held by a white clamp gave ``auto`` no dark clamp to start from: it
-    walked every photo of a rendered ramp from the tip, and psi had the wrong sign in each.
+    walked every photo of a rendered ramp from the tip, and psi had the wrong sign in each.  A
+    body (whose doubtful rows may have had a second look against the ramp's empty scene) is
+    left to :func:`guessed_at_the_free_end`'s flag.
     """
     ends = [_line_ends(r) for r in rows]
     manifest = ps.manifest
@@ -704,34 +711,44 @@ def _from_ramp_starts(
         return rows
     guessed = [
         i for i, t in enumerate(tasks)
-        if t.settings is not None and t.settings.fixed_end_px is None and ends[i] is not None
+        if t.settings is not None and t.settings.fixed_end_px is None
+        and t.settings.target == "line" and ends[i] is not None
     ]
     ramps: dict[tuple[str, ...], list[int]] = {}
     for i in guessed:
         ramps.setdefault(tuple(str(manifest[k].iloc[i]) for k in RAMP_KEYS), []).append(i)
     starts = walked_from_the_tip(list(ramps.values()), ends, [r["length_px"] for r in rows])
-    again: list[tuple[int, Task]] = []
-    for i, start in starts.items():
-        settings = tasks[i].settings
-        assert settings is not None
-        fixed_end = (float(start[0]), float(start[1]))
-        again.append((i, replace(tasks[i], settings=replace(settings, fixed_end_px=fixed_end))))
-    if not again:
+    if not starts:
         return rows
     out = list(rows)
-    measured = _measured([t for _, t in again], jobs, cache_dir, set() if used is None else used)
-    for (i, _), row in zip(again, measured, strict=True):
-        row.pop("from_cache")
-        if row["status"] == "failed":
-            continue
-        first = rows[i]
-        note = (
-            f"{NOTE_FROM_RAMP_START} where its ramp's photos' lines start, near "
-            f"({starts[i][0]:.0f}, {starts[i][1]:.0f}) (the walk from the tip read "
-            f"{first['psi_deg']:+.1f} deg): set fixed_end, the pixel where the actuator leaves "
-            "the clamp"
+    with tempfile.TemporaryDirectory(prefix="ramp-starts-") as tmp:
+        again: list[tuple[int, Task]] = []
+        for i, start in starts.items():
+            settings, overlay = tasks[i].settings, tasks[i].overlay_path
+            assert settings is not None
+            fixed_end = (float(start[0]), float(start[1]))
+            again.append((i, replace(
+                tasks[i],
+                settings=replace(settings, fixed_end_px=fixed_end),
+                overlay_path=None if overlay is None else str(Path(tmp) / f"{i}.jpg"),
+            )))
+        measured = _measured(
+            [t for _, t in again], jobs, cache_dir, set() if used is None else used
         )
-        out[i] = {**row, "reason": f"{row['reason']}; {note}" if row["reason"] else note}
+        for (i, task), row in zip(again, measured, strict=True):
+            row.pop("from_cache")
+            if row["status"] == "failed":
+                continue
+            note = (
+                f"{NOTE_FROM_RAMP_START}, near "
+                f"({starts[i][0]:.0f}, {starts[i][1]:.0f}): fixed_end auto had taken the free "
+                f"end (psi {rows[i]['psi_deg']:+.1f} deg from there); set fixed_end, the pixel "
+                "where the actuator leaves the clamp"
+            )
+            out[i] = {**row, "reason": f"{row['reason']}; {note}" if row["reason"] else note}
+            drawn, final = task.overlay_path, tasks[i].overlay_path
+            if drawn is not None and final is not None:
+                shutil.move(drawn, final)
     return out
 
 

@@ -250,7 +250,7 @@ NOTE_GIVEN_OFF = "the bodies of this ramp leave the clamp at"
 #: a doubtful body measured again against its ramp's estimate of the empty scene, and kept
 NOTE_RAMP_BACKGROUND = "measured against the empty scene estimated from its ramp's photos"
 #: a line walked from its tip by ``fixed_end: auto``, measured again from its ramp's start
-NOTE_FROM_RAMP_START = "fixed end guessed at the free end, measured again from"
+NOTE_FROM_RAMP_START = "measured again from where its ramp's photos' lines start"
 #: a capped body measured without ``sealed_end_mm``, bent this much (deg) or more
 NOTE_NO_SEALED_END = "no sealed_end_mm"
 NO_SEALED_END_PSI_DEG = 100.0
