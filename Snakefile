@@ -48,10 +48,14 @@ onerror:
 
     from pipeline.photoset_measure import set_aside_stale_report
 
-    stale = set_aside_stale_report(Path(f"{RESULTS}/report.pdf"))
+    stale = set_aside_stale_report(
+        Path(f"{RESULTS}/report.pdf"),
+        [Path(f"{RESULTS}/datasets/{name}/angles.csv") for name in DATASETS],
+    )
     if stale is not None:
         print(
             f"The run stopped before it made the report again: the earlier run's, which does not "
-            f"show what changed since, is now {stale}. Fix what is said above and run again.",
+            f"show what changed since, is now {stale}. Run again (once what is said above, if "
+            "anything, is fixed).",
             file=sys.stderr,
         )

@@ -899,10 +899,11 @@ def run_summaries(
 STALE_REPORT_SUFFIX = ".STALE.pdf"
 
 
-def set_aside_stale_report(report: Path) -> Path | None:
-    """Rename ``report`` (an earlier run's, which a failed run did not make again) to
-    ``<name>.STALE.pdf``, replacing an older one; return the new path, or None where there was
-    no report.
+def set_aside_stale_report(report: Path, angles_paths: Sequence[Path]) -> Path | None:
+    """Rename ``report`` to ``<name>.STALE.pdf`` (replacing an older one) when it is stale: an
+    earlier run's, older than one of the sets' ``angles_paths`` or with one of them missing (a
+    failed or interrupted measure job's is removed); return the new path, or None where the
+    report is not there or not stale (a failed benchmark or rig job leaves it as it is).
 
     Customer 47's run stopped on a set's photoset.yaml, and the report of the run before, whose
     numbers no longer matched the photos, stayed as ``results/report.pdf`` for anyone to open
@@ -911,12 +912,15 @@ def set_aside_stale_report(report: Path) -> Path | None:
 
     Examples
     --------
-    >>> import tempfile
-    >>> report = Path(tempfile.mkdtemp()) / "report.pdf"
-    >>> set_aside_stale_report(report) is None
+    >>> import tempfile, os
+    >>> root = Path(tempfile.mkdtemp())
+    >>> report, angles = root / "report.pdf", root / "angles.csv"
+    >>> _ = angles.write_text("x"); _ = report.write_bytes(b"%PDF")
+    >>> os.utime(angles, (1, 1))
+    >>> set_aside_stale_report(report, [angles]) is None  # newer than its table
     True
-    >>> _ = report.write_bytes(b"%PDF")
-    >>> set_aside_stale_report(report).name, report.exists()
+    >>> angles.unlink()
+    >>> set_aside_stale_report(report, [angles]).name, report.exists()
     ('report.STALE.pdf', False)
     >>> _ = report.write_bytes(b"%PDF"); remove_stale_report(report); report.exists()
     True
@@ -924,6 +928,9 @@ def set_aside_stale_report(report: Path) -> Path | None:
     False
     """
     if not report.is_file():
+        return None
+    made = report.stat().st_mtime
+    if all(p.is_file() and p.stat().st_mtime <= made for p in map(Path, angles_paths)):
         return None
     stale = report.with_name(report.stem + STALE_REPORT_SUFFIX)
     os.replace(report, stale)

@@ -255,6 +255,10 @@ def direction_breaks(legs: list[pd.DataFrame], pressures_kpa: pd.Series) -> dict
     ...                        "direction": ["up"] * 3 + ["down"] * 2 + ["up"] * 2 + ["down"] * 2})
     >>> direction_breaks(runs(cycles), cycles.pressure_kpa)  # a second cycle
     {}
+    >>> hold = pd.DataFrame({"pressure_kpa": [0, 60, 120, 120, 120, 140, 160],
+    ...                      "direction": ["up"] * 3 + ["down"] * 2 + ["up"] * 2})
+    >>> direction_breaks(runs(hold), hold.pressure_kpa)  # held at the top, then on up
+    {}
     """
     out: dict[Any, str] = {}
     for before, run, after in zip(legs, legs[1:], legs[2:]):
@@ -263,8 +267,10 @@ def direction_breaks(legs: list[pd.DataFrame], pressures_kpa: pd.Series) -> dict
             continue
         rows = [before.index[-1], *run.index, after.index[0]]
         sign = 1.0 if other == DIRECTIONS[0] else -1.0
-        if (np.diff(sign * pressures_kpa[rows].to_numpy(float)) < -PRESSURE_SLACK_MIN_KPA).any():
-            continue  # its pressures do not follow the other direction's either
+        if (np.diff(sign * pressures_kpa[rows].to_numpy(float)) <= PRESSURE_SLACK_MIN_KPA).any():
+            # its pressures do not go on the other direction's way (a hold at one pressure, or
+            # one level approached from both sides, goes both ways)
+            continue
         shown = " -> ".join(f"{float(pressures_kpa[ix]):g}" for ix in rows)
         for ix in run.index:
             out[ix] = (
