@@ -312,7 +312,10 @@ def _fsync_dir(folder: Path) -> None:
 
 
 def check_replaceable_table(
-    path: str | os.PathLike[str], columns: Sequence[str], option: str = "--out"
+    path: str | os.PathLike[str],
+    columns: Sequence[str],
+    option: str = "--out",
+    example: str | os.PathLike[str] | None = None,
 ) -> None:
     """Refuse to write a table over a file that is not an earlier one of its kind: an existing
     ``path`` whose first line does not name every one of ``columns`` (a photo, a hand-made
@@ -328,6 +331,8 @@ def check_replaceable_table(
     >>> d = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (d / "angles.csv").write_text("image,psi_deg,status\\na.jpg,1.0,ok\\n")
     >>> check_replaceable_table(d / "angles.csv", ["psi_deg", "status"])
+    >>> _ = (d / "excel.csv").write_text("image;psi_deg;status\\na.jpg;1,0;ok\\n")
+    >>> check_replaceable_table(d / "excel.csv", ["psi_deg", "status"])
     >>> check_replaceable_table(d / "new.csv", ["psi_deg", "status"])
     >>> _ = (d / "manifest.csv").write_text("image,pressure_kpa\\na.jpg,0\\n")
     >>> try:
@@ -342,15 +347,14 @@ def check_replaceable_table(
     if not path.exists():
         return
     with open(path, "rb") as fh:
-        first = fh.read(1 << 16).split(b"\n", 1)[0].decode("utf-8", "replace").lstrip("\ufeff")
-    names = {n.strip().strip('"') for n in first.rstrip("\r").split(",")}
+        first = _user_text(fh.read(1 << 16)).splitlines()[:1]
+    header = first[0] if first else ""
+    names = {n.strip().strip('"') for n in header.split(csv_separator(header))}
     if not set(columns) <= names:
-        example = path.with_name(f"{path.stem}_angles.csv") if path.suffix == ".csv" else (
-            path.with_name("angles.csv")
-        )
         raise UserInputError(
             f"{option} {path}: exists and is not a table this command wrote (its first line has "
-            f"no {', '.join(columns)}), so it is not replaced: give a new file, e.g. {example}"
+            f"no {', '.join(columns)}), so it is not replaced: give a new file"
+            + (f", e.g. {example}" if example is not None else "")
         )
 
 

@@ -70,7 +70,10 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.photoset_measure import measure_photoset, summary, write_angles
 
     t0 = time.perf_counter()
-    check_replaceable_table(args.out, ("psi_deg", "status"))  # before minutes of measuring
+    folder = Path(args.photoset)
+    check_replaceable_table(  # before minutes of measuring
+        args.out, ("psi_deg", "status"), example=folder.parent / f"{folder.name}_angles.csv"
+    )
     ps = load_photoset(args.photoset)
     kw = {
         "method": args.method, "jobs": args.jobs, "ramp_check": args.ramp_check,

@@ -33,6 +33,7 @@ from pipeline.measure.ramp_background import (
     estimate_background,
     estimates_background,
 )
+from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.measure.worker import Task
 from pipeline.photoset import (
     PhotoSet,
@@ -512,16 +513,15 @@ def _measure_photos(
     result["calibration_mm"] = [mm for _, mm in rms]
     carried = [c for c in CARRIED_FIRST if c in manifest.columns]
     # every other column of the manifest, its setting columns as given (customer 47 could not
-    # trace a row's fixed_end_x), but those angles.csv writes itself: the settings it writes as
-    # used (l0_mm, positive_turn, ...), and a column of the user's own of such a name ('reason',
-    # 'seconds': angles.csv would hold two columns of that name)
-    carried += [
-        c for c in manifest.columns
-        if c != "manifest_line" and c not in carried and c not in RESULT_COLUMNS
-    ]
-    out = pd.concat([result[list(RESULT_COLUMNS)], manifest[carried]], axis=1).reset_index(
-        drop=True
+    # trace a row's fixed_end_x), but the settings angles.csv writes as used (l0_mm,
+    # positive_turn, ...); a column of the user's own named as one angles.csv writes ('reason',
+    # 'seconds') as manifest_<name> (angles.csv would hold two columns of that name)
+    as_used = {"image", "manifest_line", *(set(OVERRIDE_COLUMNS) & set(RESULT_COLUMNS))}
+    carried += [c for c in manifest.columns if c not in as_used and c not in carried]
+    own = manifest[carried].rename(
+        columns={c: f"manifest_{c}" for c in carried if c in RESULT_COLUMNS}
     )
+    out = pd.concat([result[list(RESULT_COLUMNS)], own], axis=1).reset_index(drop=True)
     out.attrs["from_cache"] = sum(cached)
     out.attrs["cached_seconds"] = cached_s
     out.attrs["line_ends"] = [_line_ends(r) for r in rows]

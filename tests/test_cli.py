@@ -271,8 +271,12 @@ def test_a_manifest_column_spelt_almost_as_a_setting_is_refused_as_a_typo(photo_
         assert out.returncode != 0, said
         assert "manifest.csv line 1: column 'postive_turn', a typo of positive_turn?" in said
         assert "(fix: rename it positive_turn" in said
-    # a column of the user's own is carried as before
-    manifest.assign(operator="Ann").to_csv(photo_folder / "manifest.csv", index=False)
+    # a column of the user's own is carried as before; one named as angles.csv's own (the
+    # review: 'reason' was left out without a word) as manifest_<name>
+    manifest.assign(operator="Ann", reason="retaken").to_csv(photo_folder / "manifest.csv",
+                                                             index=False)
     out = _run("measure", str(photo_folder), "--out", str(photo_folder.parent / "a.csv"))
     assert out.returncode == 0, out.stderr
-    assert (pd.read_csv(photo_folder.parent / "a.csv")["operator"] == "Ann").all()
+    angles = pd.read_csv(photo_folder.parent / "a.csv")
+    assert (angles["operator"] == "Ann").all() and (angles["manifest_reason"] == "retaken").all()
+    assert list(angles.columns).count("reason") == 1

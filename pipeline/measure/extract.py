@@ -760,9 +760,12 @@ def extract_centreline(
                 # moved the clamp 100-200 px off customer 46's one fixed end, and psi, the
                 # line's curvature times its length, read up to 9 % high, ok)
                 gap_fixed = min(gap_fixed, face)
-                # a line running out of the clamp that holds the fixed end reaches it
+                # a line running out of the clamp that holds the fixed end, near it, reaches it
                 face_xy = gpts[0] + (face / scale + 2.0) * _back_tangent(gpts)
-                at_fixed = at_fixed or _dark_between(image_bgr, face_xy, np.asarray(fe))
+                at_fixed = at_fixed or (
+                    float(np.hypot(*(face_xy - np.asarray(fe)))) <= 0.15 * s_along[-1]
+                    and _dark_between(image_bgr, face_xy, np.asarray(fe))
+                )
         else:
             gap_fixed = _face_distance(image_bgr, gpts, best.half_width) * scale
         if gap_fixed < 0.15 * s_along[-1] * scale:

@@ -21,7 +21,6 @@ import numpy as np
 import pandas as pd
 
 from pipeline.constants import RAMP_KEYS
-from pipeline.measure.settings import OVERRIDE_COLUMNS
 from pipeline.photoset import VIDEO_OPTIONAL_COLUMNS, PhotoSet
 from pipeline.pool import map_photos
 from pipeline.video.clips import Clip, frame_settings, resolve_clips, span_problem
@@ -204,14 +203,8 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
     df["calibration_px"], df["calibration_mm"] = (
         (np.nan, np.nan) if settings is None else settings.calibration_rms
     )
-    drop = {
-        "video",
-        "pressure_log",
-        "manifest_line",
-        *VIDEO_OPTIONAL_COLUMNS,
-        *OVERRIDE_COLUMNS,
-        *df.columns,
-    }
+    # a row's own setting columns as given, as for photos (not those written as used)
+    drop = {"video", "pressure_log", "manifest_line", *VIDEO_OPTIONAL_COLUMNS, *df.columns}
     for column in ps.manifest.columns:
         if column not in drop:
             df[column] = row[column]
