@@ -33,7 +33,7 @@ from pipeline.measure.ramp_background import (
     estimate_background,
     estimates_background,
 )
-from pipeline.measure.settings import OVERRIDE_COLUMNS
+from pipeline.measure.settings import OVERRIDE_COLUMNS, MeasureSettings
 from pipeline.measure.worker import Task
 from pipeline.photoset import (
     PhotoSet,
@@ -644,24 +644,12 @@ def _on_ramp_backgrounds(
     out = list(rows)
     with tempfile.TemporaryDirectory(prefix="ramp-backgrounds-") as tmp:
         estimates = _ramp_estimates(ps, tasks, rows, Path(tmp))
-        again: list[tuple[int, Task]] = []
-        for i, path in estimates.items():
-            settings = tasks[i].settings
-            if settings is None:
-                continue
-            overlay = tasks[i].overlay_path
-            again.append((i, replace(
-                tasks[i],
-                settings=replace(settings, background_path=str(path), background_estimated=True),
-                overlay_path=None if overlay is None else str(Path(tmp) / f"{i}.jpg"),
-            )))
-        measured = (
-            _measured([t for _, t in again], jobs, cache_dir, set() if used is None else used)
-            if again
-            else []
-        )
-        for (i, task), row in zip(again, measured, strict=True):
-            row.pop("from_cache")
+        changed = {
+            i: replace(settings, background_path=str(path), background_estimated=True)
+            for i, path in estimates.items()
+            if (settings := tasks[i].settings) is not None
+        }
+        for i, (task, row) in _measured_again(tasks, changed, jobs, cache_dir, used, tmp).items():
             first = rows[i]
             apart = abs(float(row["psi_deg"]) - float(first["psi_deg"]))
             if row["status"] != "ok" or (
@@ -680,10 +668,45 @@ def _on_ramp_backgrounds(
             elif cause := first_cause(str(first["reason"] or "")):
                 read += f": {cause}"  # customer 29 had to run preview to learn why
             out[i] = {**row, "reason": f"{row['reason']} (the first look read {read})"}
-            drawn, final = task.overlay_path, tasks[i].overlay_path
-            if drawn is not None and final is not None:
-                shutil.move(drawn, final)  # the temporary folder may be on another disk
+            _keep_overlay(task, tasks[i])
     return out
+
+
+def _measured_again(
+    tasks: list[Task],
+    settings: dict[int, MeasureSettings],
+    jobs: int,
+    cache_dir: Path | None,
+    used: set[str] | None,
+    tmp: str,
+) -> dict[int, tuple[Task, dict[str, Any]]]:
+    """Measure photos ``tasks[i]`` again with ``settings[i]``, each drawing its overlay into
+    ``tmp`` (kept only by :func:`_keep_overlay`): row ``i`` -> (its task, its row)."""
+    again = [
+        (i, replace(
+            tasks[i],
+            settings=s,
+            overlay_path=None if tasks[i].overlay_path is None else str(Path(tmp) / f"{i}.jpg"),
+        ))
+        for i, s in settings.items()
+    ]
+    measured = (
+        _measured([t for _, t in again], jobs, cache_dir, set() if used is None else used)
+        if again
+        else []
+    )
+    out = {}
+    for (i, task), row in zip(again, measured, strict=True):
+        row.pop("from_cache")
+        out[i] = (task, row)
+    return out
+
+
+def _keep_overlay(task: Task, first: Task) -> None:
+    """Put the overlay a photo measured again drew (``task``) where its first one was."""
+    drawn, final = task.overlay_path, first.overlay_path
+    if drawn is not None and final is not None:
+        shutil.move(drawn, final)  # the temporary folder may be on another disk
 
 
 def _from_ramp_starts(
@@ -721,34 +744,23 @@ def _from_ramp_starts(
     if not starts:
         return rows
     out = list(rows)
+    changed = {}
+    for i, start in starts.items():
+        settings = tasks[i].settings
+        assert settings is not None
+        changed[i] = replace(settings, fixed_end_px=(float(start[0]), float(start[1])))
     with tempfile.TemporaryDirectory(prefix="ramp-starts-") as tmp:
-        again: list[tuple[int, Task]] = []
-        for i, start in starts.items():
-            settings, overlay = tasks[i].settings, tasks[i].overlay_path
-            assert settings is not None
-            fixed_end = (float(start[0]), float(start[1]))
-            again.append((i, replace(
-                tasks[i],
-                settings=replace(settings, fixed_end_px=fixed_end),
-                overlay_path=None if overlay is None else str(Path(tmp) / f"{i}.jpg"),
-            )))
-        measured = _measured(
-            [t for _, t in again], jobs, cache_dir, set() if used is None else used
-        )
-        for (i, task), row in zip(again, measured, strict=True):
-            row.pop("from_cache")
+        for i, (task, row) in _measured_again(tasks, changed, jobs, cache_dir, used, tmp).items():
             if row["status"] == "failed":
                 continue
             note = (
                 f"{NOTE_FROM_RAMP_START}, near "
                 f"({starts[i][0]:.0f}, {starts[i][1]:.0f}): fixed_end auto had taken the free "
-                f"end (psi {rows[i]['psi_deg']:+.1f} deg from there); set fixed_end, the pixel "
-                "where the actuator leaves the clamp"
+                f"end (psi {rows[i]['psi_deg']:+.1f} deg from there), so set fixed_end, the "
+                "pixel where the actuator leaves the clamp"
             )
             out[i] = {**row, "reason": f"{row['reason']}; {note}" if row["reason"] else note}
-            drawn, final = task.overlay_path, tasks[i].overlay_path
-            if drawn is not None and final is not None:
-                shutil.move(drawn, final)
+            _keep_overlay(task, tasks[i])
     return out
 
 
