@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from pipeline.aggregate import aggregate_hysteresis, aggregate_per_actuator, read_angles
-from pipeline.fileio import write_table
+from pipeline.fileio import check_replaceable_table, write_table
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -56,6 +56,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Aggregate and write; print a one-line summary."""
+    check_replaceable_table(args.out, ("psi_mean_deg", "n_excluded"))  # a person's file stays
     angles = read_angles(args.angles)
     hyst = aggregate_hysteresis(angles, bin_kpa=args.bin_kpa, include_flagged=args.include_flagged)
     write_table(hyst, args.out)

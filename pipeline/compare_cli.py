@@ -13,7 +13,7 @@ import pandas as pd
 from pipeline.aggregate import read_angles
 from pipeline.compare import check_hysteresis, compare, file_model, model_callables
 from pipeline.errors import UserInputError
-from pipeline.fileio import FLOAT_FORMAT, read_table, write_table
+from pipeline.fileio import FLOAT_FORMAT, check_replaceable_table, read_table, write_table
 from pipeline.model.cli import add_reading_arguments, reading_options
 from pipeline.photoset import TRUTH
 
@@ -202,6 +202,7 @@ def run(args: argparse.Namespace) -> int:
     """Compare and write rms.csv (and the model curves); print a one-line summary per row."""
     from pipeline import model
 
+    check_replaceable_table(args.out, ("rms_deg",))  # a person's file is never replaced
     names = dataset_names(args.hysteresis, args.datasets)
     if args.n_boot < 0:
         raise UserInputError(f"--bootstrap must be >= 0 resamples, got {args.n_boot}")

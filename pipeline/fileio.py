@@ -358,6 +358,29 @@ def check_replaceable_table(
         )
 
 
+def check_replaceable_pdf(path: str | os.PathLike[str], option: str = "--out") -> None:
+    """Refuse to write a PDF over an existing ``path`` that is not one (a photo, a table, a
+    person's document): as :func:`check_replaceable_table` for a report.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "report.pdf").write_bytes(b"%PDF-1.4 ...")
+    >>> check_replaceable_pdf(d / "report.pdf"); check_replaceable_pdf(d / "new.pdf")
+    >>> _ = (d / "manifest.csv").write_text("image,pressure_kpa\\n")
+    >>> check_replaceable_pdf(d / "manifest.csv")  # doctest: +IGNORE_EXCEPTION_DETAIL
+    Traceback (most recent call last):
+    pipeline.errors.UserInputError: --out .../manifest.csv: exists and is not a PDF ...
+    """
+    path = Path(path)
+    if path.is_dir() or (path.exists() and not path.read_bytes()[:5] == b"%PDF-"):
+        raise UserInputError(
+            f"{option} {path}: exists and is not a PDF this command wrote, so it is not "
+            "replaced: give a new file, e.g. report.pdf"
+        )
+
+
 def table_bytes(table: pd.DataFrame, float_format: str | None = FLOAT_FORMAT) -> bytes:
     """The CSV bytes of a table as every stage writes it (no index, ``\\n`` line ends)."""
     return table.to_csv(index=False, lineterminator="\n", float_format=float_format).encode()

@@ -246,6 +246,17 @@ def test_measure_out_never_replaces_a_photo_or_the_manifest(photo_folder):
     for _ in range(2):
         out = _run("measure", str(photo_folder), "--out", str(angles))
         assert out.returncode == 0, out.stderr
+    # nor does a later stage's --out replace a person's file (the review: they had no guard)
+    hysteresis = photo_folder.parent / "hysteresis.csv"
+    out = _run("aggregate", str(angles), "--out", str(hysteresis))
+    assert out.returncode == 0, out.stderr
+    for command in (("aggregate", str(angles)), ("report", "--angles", str(angles)),
+                    ("compare", str(hysteresis))):
+        for target in kept:
+            out = _run(*command, "--out", str(target))
+            assert out.returncode != 0, out.stdout
+            assert f"--out {target}: exists and is not a" in out.stderr, out.stderr
+    assert {p: p.read_bytes() for p in kept} == kept
     # an angles.csv put where the manifest was is named as such (measure stopped in a TypeError)
     (photo_folder / "manifest.csv").write_bytes(angles.read_bytes())
     for command in (("photoset", "check", str(photo_folder)),

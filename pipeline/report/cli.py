@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from pipeline.errors import UserInputError
+from pipeline.fileio import check_replaceable_pdf
 
 NONE_MARK = "-"
 
@@ -171,6 +172,7 @@ def run(args: argparse.Namespace) -> int:
     from pipeline.report.build import build_report  # matplotlib is imported only when building
     from pipeline.report.data import Dataset, ReportInputs
 
+    check_replaceable_pdf(args.out)  # a person's file is never replaced
     n = len(args.angles)
     names = args.datasets if args.datasets is not None else default_names(args.angles)
     if len(names) != n:
