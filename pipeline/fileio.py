@@ -341,20 +341,15 @@ def check_replaceable_table(
     ...     print(str(exc).split(": ", 1)[1][:72])
     exists and is not a table this command wrote (its first line has no psi_
     """
-    path = Path(path)
-    if path.is_dir():
-        raise UserInputError(f"{option} {path}: is a folder; give a file, e.g. {path / 'x.csv'}")
-    if not path.exists():
+    head = _existing_head(path, option)
+    if head is None:
         return
-    with open(path, "rb") as fh:
-        first = _user_text(fh.read(1 << 16)).splitlines()[:1]
+    first = _user_text(head).splitlines()[:1]
     header = first[0] if first else ""
-    names = {n.strip().strip('"') for n in header.split(csv_separator(header))}
-    if not set(columns) <= names:
-        raise UserInputError(
-            f"{option} {path}: exists and is not a table this command wrote (its first line has "
-            f"no {', '.join(columns)}), so it is not replaced: give a new file"
-            + (f", e.g. {example}" if example is not None else "")
+    if not set(columns) <= {n.strip().strip('"') for n in header.split(csv_separator(header))}:
+        raise _not_replaced(
+            path, f"a table this command wrote (its first line has no {', '.join(columns)})",
+            option, example,
         )
 
 
@@ -373,12 +368,31 @@ def check_replaceable_pdf(path: str | os.PathLike[str], option: str = "--out") -
     Traceback (most recent call last):
     pipeline.errors.UserInputError: --out .../manifest.csv: exists and is not a PDF ...
     """
+    head = _existing_head(path, option)
+    if head is not None and not head.startswith(b"%PDF-"):
+        raise _not_replaced(path, "a PDF this command wrote", option, "report.pdf")
+
+
+def _existing_head(path: str | os.PathLike[str], option: str) -> bytes | None:
+    """The first 64 KiB of an existing output file (None where there is none yet); a folder
+    there is refused."""
     path = Path(path)
-    if path.is_dir() or (path.exists() and not path.read_bytes()[:5] == b"%PDF-"):
-        raise UserInputError(
-            f"{option} {path}: exists and is not a PDF this command wrote, so it is not "
-            "replaced: give a new file, e.g. report.pdf"
-        )
+    if path.is_dir():
+        raise UserInputError(f"{option} {path}: is a folder; give a file in it")
+    if not path.exists():
+        return None
+    with open(path, "rb") as fh:
+        return fh.read(1 << 16)
+
+
+def _not_replaced(
+    path: str | os.PathLike[str], kind: str, option: str, example: Any = None
+) -> UserInputError:
+    """The refusal to write over ``path``, a file that is not ``kind``."""
+    return UserInputError(
+        f"{option} {path}: exists and is not {kind}, so it is not replaced: give a new file"
+        + (f", e.g. {example}" if example is not None else "")
+    )
 
 
 def table_bytes(table: pd.DataFrame, float_format: str | None = FLOAT_FORMAT) -> bytes:
