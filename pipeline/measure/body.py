@@ -33,7 +33,7 @@ import pandas as pd
 from scipy.sparse.csgraph import dijkstra
 
 from pipeline.measure.colors import color_mask
-from pipeline.measure.estimators import end_tangents
+from pipeline.measure.estimators import TANGENT_WINDOW_FRACTION, end_tangents
 from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
 from pipeline.measure.settings import MeasureSettings, Polygon
 
@@ -61,6 +61,22 @@ OUTLINE_MIN_ELONGATION = 3.0
 HOLLOW_WIDTHS = 4.0
 #: the centre line is smoothed over this many half-widths (ragged, textured edges)
 SMOOTH_HALF_WIDTHS = 0.6
+
+
+@dataclass(frozen=True)
+class TipFace:
+    """The square, flat face ending a body at its free end (:func:`tip_face_normal`).
+
+    Attributes
+    ----------
+    normal_rad : float
+        Its outward normal (rad, image axes: y down): the tip's direction.
+    middle_px : (float, float)
+        Its middle (x, y), px.
+    """
+
+    normal_rad: float
+    middle_px: tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -106,6 +122,12 @@ class BodyExtraction:
     tip_capped : bool
         The centre line stopped at the free end where the body goes on wider, centred on its
         course: a rigid cap, over which the body does not bend.
+    chambered : bool
+        The gaps between a row of chambers were filled (:func:`fill_chamber_gaps`): the centre
+        line's course is a polygon, one side per chamber, and its start the first chamber's.
+    tip_face : TipFace or None
+        The square, flat face ending the body (original px), None where the end is not one
+        (:func:`tip_face_normal`).
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
         (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
@@ -127,6 +149,8 @@ class BodyExtraction:
     side_on_border: bool = False
     tip_at_region_edge: bool = False
     hollow_outline: bool = False
+    tip_face: TipFace | None = None
+    chambered: bool = False
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -904,6 +928,66 @@ def _clean(mask: np.ndarray) -> np.ndarray:
     return m
 
 
+#: a PneuNet's chambers: the gaps between them are closed over up to this many half-widths wide
+#: (the chambers' own half-height, as the ridge through them reads it) ...
+CHAMBER_GAP_HALF_WIDTHS = 1.5
+#: ... where at least CHAMBER_GAPS_MIN of them, each a slot at least CHAMBER_GAP_DEPTH
+#: half-widths deep, twice as deep as it is wide and at least CHAMBER_GAP_AREA square
+#: half-widths large, cut into the body from one side (a translucent body's faint patches and
+#: dots leave smaller ones)
+CHAMBER_GAPS_MIN, CHAMBER_GAP_DEPTH, CHAMBER_GAP_AREA = 3, 0.5, 0.2
+
+
+def fill_chamber_gaps(comp: np.ndarray, half: float) -> np.ndarray:
+    """``comp`` with the gaps between a row of chambers filled (a PneuNet seen from the side: a
+    comb of chambers on the layer that does not stretch), or ``comp`` itself where it shows no
+    such row.
+
+    The body of a chambered actuator is the envelope of its chambers: its centre line runs
+    between the layer and the chambers' tops.  Unfilled, the ridge of the selection zig-zagged
+    into every chamber and out through the strip below each gap (customer 48's PneuNets, 20 mm
+    high with 1.6 mm gaps: no photo above 10 kPa `ok`).  A closing as wide as
+    :data:`CHAMBER_GAP_HALF_WIDTHS` half-widths fills the gaps; it is kept where it fills at least
+    :data:`CHAMBER_GAPS_MIN` slots at least :data:`CHAMBER_GAP_DEPTH` half-widths deep (and
+    :data:`CHAMBER_GAP_AREA` large) and encloses no backdrop (two arms of a curl bridged).
+
+    Examples
+    --------
+    >>> comb = np.zeros((60, 200), np.uint8)
+    >>> comb[35:45, 10:190] = 1  # the layer
+    >>> for x in range(10, 190, 20):
+    ...     comb[15:35, x : x + 16] = 1  # chambers 16 px wide, 4 px gaps
+    >>> filled = fill_chamber_gaps(comb, 14.0)
+    >>> int(comb[25, 26:30].sum()), int(filled[25, 26:30].sum())
+    (0, 4)
+    >>> solid = np.zeros((60, 200), np.uint8); solid[15:45, 10:190] = 1
+    >>> fill_chamber_gaps(solid, 15.0) is solid
+    True
+    """
+    d = max(5, round(float(CHAMBER_GAP_HALF_WIDTHS * half)) | 1)
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d, d))
+    closed = cv2.morphologyEx(comp, cv2.MORPH_CLOSE, disc)
+    added = (closed > 0) & (comp == 0)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(added.astype(np.uint8), connectivity=8)
+    slots = []
+    for i in range(1, n):
+        if stats[i, cv2.CC_STAT_AREA] < max(4.0, CHAMBER_GAP_AREA * half * half):
+            continue
+        ys, xs = np.nonzero(labels == i)
+        (_, _), (a, b), _ = cv2.minAreaRect(np.c_[xs, ys].astype(np.float32))
+        if max(a, b) >= CHAMBER_GAP_DEPTH * half and max(a, b) >= 2.0 * min(a, b):
+            slots.append(i)
+    if len(slots) < CHAMBER_GAPS_MIN:
+        return comp
+    out = ((comp > 0) | np.isin(labels, slots)).astype(np.uint8)
+
+    def holes(m: np.ndarray) -> int:
+        _, hier = cv2.findContours(m, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE)
+        return 0 if hier is None else int((hier[0][:, 3] != -1).sum())
+
+    return out if holes(out) <= holes(comp) else comp
+
+
 def _component(
     mask: np.ndarray, fixed_xy: tuple[float, float] | None
 ) -> tuple[np.ndarray, int, bool]:
@@ -1233,6 +1317,226 @@ CLAMP_WIDTH_RATIO = 1.3
 FREE_TIP_ACROSS = 0.3
 
 
+#: the tip's end face: its contour within this many half-widths of the centre line's course ...
+FACE_ACROSS_HALF_WIDTHS = 0.6
+#: ... and within this many half-widths of the farthest of it along that course is fitted with a
+#: straight line; it counts as a flat face when it spans at least FACE_MIN_SPAN half-widths
+#: across, the body is at least FACE_MIN_HALF_PX px wide a half-width, and the fit's RMS is at
+#: most FACE_MAX_RMS half-widths (a rounded tip: about 0.07)
+FACE_DEPTH_HALF_WIDTHS = 0.5
+FACE_MIN_SPAN, FACE_MIN_HALF_PX, FACE_MAX_RMS = 0.9, 6.0, 0.04
+#: the face is square to the body when its normal lies within this (deg) of the body's direction
+#: there, from the two long edges next to it (each from FACE_EDGE_FROM to FACE_EDGE_TO
+#: half-widths along the outline from its corner: an arc, or a straight body, fitted to both)
+FACE_SQUARE_DEG = 4.0
+FACE_EDGE_FROM, FACE_EDGE_TO = 0.4, 2.5
+#: ... where those edges fit the arc (or the lines) within this many half-widths RMS; where they
+#: do not (a chamber's gap, a dot, a faint side beside the face) they cannot say
+FACE_EDGE_RMS = 0.02
+
+
+def tip_face_normal(
+    comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float, *, chambered: bool = False
+) -> TipFace | None:
+    """The square, flat face ending the body at its free end: its outward normal and middle;
+    None where the end is not one (rounded, ragged, too narrow, or cut at a slant).
+
+    A square end, and a rigid cap's end, is square to the body's last direction: the face's
+    normal is the tip's direction wherever the centre line stops short of the face (a thick
+    body bent tightly: its profiles stop about a half-width before the face, where "between the
+    two long edges" no longer holds).  The face is found on ``comp``'s outline and located to a
+    fraction of a pixel where ``soft`` crosses 0.5 along the centre line's course; it counts as
+    square when its normal is the body's direction at the face from the two long edges beside
+    it (:func:`_edges_direction`; a face cut 10-20 deg aslant read as the tip turned psi by up to
+    29 deg, `ok`).  Where those edges are too uneven to say (dots, a faint side), the face is
+    not taken (a translucent body's read psi 3-7 deg high, `ok`), unless the body is
+    ``chambered``: a PneuNet's last chamber's end wall, whose edges beside it are cut by the
+    gap before it.
+
+    Parameters
+    ----------
+    comp : ndarray (H, W) uint8
+        The body.
+    soft : ndarray (H, W) float32
+        The body as a 0..1 field whose 0.5 level is its edge (:func:`_soft_body`).
+    pts : ndarray (N, 2)
+        Its centre line (x, y), fixed end first.
+    half : float
+        The body's half-width (px).
+
+    Examples
+    --------
+    >>> comp = np.zeros((80, 140), np.uint8)
+    >>> comp[20:60, 10:110] = 1  # a straight body 40 px wide, its face at x = 109.5
+    >>> pts = np.c_[np.arange(10.0, 90.0), np.full(80, 39.5)]
+    >>> face = tip_face_normal(comp, comp.astype(np.float32), pts, 20.0)
+    >>> abs(round(float(np.rad2deg(face.normal_rad)), 1)), np.round(face.middle_px, 1).tolist()
+    (0.0, [109.5, 39.5])
+    >>> slant = comp.copy()
+    >>> slant[:, 100:] = 0
+    >>> _ = cv2.fillPoly(slant, [np.array([[100, 20], [117, 20], [103, 59], [100, 59]])], 1)
+    >>> print(tip_face_normal(slant, slant.astype(np.float32), pts, 20.0))  # cut 20 deg aslant
+    None
+    >>> comp[:, 90:] = 0
+    >>> _ = cv2.circle(comp, (90, 40), 20, 1, -1)  # a rounded tip
+    >>> print(tip_face_normal(comp, comp.astype(np.float32), pts, 20.0))
+    None
+    """
+    if half < FACE_MIN_HALF_PX or len(pts) < 6:
+        return None
+    t = pts[-1] - pts[-6]
+    t = t / max(float(np.hypot(*t)), 1e-9)
+    n = np.array([-t[1], t[0]])
+    contours, _ = cv2.findContours(comp, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    best: tuple[int, np.ndarray, np.ndarray] | None = None
+    for k in contours:
+        c = k[:, 0, :].astype(float)
+        d = c - pts[-1]
+        along, across = d @ t, d @ n
+        near = (np.abs(across) <= FACE_ACROSS_HALF_WIDTHS * half) & (along > 0)
+        if near.any():
+            near &= along >= along[near].max() - FACE_DEPTH_HALF_WIDTHS * half
+        if best is None or near.sum() > best[0]:
+            best = (int(near.sum()), c, near)
+    if best is None or best[0] < 5:
+        return None
+    _, c, near = best
+    face = float(((c[near] - pts[-1]) @ t).max())
+    # along rays parallel to the course, across the face's middle: where soft falls through 0.5
+    u = np.arange(-FACE_ACROSS_HALF_WIDTHS * half, FACE_ACROSS_HALF_WIDTHS * half + 1e-9, 1.0)
+    a = np.arange(face - FACE_DEPTH_HALF_WIDTHS * half - 2.0, face + 3.0, 0.25)
+    xy = pts[-1] + a[None, :, None] * t + u[:, None, None] * n
+    prof = cv2.remap(
+        soft, xy[..., 0].astype(np.float32), xy[..., 1].astype(np.float32), cv2.INTER_LINEAR,
+        borderValue=0.0,
+    )
+    inside = prof >= 0.5
+    found = inside[:, 0] & ~inside[:, -1]
+    last = inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1)  # last inside sample
+    rows = np.flatnonzero(found & (last < inside.shape[1] - 1))
+    if len(rows) < 5:
+        return None
+    p0, p1 = prof[rows, last[rows]], prof[rows, last[rows] + 1]
+    cross = a[last[rows]] + 0.25 * np.clip((p0 - 0.5) / np.maximum(p0 - p1, 1e-6), 0.0, 1.0)
+    q = np.c_[cross, u[rows]]
+    centred = q - q.mean(axis=0)
+    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
+    span = float(np.ptp(centred @ vt[0]))
+    rms = float(sv[1] / np.sqrt(len(q)))
+    if span < FACE_MIN_SPAN * half or rms > FACE_MAX_RMS * half:
+        return None
+    normal = np.array([vt[0][1], -vt[0][0]])  # in (along, across)
+    if normal[0] < 0:
+        normal = -normal
+    world = normal[0] * t + normal[1] * n
+    middle = pts[-1] + q.mean(axis=0)[0] * t + q.mean(axis=0)[1] * n
+    body = _edges_direction(c, near, middle, world, half, soft)
+    if body is None and not chambered:
+        return None
+    if body is not None and float(np.degrees(np.arccos(np.clip(abs(world @ body), -1.0, 1.0)))) > (
+        FACE_SQUARE_DEG
+    ):
+        return None
+    return TipFace(float(np.arctan2(world[1], world[0])), (float(middle[0]), float(middle[1])))
+
+
+def _in_original_px(face: TipFace | None, scale: float) -> TipFace | None:
+    """``face`` found on the work image (reduced by ``scale``), in the original's px."""
+    if face is None:
+        return None
+    x, y = face.middle_px
+    return TipFace(face.normal_rad, (x * scale + (scale - 1) / 2, y * scale + (scale - 1) / 2))
+
+
+def _on_edge(soft: np.ndarray, walk: np.ndarray) -> np.ndarray:
+    """The points of an outline stretch ``walk`` (in order along it) moved across it to where
+    ``soft`` crosses 0.5 (sub-pixel; a point without a crossing within 2 px is dropped)."""
+    if len(walk) < 5:
+        return walk
+    smooth = cv2.GaussianBlur(walk.reshape(-1, 1, 2).astype(np.float32), (1, 5), 0).reshape(-1, 2)
+    tangent = np.gradient(smooth, axis=0)
+    tangent /= np.maximum(np.hypot(*tangent.T), 1e-9)[:, None]
+    normal = np.c_[-tangent[:, 1], tangent[:, 0]]
+    offs = np.arange(-2.5, 2.51, 0.25)
+    xy = smooth[:, None, :] + offs[None, :, None] * normal[:, None, :]
+    prof = cv2.remap(soft, xy[..., 0].astype(np.float32), xy[..., 1].astype(np.float32),
+                     cv2.INTER_LINEAR, borderValue=0.0)
+    inside = prof >= 0.5
+    flips = np.flatnonzero(np.any(inside[:, :-1] != inside[:, 1:], axis=0))
+    out = []
+    for i in range(len(walk)):
+        f = np.flatnonzero(inside[i, :-1] != inside[i, 1:])
+        if len(f) != 1:
+            continue
+        j = int(f[0])
+        p0, p1 = prof[i, j], prof[i, j + 1]
+        at = offs[j] + 0.25 * (p0 - 0.5) / (p0 - p1) if p0 != p1 else offs[j]
+        out.append(smooth[i] + at * normal[i])
+    del flips
+    return np.array(out).reshape(-1, 2)
+
+
+def _edges_direction(
+    contour: np.ndarray,
+    face: np.ndarray,
+    middle: np.ndarray,
+    normal: np.ndarray,
+    half: float,
+    soft: np.ndarray,
+) -> np.ndarray | None:
+    """The body's direction (unit vector, either sense) at the point ``middle`` of its end face,
+    from the two long edges beside the face: the stretches of the closed ``contour`` from
+    :data:`FACE_EDGE_FROM` to :data:`FACE_EDGE_TO` half-widths along it from either corner (where
+    the outline, followed on from the face's middle run ``face``, a mask of its points, leaves
+    the face's line through ``middle`` square to ``normal``), put on the edge to a fraction of
+    a pixel (:func:`_on_edge`) and fitted with two concentric circles (a bent body: the
+    direction square to the radius through ``middle``), or two parallel lines where that is as
+    good (a straight one).  None where the face's run is not one piece or an edge is too short.
+    """
+    m = len(contour)
+    idx = np.flatnonzero(face)
+    if m < 8 or len(idx) < 2:
+        return None
+    gaps = np.diff(np.r_[idx, idx[0] + m])
+    k = int(np.argmax(gaps))  # the run is what lies outside the largest gap between face points
+    if (gaps > 1).sum() > 1 and np.sort(gaps)[-2] > 0.5 * half:
+        return None
+    off_face = np.abs((contour - middle) @ normal) > max(1.0, 0.1 * half)
+
+    def stretch(run_end: int, sense: int) -> np.ndarray:
+        walk_at = (run_end + sense * np.arange(m // 2)) % m
+        corner = int(np.argmax(off_face[walk_at]))  # the first point off the face's line
+        walk = contour[walk_at[corner:]]
+        walked = np.r_[0.0, np.cumsum(np.hypot(*np.diff(walk, axis=0).T))]
+        return walk[(walked >= FACE_EDGE_FROM * half) & (walked <= FACE_EDGE_TO * half)]
+
+    start, end = idx[(k + 1) % len(idx)], idx[k]
+    side_a, side_b = _on_edge(soft, stretch(start, -1)), _on_edge(soft, stretch(end, +1))
+    if min(len(side_a), len(side_b)) < 4:
+        return None
+    both = np.r_[side_a, side_b]
+    # two concentric circles: x^2 + y^2 = 2 a x + 2 b y + c_side
+    design = np.c_[2.0 * both, np.r_[np.ones(len(side_a)), np.zeros(len(side_b))],
+                   np.r_[np.zeros(len(side_a)), np.ones(len(side_b))]]
+    rhs = (both**2).sum(axis=1)
+    sol, *_ = np.linalg.lstsq(design, rhs, rcond=None)
+    centre = sol[:2]
+    radii = np.hypot(*(both - centre).T)
+    fit_arc = float(np.mean((radii - np.r_[np.full(len(side_a), radii[: len(side_a)].mean()),
+                                           np.full(len(side_b), radii[len(side_a):].mean())]) ** 2))
+    # two parallel lines: a common direction through both sides' own centres
+    centred = np.r_[side_a - side_a.mean(axis=0), side_b - side_b.mean(axis=0)]
+    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
+    fit_line = float(sv[1] ** 2 / len(centred))
+    radius = float(np.hypot(*(middle - centre)))
+    if np.sqrt(min(fit_line, fit_arc)) > FACE_EDGE_RMS * half:
+        return None  # edges neither an arc nor straight there: a chamber's gap, a dot, a cap
+    if fit_line <= 1.5 * fit_arc or radius > 40.0 * half:
+        return np.asarray(vt[0])
+    radial = (middle - centre) / max(radius, 1e-9)
+    return np.array([-radial[1], radial[0]])
+
+
 def _uncovered(ridge: np.ndarray, end: np.ndarray) -> float:
     """Length of the ridge path beyond the point nearest ``end`` (px)."""
     seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(ridge, axis=0).T))))
@@ -1434,7 +1738,7 @@ def _extensions(
         t = pts[end] - pts[inner]
         t = t / max(float(np.hypot(*t)), 1e-9)  # outward tangent
         if end == 0 and fixed_xy is not None:
-            reach = max(0.0, float((np.asarray(fixed_xy) - p) @ t))
+            reach = face_reach(pts, np.asarray(fixed_xy, float))
             if not free_end_bends:
                 reach = min(reach, _clamp_distance(dt, p, t, half, reach))
             out.append(reach)
@@ -1459,6 +1763,40 @@ def _extensions(
         else:
             out.append(0.0)
     return out[0], out[1]
+
+
+def face_reach(pts: np.ndarray, fixed_xy: np.ndarray) -> float:
+    """How far the centre line's first point lies from the face through ``fixed_xy`` (px): the
+    face is square to the body's direction there, which is the start's direction turned back at
+    the start's curvature over that distance.
+
+    The fixed end is often given on an edge, half a width beside the centre line; measured along
+    the start's own direction, a body that bends right from the clamp took in half its width
+    times the sine of its turn over that stretch (its base read 2-5 deg off on a body 50 px wide
+    at psi 200 over 250 px).
+
+    Examples
+    --------
+    >>> k = 1.0 / 60.0  # an arc of radius 60 leaving the face x = 0 along +x, begun 8 px in
+    >>> s = np.arange(8.0, 200.0)
+    >>> pts = np.c_[np.sin(k * s), 1.0 - np.cos(k * s)] / k
+    >>> round(face_reach(pts, np.array([0.0, 25.0])), 1), round(face_reach(pts, np.zeros(2)), 1)
+    (8.0, 8.0)
+    """
+    seg = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
+    head = pts[seg <= max(TANGENT_WINDOW_FRACTION * seg[-1], 6.0)]
+    if len(head) < 4:
+        return max(0.0, float((pts[0] - fixed_xy) @ (pts[-1] - pts[0])) / max(seg[-1], 1e-9))
+    d = np.diff(head, axis=0)
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    along = np.cumsum(np.hypot(d[:, 0], d[:, 1])) - 0.5 * np.hypot(d[:, 0], d[:, 1])
+    kappa, theta0 = np.polyfit(along, theta, 1)
+    off = pts[0] - fixed_xy
+    reach = 0.0
+    for _ in range(40):  # the distance along the direction it gives, at half steps
+        a = theta0 - kappa * reach
+        reach = 0.5 * (reach + max(0.0, float(off @ np.array([np.cos(a), np.sin(a)]))))
+    return reach
 
 
 def _clamp_distance(
@@ -1786,6 +2124,14 @@ def extract_body(
     # joined to it would pull a component-wide figure far off)
     xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
     half = float(np.median(dt[yi, xi])) if len(path) else 0.0
+    filled = fill_chamber_gaps(comp, half)
+    chambered = filled is not comp
+    if chambered:  # a row of chambers: the body is their envelope
+        comp = filled
+        dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+        path, _ = _ridge_path(comp, dt, fe if reached else None)
+        xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
+        half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
         raise NoLineFound(
@@ -1882,4 +2228,8 @@ def extract_body(
             if settings.sealed_end_mm is None and settings.free_end != "capped"
             else _extensions(comp, dt, pts, half, None, free_end_bends=True)[1] * scale
         ),
+        tip_face=_in_original_px(
+            tip_face_normal(comp, soft, pts, half, chambered=chambered), scale
+        ),
+        chambered=chambered,
     )

@@ -17,7 +17,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import cv2
 import numpy as np
@@ -45,10 +45,14 @@ from pipeline.measure.quality import (
     assess_body,
     start_seen,
     tip_out_of_reach,
+    tip_seen_whole,
     tip_turn_deg,
 )
 from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
+
+if TYPE_CHECKING:
+    from pipeline.measure.body import TipFace
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
@@ -538,6 +542,36 @@ def measure_body(
     except (ValueError, np.linalg.LinAlgError) as exc:
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
+    # a flat end face's normal is the tip's direction, where the centre line stops short of it
+    centre_start, centre_end, _ = end_tangents(pts, ends_px=ends)
+    seen_px = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
+    # the way the body bends (its turning's sign: a hooked centre line's end may curve either
+    # way) at the free end's curvature, or the body's mean where that is more (a tip the centre
+    # line follows badly reads straight)
+    curvature = np.sign(tip.turning_rad) * max(
+        abs(end_curvature(line.centreline_px)), abs(tip.turning_rad) / max(seen_px, 1.0)
+    )
+    face_turn = tip_face_turn_rad(
+        _face_direction(body.tip_face, settings) - centre_end,
+        curvature * (body.end_short_px + 0.5 * line.width_px),
+    )
+    # ... where that face is the body's own end, not where the selection fades
+    face_used = (
+        est is tip
+        and bool(np.isfinite(face_turn))
+        and tip_seen_whole(
+            body.end_short_px, line.width_px, body.free_end_width_ratio, body.ridge_tip_deg
+        )
+    )
+    if face_used:
+        # the check of the tip's window is moot with the tip read on its face: the fixed end's
+        # alone stays (the change of its direction over a window twice as long)
+        base_shift = centre_start - end_tangents(
+            pts, ends_px=ends, window_fraction=2 * TANGENT_WINDOW_FRACTION
+        )[0]
+        turned = _turned(tip, face_turn, 0.0 if base is not None else base_shift)
+        free = turned if free is tip else _turned(free, face_turn, base_shift)
+        est = tip = turned
     # the same turning from a smooth fit of the whole centre line: the check of a wobbly line.
     # With the base known psi does not depend on the fixed end, so neither reading is carried
     # back over a stretch the centre line stops short of there (on a long one a fit runs away)
@@ -549,6 +583,11 @@ def measure_body(
         smooth_turning = check_end - check_start  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
+    if mismatch is not None and body.chambered:
+        # a chambered body's own start is its first chamber's side, not the strip's direction:
+        # not compared with the one given (customer 48's PneuNets: 16 of 22 rows "-20 to -42
+        # deg off fixed_direction_deg", right ones among them)
+        mismatch = 0.0
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
     start, end, _ = end_tangents(pts, ends_px=ends)
     start_short, end_short, _ = end_tangents(
@@ -556,8 +595,10 @@ def measure_body(
     )
     short_shift = (
         0.0 if base is not None else float(np.rad2deg(start_short - start)),
-        float(np.rad2deg(end_short - end)),
+        0.0 if face_used else float(np.rad2deg(end_short - end)),
     )
+    if face_used:  # the tip is read on its face: the turn of what the centre line misses is moot
+        missed_tip_deg = 0.0
     quality = assess_body(
         line,
         psi_deg=psi,
@@ -581,11 +622,19 @@ def measure_body(
         background_given=settings.background_path is not None and not settings.background_estimated,
         video_frame=settings.video_frame,
         missed_tip_deg=missed_tip_deg,
-        smooth_mismatch_deg=float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
+        # with the base given and the tip read on its face psi does not depend on the centre
+        # line's course (a chambered body's is a polygon, one side per chamber)
+        smooth_mismatch_deg=0.0
+        if face_used and base is not None
+        else float(np.rad2deg(sign * (smooth_turning - (check_end - check_start)))),
         short_end_shift_deg=short_shift,
         excluded=bool(settings.exclude),
         hollow_outline=body.hollow_outline,
-        sealed_end_unknown=settings.sealed_end_mm is None and settings.free_end == "capped",
+        sealed_end_unknown=settings.sealed_end_mm is None
+        and settings.free_end == "capped"
+        and not face_used,
+        tip_face_turn_deg=float(np.rad2deg(sign * face_turn)) if face_used else None,
+        chambered=body.chambered,
         sealed_end_px=(settings.sealed_end_mm or 0.0) / settings.mm_per_px
         if settings.mm_per_px
         else 0.0,
@@ -611,13 +660,76 @@ def measure_body(
     )
     if est is not tip:
         return measured
-    tip_px = read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))
+    tip_px = (
+        body.tip_face.middle_px
+        if face_used and body.tip_face is not None
+        else read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))
+    )
     if base is not None:  # the body's own, beside the one given: where its start is seen
-        seen = start_seen(body.start_gap_px, line.width_px)
+        seen = start_seen(body.start_gap_px, line.width_px) and not body.chambered
         return replace(
             measured, base_direction_deg=own_base_deg if seen else float("nan"), tip_px=tip_px
         )
     return replace(measured, base_direction_deg=own_base_deg, tip_px=tip_px)
+
+
+#: a flat end face's normal is taken for the tip's direction when it turns the centre line's
+#: tip direction on the way the body bends by no more than the part of the body the centre line
+#: does not cover turns at the free end's curvature, plus FACE_AGREE_DEG, and back by no more
+#: than FACE_BACK_DEG: past the centre line's end a body bends on or runs straight (a sealed
+#: end, a cap).  Else the face is not square to the body (a slanted cut, a dot or a shadow on
+#: it, a clear body's faint corner: rendered clear bodies' faces turned psi back 2-8 deg) and the
+#: centre line's direction stands
+FACE_AGREE_DEG, FACE_BACK_DEG = 3.0, 1.0
+
+
+def tip_face_turn_rad(turn_rad: float, expected_rad: float) -> float:
+    """The turn from the centre line's tip direction to the end face's normal (rad, wrapped to
+    +-pi), when it is one the uncovered tip can make: between 0 and ``expected_rad`` (the turn of
+    the uncovered part at the free end's curvature, signed) within :data:`FACE_AGREE_DEG` past
+    it and :data:`FACE_BACK_DEG` back; NaN otherwise (and where there is no flat face:
+    ``turn_rad`` NaN).
+
+    Examples
+    --------
+    >>> round(tip_face_turn_rad(np.deg2rad(14.0 - 360.0), np.deg2rad(15.0)), 4)
+    0.2443
+    >>> tip_face_turn_rad(np.deg2rad(19.0), np.deg2rad(15.0))  # more than 15 + 3 deg
+    nan
+    >>> tip_face_turn_rad(np.deg2rad(-4.0), np.deg2rad(15.0))  # back against the bend
+    nan
+    """
+    turn = float((turn_rad + np.pi) % (2.0 * np.pi) - np.pi)
+    agree, back = np.deg2rad(FACE_AGREE_DEG), np.deg2rad(FACE_BACK_DEG)
+    low, high = (-back, expected_rad + agree) if expected_rad >= 0 else (expected_rad - agree, back)
+    return turn if low <= turn <= high else float("nan")
+
+
+def _face_direction(face: TipFace | None, settings: MeasureSettings) -> float:
+    """The tip face's normal as the estimators take directions: y up, on the plane when the
+    photo is calibrated (rad; NaN without a face)."""
+    if face is None:
+        return float("nan")
+    cal = settings.calibration
+    if cal is None or cal.plane is None:
+        return -face.normal_rad
+    at = np.asarray(face.middle_px, float)
+    out = np.array([np.cos(face.normal_rad), np.sin(face.normal_rad)])
+    d = cal.plane.to_plane([at, at + 10.0 * out])
+    return float(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0]))
+
+
+def _turned(est: CurveEstimate, turn_rad: float, base_shift_rad: float) -> CurveEstimate:
+    """``est`` with its free end turned on by ``turn_rad`` to the face's direction, and its
+    check the same turning from the fixed end's direction over a longer window (shifted by
+    ``base_shift_rad``)."""
+    turning = est.turning_rad + turn_rad
+    return replace(
+        est,
+        turning_rad=turning,
+        kappa_per_px=turning / est.length_px if est.length_px else est.kappa_per_px,
+        neighbour_turning_rad=turning + base_shift_rad,
+    )
 
 
 def read_point_px(centreline_px: NDArray[np.float64], beyond_px: float) -> tuple[float, float]:

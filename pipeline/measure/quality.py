@@ -216,6 +216,29 @@ def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
     return end_short_px > 1.5 * width_px + 4.0
 
 
+def tip_seen_whole(
+    end_short_px: float, width_px: float, free_end_width_ratio: float, ridge_tip_deg: float
+) -> bool:
+    """Whether the selection holds the body's free end whole: the centre line stops at most
+    :data:`FAINT_TIP_SHORT_WIDTHS` widths short of it, the free end is as wide as the body
+    (:data:`FAINT_TIP_WIDTH`) and the selection's ridge does not turn on past the centre line
+    (:data:`RIDGE_TIP_DEG`).  Where it does not, what ends the selection is not the body's own
+    end (a faint tip or side the selection fades at).
+
+    Examples
+    --------
+    >>> tip_seen_whole(28.0, 68.0, 1.0, 0.0), tip_seen_whole(70.0, 60.0, 1.0, 0.0)
+    (True, False)
+    >>> tip_seen_whole(20.0, 60.0, 0.8, 0.0), tip_seen_whole(20.0, 60.0, 1.0, 6.0)
+    (False, False)
+    """
+    return (
+        end_short_px <= FAINT_TIP_SHORT_WIDTHS * width_px
+        and free_end_width_ratio >= FAINT_TIP_WIDTH
+        and abs(ridge_tip_deg) <= RIDGE_TIP_DEG
+    )
+
+
 def tip_turn_deg(
     ridge_tip_deg: float, missed_tip_deg: float, *, out_of_reach: bool = False
 ) -> float:
@@ -254,11 +277,16 @@ NOTE_FROM_RAMP_START = "measured again from where its ramp's photos' lines start
 #: a capped body measured without ``sealed_end_mm``, bent this much (deg) or more
 NOTE_NO_SEALED_END = "no sealed_end_mm"
 NO_SEALED_END_PSI_DEG = 100.0
+#: a body whose tip direction was read on the flat face ending it, where that turned psi by at
+#: least TIP_FACE_NOTE_DEG from where its centre line stops
+NOTE_TIP_FACE = "tip direction read on the flat face that ends the body"
+TIP_FACE_NOTE_DEG = 1.0
 #: the sealed-end check's note where an actuator's photos show a straight end a little longer
 #: than the sealed_end_mm given (pipeline.sealed_end_check)
 NOTE_SEALED_END_LONGER = "the photos show a longer straight end"
 NOTES: tuple[str, ...] = (
     NOTE_NO_SEALED_END,
+    NOTE_TIP_FACE,
     NOTE_SEALED_END_LONGER,
     NOTE_FIXED_DIRECTION,
     NOTE_SIDE_ON_BORDER,
@@ -330,6 +358,8 @@ def assess_body(
     fixed_direction_deg: float | None = None,
     hollow_outline: bool = False,
     sealed_end_unknown: bool = False,
+    tip_face_turn_deg: float | None = None,
+    chambered: bool = False,
     sealed_end_px: float = 0.0,
     method: str = "tangents",
     psi_tip_deg: float | None = None,
@@ -357,7 +387,11 @@ def assess_body(
     than ``l0`` (partly hidden); or, in a video frame (``video_frame``), its free end is wider than
     :data:`SMEARED_FREE_END` times the body (smeared by motion).  Notes (status stays ``ok``) say
     how psi was taken, and that a capped body bent :data:`NO_SEALED_END_PSI_DEG` or more was
-    read without its sealed end's length (``sealed_end_unknown``): its |psi| reads high.  With
+    read without its sealed end's length (``sealed_end_unknown``): its |psi| reads high, and that
+    its tip's direction was read on the flat face ending it (``tip_face_turn_deg``: how far that
+    turned psi on from the centre line's end, noted from :data:`TIP_FACE_NOTE_DEG`).  A
+    ``chambered`` body (a PneuNet's row of chambers, filled) without the base's direction given
+    is flagged: its own is its first chamber's.  With
     another ``method`` than the tip angle, psi further than :data:`DISAGREE_DEG` from the tip
     angle (``psi_tip_deg``) is flagged: a body is rarely an arc.
     """
@@ -391,6 +425,17 @@ def assess_body(
             f"{NOTE_NO_SEALED_END}: psi read where the centre line stops, as if the body bent to "
             "its end, and a straight sealed end and cap there read |psi| high (2-7 deg at |psi| "
             "100-220 for an 8 mm one): give sealed_end_mm"
+        )
+    if chambered and base_mismatch_deg is None:
+        flags.append(
+            "a row of chambers (a PneuNet?): its centre line runs through them as a polygon, so "
+            "the direction it leaves the clamp in is its first chamber's: give "
+            "fixed_direction_deg, the direction of the strip under the chambers at the clamp"
+        )
+    if tip_face_turn_deg is not None and abs(tip_face_turn_deg) >= TIP_FACE_NOTE_DEG:
+        notes.append(
+            f"{NOTE_TIP_FACE} ({tip_face_turn_deg:+.1f} deg on from where its centre line stops, "
+            "about half a width short of it)"
         )
     if tip_at_region_edge:
         flags.append(
