@@ -850,7 +850,7 @@ def test_page_one_keeps_its_overview_plot_when_no_photo_is_doubted(tmp_path):
     col = [c.header for c in table.columns].index("ψ check (deg)\nmedian / 95 %")
     # a real set's figure is how far its trials differ: no column calls it an error (customer 25)
     assert not any("error" in c.header for c in table.columns)
-    assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d trials", r[col]) for r in table.rows[:-1])
+    assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d\d trials", r[col]) for r in table.rows[:-1])
     plain = dataclasses.replace(
         table, rows=tuple((*r[:col], "0", *r[col + 1:]) for r in table.rows)
     )
@@ -1281,6 +1281,23 @@ def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
         data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
         notes = " ".join(missing_notes(data))
         assert "(straight at rest) and does not come back" in notes, (rest_deg, notes)
+
+
+def test_a_curve_of_its_rest_photos_alone_is_not_said_to_never_reach_psi_zero(tmp_path):
+    # customer 48's PneuNets, ok at 0 kPa alone: "the mean curve never reaches ψ = 0 up to 60
+    # kPa (smallest mean ψ 2°)", a pressure no photo measured ok was taken at
+    from pipeline.report.summary import missing_notes
+
+    d = make_dataset(tmp_path, "SS40", overlays=False)
+    a = pd.read_csv(d.angles_csv)
+    a["psi_deg"] = 2.0 + 0.8 * a["pressure_kpa"]
+    a.loc[a["pressure_kpa"] > 0, "status"] = "flagged"
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    notes = " ".join(missing_notes(data))
+    assert "SS40: only its photos at 0 kPa were measured ok, so there is no curve" in notes, notes
+    assert "never reaches" not in notes and "up to" not in notes
 
 
 def test_a_strip_of_portrait_photos_keeps_its_captions_apart():

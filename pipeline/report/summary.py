@@ -338,9 +338,19 @@ def missing_notes(data: ReportData) -> list[str]:
                 "select)."
             )
             continue
+        measured = h.dropna(subset=["psi_mean_deg"])
+        if measured["pressure_kpa"].nunique() == 1:
+            # customer 48's PneuNets, ok at 0 kPa alone, read "never reaches ψ = 0 up to 60 kPa"
+            out.append(
+                f"{m}: only its photos at {fmt(measured['pressure_kpa'].iloc[0], 0)} kPa were "
+                "measured ok, so there is no curve and its values read n/a or rest on that one "
+                "level (the quality table gives the reasons)."
+            )
+            continue
         if not np.isfinite(float(g.get("p_zero_up_kpa", np.nan))):
             low = fmt(h["psi_mean_deg"].min(), 0)
-            top = fmt(h["pressure_kpa"].max(), 0)
+            # the highest pressure with a mean: a level whose photos were all left out has none
+            top = fmt(measured["pressure_kpa"].max(), 0)
             paper = (
                 " (the paper gives none either)"
                 if not np.isfinite(float(g.get("paper_p_zero_kpa", np.nan)))
