@@ -1336,7 +1336,7 @@ FACE_EDGE_RMS = 0.02
 
 
 def tip_face_normal(
-    comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float, *, chambered: bool = False
+    comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float
 ) -> TipFace | None:
     """The square, flat face ending the body at its free end: its outward normal and middle;
     None where the end is not one (rounded, ragged, too narrow, or cut at a slant).
@@ -1348,10 +1348,9 @@ def tip_face_normal(
     fraction of a pixel where ``soft`` crosses 0.5 along the centre line's course; it counts as
     square when its normal is the body's direction at the face from the two long edges beside
     it (:func:`_edges_direction`; a face cut 10-20 deg aslant read as the tip turned psi by up to
-    29 deg, `ok`).  Where those edges are too uneven to say (dots, a faint side), the face is
-    not taken (a translucent body's read psi 3-7 deg high, `ok`), unless the body is
-    ``chambered``: a PneuNet's last chamber's end wall, whose edges beside it are cut by the
-    gap before it.
+    29 deg, `ok`), or the one of them that is smooth (a PneuNet's strip, beside the gap before
+    its last chamber).  Where neither says (dots, a faint side), the face is not taken (a
+    translucent body's read psi 3-7 deg high, `ok`).
 
     Parameters
     ----------
@@ -1431,7 +1430,7 @@ def tip_face_normal(
     world = normal[0] * t + normal[1] * n
     middle = pts[-1] + q.mean(axis=0)[0] * t + q.mean(axis=0)[1] * n
     body = _edges_direction(c, near, middle, world, half, soft)
-    if body is None and not chambered:
+    if body is None:
         return None
     if body is not None and float(np.degrees(np.arccos(np.clip(abs(world @ body), -1.0, 1.0)))) > (
         FACE_SQUARE_DEG
@@ -1462,7 +1461,6 @@ def _on_edge(soft: np.ndarray, walk: np.ndarray) -> np.ndarray:
     prof = cv2.remap(soft, xy[..., 0].astype(np.float32), xy[..., 1].astype(np.float32),
                      cv2.INTER_LINEAR, borderValue=0.0)
     inside = prof >= 0.5
-    flips = np.flatnonzero(np.any(inside[:, :-1] != inside[:, 1:], axis=0))
     out = []
     for i in range(len(walk)):
         f = np.flatnonzero(inside[i, :-1] != inside[i, 1:])
@@ -1472,7 +1470,6 @@ def _on_edge(soft: np.ndarray, walk: np.ndarray) -> np.ndarray:
         p0, p1 = prof[i, j], prof[i, j + 1]
         at = offs[j] + 0.25 * (p0 - 0.5) / (p0 - p1) if p0 != p1 else offs[j]
         out.append(smooth[i] + at * normal[i])
-    del flips
     return np.array(out).reshape(-1, 2)
 
 
@@ -1503,10 +1500,13 @@ def _edges_direction(
         return None
     off_face = np.abs((contour - middle) @ normal) > max(1.0, 0.1 * half)
 
+    corners = []
+
     def stretch(run_end: int, sense: int) -> np.ndarray:
         walk_at = (run_end + sense * np.arange(m // 2)) % m
         corner = int(np.argmax(off_face[walk_at]))  # the first point off the face's line
         walk = contour[walk_at[corner:]]
+        corners.append(walk[0])
         walked = np.r_[0.0, np.cumsum(np.hypot(*np.diff(walk, axis=0).T))]
         return walk[(walked >= FACE_EDGE_FROM * half) & (walked <= FACE_EDGE_TO * half)]
 
@@ -1530,11 +1530,44 @@ def _edges_direction(
     fit_line = float(sv[1] ** 2 / len(centred))
     radius = float(np.hypot(*(middle - centre)))
     if np.sqrt(min(fit_line, fit_arc)) > FACE_EDGE_RMS * half:
-        return None  # edges neither an arc nor straight there: a chamber's gap, a dot, a cap
+        # the two edges neither an arc nor straight there: one of them may be (a PneuNet's strip
+        # beside the gap before its last chamber)
+        sides = [
+            d
+            for d in (
+                _side_direction(side_a, corners[0], half),
+                _side_direction(side_b, corners[1], half),
+            )
+            if d
+        ]
+        return min(sides, key=lambda d: d[1])[0] if sides else None
     if fit_line <= 1.5 * fit_arc or radius > 40.0 * half:
         return np.asarray(vt[0])
     radial = (middle - centre) / max(radius, 1e-9)
     return np.array([-radial[1], radial[0]])
+
+
+def _side_direction(
+    side: np.ndarray, corner: np.ndarray, half: float
+) -> tuple[np.ndarray, float] | None:
+    """One long edge's direction at the ``corner`` its stretch (of :func:`_edges_direction`)
+    starts from, from a circle (or a line, where that fits as well) fitted to it, with the fit's
+    RMS (px); None where neither fits within :data:`FACE_EDGE_RMS` half-widths."""
+    if len(side) < 4:
+        return None
+    sol, *_ = np.linalg.lstsq(np.c_[2.0 * side, np.ones(len(side))], (side**2).sum(axis=1),
+                              rcond=None)
+    centre = sol[:2]
+    radii = np.hypot(*(side - centre).T)
+    fit_arc = float(np.sqrt(np.mean((radii - radii.mean()) ** 2)))
+    _, sv, vt = np.linalg.svd(side - side.mean(axis=0), full_matrices=False)
+    fit_line = float(sv[1] / np.sqrt(len(side)))
+    if min(fit_arc, fit_line) > FACE_EDGE_RMS * half:
+        return None
+    if fit_line <= 1.5 * fit_arc or radii.mean() > 40.0 * half:
+        return np.asarray(vt[0]), fit_line
+    radial = (corner - centre) / max(float(np.hypot(*(corner - centre))), 1e-9)
+    return np.array([-radial[1], radial[0]]), fit_arc
 
 
 def _uncovered(ridge: np.ndarray, end: np.ndarray) -> float:
@@ -2228,8 +2261,6 @@ def extract_body(
             if settings.sealed_end_mm is None and settings.free_end != "capped"
             else _extensions(comp, dt, pts, half, None, free_end_bends=True)[1] * scale
         ),
-        tip_face=_in_original_px(
-            tip_face_normal(comp, soft, pts, half, chambered=chambered), scale
-        ),
+        tip_face=_in_original_px(tip_face_normal(comp, soft, pts, half), scale),
         chambered=chambered,
     )

@@ -555,9 +555,12 @@ def measure_body(
         _face_direction(body.tip_face, settings) - centre_end,
         curvature * (body.end_short_px + 0.5 * line.width_px),
     )
-    # ... where that face is the body's own end, not where the selection fades
+    # ... where that face is the body's own end, not where the selection fades, and the end
+    # that does not bend is not given (the tip is then read where it begins; not on a row of
+    # chambers, whose centre line's end is a chamber's side)
     face_used = (
         est is tip
+        and (settings.sealed_end_mm is None or body.chambered)
         and bool(np.isfinite(face_turn))
         and tip_seen_whole(
             body.end_short_px, line.width_px, body.free_end_width_ratio, body.ridge_tip_deg

@@ -391,7 +391,8 @@ def assess_body(
     its tip's direction was read on the flat face ending it (``tip_face_turn_deg``: how far that
     turned psi on from the centre line's end, noted from :data:`TIP_FACE_NOTE_DEG`).  A
     ``chambered`` body (a PneuNet's row of chambers, filled) without the base's direction given
-    is flagged: its own is its first chamber's.  With
+    is flagged (its own is its first chamber's), and so is one whose tip was not read on its
+    flat end face.  With
     another ``method`` than the tip angle, psi further than :data:`DISAGREE_DEG` from the tip
     angle (``psi_tip_deg``) is flagged: a body is rarely an arc.
     """
@@ -431,6 +432,14 @@ def assess_body(
             "a row of chambers (a PneuNet?): its centre line runs through them as a polygon, so "
             "the direction it leaves the clamp in is its first chamber's: give "
             "fixed_direction_deg, the direction of the strip under the chambers at the clamp"
+        )
+    if chambered and tip_face_turn_deg is None:
+        # its centre line's end is a chamber's side: a rounded or slanted last chamber read
+        # 3-16 deg off, ok (the review's rendered PneuNets)
+        flags.append(
+            "a row of chambers (a PneuNet?) whose tip is not read on a flat end face square to "
+            "the strip under the chambers (rounded, cut aslant, faint, or a sealed_end_mm given): "
+            "its centre line's end is a chamber's side; check with photoset preview"
         )
     if tip_face_turn_deg is not None and abs(tip_face_turn_deg) >= TIP_FACE_NOTE_DEG:
         notes.append(
