@@ -44,7 +44,7 @@ def test_two_trials_differ_by_what_their_photos_read_at_each_level():
     assert sorted(set(np.round(diffs, 6))) == [0.5, 1.0, 1.5]
     acc = angle_accuracy(a, None)
     assert (acc.basis, acc.n, acc.median_deg) == ("trials", 33, 1.0)
-    assert acc.cell() == "1.00 / 1.50 trials"
+    assert acc.cell() == "1.00 / 1.5 trials"
 
 
 def test_a_flagged_photo_and_another_actuators_trial_are_not_paired():
@@ -88,7 +88,7 @@ def test_a_real_set_gets_the_trials_figure_and_the_note_says_what_it_cannot_see(
     a = ramps(2)
     info = dataset_info(write_set(tmp_path / "mine", a, None), a)
     assert info.source == "real" and info.accuracy.basis == "trials"
-    assert info.accuracy.cell() == "0.50 / 0.50 trials"
+    assert info.accuracy.cell() == "0.50 / 0.5 trials"
     assert "blind to an error all photos share" in ACCURACY_NOTE
     assert "fixed_direction_deg" in ACCURACY_NOTE
     assert "empty scene" not in ACCURACY_NOTE  # customer 31 gave one: its error was shared

@@ -50,11 +50,11 @@ class AngleAccuracy:
         Examples
         --------
         >>> AngleAccuracy("truth", 40, 0.31, 1.24, 1).cell()
-        '0.31 / 1.24 truth, 1 ok > 5°'
+        '0.31 / 1.2 truth, 1 ok > 5°'
         >>> AngleAccuracy("truth", 40, 0.31, 1.24, 0).cell()
-        '0.31 / 1.24 truth'
+        '0.31 / 1.2 truth'
         >>> AngleAccuracy("trials", 12, 0.8, 2.14).cell()
-        '0.80 / 2.14 trials'
+        '0.80 / 2.1 trials'
         >>> AngleAccuracy("none", 0).cell()
         'n/a (one trial)'
         >>> AngleAccuracy("no ok photo", 0).cell()
@@ -64,8 +64,7 @@ class AngleAccuracy:
             return "n/a (one trial)"
         if self.basis == NO_OK:
             return f"n/a ({NO_OK})"
-        # both to the same places: "0.14 / 0.1" read as a 95th percentile below its median
-        figure = f"{self.median_deg:.2f} / {self.p95_deg:.2f} {self.basis}"
+        figure = f"{self.median_deg:.2f} / {self.p95_deg:.1f} {self.basis}"
         return f"{figure}, {self.off} ok > {OFF_DEG:g}°" if self.off else figure
 
 
