@@ -850,7 +850,7 @@ def test_page_one_keeps_its_overview_plot_when_no_photo_is_doubted(tmp_path):
     col = [c.header for c in table.columns].index("ψ check (deg)\nmedian / 95 %")
     # a real set's figure is how far its trials differ: no column calls it an error (customer 25)
     assert not any("error" in c.header for c in table.columns)
-    assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d\d trials", r[col]) for r in table.rows[:-1])
+    assert all(re.fullmatch(r"\d\.\d\d / \d+\.\d trials", r[col]) for r in table.rows[:-1])
     plain = dataclasses.replace(
         table, rows=tuple((*r[:col], "0", *r[col + 1:]) for r in table.rows)
     )
