@@ -2269,6 +2269,9 @@ def extract_body(
             if settings.sealed_end_mm is None and settings.free_end != "capped"
             else _extensions(comp, dt, pts, half, None, free_end_bends=True)[1] * scale
         ),
-        tip_face=_in_original_px(tip_face_normal(comp, soft, pts, half), scale),
+        # the face is not read where the end that does not bend is given (but on chambers)
+        tip_face=_in_original_px(tip_face_normal(comp, soft, pts, half), scale)
+        if settings.sealed_end_mm is None or chambered
+        else None,
         chambered=chambered,
     )

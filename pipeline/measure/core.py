@@ -543,18 +543,20 @@ def measure_body(
         return failed(method, f"curvature fit failed: {exc}")
     sign = settings.sign
     # a flat end face's normal is the tip's direction, where the centre line stops short of it
-    centre_start, centre_end, _ = end_tangents(pts, ends_px=ends)
-    seen_px = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
-    # the way the body bends (its turning's sign: a hooked centre line's end may curve either
-    # way) at the free end's curvature, or the body's mean where that is more (a tip the centre
-    # line follows badly reads straight)
-    curvature = np.sign(tip.turning_rad) * max(
-        abs(end_curvature(line.centreline_px)), abs(tip.turning_rad) / max(seen_px, 1.0)
-    )
-    face_turn = tip_face_turn_rad(
-        _face_direction(body.tip_face, settings) - centre_end,
-        curvature * (body.end_short_px + 0.5 * line.width_px),
-    )
+    start, end, _ = end_tangents(pts, ends_px=ends)
+    face_turn = float("nan")
+    if body.tip_face is not None:
+        seen_px = float(np.sum(np.hypot(*np.diff(line.centreline_px, axis=0).T)))
+        # the way the body bends (its turning's sign: a hooked centre line's end may curve either
+        # way) at the free end's curvature, or the body's mean where that is more (a tip the
+        # centre line follows badly reads straight)
+        curvature = np.sign(tip.turning_rad) * max(
+            abs(end_curvature(line.centreline_px)), abs(tip.turning_rad) / max(seen_px, 1.0)
+        )
+        face_turn = tip_face_turn_rad(
+            _face_direction(body.tip_face, settings) - end,
+            curvature * (body.end_short_px + 0.5 * line.width_px),
+        )
     # ... where that face is the body's own end, not where the selection fades, and the end
     # that does not bend is not given (the tip is then read where it begins; not on a row of
     # chambers, whose centre line's end is a chamber's side)
@@ -569,7 +571,7 @@ def measure_body(
     if face_used:
         # the check of the tip's window is moot with the tip read on its face: the fixed end's
         # alone stays (the change of its direction over a window twice as long)
-        base_shift = centre_start - end_tangents(
+        base_shift = start - end_tangents(
             pts, ends_px=ends, window_fraction=2 * TANGENT_WINDOW_FRACTION
         )[0]
         turned = _turned(tip, face_turn, 0.0 if base is not None else base_shift)
@@ -592,7 +594,6 @@ def measure_body(
         # deg off fixed_direction_deg", right ones among them)
         mismatch = 0.0
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
-    start, end, _ = end_tangents(pts, ends_px=ends)
     start_short, end_short, _ = end_tangents(
         pts, ends_px=ends, window_fraction=0.5 * TANGENT_WINDOW_FRACTION
     )
