@@ -773,6 +773,22 @@ def test_a_pneunets_chambers_are_measured_as_one_body(psi):
     assert NOTE_TIP_FACE in res.reason
 
 
+@pytest.mark.parametrize("psi", [180.0, 240.0, -240.0])
+def test_a_pneunet_leaves_the_clamp_along_its_strip(psi):
+    # the review of stop 56: a chambered body's own base was not read (its centre line starts
+    # on its first chamber), so a fixed_direction_deg 25 deg off gave rows ok and 25 deg off,
+    # and without one no row was ok.  The strip's edge says how it leaves the clamp
+    img, fe = chambered_photo(psi, seed=int(abs(psi)))
+    own = measure_image(img, settings_for(fe))
+    assert own.status == "ok", own.reason
+    assert own.psi_deg == pytest.approx(psi, abs=3.0)
+    assert own.base_direction_deg == pytest.approx(0.0, abs=3.0)
+    off = measure_image(img, settings_for(fe, fixed_direction_deg=25.0))
+    assert off.status == "flagged", off.reason
+    assert "leaves the clamp" in off.reason and "off fixed_direction_deg" in off.reason
+    assert off.base_direction_deg == pytest.approx(own.base_direction_deg, abs=1e-9)
+
+
 def test_a_pneunet_is_never_an_ok_psi_far_off():
     # where the centre line of the filled chambers stops more than a width short of the tip,
     # the face is not taken (a faint tip ends the same way) and the row is flagged, as is one

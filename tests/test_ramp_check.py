@@ -541,6 +541,19 @@ def test_bodies_whose_sides_diverge_do_not_doubt_the_direction_given():
     assert turned["reason"].str.startswith("psi may be 8.4 deg off").all()
 
 
+def test_sides_read_on_a_few_bodies_of_a_ramp_do_not_excuse_the_direction_given():
+    # customer 48's PneuNets with a direction 10 deg off: the chambered bodies' own base is
+    # their strip's edge (no split of two sides); the 6 of 13 straight ones whose gaps were too
+    # narrow to fill carry their comb's split (-2 to -7 deg), and their median excused the
+    # direction given 15 deg, so 14 rows stayed ok 10 deg off
+    psi = _ds20_like()
+    split = np.where(np.arange(12) < 5, -3.0, np.nan)
+    out = check_ramps(_bodies(psi, np.full(12, -98.4), fixed_direction_deg=-88.0,
+                              base_side_split_deg=split))
+    assert (out["status"] == "flagged").all(), out["reason"].iloc[0]
+    assert out["reason"].str.startswith("psi may be 10.4 deg off").all()
+
+
 def test_a_ramp_that_doubles_its_steps_is_no_typo():
     doubling = _ramp(_ds20_like(7))
     doubling["pressure_kpa"] = [0.0, 5, 10, 20, 40, 80, 160]

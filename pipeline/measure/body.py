@@ -64,18 +64,20 @@ SMOOTH_HALF_WIDTHS = 0.6
 
 
 @dataclass(frozen=True)
-class TipFace:
-    """The square, flat face ending a body at its free end (:func:`tip_face_normal`).
+class EndFace:
+    """A flat face ending the body, and the body's direction read there: at the free end the
+    face's outward normal (:func:`tip_face_normal`), at the fixed end the way the body leaves
+    the clamp, from its long edges beside the face the clamp cuts (:func:`base_edge_direction`).
 
     Attributes
     ----------
-    normal_rad : float
-        Its outward normal (rad, image axes: y down): the tip's direction.
+    direction_rad : float
+        The direction (rad, image axes: y down): the tip's, or the body's out of the clamp.
     middle_px : (float, float)
-        Its middle (x, y), px.
+        The face's middle (x, y), px.
     """
 
-    normal_rad: float
+    direction_rad: float
     middle_px: tuple[float, float]
 
 
@@ -125,9 +127,12 @@ class BodyExtraction:
     chambered : bool
         The gaps between a row of chambers were filled (:func:`fill_chamber_gaps`): the centre
         line's course is a polygon, one side per chamber, and its start the first chamber's.
-    tip_face : TipFace or None
+    tip_face : EndFace or None
         The square, flat face ending the body (original px), None where the end is not one
         (:func:`tip_face_normal`).
+    base_edge : EndFace or None
+        A chambered body's direction out of the clamp, from its strip's edge there (original
+        px; :func:`base_edge_direction`); None where it is not read.
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
         (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
@@ -149,8 +154,9 @@ class BodyExtraction:
     side_on_border: bool = False
     tip_at_region_edge: bool = False
     hollow_outline: bool = False
-    tip_face: TipFace | None = None
+    tip_face: EndFace | None = None
     chambered: bool = False
+    base_edge: EndFace | None = None
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -1345,7 +1351,7 @@ FACE_EDGE_RMS = 0.02
 
 def tip_face_normal(
     comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float
-) -> TipFace | None:
+) -> EndFace | None:
     """The square, flat face ending the body at its free end: its outward normal and middle;
     None where the end is not one (rounded, ragged, too narrow, or cut at a slant).
 
@@ -1377,7 +1383,7 @@ def tip_face_normal(
     >>> comp[20:60, 10:110] = 1  # a straight body 40 px wide, its face at x = 109.5
     >>> pts = np.c_[np.arange(10.0, 90.0), np.full(80, 39.5)]
     >>> face = tip_face_normal(comp, comp.astype(np.float32), pts, 20.0)
-    >>> abs(round(float(np.rad2deg(face.normal_rad)), 1)), np.round(face.middle_px, 1).tolist()
+    >>> abs(round(float(np.rad2deg(face.direction_rad)), 1)), np.round(face.middle_px, 1).tolist()
     (0.0, [109.5, 39.5])
     >>> slant = comp.copy()
     >>> slant[:, 100:] = 0
@@ -1389,6 +1395,121 @@ def tip_face_normal(
     >>> print(tip_face_normal(comp, comp.astype(np.float32), pts, 20.0))
     None
     """
+    found = _end_face(comp, soft, pts, half)
+    if found is None:
+        return None
+    world, middle, c, near = found
+    body = _edges_direction(c, near, middle, world, half, soft)
+    if body is None:
+        return None
+    if float(np.degrees(np.arccos(np.clip(abs(world @ body), -1.0, 1.0)))) > FACE_SQUARE_DEG:
+        return None
+    return EndFace(float(np.arctan2(world[1], world[0])), (float(middle[0]), float(middle[1])))
+
+
+#: a chambered body's strip is the side of its centre line whose edge (the last crossing of
+#: the body's outline within STRIP_REACH half-widths along the normals) lies within
+#: STRIP_EDGE_OFF half-widths of its own running median over STRIP_MEDIAN half-widths at no
+#: more than STRIP_ROUGH of the points (on the chambers' side a gap takes every one in it)
+STRIP_REACH, STRIP_EDGE_OFF, STRIP_MEDIAN, STRIP_ROUGH = 2.5, 0.1, 3.0, 0.05
+#: ... cast from the centre line smoothed over this many half-widths
+STRIP_GUIDE = 0.75
+
+
+def strip_edge(comb: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray:
+    """The edge of a chambered body's strip (the layer that does not stretch), from the fixed
+    end on: one point (x, y) per point of the centre line where it is found; empty where neither
+    side of the body runs smooth.
+
+    A PneuNet's filled row of chambers (:func:`fill_chamber_gaps`) starts where its first
+    chamber does, so its centre line's start does not say how it leaves the clamp; the strip
+    does, and any curve along it turns through the body's psi.
+
+    Parameters
+    ----------
+    comb : ndarray (H, W) uint8
+        The body, its chambers' gaps not filled.
+    soft : ndarray (H, W) float32
+        ``comb`` as a 0..1 field whose 0.5 level is its edge (:func:`_soft_body`).
+    pts : ndarray (N, 2)
+        The filled body's centre line (x, y), fixed end first, about 1 px apart.
+    half : float
+        The body's half-width (px).
+
+    Examples
+    --------
+    >>> comb = np.zeros((90, 240), np.uint8)
+    >>> comb[55:65, 20:220] = 1  # the strip, leaving the clamp (x < 20) along +x
+    >>> for x in range(20, 220, 25):
+    ...     comb[25:55, x : x + 20] = 1  # chambers 20 px wide, 5 px gaps
+    >>> pts = np.c_[np.arange(20.0, 200.0), np.full(180, 45.0)]
+    >>> edge = strip_edge(comb, comb.astype(np.float32), pts, 20.0)
+    >>> len(edge), np.round(edge[0], 1).tolist(), float(np.ptp(edge[:, 1]))
+    (180, [20.0, 64.5], 0.0)
+    """
+    # along normals of the centre line smoothed over STRIP_GUIDE half-widths: the filled
+    # chambers' centre line zig-zags, one side per chamber, and its own normals swept the edge
+    # points back and forth
+    pts = _smooth(pts, STRIP_GUIDE * half)
+    n = _normals(pts)
+    u = np.arange(0.0, STRIP_REACH * half, 0.25)
+    window = max(3, int(round(STRIP_MEDIAN * half)) | 1)  # noqa: RUF046 (numpy scalar)
+    best: tuple[float, np.ndarray] | None = None
+    for sense in (1.0, -1.0):
+        xy = pts[:, None, :] + sense * u[None, :, None] * n[:, None, :]
+        prof = cv2.remap(soft, xy[..., 0].astype(np.float32), xy[..., 1].astype(np.float32),
+                         cv2.INTER_LINEAR, borderValue=0.0)
+        leaves = (prof[:, :-1] >= 0.5) & (prof[:, 1:] < 0.5)
+        j = leaves.shape[1] - 1 - np.argmax(leaves[:, ::-1], axis=1)  # the last crossing out
+        rows = np.arange(len(pts))
+        p0, p1 = prof[rows, j], prof[rows, j + 1]
+        off = u[j] + 0.25 * (p0 - 0.5) / np.maximum(p0 - p1, 1e-6)
+        off[~leaves.any(axis=1)] = np.nan
+        steady = pd.Series(off).rolling(window, center=True, min_periods=1).median().to_numpy()
+        smooth = np.abs(off - steady) <= STRIP_EDGE_OFF * half
+        rough = 1.0 - float(smooth.mean())
+        if rough <= STRIP_ROUGH and (best is None or rough < best[0]):
+            best = (rough, pts[smooth] + sense * off[smooth, None] * n[smooth])
+    return best[1] if best is not None else np.empty((0, 2))
+
+
+def base_edge_direction(
+    comb: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float, reach_px: float = 0.0
+) -> EndFace | None:
+    """The direction in which a chambered body leaves the clamp: its strip's edge's
+    (:func:`strip_edge`) start tangent, read as the centre line's is (carried back ``reach_px``
+    to the clamp face, as far as the centre line stops short of it); None without a strip.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, np.pi, 400)  # a strip bent through 180 deg, leaving along +x
+    >>> comb = np.zeros((260, 260), np.uint8)
+    >>> outer = np.c_[30 + 100 * np.sin(t), 230 - 100 * (1 - np.cos(t))]
+    >>> inner = np.c_[30 + 90 * np.sin(t), 230 - 90 * (1 - np.cos(t)) - 10]
+    >>> _ = cv2.fillPoly(comb, [np.round(np.r_[outer, inner[::-1]]).astype(np.int32)], 1)
+    >>> for a in np.arange(0.1, 3.0, 0.3):  # chambers on the inside
+    ...     c = (30 + 78 * np.sin(a), 230 - 78 * (1 - np.cos(a)) - 22)
+    ...     _ = cv2.circle(comb, (int(c[0]), int(c[1])), 13, 1, -1)
+    >>> mid = np.c_[30 + 85 * np.sin(t), 230 - 85 * (1 - np.cos(t)) - 15]
+    >>> soft = cv2.GaussianBlur(comb.astype(np.float32), (0, 0), 0.7)
+    >>> face = base_edge_direction(comb, soft, mid, 15.0)
+    >>> round(float(np.rad2deg(face.direction_rad)), 1)
+    -0.3
+    """
+    edge = strip_edge(comb, soft, pts, half)
+    if len(edge) < 8:
+        return None
+    start = end_tangents(np.c_[edge[:, 0], -edge[:, 1]], ends_px=(reach_px, 0.0))[0]
+    return EndFace(float(-start), (float(edge[0, 0]), float(edge[0, 1])))
+
+
+def _end_face(
+    comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The flat face ending ``comp`` past the end ``pts[-1]`` of its centre line: its outward
+    normal, its middle (sub-pixel, where ``soft`` crosses 0.5 along the centre line's course),
+    the outline it lies on and a mask of the outline's points on it; None where that end is not
+    flat (see :func:`tip_face_normal`)."""
     if half < FACE_MIN_HALF_PX or len(pts) < 6:
         return None
     t = pts[-1] - pts[-6]
@@ -1437,22 +1558,15 @@ def tip_face_normal(
         normal = -normal
     world = normal[0] * t + normal[1] * n
     middle = pts[-1] + q.mean(axis=0)[0] * t + q.mean(axis=0)[1] * n
-    body = _edges_direction(c, near, middle, world, half, soft)
-    if body is None:
-        return None
-    if body is not None and float(np.degrees(np.arccos(np.clip(abs(world @ body), -1.0, 1.0)))) > (
-        FACE_SQUARE_DEG
-    ):
-        return None
-    return TipFace(float(np.arctan2(world[1], world[0])), (float(middle[0]), float(middle[1])))
+    return world, middle, c, near
 
 
-def _in_original_px(face: TipFace | None, scale: float) -> TipFace | None:
+def _in_original_px(face: EndFace | None, scale: float) -> EndFace | None:
     """``face`` found on the work image (reduced by ``scale``), in the original's px."""
     if face is None:
         return None
     x, y = face.middle_px
-    return TipFace(face.normal_rad, (x * scale + (scale - 1) / 2, y * scale + (scale - 1) / 2))
+    return EndFace(face.direction_rad, (x * scale + (scale - 1) / 2, y * scale + (scale - 1) / 2))
 
 
 def _on_edge(soft: np.ndarray, walk: np.ndarray) -> np.ndarray:
@@ -2167,6 +2281,7 @@ def extract_body(
     half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     filled = fill_chamber_gaps(comp, half)
     chambered = filled is not comp
+    comb = comp  # the chambers with their gaps
     if chambered:  # a row of chambers: the body is their envelope
         comp = filled
         dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
@@ -2274,4 +2389,14 @@ def extract_body(
         if settings.sealed_end_mm is None or chambered
         else None,
         chambered=chambered,
+        # a row of chambers leaves the clamp along its strip (its centre line starts on its
+        # first chamber)
+        base_edge=_in_original_px(
+            base_edge_direction(
+                comb, _soft_body(comb, selection.strength), pts, half, trimmed[0]
+            ),
+            scale,
+        )
+        if chambered
+        else None,
     )

@@ -52,7 +52,7 @@ from pipeline.measure.refine import refine_centreline
 from pipeline.measure.settings import MeasureSettings
 
 if TYPE_CHECKING:
-    from pipeline.measure.body import TipFace
+    from pipeline.measure.body import EndFace
 
 #: default estimator (see the package docstring for the measurements behind the choice)
 DEFAULT_METHOD = "auto"
@@ -528,9 +528,14 @@ def measure_body(
             "needs its empty scene: background)",
         )
     rng = np.random.default_rng(SEED)
-    base = (
+    given = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
     )
+    # a chambered body's own start is its first chamber's side: it leaves the clamp along its
+    # strip's edge (customer 48's PneuNets, by their centre lines: 16 of 22 rows "-20 to -42 deg
+    # off fixed_direction_deg", right ones among them), the base where none is given
+    strip = _face_direction(body.base_edge, settings) if body.chambered else float("nan")
+    base = strip if given is None and np.isfinite(strip) else given
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
@@ -588,11 +593,15 @@ def measure_body(
         smooth_turning = check_end - check_start  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
-    if mismatch is not None and body.chambered:
-        # a chambered body's own start is its first chamber's side, not the strip's direction:
-        # not compared with the one given (customer 48's PneuNets: 16 of 22 rows "-20 to -42
-        # deg off fixed_direction_deg", right ones among them)
-        mismatch = 0.0
+    own_start = start
+    if body.chambered:  # its own start is its strip's, which a direction given is checked by
+        own_start = strip
+        if mismatch is not None:
+            mismatch = (
+                float(np.rad2deg(np.angle(np.exp(1j * (given - strip)))))
+                if given is not None and np.isfinite(strip)
+                else 0.0
+            )
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
     start_short, end_short, _ = end_tangents(
         pts, ends_px=ends, window_fraction=0.5 * TANGENT_WINDOW_FRACTION
@@ -654,12 +663,13 @@ def measure_body(
         ),
         est, line, quality, settings, used,
     )
-    own_base_deg = float(np.rad2deg(sign * start))
+    own_base_deg = float(np.rad2deg(sign * own_start))
     measured = replace(
         measured,
-        base_side_split_deg=base_side_split_deg(
-            line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION
-        ),
+        # a chambered body's own base is its strip's edge alone (its other side a comb)
+        base_side_split_deg=float("nan")
+        if body.chambered
+        else base_side_split_deg(line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION),
         straight_end_mm=straight_end_mm if measured.status != "failed" else float("nan"),
     )
     if est is not tip:
@@ -670,7 +680,7 @@ def measure_body(
         else read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))
     )
     if base is not None:  # the body's own, beside the one given: where its start is seen
-        seen = start_seen(body.start_gap_px, line.width_px) and not body.chambered
+        seen = start_seen(body.start_gap_px, line.width_px) or body.chambered
         return replace(
             measured, base_direction_deg=own_base_deg if seen else float("nan"), tip_px=tip_px
         )
@@ -709,16 +719,16 @@ def tip_face_turn_rad(turn_rad: float, expected_rad: float) -> float:
     return turn if low <= turn <= high else float("nan")
 
 
-def _face_direction(face: TipFace | None, settings: MeasureSettings) -> float:
+def _face_direction(face: EndFace | None, settings: MeasureSettings) -> float:
     """The tip face's normal as the estimators take directions: y up, on the plane when the
     photo is calibrated (rad; NaN without a face)."""
     if face is None:
         return float("nan")
     cal = settings.calibration
     if cal is None or cal.plane is None:
-        return -face.normal_rad
+        return -face.direction_rad
     at = np.asarray(face.middle_px, float)
-    out = np.array([np.cos(face.normal_rad), np.sin(face.normal_rad)])
+    out = np.array([np.cos(face.direction_rad), np.sin(face.direction_rad)])
     d = cal.plane.to_plane([at, at + 10.0 * out])
     return float(np.arctan2(-(d[1, 1] - d[0, 1]), d[1, 0] - d[0, 0]))
 
