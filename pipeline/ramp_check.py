@@ -682,7 +682,7 @@ def _sides_diverge(
     # on most of the ramp's bodies (a PneuNet's chambered ones have no split: their own base is
     # their strip's edge alone; its few straight ones, whose comb side's gaps are too narrow
     # to fill, are no reason to doubt it)
-    if read.sum() < max(BASE_MIN_PHOTOS, 0.5 * measured.sum()):
+    if read.sum() < max(BASE_MIN_PHOTOS, 0.5 * (measured & np.isfinite(own)).sum()):
         return False
     spread = _wrap_deg(own[read] - own[read][0])
     if float(np.median(np.abs(spread - np.median(spread)))) > BASE_SPREAD_DEG:

@@ -1412,14 +1412,19 @@ def tip_face_normal(
 #: STRIP_EDGE_OFF half-widths of its own running median over STRIP_MEDIAN half-widths at no
 #: more than STRIP_ROUGH of the points (on the chambers' side a gap takes every one in it)
 STRIP_REACH, STRIP_EDGE_OFF, STRIP_MEDIAN, STRIP_ROUGH = 2.5, 0.1, 3.0, 0.05
-#: ... cast from the centre line smoothed over this many half-widths
+#: ... cast from the centre line smoothed over this many half-widths; read at the clamp where
+#: it is found smooth over the first STRIP_LEAD half-widths from there (its first points hooked
+#: back and jumped: psi -180 read -339.5, ok, in the review) from at most STRIP_LEAD half-widths
+#: out, and taken where it leaves the clamp within STRIP_CENTRE_DEG of the centre line's start
+#: (which its first chamber turns)
 STRIP_GUIDE = 0.75
+STRIP_LEAD, STRIP_CENTRE_DEG = 1.0, 60.0
 
 
 def strip_edge(comb: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float) -> np.ndarray:
     """The edge of a chambered body's strip (the layer that does not stretch), from the fixed
-    end on: one point (x, y) per point of the centre line where it is found; empty where neither
-    side of the body runs smooth.
+    end on: one point (x, y) per point of the centre line, NaN where it is not found; all NaN
+    where neither side of the body runs smooth.
 
     A PneuNet's filled row of chambers (:func:`fill_chamber_gaps`) starts where its first
     chamber does, so its centre line's start does not say how it leaves the clamp; the strip
@@ -1444,7 +1449,7 @@ def strip_edge(comb: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float)
     ...     comb[25:55, x : x + 20] = 1  # chambers 20 px wide, 5 px gaps
     >>> pts = np.c_[np.arange(20.0, 200.0), np.full(180, 45.0)]
     >>> edge = strip_edge(comb, comb.astype(np.float32), pts, 20.0)
-    >>> len(edge), np.round(edge[0], 1).tolist(), float(np.ptp(edge[:, 1]))
+    >>> len(edge), np.round(edge[0], 1).tolist(), round(float(np.nanstd(edge[:, 1])), 6)
     (180, [20.0, 64.5], 0.0)
     """
     # along normals of the centre line smoothed over STRIP_GUIDE half-widths: the filled
@@ -1469,8 +1474,8 @@ def strip_edge(comb: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float)
         smooth = np.abs(off - steady) <= STRIP_EDGE_OFF * half
         rough = 1.0 - float(smooth.mean())
         if rough <= STRIP_ROUGH and (best is None or rough < best[0]):
-            best = (rough, pts[smooth] + sense * off[smooth, None] * n[smooth])
-    return best[1] if best is not None else np.empty((0, 2))
+            best = (rough, np.where(smooth[:, None], pts + sense * off[:, None] * n, np.nan))
+    return best[1] if best is not None else np.full(pts.shape, np.nan)
 
 
 def base_edge_direction(
@@ -1497,9 +1502,24 @@ def base_edge_direction(
     -0.3
     """
     edge = strip_edge(comb, soft, pts, half)
-    if len(edge) < 8:
-        return None
-    start = end_tangents(np.c_[edge[:, 0], -edge[:, 1]], ends_px=(reach_px, 0.0))[0]
+    lead = max(2, int(round(STRIP_LEAD * half)))  # noqa: RUF046 (numpy scalar)
+    found = np.isfinite(edge[:, 0])
+    first = int(np.argmax(found))
+    if len(edge) < first + 2 * lead or first > lead or not found[first : first + 2 * lead].all():
+        return None  # not smooth from near the clamp on: a hook, the clamp, a gap
+    # carried back over as much of the strip as the centre line misses there, and the stretch
+    # before its first point found (the strip on the inside of the bend is shorter: carried
+    # back the centre line's length it turned 8-11 deg too far at psi 240, the review)
+    steps = np.hypot(*np.diff(pts[: first + 2 * lead], axis=0).T)
+    ratio = np.hypot(*np.diff(edge[first : first + 2 * lead], axis=0).T).sum() / max(
+        float(steps[first:].sum()), 1e-9
+    )
+    back = (reach_px + float(steps[:first].sum())) * ratio
+    edge = edge[found]
+    start = end_tangents(np.c_[edge[:, 0], -edge[:, 1]], ends_px=(back, 0.0))[0]
+    own = end_tangents(np.c_[pts[:, 0], -pts[:, 1]])[0]
+    if abs(np.angle(np.exp(1j * (start - own)))) > np.deg2rad(STRIP_CENTRE_DEG):
+        return None  # the strip's edge runs off the body's course: not the strip
     return EndFace(float(-start), (float(edge[0, 0]), float(edge[0, 1])))
 
 

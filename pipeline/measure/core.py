@@ -533,9 +533,11 @@ def measure_body(
     )
     # a chambered body's own start is its first chamber's side: it leaves the clamp along its
     # strip's edge (customer 48's PneuNets, by their centre lines: 16 of 22 rows "-20 to -42 deg
-    # off fixed_direction_deg", right ones among them), the base where none is given
+    # off fixed_direction_deg", right ones among them), which checks a direction given.  Not
+    # psi's base without one: read on one edge, carried back to the clamp, it read psi 8-27
+    # deg off, ok, in the review (a fixed end clicked inside the clamp, a bend of 240 deg)
     strip = _face_direction(body.base_edge, settings) if body.chambered else float("nan")
-    base = strip if given is None and np.isfinite(strip) else given
+    base = given
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip

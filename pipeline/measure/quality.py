@@ -429,10 +429,9 @@ def assess_body(
         )
     if chambered and base_mismatch_deg is None:
         flags.append(
-            "a row of chambers (a PneuNet?) whose strip under the chambers is not found smooth "
-            "at the clamp: its centre line runs through them as a polygon, so the direction it "
-            "leaves the clamp in is its first chamber's: give fixed_direction_deg, the "
-            "direction of the strip at the clamp"
+            "a row of chambers (a PneuNet?): its centre line runs through them as a polygon, so "
+            "the direction it leaves the clamp in is its first chamber's: give "
+            "fixed_direction_deg, the direction of the strip under the chambers at the clamp"
         )
     if chambered and tip_face_turn_deg is None:
         # its centre line's end is a chamber's side: a rounded or slanted last chamber read
