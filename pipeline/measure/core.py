@@ -595,15 +595,12 @@ def measure_body(
         smooth_turning = check_end - check_start  # too short a line for the fit: no check
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
-    own_start = start
-    if body.chambered:  # its own start is its strip's, which a direction given is checked by
+    own_start = start  # what psi is measured from without a direction given
+    if body.chambered and given is not None:  # its own is its strip's, which checks the one given
         own_start = strip
-        if mismatch is not None:
-            mismatch = (
-                float(np.rad2deg(np.angle(np.exp(1j * (given - strip)))))
-                if given is not None and np.isfinite(strip)
-                else 0.0
-            )
+        mismatch = (
+            float(np.rad2deg(np.angle(np.exp(1j * (given - strip))))) if np.isfinite(strip) else 0.0
+        )
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
     start_short, end_short, _ = end_tangents(
         pts, ends_px=ends, window_fraction=0.5 * TANGENT_WINDOW_FRACTION
