@@ -1326,6 +1326,8 @@ MARCH_HALF_WIDTHS = 2.0
 MARCH_STEP_PX = 2.0
 #: the selection is a clamp, not the body, where it is wider than this many of the body's widths
 CLAMP_WIDTH_RATIO = 1.3
+#: a clamp block's face found this far (px) or less before the fixed end given is the same face
+CLAMP_FACE_SLACK_PX = 1.0
 #: a free end that bends (``free_end: bends``) is carried on to the last body pixel within this
 #: many half-widths of the centre line's course (the middle of its end face, not a corner)
 FREE_TIP_ACROSS = 0.3
@@ -1915,7 +1917,7 @@ def _extensions(
         if end == 0 and fixed_xy is not None:
             reach = face_reach(pts, np.asarray(fixed_xy, float))
             if not free_end_bends:
-                reach = min(reach, _clamp_distance(dt, p, t, half, reach))
+                reach = min(reach, _clamp_distance(comp, p, t, half, reach))
             out.append(reach)
             continue
         if end == -1 and not free_end_bends:
@@ -1975,34 +1977,55 @@ def face_reach(pts: np.ndarray, fixed_xy: np.ndarray) -> float:
 
 
 def _clamp_distance(
-    dt: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
+    comp: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
 ) -> float:
-    """How far (px, up to ``reach``) from ``start`` along ``direction`` the selection stays no
-    wider than the body: where its distance transform ``dt`` first exceeds :data:`CLAMP_WIDTH_RATIO`
-    times the body's half-width, the ray has entered a wider block (a clamp plate or bracket that
-    the selection took in), whose face lies a little before (for a square face).  A faint,
-    unselected stretch of body does not stop it.
+    """How far (px, up to ``reach``) from ``start`` along ``direction`` the selection ``comp``
+    stays no wider than the body: where its run across the ray first exceeds
+    :data:`CLAMP_WIDTH_RATIO` times the body's width (``2 * half``), the ray has entered a wider
+    block (a clamp plate or bracket that the selection took in), whose face lies there.  A faint,
+    unselected stretch of body does not stop it.  The block is looked for a width past
+    ``reach`` too, and its face taken where it lies more than :data:`CLAMP_FACE_SLACK_PX` before
+    it: a fixed end clicked 5-15 px inside a clamp block carried the base's curvature on over it
+    (2-6 deg off, ok, at psi 240), and one on the face stays where it was given.
 
     Examples
     --------
     >>> comp = np.zeros((40, 120), np.uint8); comp[15:25, 20:80] = 1; comp[0:40, 80:110] = 1
-    >>> dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
-    >>> round(_clamp_distance(dt, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0))
-    30
-    >>> _clamp_distance(dt, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
+    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0)
+    29.5
+    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 30.0)
+    30.0
+    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
     20.0
     """
     if not np.isfinite(reach) or reach <= 0:
         return reach
-    h, w = dt.shape
-    for a in np.arange(0.0, reach + 1.0, 1.0):
-        x, y = np.round(start + a * direction).astype(int)
-        if not (0 <= x < w and 0 <= y < h):
-            break
-        if dt[y, x] > CLAMP_WIDTH_RATIO * half:
-            # entering a block from a band of half-width ``half``, the distance to the nearest
-            # edge passes CLAMP_WIDTH_RATIO * half this far past the block's face
-            return max(0.0, float(a) - float(np.sqrt(CLAMP_WIDTH_RATIO**2 - 1.0)) * half)
+    h, w = comp.shape
+    normal = np.array([-direction[1], direction[0]])
+    u = np.arange(-3.0 * half, 3.0 * half + 0.5, 1.0)
+    centre = int(np.argmin(np.abs(u)))
+
+    def run(a: float) -> int:
+        """The selection's run across the ray, through it, ``a`` px along (0 off it)."""
+        xy = np.round(start + a * direction + u[:, None] * normal).astype(int)
+        seen = (xy[:, 0] >= 0) & (xy[:, 0] < w) & (xy[:, 1] >= 0) & (xy[:, 1] < h)
+        inside = np.zeros(len(u), bool)
+        inside[seen] = comp[xy[seen, 1], xy[seen, 0]] > 0
+        if not inside[centre]:
+            return 0
+        lo = centre - int(np.argmin(inside[centre::-1])) if not inside[: centre + 1].all() else 0
+        hi = centre + int(np.argmin(inside[centre:])) if not inside[centre:].all() else len(u)
+        return hi - lo
+
+    for a in np.arange(0.0, reach + 2.0 * half + 1.0, 1.0):
+        if run(a) > CLAMP_WIDTH_RATIO * 2.0 * half:
+            # the block's face: half-way from where the run first widens past the body's to
+            # where it reaches the block's own (the selection's corners where the body meets the
+            # block are rounded: either alone read the face 1-2 px off, early or late)
+            block = run(a + half)
+            full = next((b for b in np.arange(a, a + half + 1.0, 1.0) if run(b) >= block - 2), a)
+            face = max(0.0, 0.5 * (float(a) + float(full)) - 0.5)
+            return face if face < reach - CLAMP_FACE_SLACK_PX else reach
     return reach
 
 
