@@ -1917,7 +1917,7 @@ def _extensions(
         if end == 0 and fixed_xy is not None:
             reach = face_reach(pts, np.asarray(fixed_xy, float))
             if not free_end_bends:
-                reach = min(reach, _clamp_distance(comp, p, t, half, reach))
+                reach = min(reach, _clamp_distance(comp, dt, p, t, half, reach))
             out.append(reach)
             continue
         if end == -1 and not free_end_bends:
@@ -1977,30 +1977,44 @@ def face_reach(pts: np.ndarray, fixed_xy: np.ndarray) -> float:
 
 
 def _clamp_distance(
-    comp: np.ndarray, start: np.ndarray, direction: np.ndarray, half: float, reach: float
+    comp: np.ndarray,
+    dt: np.ndarray,
+    start: np.ndarray,
+    direction: np.ndarray,
+    half: float,
+    reach: float,
 ) -> float:
     """How far (px, up to ``reach``) from ``start`` along ``direction`` the selection ``comp``
-    stays no wider than the body: where its run across the ray first exceeds
-    :data:`CLAMP_WIDTH_RATIO` times the body's width (``2 * half``), the ray has entered a wider
-    block (a clamp plate or bracket that the selection took in), whose face lies there.  A faint,
-    unselected stretch of body does not stop it.  The block is looked for a width past
-    ``reach`` too, and its face taken where it lies more than :data:`CLAMP_FACE_SLACK_PX` before
-    it: a fixed end clicked 5-15 px inside a clamp block carried the base's curvature on over it
-    (2-6 deg off, ok, at psi 240), and one on the face stays where it was given.
+    stays no wider than the body: where its distance transform ``dt`` first exceeds
+    :data:`CLAMP_WIDTH_RATIO` times the body's half-width, the ray has entered a wider block (a
+    clamp plate or bracket that the selection took in), whose face lies a little before.  A
+    faint, unselected stretch of body does not stop it.
+
+    The block is looked for as far past ``reach`` as that, and its face taken where it lies
+    more than :data:`CLAMP_FACE_SLACK_PX` before ``reach``: a fixed end clicked 5-15 px inside
+    a clamp block, short of where ``dt`` rises, carried the base's curvature on over it (2-6
+    deg off, ok, at psi 240), and one on the face stays where it was given.  The face is
+    located on the selection's run across the ray, half-way from where it first widens past
+    the body's width to where it reaches the block's (the corners where the body meets the
+    block are rounded: either alone read the face 1-2 px off); ``dt`` alone read it up to 2 px
+    early, and the run alone, cut aslant across a body bending from the clamp, took the body
+    for a block.
 
     Examples
     --------
     >>> comp = np.zeros((40, 120), np.uint8); comp[15:25, 20:80] = 1; comp[0:40, 80:110] = 1
-    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0)
-    29.5
-    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 30.0)
+    >>> dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
+    >>> round(_clamp_distance(comp, dt, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 60.0), 1)
+    29.3
+    >>> _clamp_distance(comp, dt, np.array([50.0, 20.0]), np.array([1.0, 0.0]), 5.0, 30.0)
     30.0
-    >>> _clamp_distance(comp, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
+    >>> _clamp_distance(comp, dt, np.array([50.0, 20.0]), np.array([-1.0, 0.0]), 5.0, 20.0)
     20.0
     """
     if not np.isfinite(reach) or reach <= 0:
         return reach
     h, w = comp.shape
+    past = float(np.sqrt(CLAMP_WIDTH_RATIO**2 - 1.0)) * half
     normal = np.array([-direction[1], direction[0]])
     u = np.arange(-3.0 * half, 3.0 * half + 0.5, 1.0)
     centre = int(np.argmin(np.abs(u)))
@@ -2017,14 +2031,21 @@ def _clamp_distance(
         hi = centre + int(np.argmin(inside[centre:])) if not inside[centre:].all() else len(u)
         return hi - lo
 
-    for a in np.arange(0.0, reach + 2.0 * half + 1.0, 1.0):
-        if run(a) > CLAMP_WIDTH_RATIO * 2.0 * half:
-            # the block's face: half-way from where the run first widens past the body's to
-            # where it reaches the block's own (the selection's corners where the body meets the
-            # block are rounded: either alone read the face 1-2 px off, early or late)
-            block = run(a + half)
-            full = next((b for b in np.arange(a, a + half + 1.0, 1.0) if run(b) >= block - 2), a)
-            face = max(0.0, 0.5 * (float(a) + float(full)) - 0.5)
+    for a in np.arange(0.0, reach + past + 1.0, 1.0):
+        x, y = np.round(start + a * direction).astype(int)
+        if not (0 <= x < w and 0 <= y < h):
+            break
+        if dt[y, x] > CLAMP_WIDTH_RATIO * half:
+            steps = np.arange(max(0.0, a - past - 2.0), a + half + 1.0, 1.0)
+            runs = np.array([run(b) for b in steps])
+            wide = runs > CLAMP_WIDTH_RATIO * 2.0 * half
+            if not wide.any():
+                face = a - past
+            else:
+                rise = int(np.argmax(wide))
+                full = rise + int(np.argmax(runs[rise:] >= runs[-1] - 2))
+                face = 0.5 * (steps[rise] + steps[full]) - 0.5
+            face = max(0.0, float(face))
             return face if face < reach - CLAMP_FACE_SLACK_PX else reach
     return reach
 
