@@ -124,6 +124,17 @@ def test_a_fixed_end_clicked_inside_the_clamp_adds_no_bend(psi, inside_px):
     assert res.psi_deg == pytest.approx(psi, abs=1.6), res.reason
 
 
+@pytest.mark.parametrize("psi", [240.0, 120.0, -200.0])
+def test_an_excluded_clamp_does_not_carry_the_body_past_its_face(psi):
+    # the clamp excluded and the fixed end on its face: the clamp's strong difference beside the
+    # body's end let the centre line march 2 px on over it, hooking its start (psi 240 read
+    # 5.5 deg high, ok)
+    img, fe, clamp = body_photo(psi, seed=int(abs(psi)))
+    res = measure_image(img, settings_for(fe, exclude=[clamp]))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=1.5)
+
+
 @pytest.mark.parametrize("psi", [150.0, -120.0])
 def test_textured_body_and_excluded_clamp(psi):
     img, fe, clamp = body_photo(psi, texture=True, seed=3)
