@@ -128,3 +128,25 @@ def test_a_straight_end_a_little_longer_than_given_is_noted_and_counted_as_no_ca
     # a right 10 mm end read 11.2 (12 % long, under the share) is not noted
     right = check_sealed_ends(rows.assign(straight_end_mm=[np.nan, 11.2, 11.1, 11.2]))
     assert not right["reason"].str.contains("longer straight end").any()
+
+
+def test_straight_ends_that_scatter_are_no_verdict_and_the_long_ones_are_flagged_alone():
+    # customer 49's clear body without its empty scene: 3 frames showed 5.9, 13.5 and 22.7 mm
+    # for its 6 (two tips not seen whole, reading psi 7-9 deg low); every bent frame was flagged
+    # "measure it again ... (about 13 mm)", 9 of 11 right, and the 13 mm advised put 10 frames
+    # ok 13-20 deg low
+    psi = np.r_[np.linspace(0.0, 210.0, 15)]
+    seen = np.full(15, np.nan)
+    seen[[5, 6, 7]] = [5.9, 13.5, 22.7]
+    rows = pd.DataFrame({"material": "M", "actuator": "A", "psi_deg": psi, "l0_mm": 100.0,
+                         "status": "ok", "reason": "", "sealed_end_mm": 6.0,
+                         "straight_end_mm": seen})
+    out = check_sealed_ends(rows)
+    assert out.index[out["status"] == "flagged"].tolist() == [6, 7]
+    assert not out["reason"].str.contains("measure it again").any()
+    assert out["reason"][6].startswith(
+        "this photo's last 13.5 mm stay straight, more than twice sealed_end_mm (6)"
+    )
+    # straight ends that agree are still a verdict
+    agree = check_sealed_ends(rows.assign(straight_end_mm=np.where(np.isnan(seen), np.nan, 13.0)))
+    assert agree["reason"].str.contains("measure it again").sum() >= 3
