@@ -36,10 +36,10 @@ SEALED_END_MIN_SHARE = 0.15
 #: empty scene showed 5.9, 13.5 and 22.7 mm for its 6, two of them tips not seen whole, and the
 #: advice to give 13 put 10 of 15 frames ok 13-20 deg low)
 SEALED_END_SPREAD_SHARE = 0.25
-#: without such a verdict, a photo whose own straight end is this many times the one given (and
-#: longer by SEALED_END_MARGIN_MM) is flagged alone: its tip is likely not seen whole (customer
-#: 49's 13.5 mm for 6 read psi 7 deg low, ok)
-SEALED_END_STRAY_FACTOR = 2.0
+#: where they scatter so, a photo whose own straight end is this many times the one given, and
+#: SEALED_END_STRAY_MM longer, is flagged alone: its tip is likely not seen whole (customer 49's
+#: 13.5 mm for 6 read psi 7 deg low, ok; a 2 mm end given without its dome shows 4.3)
+SEALED_END_STRAY_FACTOR, SEALED_END_STRAY_MM = 2.0, 4.0
 #: the straight end the photos show must exceed the one given by more than this (mm), and by
 #: more than SEALED_END_MARGIN_SHARE of itself (without mm_per_px the scale is the bent body's
 #: length against l0_mm, a few % off: a 25 mm end read 27.9) ...
@@ -110,12 +110,10 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
     for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
         shown = seen[g.index].dropna()
         bent = int((psi_abs[g.index] >= 90.0).sum())
-        spread = float((shown - shown.median()).abs().median()) if len(shown) else 0.0
-        if (
-            len(shown) < SEALED_END_MIN_PHOTOS
-            or len(shown) <= SEALED_END_MIN_SHARE * bent
-            or spread > max(SEALED_END_MARGIN_MM, SEALED_END_SPREAD_SHARE * float(shown.median()))
-        ):
+        if len(shown) < SEALED_END_MIN_PHOTOS or len(shown) <= SEALED_END_MIN_SHARE * bent:
+            continue
+        spread = float((shown - shown.median()).abs().median())
+        if spread > max(SEALED_END_MARGIN_MM, SEALED_END_SPREAD_SHARE * float(shown.median())):
             _flag_strays(out, g.index, seen, given)
             continue
         shown_mm = float(shown.median())
@@ -170,8 +168,9 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
 
 def _flag_strays(out: pd.DataFrame, rows: pd.Index, seen: pd.Series, given: pd.Series) -> None:
     """Flag (in place in ``out``) each of ``rows`` whose own straight end (``seen``, mm) is
-    :data:`SEALED_END_STRAY_FACTOR` times the sealed end given (``given``) or more: where its
-    actuator's photos give no verdict, such a photo's tip is likely not seen whole.
+    :data:`SEALED_END_STRAY_FACTOR` times the sealed end given (``given``) or more, and
+    :data:`SEALED_END_STRAY_MM` longer: where the straight ends of its actuator's photos
+    scatter, such a photo's tip is likely not seen whole.
 
     Examples
     --------
@@ -181,14 +180,16 @@ def _flag_strays(out: pd.DataFrame, rows: pd.Index, seen: pd.Series, given: pd.S
     ['ok', 'flagged', 'ok']
     """
     stray = (seen[rows] >= SEALED_END_STRAY_FACTOR * given[rows]) & (
-        seen[rows] - given[rows] > SEALED_END_MARGIN_MM
+        seen[rows] - given[rows] >= SEALED_END_STRAY_MM
     )
+    shown = seen[rows].dropna()
     for i in rows[stray.to_numpy()]:
         cause = (
-            f"this photo's last {seen[i]:.1f} mm stay straight, more than twice sealed_end_mm "
-            f"({given[i]:g}), where its actuator's other photos do not show that: its tip may "
-            "not be seen whole (a clear or faint tip: an empty scene, background, helps), so "
-            "psi may be off; check with photoset preview"
+            f"this photo's last {seen[i]:.1f} mm stay straight, twice sealed_end_mm "
+            f"({given[i]:g}) or more, where its actuator's photos show straight ends that "
+            f"scatter ({shown.min():.1f} to {shown.max():.1f} mm): its tip may not be seen whole "
+            "(a clear or faint tip: an empty scene, background, helps), so psi may be off; "
+            "check with photoset preview"
         )
         reason = out.at[i, "reason"]
         out.at[i, "status"] = "flagged"

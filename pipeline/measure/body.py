@@ -781,10 +781,7 @@ def body_mask(
         if background_bgr is None or not settings.background_estimated:
             differs, hollow = fill_outlined(differs, diff, allowed, OUTLINE_FILL_SIGMAS * sigma)
         mask &= differs
-        # nor does what is not looked at: an excluded clamp's strong difference beside the body's
-        # end let the centre line march on 2 px over the clamp's face, hooking its start (psi 240
-        # read 5.5 deg high, ok, with the clamp excluded and the fixed end on its face)
-        strength = np.where(allowed > 0, diff / max(thr, 1e-6), 0.0).astype(np.float32)
+        strength = diff / max(thr, 1e-6)
         if unlit is not None:
             # the shadow does not place the body's edges either: beside a clamp's shadow the
             # edge crept out by a fraction of a pixel, enough to turn the base by 1 deg (customer
@@ -1803,7 +1800,12 @@ def _cap_ahead(
 
 
 def _march(
-    soft: np.ndarray, pts: np.ndarray, widths: np.ndarray, half: float, end_med: tuple[float, float]
+    soft: np.ndarray,
+    pts: np.ndarray,
+    widths: np.ndarray,
+    half: float,
+    end_med: tuple[float, float],
+    region: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     """Carry the centre line on towards both ends, 1 px at a time, while it is still "between two
     edges": each new point is the middle of the profile across the body ahead, kept while the
@@ -1815,7 +1817,10 @@ def _march(
     The ridge path stops about a half-width short of each end (there the medial axis forks into
     the corners); marching recovers that part, so a tip that curls to its end is measured to its
     end, and a straight sealed cap is followed to its end face.  Also returns whether the march
-    at the free end stopped at a cap (:func:`_cap_ahead`).
+    at the free end stopped at a cap (:func:`_cap_ahead`).  It does not step out of ``region``
+    (the pixels looked at, 1): an excluded clamp's strong difference beside the body's end
+    carried the centre line 2 px on over the clamp's face, hooking its start (psi 240 read 5.5
+    deg high, ok, the fixed end on the face).
     """
     k = 6
     ends = []
@@ -1840,6 +1845,11 @@ def _march(
                 )
                 break
             step = mid[1]
+            if region is not None:
+                x, y = round(float(step[0])), round(float(step[1]))
+                h, w = region.shape
+                if not (0 <= y < h and 0 <= x < w) or not region[y, x]:
+                    break  # into what is not looked at
             d = step - prev  # the course over the last few points, not one step's jitter
             off_deg = float(np.rad2deg(np.arccos(np.clip(
                 float(d @ t) / max(float(np.hypot(*d)), 1e-9), -1.0, 1.0
@@ -2399,7 +2409,7 @@ def extract_body(
         else (2.0 * half,) * 2
     )
     body_width = float(np.nanmedian(widths)) if np.isfinite(widths).any() else 2.0 * half
-    pts, widths, tip_capped = _march(soft, pts, widths, half, end_med)
+    pts, widths, tip_capped = _march(soft, pts, widths, half, end_med, region)
     along_ridge = _follow_ridge(ridge, pts, half)
     ridge_tip_deg = 0.0
     if len(along_ridge) > len(pts) and len(pts) >= 8:
