@@ -135,6 +135,22 @@ def test_an_excluded_clamp_does_not_carry_the_body_past_its_face(psi):
     assert res.psi_deg == pytest.approx(psi, abs=2.0)
 
 
+def test_a_label_in_a_far_corner_is_no_rival_body():
+    # customer 49: a paper label in a corner, never touching the body, flagged 15 of 84 right
+    # rows "2 candidate bodies"; with the fixed end reached, a smaller selection far from the
+    # body is no rival, and one beside it (a ruler along it) still is
+    img, fe, _ = body_photo(150.0, seed=4)
+    labelled = img.copy()
+    cv2.rectangle(labelled, (W - 170, H - 100), (W - 20, H - 20), (250, 250, 250), -1)
+    res = measure_image(labelled, settings_for(fe))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(150.0, abs=2.5)
+    beside = img.copy()
+    cv2.rectangle(beside, (int(fe[0]) - 10, int(fe[1]) + 40), (int(fe[0]) + 500, int(fe[1]) + 70),
+                  (250, 250, 250), -1)
+    assert "candidate bodies" in measure_image(beside, settings_for(fe)).reason
+
+
 @pytest.mark.parametrize("psi", [150.0, -120.0])
 def test_textured_body_and_excluded_clamp(psi):
     img, fe, clamp = body_photo(psi, texture=True, seed=3)
@@ -395,14 +411,23 @@ def test_two_actuators_in_one_photo_are_flagged_with_the_roi_fix_and_measured_wi
 
 def test_a_ruler_in_view_is_flagged_with_the_exclude_fix_and_measured_with_it():
     # customer 30 laid a ruler along the bottom of the frame, as the README suggests for the
-    # scale: every row was flagged 'another actuator in view ... set roi', which a ruler is not
+    # scale: every row was flagged 'another actuator in view ... set roi', which a ruler is not.
+    # Far from the body that reaches the fixed end, and smaller, it is no rival (customer 49);
+    # beside the body it is, and the reason says what to do
     img, fe, _ = body_photo(120.0, seed=3)
     h, w = img.shape[:2]
-    img[h - 40 : h - 16, 20 : w - 20] = (90, 140, 200)  # as the body differs from the backdrop
-    res = measure_image(img, settings_for(fe))
+    far = img.copy()
+    far[h - 40 : h - 16, 20 : w - 20] = (90, 140, 200)  # as the body differs from the backdrop
+    res = measure_image(far, settings_for(fe))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(120.0, abs=2.5)
+    near = img.copy()
+    y = int(fe[1]) + 60  # clear of the clamp (30 px below, touching it, it joins the body)
+    near[y : y + 24, 20 : w - 20] = (90, 140, 200)
+    res = measure_image(near, settings_for(fe))
     assert res.status == "flagged" and res.reason.startswith("2 candidate bodies"), res.reason
     assert "such as a ruler" in res.reason and "give exclude (a box over it)" in res.reason
-    res = measure_image(img, settings_for(fe, exclude=[[10, h - 50, w - 10, h - 6]]))
+    res = measure_image(near, settings_for(fe, exclude=[[10, y - 6, w - 10, y + 30]]))
     assert res.status == "ok", res.reason
     assert res.psi_deg == pytest.approx(120.0, abs=2.5)
 

@@ -1036,6 +1036,44 @@ def _component(
     return (labels == pick).astype(np.uint8), rivals, reached
 
 
+#: another selection smaller than the body that reaches the fixed end given, and farther from
+#: it than this fraction of the photo's diagonal, is no rival body (a label or a ruler in a
+#: corner: customer 49's 15 of 84 right rows flagged "2 candidate bodies")
+RIVAL_FAR_FRACTION = 0.1
+
+
+def _rivals(others: np.ndarray, comp: np.ndarray, *, far_apart: bool) -> int:
+    """How many components of ``others`` (the selection less the body ``comp``) are a quarter
+    of the body's area or more: rival bodies.  With ``far_apart`` (the body reaches the fixed
+    end given) one smaller than the body lying farther than :data:`RIVAL_FAR_FRACTION` of the
+    photo's diagonal from it is not counted: a part of this body beyond a gap lies nearer, or
+    ahead of its free end (``BodyExtraction.continues``), and a larger one still counts (the
+    body may be a stub at the clamp).
+
+    Examples
+    --------
+    >>> comp = np.zeros((100, 200), np.uint8); comp[40:50, 10:150] = 1
+    >>> others = np.zeros_like(comp); others[85:99, 170:199] = 1  # a label in a corner
+    >>> _rivals(others, comp, far_apart=True), _rivals(others, comp, far_apart=False)
+    (0, 1)
+    >>> others[55:60, 10:150] = 1  # a ruler beside the body
+    >>> _rivals(others, comp, far_apart=True)
+    1
+    """
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(others, connectivity=8)
+    area = float(comp.sum())
+    big = [i for i in range(1, n) if stats[i, cv2.CC_STAT_AREA] >= 0.25 * area]
+    if not far_apart or not big:
+        return len(big)
+    away = cv2.distanceTransform((1 - comp).astype(np.uint8), cv2.DIST_L2, 3)
+    far = RIVAL_FAR_FRACTION * float(np.hypot(*comp.shape))
+    return sum(
+        1
+        for i in big
+        if stats[i, cv2.CC_STAT_AREA] >= area or float(away[labels == i].min()) <= far
+    )
+
+
 #: the ridge's far end is not one reached only across a block: when the widest point on the way
 #: to the selection's farthest pixel is more than :data:`BLOB_THICKNESS` times the ridge's median
 #: thickness, the way crosses a clamp block or plate that the selection took in, with the tube
@@ -2349,9 +2387,8 @@ def extract_body(
         ) from None
     comp, dt, path, gaps = _bridge_gaps(mask, comp, fe if reached else None)
     guessed = not reached or fe is None
-    if gaps:  # the pieces joined are no longer rivals
-        _, _, stats, _ = cv2.connectedComponentsWithStats(mask & (1 - comp), connectivity=8)
-        rivals = int((stats[1:, cv2.CC_STAT_AREA] >= 0.25 * comp.sum()).sum())
+    if gaps or (reached and fe is not None):  # the pieces joined are no longer rivals
+        rivals = _rivals(mask & (1 - comp), comp, far_apart=reached and fe is not None)
     # the body's half-width along its own ridge (not over the whole component: a tube or a clamp
     # joined to it would pull a component-wide figure far off)
     xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
