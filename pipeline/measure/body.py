@@ -65,16 +65,16 @@ SMOOTH_HALF_WIDTHS = 0.6
 
 @dataclass(frozen=True)
 class EndFace:
-    """A flat face ending the body, and the body's direction read there: at the free end the
-    face's outward normal (:func:`tip_face_normal`), at the fixed end the way the body leaves
-    the clamp, from its long edges beside the face the clamp cuts (:func:`base_edge_direction`).
+    """A direction the body is read to have at one of its ends: at the free end the outward
+    normal of the flat face ending it (:func:`tip_face_normal`), at the fixed end the way a
+    chambered body leaves the clamp, on its strip's edge (:func:`base_edge_direction`).
 
     Attributes
     ----------
     direction_rad : float
         The direction (rad, image axes: y down): the tip's, or the body's out of the clamp.
     middle_px : (float, float)
-        The face's middle (x, y), px.
+        Where it is read (x, y), px: the face's middle, or the strip edge's first point.
     """
 
     direction_rad: float
@@ -2387,7 +2387,7 @@ def extract_body(
         ) from None
     comp, dt, path, gaps = _bridge_gaps(mask, comp, fe if reached else None)
     guessed = not reached or fe is None
-    if gaps or (reached and fe is not None):  # the pieces joined are no longer rivals
+    if gaps or (rivals and reached and fe is not None):  # the pieces joined are no longer rivals
         rivals = _rivals(mask & (1 - comp), comp, far_apart=reached and fe is not None)
     # the body's half-width along its own ridge (not over the whole component: a tube or a clamp
     # joined to it would pull a component-wide figure far off)
@@ -2511,6 +2511,6 @@ def extract_body(
             ),
             scale,
         )
-        if chambered
+        if chambered and settings.fixed_direction_deg is not None  # what it checks
         else None,
     )

@@ -528,7 +528,7 @@ def measure_body(
             "needs its empty scene: background)",
         )
     rng = np.random.default_rng(SEED)
-    given = (
+    base = (
         None if settings.fixed_direction_deg is None else np.deg2rad(settings.fixed_direction_deg)
     )
     # a chambered body's own start is its first chamber's side: it leaves the clamp along its
@@ -537,7 +537,6 @@ def measure_body(
     # psi's base without one: read on one edge, carried back to the clamp, it read psi 8-27
     # deg off, ok, in the review (a fixed end clicked inside the clamp, a bend of 240 deg)
     strip = _face_direction(body.base_edge, settings) if body.chambered else float("nan")
-    base = given
     try:
         tip = tangents(pts, rng, ends_px=ends, base_rad=base)
         free = tangents(pts, rng, ends_px=ends) if base is not None else tip
@@ -596,10 +595,10 @@ def measure_body(
     psi = float(np.rad2deg(sign * est.turning_rad))
     mismatch = None if base is None else float(np.rad2deg(free.turning_rad - tip.turning_rad))
     own_start = start  # what psi is measured from without a direction given
-    if body.chambered and given is not None:  # its own is its strip's, which checks the one given
+    if body.chambered and base is not None:  # its own is its strip's, which checks the one given
         own_start = strip
         mismatch = (
-            float(np.rad2deg(np.angle(np.exp(1j * (given - strip))))) if np.isfinite(strip) else 0.0
+            float(np.rad2deg(np.angle(np.exp(1j * (base - strip))))) if np.isfinite(strip) else 0.0
         )
     # each end fitted over half its window: a hook in its last pixels (the clamp, the tip)
     start_short, end_short, _ = end_tangents(
