@@ -1558,3 +1558,22 @@ def test_dots_standing_half_out_of_the_outline_do_not_turn_the_tip():
                 ok += 1
                 errors.append(abs(res.psi_deg - psi))
     assert ok >= 7 and max(errors) < 3.5, (ok, errors)
+
+
+def test_a_row_of_chamber_crests_is_no_bump():
+    # customer 48's PneuNet (83 px wide) given a direction 10 deg off: its chamber crests stood
+    # out of the comb side's running median by 15-72 px, were set back as marker bumps, and the
+    # ramp check no longer saw the direction (15 rows ok 10 deg off); a marker stands out half its
+    # own size, 10-20 % of a body's width
+    from pipeline.measure.body import _without_bumps
+
+    n, width = 400, 80.0
+    left = np.full(n, -width / 2)
+    comb = np.full(n, width / 2)
+    for start in range(20, n - 40, 60):  # chambers 40 px long, 20 px apart, half the strip high
+        comb[start : start + 40] += 0.5 * width
+    good = np.ones(n, bool)
+    assert (_without_bumps(left, comb, good)[1] == comb).all()
+    dot = np.full(n, width / 2)
+    dot[200:210] += 0.12 * width  # a marker dot half out of the outline
+    assert (_without_bumps(left, dot, good)[1] == width / 2).all()

@@ -2142,8 +2142,11 @@ BUMP_MIN_PX = 2.0
 BUMP_MIN_CONTRAST = 25.0
 #: ... nor within this many widths of either end of the centre line (at least its end point) ...
 BUMP_END_WIDTHS = 0.0
-#: ... and by more than this many sigmas of that side's own wander from its course
-BUMP_WANDER_SIGMAS = 4.0
+#: ... and by more than this many sigmas of that side's own wander from its course, but by no
+#: more than this fraction of the width (a marker stands half its own size out, 10-20 % of a
+#: body's width; a PneuNet's chamber crests 20-90 %: set back, its ramp check no longer saw a
+#: direction given 10 deg off, 15 rows ok 10 deg off)
+BUMP_WANDER_SIGMAS, BUMP_MAX_WIDTH_FRACTION = 4.0, 0.25
 
 
 def _without_bumps(
@@ -2192,7 +2195,9 @@ def _without_bumps(
     margin = max(1, round(BUMP_END_WIDTHS * width))
     inner[margin : len(left) - margin] = True
     bulge_l, bulge_r = (
-        _short_runs(out - course > max(limit, spread), width, inner)
+        _short_runs(
+            out - course, max(limit, spread), width, BUMP_MAX_WIDTH_FRACTION * width, inner
+        )
         for out, course, spread in ((out_l, course_l, wander[0]), (out_r, course_r, wander[1]))
     )
     return (
@@ -2201,20 +2206,24 @@ def _without_bumps(
     )
 
 
-def _short_runs(flags: np.ndarray, longest: float, within: np.ndarray) -> np.ndarray:
-    """``flags`` with only its runs of True at most ``longest`` long and all ``within`` kept.
+def _short_runs(
+    excess: np.ndarray, limit: float, longest: float, tallest: float, within: np.ndarray
+) -> np.ndarray:
+    """Where ``excess`` is over ``limit``, in runs at most ``longest`` long, at most ``tallest``
+    high and all ``within``.
 
     Examples
     --------
-    >>> f = np.array([1, 1, 0, 1, 1, 1, 1, 0, 1], bool)
-    >>> _short_runs(f, 3, np.r_[np.ones(8, bool), False]).astype(int)
-    array([1, 1, 0, 0, 0, 0, 0, 0, 0])
+    >>> e = np.array([3, 3, 0, 3, 3, 3, 3, 0, 9, 9, 0, 3], float)
+    >>> _short_runs(e, 1.0, 3, 5.0, np.r_[np.ones(11, bool), False]).astype(int)
+    array([1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0])
     """
+    flags = np.nan_to_num(excess) > limit
     edges = np.diff(np.r_[0, flags.astype(np.int8), 0])
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     out = np.zeros_like(flags, dtype=bool)
     for a, b in zip(starts, stops):
-        out[a:b] = b - a <= longest and bool(within[a:b].all())
+        out[a:b] = b - a <= longest and excess[a:b].max() <= tallest and bool(within[a:b].all())
     return out
 
 
@@ -2512,8 +2521,10 @@ def extract_body(
     window = int(round(LOCAL_WIDTH_HALF_WIDTHS * half))  # noqa: RUF046 (numpy scalar)
     reach = 3.0 * half + 4.0
     # a bump on one side (a marker dot) is left out where the outline is clear: a faint one's
-    # edges wander as much (the translucent body on grey, without its empty scene)
-    clear_outline = selection.contrast >= BUMP_MIN_CONTRAST
+    # edges wander as much (the translucent body on grey, without its empty scene); not on a row
+    # of chambers, whose comb side is all bumps (customer 48's PneuNet given a direction 10 deg
+    # off: its ramp check no longer saw it, 15 rows ok 10 deg off)
+    clear_outline = selection.contrast >= BUMP_MIN_CONTRAST and not chambered
     for _ in range(2):
         moved, wid, cut = _midpoints(soft, pts, reach=reach, without_bumps=clear_outline)
         if cut.any():
