@@ -2140,8 +2140,6 @@ BUMP_MIN_PX = 2.0
 #: sigmas (:attr:`BodySelection.contrast`; rendered opaque bodies 34-100, the translucent body on
 #: grey without its empty scene 16-18, whose wandering edges this read 6-8 deg off)
 BUMP_MIN_CONTRAST = 25.0
-#: ... nor within this many widths of either end of the centre line (at least its end point) ...
-BUMP_END_WIDTHS = 0.0
 #: ... and by more than this many sigmas of that side's own wander from its course, but by no
 #: more than this fraction of the width (a marker stands half its own size out, 10-20 % of a
 #: body's width; a PneuNet's chamber crests 20-90 %: set back, its ramp check no longer saw a
@@ -2190,10 +2188,10 @@ def _without_bumps(
         BUMP_WANDER_SIGMAS * 1.4826 * float(np.nanmedian(np.abs(out - course)))
         for out, course in ((out_l, course_l), (out_r, course_r))
     ]
-    # not at the ends, where the window is cut short and the outline turns round the tip
+    # not touching the ends, where the window is cut short and the outline turns round the tip
+    # (a wider margin, a quarter of the width, let customer 50's dot near the tip turn it again)
     inner = np.zeros(len(left), bool)
-    margin = max(1, round(BUMP_END_WIDTHS * width))
-    inner[margin : len(left) - margin] = True
+    inner[1:-1] = True
     bulge_l, bulge_r = (
         _short_runs(
             out - course, max(limit, spread), width, BUMP_MAX_WIDTH_FRACTION * width, inner

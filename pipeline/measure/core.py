@@ -1178,8 +1178,10 @@ def _refined(
     at full size).
     """
     unsteady: AngleResult | None = None
-    while factor > 1 and (_too_coarse(res, factor) or (unsteady and res.status != "ok")):
-        if unsteady is None and res.status == "flagged" and UNSTEADY in res.reason:
+    while factor > 1 and (
+        _too_coarse(res, factor) or (unsteady is not None and res.status != "ok")
+    ):
+        if unsteady is None and _unsteady(res):
             unsteady = res
         finer = finer_reading(factor // 2)
         if finer is None:
@@ -1195,8 +1197,13 @@ def _too_coarse(res: AngleResult, factor: int) -> bool:
     return (
         res.status == "failed"
         or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX
-        or (res.status == "flagged" and UNSTEADY in res.reason)
+        or _unsteady(res)
     )
+
+
+def _unsteady(res: AngleResult) -> bool:
+    """Whether :func:`steady_reading` flagged ``res``."""
+    return res.status == "flagged" and UNSTEADY in res.reason
 
 
 def measure_decoded(
