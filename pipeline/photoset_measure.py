@@ -62,7 +62,8 @@ from pipeline.sealed_end_check import check_sealed_ends
 #: length psi was computed with; ``calibration_px`` /
 #: ``calibration_mm``: reprojection error of the row's camera calibration, empty when uncalibrated;
 #: ``sealed_end_mm``: the one given; ``straight_end_mm``: the straight end seen on a capped
-#: body's centre line, see :mod:`pipeline.sealed_end_check`)
+#: body's centre line; ``past_l0_mm``: how far it runs past l0_mm at the scale given, see
+#: :mod:`pipeline.sealed_end_check`)
 RESULT_COLUMNS: tuple[str, ...] = (
     "image",
     "psi_deg",
@@ -86,6 +87,7 @@ RESULT_COLUMNS: tuple[str, ...] = (
     "calibration_mm",
     "sealed_end_mm",
     "straight_end_mm",
+    "past_l0_mm",
 )
 #: an ``ok`` first look and an ``ok`` second look further apart than this (deg): the second is
 #: taken.  A first look told from a model of the backdrop misses a faint side of a translucent

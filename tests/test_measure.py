@@ -354,7 +354,7 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
     folder, truth = photoset
     serial = measure_photoset(folder)
     par = measure_photoset(folder, jobs=2, overlays_dir=tmp_path / "ov")
-    assert list(par.columns[:22]) == [
+    assert list(par.columns[:23]) == [
         "image",
         "psi_deg",
         "kappa_per_mm",
@@ -377,14 +377,16 @@ def test_measure_photoset_parallel_with_overlays(photoset, tmp_path: Path) -> No
         "calibration_mm",
         "sealed_end_mm",
         "straight_end_mm",
+        "past_l0_mm",
     ]
     assert par["base_direction_deg"].isna().all()  # drawn lines: no body base to share
     assert par["straight_end_mm"].isna().all()  # a drawn line's
+    assert par["past_l0_mm"].isna().all()
     assert par["base_side_split_deg"].isna().all()
     assert par["camera_turn_deg"].isna().all()  # a drawn line's psi does not depend on it
     assert par["fixed_direction_deg"].isna().all()
     assert (par["positive_turn"] == "ccw").all()
-    assert list(par.columns[22:28]) == [
+    assert list(par.columns[23:29]) == [
         "pressure_kpa",
         "direction",
         "material",
@@ -432,7 +434,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
     assert "method turning ->" in run.stdout  # what was asked is what every row took
     angles = pd.read_csv(out)
     assert (angles["method"] == "turning").all()
-    assert list(angles.columns[15:23]) == [
+    assert list(angles.columns[15:24]) == [
         "seconds",
         "degree",
         "l0_mm",
@@ -440,6 +442,7 @@ def test_cli_measure(photoset, tmp_path: Path) -> None:
         "calibration_mm",
         "sealed_end_mm",
         "straight_end_mm",
+        "past_l0_mm",
         "pressure_kpa",
     ]
     assert (angles["degree"][:6] >= 1).all() and np.isnan(angles["degree"].iloc[-1])

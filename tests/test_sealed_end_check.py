@@ -156,3 +156,31 @@ def test_straight_ends_that_scatter_are_no_verdict_and_the_long_ones_are_flagged
     # straight ends that agree are still a verdict
     agree = check_sealed_ends(rows.assign(straight_end_mm=np.where(np.isnan(seen), np.nan, 13.0)))
     assert agree["reason"].str.contains("measure it again").sum() >= 3
+
+
+def test_a_sealed_end_too_short_to_show_straight_is_seen_by_the_bodys_length(tmp_path):
+    # a 12 mm sealed end on a 255 mm body is under the ~3/64 of the line a straight end must
+    # span to show (straight_end_mm all NaN); left out, 8 of 9 rows read 5.5-16 deg off, ok, with
+    # a note. With mm_per_px given the body's length shows it: l0_mm, plus the centre line's
+    # stretch as it bends (a straight line in psi), plus the end that does not bend
+    folder = tmp_path / "s"
+    truth = render_photoset(
+        folder, "DS20", actuators=1, trials=1, seed=3, scene="grey_dots", step_kpa=40,
+        scene_overrides={"width": 1280, "height": 960, "sealed_end_mm": 12.0},
+    )
+    settings = (folder / "photoset.yaml").read_text()
+    assert "mm_per_px" in settings and "sealed_end_mm" not in settings
+    out = measure_photoset(folder, jobs=2)
+    error = (out["psi_deg"] - out["image"].map(truth.set_index("image")["psi_deg"])).abs()
+    assert out["straight_end_mm"].isna().all()
+    said = out["reason"].fillna("").str.startswith(
+        "sealed end not given, and this actuator's last 14 mm run past l0_mm"
+    )
+    assert said.sum() >= 5 and (out.loc[said, "status"] == "flagged").all(), out["reason"]
+    assert said[error > 6.0].all(), out.assign(error=error)[["psi_deg", "error", "status"]]
+    # given, nothing is said, and every row is within 3 deg
+    (folder / "photoset.yaml").write_text(settings + "sealed_end_mm: 12\n")
+    out = measure_photoset(folder, jobs=2)
+    error = (out["psi_deg"] - out["image"].map(truth.set_index("image")["psi_deg"])).abs()
+    assert not out["reason"].fillna("").str.contains("sealed end").any(), out["reason"]
+    assert (out["status"] == "ok").all() and error.max() < 3.0, error

@@ -121,6 +121,11 @@ class AngleResult:
         A capped body's straight end seen on its centre line, with the tip's face beyond it (mm,
         :func:`~pipeline.measure.estimators.straight_end`): NaN where none shows, for a line,
         for ``free_end: bends`` and when failed.
+    past_l0_mm : float
+        How far a capped body, from the fixed end to its tip's face, runs past ``l0_mm`` at the
+        scale given (mm): the end that does not bend as the photo shows it, however short.  NaN
+        without ``mm_per_px`` (or a calibration), for a line, for ``free_end: bends`` and when
+        failed.
     """
 
     psi_deg: float
@@ -138,6 +143,7 @@ class AngleResult:
     base_side_split_deg: float = float("nan")
     tip_px: tuple[float, float] | None = None
     straight_end_mm: float = float("nan")
+    past_l0_mm: float = float("nan")
 
 
 #: no actuator turns further than this (deg): a psi beyond it is a line that is not its own
@@ -574,6 +580,13 @@ def measure_body(
     # the body from the fixed end to its tip's face, in the units of pts
     seen_work_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
     body_work_px = seen_work_px + body.tip_face_px * per_image_px
+    # ... and how far that runs past l0_mm at the scale given: the end that does not bend, from
+    # the clamp face (the centre line's start carried back to it) to the tip's face
+    past_l0_mm = (
+        (body_work_px + max(ends[0], 0.0)) * settings.mm_per_px - settings.l0_mm
+        if settings.mm_per_px and settings.free_end == "capped"
+        else float("nan")
+    )
     mm_per_work_px = settings.mm_per_px or length_scale_mm_per_px(
         body_work_px, settings.l0_mm + (settings.sealed_end_mm or 0.0)
     )
@@ -761,6 +774,7 @@ def measure_body(
         if body.chambered
         else base_side_split_deg(line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION),
         straight_end_mm=straight_end_mm if measured.status != "failed" else float("nan"),
+        past_l0_mm=past_l0_mm if measured.status != "failed" else float("nan"),
     )
     if est is not tip:
         return measured

@@ -126,4 +126,5 @@ def result_fields(res: AngleResult, seconds: float) -> dict[str, Any]:
         "seconds": seconds,
         "degree": res.degree if res.status != "failed" else None,
         "straight_end_mm": res.straight_end_mm,
+        "past_l0_mm": res.past_l0_mm,
     }

@@ -187,6 +187,7 @@ def _clip_rows(ps: PhotoSet, clip: Clip, parts: list[dict[str, list]], method: s
             "residual_px",
             "degree",
             "straight_end_mm",
+            "past_l0_mm",
         ):
             df.loc[outside, column] = np.nan
         df.loc[outside, "status"] = "failed"

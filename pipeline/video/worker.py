@@ -53,6 +53,7 @@ CHUNK_COLUMNS: tuple[str, ...] = (
     "seconds",
     "degree",
     "straight_end_mm",
+    "past_l0_mm",
 )
 
 
