@@ -109,6 +109,7 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
     high = 0.5 * psi_abs / out["l0_mm"]  # deg read high per mm of the end missed
     past = pd.to_numeric(out.get("past_l0_mm", pd.Series(np.nan, out.index)), errors="coerce")
     for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
+        _flag_given_long(out, g.index, end_past_l0_mm(past[g.index], g["psi_deg"]), given)
         shown = seen[g.index].dropna()
         bent = int((psi_abs[g.index] >= 90.0).sum())
         own = seen
@@ -212,6 +213,59 @@ def end_past_l0_mm(past_l0_mm: pd.Series, psi_deg: pd.Series) -> pd.Series:
         return pd.Series(np.nan, index=past_l0_mm.index)
     slope = float(np.polyfit(np.deg2rad(psi[have]), past_l0_mm[have], 1)[0])
     return past_l0_mm - slope * np.deg2rad(psi)
+
+
+def _flag_given_long(out: pd.DataFrame, rows: pd.Index, own: pd.Series, given: pd.Series) -> None:
+    """Flag (in place in ``out``) each of ``rows`` that reads |psi| :data:`SEALED_END_FLAG_DEG`
+    or more low because ``sealed_end_mm`` (``given``) is longer than the end that does not bend
+    its body's length shows (``own``, :func:`end_past_l0_mm`) by more than
+    :data:`SEALED_END_MARGIN_MM` and :data:`SEALED_END_MARGIN_SHARE` of itself: psi is then read
+    that much into the part that bends, and misses its turning there, ``|psi| / l0_mm`` per mm
+    (customer 52's 3 mm too long on a 95 mm body: 7 rows ``ok`` 5.3-6.4 deg low; customer 49's,
+    on a tip that curls tightest, 3 mm: 20 rows 5-10.6 deg low).
+
+    Examples
+    --------
+    >>> out = pd.DataFrame({"psi_deg": [20.0, 120.0, 200.0], "l0_mm": 95.0, "status": "ok",
+    ...                     "reason": ""})
+    >>> _flag_given_long(out, out.index, pd.Series([5.2, 5.6, 5.4]), pd.Series([8.0] * 3))
+    >>> out["status"].tolist()
+    ['ok', 'flagged', 'flagged']
+    >>> print(out["reason"][2])  # doctest: +NORMALIZE_WHITESPACE
+    sealed end longer than the photos show: sealed_end_mm is 8 but this actuator's body runs 5 mm
+    past l0_mm in 3 of its photos (its length at mm_per_px, less its centre line's stretch as it
+    bends), so psi is read that much into the part that bends and |psi| reads low (about 5 deg
+    here): measure it again from where the chamber ends to the tip, cap included (about 5 mm),
+    or check l0_mm and mm_per_px
+    """
+    shown = own[rows].dropna()
+    if len(shown) < SEALED_END_MIN_PHOTOS:
+        return
+    shown_mm = float(shown.median())
+    if float((shown - shown_mm).abs().median()) > max(
+        SEALED_END_MARGIN_MM, SEALED_END_SPREAD_SHARE * abs(shown_mm)
+    ):
+        return
+    long_mm = given[rows] - shown_mm
+    low_deg = pd.to_numeric(out.loc[rows, "psi_deg"], errors="coerce").abs() / out.loc[
+        rows, "l0_mm"
+    ] * long_mm
+    margin_mm = np.maximum(SEALED_END_MARGIN_MM, SEALED_END_MARGIN_SHARE * given[rows])
+    reads_low = (long_mm > margin_mm) & (low_deg >= SEALED_END_FLAG_DEG)
+    for i in rows[reads_low.to_numpy()]:
+        cause = (
+            f"sealed end longer than the photos show: sealed_end_mm is {given[i]:g} but this "
+            f"actuator's body runs {shown_mm:.0f} mm past l0_mm in {len(shown)} of its photos "
+            "(its length at mm_per_px, less its centre line's stretch as it bends), so psi is read "
+            "that much into the part that bends and |psi| reads low (about "
+            f"{low_deg[i]:.0f} deg here): measure it again from where the chamber ends to the tip, "
+            f"cap included (about {shown_mm:.0f} mm), or check l0_mm and mm_per_px"
+        )
+        reason = out.at[i, "reason"]
+        out.at[i, "status"] = "flagged"
+        out.at[i, "reason"] = "; ".join(
+            c for c in (cause, str(reason) if pd.notna(reason) else "") if c
+        )
 
 
 def _flag_strays(out: pd.DataFrame, rows: pd.Index, seen: pd.Series, given: pd.Series) -> None:

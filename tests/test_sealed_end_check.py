@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from pipeline.photoset_measure import measure_photoset
+from pipeline.report.reasons import top_reasons
 from pipeline.sealed_end_check import check_sealed_ends
 from pipeline.synth.photoset_writer import render_photoset
 
@@ -111,8 +112,6 @@ def test_a_straight_end_a_little_longer_than_given_is_noted_and_counted_as_no_ca
     # customer 45 gave its caps without their 2 mm domes: the photos showed 1.6-2.7 mm more, too
     # little to flag, and 7 rows read 3-4 deg high, ok, with empty reasons. Now noted (status
     # kept), but not on a right end read a little long, and the note is no cause in the report
-    from pipeline.report.reasons import top_reasons
-
     rows = pd.DataFrame({"material": "M", "actuator": "A", "psi_deg": [20.0, 150, 200, 205],
                          "l0_mm": 95.0, "status": ["ok", "ok", "ok", "flagged"],
                          "reason": ["", "", "", "line partly hidden: 80% of l0 visible"],
@@ -184,3 +183,19 @@ def test_a_sealed_end_too_short_to_show_straight_is_seen_by_the_bodys_length(tmp
     error = (out["psi_deg"] - out["image"].map(truth.set_index("image")["psi_deg"])).abs()
     assert not out["reason"].fillna("").str.contains("sealed end").any(), out["reason"]
     assert (out["status"] == "ok").all() and error.max() < 3.0, error
+    # given 8 mm too long, psi is read that far into the part that bends: the rows that read
+    # low are flagged, naming the length the body shows (before: nothing checked it; customer
+    # 52's 3 mm too long: 7 rows ok 5.3-6.4 deg low)
+    (folder / "photoset.yaml").write_text(settings + "sealed_end_mm: 20\n")
+    out = measure_photoset(folder, jobs=2)
+    error = out["psi_deg"] - out["image"].map(truth.set_index("image")["psi_deg"])
+    said = out["reason"].fillna("").str.match(
+        "sealed end longer than the photos show: sealed_end_mm is 20 but this actuator's body "
+        "runs 1[34] mm past l0_mm"
+    )
+    assert said.sum() >= 4 and (out.loc[said, "status"] == "flagged").all(), out["reason"]
+    # (one row, 72 deg, reads 5.7 low, ok: the turning over the stretch misread, 2 deg, is
+    # under the 2.5 flagged; this body's tip curls more than its mean)
+    assert said[error.abs() > 6.0].all(), out.assign(error=error)[["psi_deg", "error", "status"]]
+    first = top_reasons(out.assign(dataset="d"))["d"][0]  # the report's first page names it
+    assert first == ("sealed_end_mm longer than the photos show", int(said.sum()))

@@ -227,11 +227,15 @@ def test_a_video_of_a_body_without_a_line_is_a_body_set_and_measured_as_one(tmp_
     m = out.merge(truth, on=["image", "frame"], suffixes=("", "_true"))
     err = (m["psi_deg"] - m["psi_image_deg"]).abs()
     ok = m["status"] == "ok"
-    assert ok.mean() >= 0.8 and err[ok].median() < 5.0
+    # the centre line runs on into the sealed end and the white cap, which its length at
+    # mm_per_px shows (11 mm for 10): the frames it reads high (2-4 deg at psi 210) say so
+    said = m["reason"].fillna("").str.startswith(
+        "sealed end not given, and this actuator's last 11 mm run past l0_mm"
+    )
+    assert (m.loc[said, "status"] == "flagged").all() and said[m["psi_image_deg"] > 150].all()
+    assert (ok | said).mean() >= 0.8 and err[ok].median() < 5.0
     assert truth["psi_image_deg"].max() - truth["psi_image_deg"].min() > 150  # a real step
-    # within 5 deg below psi 180; above it the centre line runs on into the sealed end and the
-    # white cap (2-11 deg high at psi 210) ...
-    assert (err[ok & (m["psi_image_deg"].abs() < 180)] < 5.0).all()
+    assert (err[ok] < 5.0).all()
     # ... unless the actuator's end that does not bend is given (4 mm sealed + 6 mm cap)
     raw = yaml.safe_load((folder / "photoset.yaml").read_text())
     (folder / "photoset.yaml").write_text(yaml.safe_dump({**raw, "sealed_end_mm": 10.0}))
@@ -559,6 +563,9 @@ def test_a_step_response_filmed_with_a_shutter_open_half_a_frame_is_smeared_and_
     }
     truth = render_video(tmp_path / "sharp", "DS20", **kw)
     render_video(tmp_path / "smeared", "DS20", shutter_s=1 / 30, **kw)
+    for d in ("sharp", "smeared"):  # its sealed end and cap (else the frames at rest are flagged)
+        settings = tmp_path / d / "photoset.yaml"
+        settings.write_text(settings.read_text() + "sealed_end_mm: 10\n")
     name = "DS20_A1_t1_steps.avi"
     assert (tmp_path / "sharp" / "truth.csv").read_bytes() == (
         tmp_path / "smeared" / "truth.csv"
