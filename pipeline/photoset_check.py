@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from pipeline.constants import RAMP_KEYS
@@ -160,6 +161,7 @@ def background_exposure_problems(ps: PhotoSet) -> list[Problem]:
     its grey-blue body ``ok`` and 7-10 deg off (1 with the empty scene taken with the photos),
     and ``check`` said nothing.
     """
+    from pipeline.measure.body import OVEREXPOSED_SHARE, white_share
     from pipeline.measure.core import decode_for_work
 
     def decoded(path: Path) -> np.ndarray | None:
@@ -191,6 +193,21 @@ def background_exposure_problems(ps: PhotoSet) -> list[Problem]:
             (None, None),
         )
         if empty is None or photo is None:
+            continue
+        white = white_share(cv2.resize(empty, photo.shape[1::-1], interpolation=cv2.INTER_AREA))
+        if white - white_share(photo) >= OVEREXPOSED_SHARE:
+            # customer 52's, at 1.25 the exposure: 88% white, and check said nothing (its
+            # channels clipped are not compared, below); measure failed 32 of 52 photos
+            out.append(_row_warning(
+                ps,
+                first,
+                f"background photo {Path(path).name} is overexposed, taken at another exposure "
+                f"than this ramp's first photo: {100 * white:.0f}% of it is white, "
+                f"{100 * white_share(photo):.0f}% of the photo, and no body differs from what is "
+                "white there",
+                "take the empty scene with the camera's exposure locked as for the photos (a "
+                "phone: lock AE/AWB, or its manual mode), just before or after the ramp",
+            ))
             continue
         offset = exposure_offset(photo, empty)
         if offset is None:

@@ -892,6 +892,11 @@ def test_check_warns_of_a_pressure_out_of_its_ramps_order_naming_the_line(photo_
         ((200, 90, 20), (1.0, 1.0, 0.6), ""),  # a blue card's red is too dark for a ratio
         ((20, 22, 18), (0.7, 0.7, 0.7), ""),  # a black backdrop: levels too low to compare
         ((255, 255, 255), (0.9, 0.9, 0.9), ""),  # a clipped white backdrop says nothing
+        # ... but an empty scene clipped where the photos are not does (customer 52's at 1.25
+        # the exposure, 88% white: measure failed 32 of 52 photos, and check said nothing)
+        ((220, 220, 220), (1.25, 1.25, 1.25), ("is overexposed, taken at another exposure "
+                                               "than this ramp's first photo: 100% of it is "
+                                               "white, 0%")),
     ],
 )
 def test_check_warns_of_an_empty_scene_taken_at_another_exposure(
@@ -914,7 +919,8 @@ def test_check_warns_of_an_empty_scene_taken_at_another_exposure(
     got = [p for p in check_photoset(photo_folder, warnings=True) if "exposure" in p.message]
     assert [p.line for p in got] == ([2, 7] if warned else []), got  # each ramp's first row
     if warned:
-        assert got[0].warning and got[0].message.startswith(
+        assert got[0].warning and got[0].message.startswith("background photo empty.png ")
+        assert "overexposed" in warned or got[0].message.startswith(
             "background photo empty.png was taken at another exposure or white balance than "
             "this ramp's first photo"
         )

@@ -2393,7 +2393,7 @@ def overexposed(
 ) -> str:
     """Why nothing may be found in a photo: ``"N% of the photo is white ...; "`` where it is
     overexposed (a lamp switched on, the exposure changed: customer 31's read only "nothing
-    differs from the background photo"), else ``""``.
+    differs from the background photo"), or its empty scene is, else ``""``.
 
     Examples
     --------
@@ -2403,20 +2403,41 @@ def overexposed(
     >>> img[:6] = 255
     >>> overexposed(img, None, img[:, :, :] * 0 + 120)
     '60% of the photo is white (overexposed: a lamp switched on, or the exposure changed?); '
+    >>> print(overexposed(img[:, :, :] * 0 + 120, None, img))  # doctest: +NORMALIZE_WHITESPACE
+    60% of the background photo is white, 0% of this photo (the empty scene overexposed: take it
+    at the photos' exposure);
     """
 
-    def white(img: np.ndarray) -> float:
-        hit = (img.min(axis=2) >= SATURATED) if img.ndim == 3 else img >= SATURATED
-        return float(hit[region > 0].mean() if region is not None else hit.mean())
-
-    share = white(image_bgr)
-    before = white(background_bgr) if background_bgr is not None else 0.0
+    share = white_share(image_bgr, region)
+    before = white_share(background_bgr, region) if background_bgr is not None else 0.0
+    if before - share >= OVEREXPOSED_SHARE:  # customer 52's empty scene at 1.25 the exposure
+        return (
+            f"{100 * before:.0f}% of the background photo is white, {100 * share:.0f}% of this "
+            "photo (the empty scene overexposed: take it at the photos' exposure); "
+        )
     if share - before < OVEREXPOSED_SHARE:
         return ""
     return (
         f"{100 * share:.0f}% of the photo is white (overexposed: a lamp switched on, or the "
         "exposure changed?); "
     )
+
+
+def white_share(image_bgr: np.ndarray, region: np.ndarray | None = None) -> float:
+    """The share of ``image_bgr`` (within ``region``, 1, where given) that is white: every
+    channel at :data:`SATURATED` or more.
+
+    Examples
+    --------
+    >>> img = np.full((10, 10, 3), 120, np.uint8)
+    >>> img[:3] = 252
+    >>> white_share(img)
+    0.3
+    """
+    hit = (
+        (image_bgr.min(axis=2) >= SATURATED) if image_bgr.ndim == 3 else image_bgr >= SATURATED
+    )
+    return float(hit[region > 0].mean() if region is not None else hit.mean())
 
 
 def extract_body(
