@@ -1283,6 +1283,32 @@ def test_a_curve_straight_at_rest_is_not_said_to_never_reach_psi_zero(tmp_path):
         assert "(straight at rest) and does not come back" in notes, (rest_deg, notes)
 
 
+def test_a_curve_that_stops_short_of_the_pressures_photographed_says_so(tmp_path):
+    # customer 52's pale body, every photo at 100 and 120 kPa flagged: page 1 read "Range 111
+    # deg" (about 178 over the ramp) and said nothing of it
+    from pipeline.report.summary import top_left_out_notes
+
+    d = make_dataset(tmp_path, "SS40", overlays=False)
+    a = pd.read_csv(d.angles_csv)
+    top = a["pressure_kpa"].max()
+    a.loc[a["pressure_kpa"] == top, "status"] = "flagged"
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    below = a.loc[a["pressure_kpa"] < top, "pressure_kpa"].max()
+    said = (
+        f"SS40: no photo at {top:g} kPa was measured ok (the quality table gives the reasons), so "
+        f"its mean curve stops at {below:g} kPa of the {top:g} kPa photographed: its range of "
+        f"motion and RMS cover the pressures up to {below:g} kPa only."
+    )
+    assert top_left_out_notes(data) == [said]
+    a["status"] = "ok"  # every level measured: nothing to say
+    a.to_csv(d.angles_csv, index=False)
+    hyst, rms = pipeline_tables(tmp_path, [d])
+    data = load_report_data(ReportInputs(datasets=(d,), hysteresis=tuple(hyst), rms=(rms,)))
+    assert top_left_out_notes(data) == []
+
+
 def test_a_curve_of_its_rest_photos_alone_is_not_said_to_never_reach_psi_zero(tmp_path):
     # customer 48's PneuNets, ok at 0 kPa alone: "the mean curve never reaches ψ = 0 up to 60
     # kPa (smallest mean ψ 2°)", a pressure no photo measured ok was taken at

@@ -125,6 +125,7 @@ def results_table(data: ReportData) -> Table:
             "model.materials_file)."
         )
     notes += missing_notes(data)
+    notes += top_left_out_notes(data)
     notes += coarse_crossing_notes(data.angles, aggregate_options(data.run_config))
     notes += [n for n in (mixed_sources_note(data, m) for m in data.materials) if n]
     if any("synthetic" in s for s in sources.values()):
@@ -320,6 +321,43 @@ def _left_out_between(
     statuses = "/".join(sorted(set(out["status"].astype(str))))
     why = f" ({statuses}: " + ", ".join(f"{c}, {n}" for c, n in causes) + ")" if causes else ""
     return f"; the {what} at {at} between them {'are' if many else 'is'} not in the curve{why}"
+
+
+def top_left_out_notes(data: ReportData) -> list[str]:
+    """Per material whose photos at its highest pressures were none measured ok: its mean curve,
+    and with it its range of motion, stops short of the pressures photographed, which page 1
+    does not show (customer 52's pale body, flagged at 100 and 120 kPa: "Range 111 deg" for
+    about 178, no word said).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> h = pd.DataFrame({"material": "SIL", "direction": ["up"] * 4 + ["down"] * 3,
+    ...                   "pressure_kpa": [0.0, 40, 80, 120, 80, 40, 0],
+    ...                   "psi_mean_deg": [0.0, 50, np.nan, np.nan, 95, 55, 1]})
+    >>> print(*top_left_out_notes(SimpleNamespace(materials=["SIL"], hysteresis=h)))
+    SIL: no photo at 120 kPa was measured ok (the quality table gives the reasons), so its mean \
+curve stops at 80 kPa of the 120 kPa photographed: its range of motion and RMS cover the \
+pressures up to 80 kPa only.
+    """
+    out = []
+    for m in data.materials:
+        h = data.hysteresis[data.hysteresis["material"].astype(str) == m]
+        mean = pd.to_numeric(h["psi_mean_deg"], errors="coerce")
+        if mean.notna().sum() == 0 or h.loc[mean.notna(), "pressure_kpa"].nunique() < 2:
+            continue  # no curve (missing_notes says so)
+        top_ok = float(h.loc[mean.notna(), "pressure_kpa"].max())
+        above = sorted(float(p) for p in h["pressure_kpa"].unique() if float(p) > top_ok)
+        if not above:
+            continue
+        levels = ", ".join(fmt(p, 0) for p in above)
+        out.append(
+            f"{m}: no photo at {levels} kPa was measured ok (the quality table gives the "
+            f"reasons), so its mean curve stops at {fmt(top_ok, 0)} kPa of the "
+            f"{fmt(above[-1], 0)} kPa photographed: its range of motion and RMS cover the "
+            f"pressures up to {fmt(top_ok, 0)} kPa only."
+        )
+    return out
 
 
 def missing_notes(data: ReportData) -> list[str]:
