@@ -123,9 +123,10 @@ class AngleResult:
         for ``free_end: bends`` and when failed.
     past_l0_mm : float
         How far a capped body, from the fixed end to its tip's face, runs past ``l0_mm`` at the
-        scale given (mm): the end that does not bend as the photo shows it, however short.  NaN
-        without ``mm_per_px`` (or a calibration), for a line, for ``free_end: bends`` and when
-        failed.
+        scale given (mm): its centre line's stretch as it bends plus the end that does not bend,
+        which :func:`pipeline.sealed_end_check.end_past_l0_mm` tells apart over an actuator's
+        photos.  NaN without ``mm_per_px`` (or a calibration), for a line, for ``free_end:
+        bends`` and when failed.
     """
 
     psi_deg: float
@@ -580,8 +581,8 @@ def measure_body(
     # the body from the fixed end to its tip's face, in the units of pts
     seen_work_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
     body_work_px = seen_work_px + body.tip_face_px * per_image_px
-    # ... and how far that runs past l0_mm at the scale given: the end that does not bend, from
-    # the clamp face (the centre line's start carried back to it) to the tip's face
+    # ... and how far that runs past l0_mm at the scale given, from the clamp face (the centre
+    # line's start carried back to it) to the tip's face
     past_l0_mm = (
         (body_work_px + max(ends[0], 0.0)) * settings.mm_per_px - settings.l0_mm
         if settings.mm_per_px and settings.free_end == "capped"
@@ -1020,6 +1021,7 @@ def measure_image(
             ),
             finer,
         ),
+        body=settings.target == "body",
     )
 
 
@@ -1183,17 +1185,20 @@ def _refined(
     res: AngleResult,
     factor: int,
     finer_reading: Callable[[int], tuple[AngleResult, int] | None],
+    *,
+    body: bool = False,
 ) -> AngleResult:
     """``res``, read on a photo reduced by ``factor``, or the reading ``finer_reading`` (half the
     factor: the result and the factor it used, None where the photo cannot be had finer) gives
     while the reading is too coarse (:func:`_too_coarse`).  Once a reading was not steady, it
     is refined on while not ``ok``, and kept where nothing finer is: a finer one flagged for
     another reason read psi 30-170 deg off (the review's 22 px body on 3200x2400 photos, right
-    at full size).
+    at full size).  A ``body`` not found at half size is not looked for at full size
+    (:func:`_too_coarse`).
     """
     unsteady: AngleResult | None = None
     while factor > 1 and (
-        _too_coarse(res, factor) or (unsteady is not None and res.status != "ok")
+        _too_coarse(res, factor, body=body) or (unsteady is not None and res.status != "ok")
     ):
         if unsteady is None and _unsteady(res):
             unsteady = res
@@ -1204,10 +1209,15 @@ def _refined(
     return unsteady if unsteady is not None and res.status != "ok" else res
 
 
-def _too_coarse(res: AngleResult, factor: int) -> bool:
+def _too_coarse(res: AngleResult, factor: int, *, body: bool = False) -> bool:
     """Whether a photo measured reduced by ``factor`` is measured again finer: not found, a line
     narrower than :data:`MIN_WORK_LINE_WIDTH_PX` there, or a body's reading not steady
-    (:func:`steady_reading`)."""
+    (:func:`steady_reading`).  Not a ``body`` not found at half size: one that is not would be
+    too few pixels across at full size for a steady reading, and the look at full size took
+    2.5-5 s a photo (customer 52's pale body without its empty scene, "nothing differs from the
+    backdrop" at each size: 52 photos of 3000x2000 in 70 s, 6 s with the empty scene)."""
+    if body and res.status == "failed" and factor <= 2:
+        return False
     return (
         res.status == "failed"
         or res.line_width_px / factor < MIN_WORK_LINE_WIDTH_PX
@@ -1261,4 +1271,4 @@ def measure_decoded(
             return None
         return measure_work_image(decoded, settings, scale=float(finer), method=method), finer
 
-    return _refined(res, factor, finer_reading)
+    return _refined(res, factor, finer_reading, body=settings.target == "body")

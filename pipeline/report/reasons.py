@@ -64,7 +64,6 @@ WORDS: tuple[tuple[str, str], ...] = (
     (r"^body short of l0 with its tip in view", "body short of l0, tip in view (out of plane?)"),
     (r"^sealed end shorter than the photos show", "sealed_end_mm shorter than the photos show"),
     (r"^sealed end not given, and", "no sealed_end_mm, and the photos show one"),
-    (r"^sealed end longer than the photos show", "sealed_end_mm longer than the photos show"),
     (r"touches the image border", "line touches the image border"),
     (r"^line partly hidden", "line partly hidden"),
     (r"^line \d+% of l0", "line longer than l0 (scale or extra marks)"),
