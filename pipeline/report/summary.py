@@ -350,12 +350,13 @@ pressures up to 80 kPa only.
         above = sorted(float(p) for p in h["pressure_kpa"].unique() if float(p) > top_ok)
         if not above:
             continue
-        levels = ", ".join(fmt(p, 0) for p in above)
+        # pressures as given (rounded, 12.4 and 12.6 kPa read "stops at 12 kPa of 13")
+        levels = ", ".join(f"{p:g}" for p in above)
         out.append(
             f"{m}: no photo at {levels} kPa was measured ok (the quality table gives the "
-            f"reasons), so its mean curve stops at {fmt(top_ok, 0)} kPa of the "
-            f"{fmt(above[-1], 0)} kPa photographed: its range of motion and RMS cover the "
-            f"pressures up to {fmt(top_ok, 0)} kPa only."
+            f"reasons), so its mean curve stops at {top_ok:g} kPa of the {above[-1]:g} kPa "
+            f"photographed: its range of motion and RMS cover the pressures up to {top_ok:g} kPa "
+            "only."
         )
     return out
 
