@@ -1215,7 +1215,14 @@ def _too_coarse(res: AngleResult, factor: int, *, body: bool = False) -> bool:
     (:func:`steady_reading`).  Not a ``body`` not found at half size: one that is not would be
     too few pixels across at full size for a steady reading, and the look at full size took
     2.5-5 s a photo (customer 52's pale body without its empty scene, "nothing differs from the
-    backdrop" at each size: 52 photos of 3000x2000 in 70 s, 6 s with the empty scene)."""
+    backdrop" at each size: 52 photos of 3000x2000 in 70 s, 6 s with the empty scene).
+
+    Examples
+    --------
+    >>> lost = failed("auto", "no body found: nothing differs from the backdrop")
+    >>> _too_coarse(lost, 4, body=True), _too_coarse(lost, 2, body=True), _too_coarse(lost, 2)
+    (True, False, True)
+    """
     if body and res.status == "failed" and factor <= 2:
         return False
     return (
