@@ -109,6 +109,7 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
     psi_abs = pd.to_numeric(out["psi_deg"], errors="coerce").abs()
     high = 0.5 * psi_abs / out["l0_mm"]  # deg read high per mm of the end missed
     past = pd.to_numeric(out.get("past_l0_mm", pd.Series(np.nan, out.index)), errors="coerce")
+    unit = "frames" if "frame" in out.columns and out["frame"].notna().any() else "photos"
     for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
         shown = seen[g.index].dropna()
         bent = int((psi_abs[g.index] >= 90.0).sum())
@@ -150,7 +151,7 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
         for i in g.index[noted]:
             note = (
                 f"{NOTE_SEALED_END_LONGER}: this actuator's last {shown_mm:.1f} mm {witness} "
-                f"in {len(shown)} of its photos, {short_mm[i]:.1f} mm more than sealed_end_mm "
+                f"in {len(shown)} of its {unit}, {short_mm[i]:.1f} mm more than sealed_end_mm "
                 f"({given[i]:g}): if its sealed end is that long (from where the chamber ends to "
                 "the very tip, cap and any rounded dome included), |psi| reads up to about "
                 f"{2.0 * high[i] * short_mm[i]:.0f} deg high here"
@@ -163,13 +164,13 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
             read_deg = float(high[i] * short_mm[i])
             cause = (
                 f"sealed end not given, and this actuator's last {shown_mm:.0f} mm {witness} "
-                f"in {len(shown)} of its photos: |psi| reads high (about {read_deg:.0f} deg "
+                f"in {len(shown)} of its {unit}: |psi| reads high (about {read_deg:.0f} deg "
                 "here): give sealed_end_mm, from where the chamber ends to the tip, cap included "
                 f"(about {shown_mm:.0f} mm)"
                 if np.isnan(given[i])
                 else f"sealed end shorter than the photos show: sealed_end_mm is {given[i]:g} but "
                 f"this actuator's last {shown_mm:.0f} mm {witness} in {len(shown)} of its "
-                f"photos, so |psi| reads high (about {read_deg:.0f} deg here): measure it again "
+                f"{unit}, so |psi| reads high (about {read_deg:.0f} deg here): measure it again "
                 "from where the chamber ends to the tip, cap included "
                 f"(about {shown_mm:.0f} mm)"
             ) + ("" if own is seen else ", or check l0_mm and mm_per_px")

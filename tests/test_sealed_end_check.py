@@ -103,6 +103,7 @@ def test_a_videos_frames_are_checked_against_the_sealed_end_too(tmp_path):
     out = measure_photoset(folder, jobs=2).merge(truth, on=["image", "frame"], suffixes=("", "_t"))
     said = out["reason"].fillna("").str.startswith("sealed end not given, and this actuator's")
     assert said.sum() >= 3 and (out.loc[said, "status"] == "flagged").all()
+    assert out.loc[said, "reason"].str.contains(r"in \d+ of its frames").all()  # not "photos"
     error = (out["psi_deg"] - out["psi_image_deg"]).abs()
     assert not ((out["status"] == "ok") & (error > 5.0)).any(), out.loc[error > 5.0, "reason"]
     assert np.nanmedian(out["straight_end_mm"]) == pytest.approx(25.0, abs=1.5)
