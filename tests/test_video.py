@@ -228,9 +228,9 @@ def test_a_video_of_a_body_without_a_line_is_a_body_set_and_measured_as_one(tmp_
     err = (m["psi_deg"] - m["psi_image_deg"]).abs()
     ok = m["status"] == "ok"
     # the centre line runs on into the sealed end and the white cap, which its length at
-    # mm_per_px shows (11 mm for 10): the frames it reads high (2-4 deg at psi 210) say so
+    # mm_per_px shows (10 mm for 10): the frames it reads high (2-4 deg at psi 210) say so
     said = m["reason"].fillna("").str.startswith(
-        "sealed end not given, and this actuator's last 11 mm run past l0_mm"
+        "sealed end not given, and this actuator's last 10 mm run past l0_mm"
     )
     assert (m.loc[said, "status"] == "flagged").all() and said[m["psi_image_deg"] > 150].all()
     assert (ok | said).mean() >= 0.8 and err[ok].median() < 5.0
