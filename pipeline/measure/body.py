@@ -1016,8 +1016,8 @@ def fill_inner_holes(comp: np.ndarray, half: float) -> np.ndarray:
     specular streak and a dot; the profiles across the body stopped at it, the centre line ran
     along the inner half and stopped 55 % along, and six right photos at 100-120 kPa were
     flagged).  A hole is filled where the body, filled, is no thicker over it than
-    :data:`INNER_HOLE_HALF_WIDTHS` half-widths: the inside of a ring, or the backdrop between two
-    arms of a curl, makes it thicker.
+    :data:`INNER_HOLE_HALF_WIDTHS` half-widths (``half``: where the body is not beside a hole):
+    the inside of a ring, or the backdrop between two arms of a curl, makes it thicker.
 
     Examples
     --------
@@ -2565,7 +2565,8 @@ def extract_body(
     # joined to it would pull a component-wide figure far off)
     xi, yi = np.round(path[:, 0]).astype(int), np.round(path[:, 1]).astype(int)
     half = float(np.median(dt[yi, xi])) if len(path) else 0.0
-    whole = fill_inner_holes(comp, half)
+    # the body's own thickness where the ridge is not beside the hole (which thins it there)
+    whole = fill_inner_holes(comp, float(np.percentile(dt[yi, xi], 90)) if len(path) else half)
     if whole is not comp:  # the profiles across the body run through its inside
         comp = whole
         dt = cv2.distanceTransform(comp, cv2.DIST_L2, 5)
