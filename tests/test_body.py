@@ -124,6 +124,17 @@ def test_a_fixed_end_clicked_inside_the_clamp_adds_no_bend(psi, inside_px):
     assert res.psi_deg == pytest.approx(psi, abs=1.6), res.reason
 
 
+@pytest.mark.parametrize("psi", [240.0, -200.0])
+@pytest.mark.parametrize("inside_px", [10.0, 30.0])
+def test_a_fixed_end_clicked_inside_an_excluded_clamp_adds_no_bend(psi, inside_px):
+    # the clamp plate under exclude and the fixed end clicked inside it: the base's curvature
+    # was carried on to the click over the plate (psi 240 read 245 at 10 px in, 249 at 20, ok)
+    img, fe, clamp = body_photo(psi, seed=int(abs(psi)))
+    res = measure_image(img, settings_for((fe[0] - inside_px, fe[1]), exclude=[clamp]))
+    assert res.status == "ok", res.reason
+    assert res.psi_deg == pytest.approx(psi, abs=2.5), res.reason
+
+
 @pytest.mark.parametrize("psi", [240.0, 120.0, -200.0])
 def test_an_excluded_clamp_does_not_carry_the_body_past_its_face(psi):
     # the clamp excluded and the fixed end on its face: the clamp's strong difference beside the

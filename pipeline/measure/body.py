@@ -1987,6 +1987,7 @@ def _extensions(
     half: float,
     fixed_xy: tuple[float, float] | None,
     free_end_bends: bool = False,
+    region: np.ndarray | None = None,
 ) -> tuple[float, float]:
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
@@ -1994,8 +1995,11 @@ def _extensions(
     the body bends right from the clamp.  Not into a clamp that is part of the selection, though
     (:func:`_clamp_distance`): the clamp does not bend, and a fixed end clicked inside it (20-40
     px at 1280x960) carried the base's curvature on over the clamp (5-14 deg off on rendered
-    analogues).  With ``free_end_bends`` (a free strip: the end walked from is a cut end too) the
-    given point is reached whatever lies there.
+    analogues).  Nor out of ``region`` (the pixels looked at, 1, :func:`_region_distance`): a
+    fixed end inside an excluded clamp plate lies in the clamp (10-20 px in, on a body 600 px
+    long, carried the curvature on and read psi 240 as 245-249, ok).  With ``free_end_bends``
+    (a free strip: the end walked from is a cut end too) the given point is reached whatever
+    lies there.
 
     The free end (``free_end: capped``): 0.  Past the centre line's last point lies the actuator's
     sealed end (a cap), which does not bend, so the tip's direction is the centre line's own at
@@ -2017,6 +2021,7 @@ def _extensions(
             reach = face_reach(pts, np.asarray(fixed_xy, float))
             if not free_end_bends:
                 reach = min(reach, _clamp_distance(comp, dt, p, t, half, reach))
+                reach = min(reach, _region_distance(region, p, t, reach))
             out.append(reach)
             continue
         if end == -1 and not free_end_bends:
@@ -2039,6 +2044,36 @@ def _extensions(
         else:
             out.append(0.0)
     return out[0], out[1]
+
+
+def _region_distance(
+    region: np.ndarray | None, start: np.ndarray, direction: np.ndarray, reach: float
+) -> float:
+    """How far (px, up to ``reach``) from ``start`` along ``direction`` the pixels looked at
+    (``region``, 1; None: all) go on: where the ray first leaves them, the edge of an
+    ``exclude`` polygon or the ``roi``, less half a pixel.  A ray leaving the photo, or one that
+    starts outside them, goes on to ``reach``.
+
+    Examples
+    --------
+    >>> region = np.ones((20, 60), np.uint8); region[:, 40:] = 0  # a clamp plate excluded
+    >>> _region_distance(region, np.array([30.0, 10.0]), np.array([1.0, 0.0]), 25.0)
+    9.5
+    >>> _region_distance(region, np.array([30.0, 10.0]), np.array([-1.0, 0.0]), 25.0)
+    25.0
+    >>> _region_distance(None, np.array([30.0, 10.0]), np.array([1.0, 0.0]), 25.0)
+    25.0
+    """
+    if region is None or not np.isfinite(reach) or reach <= 0:
+        return reach
+    h, w = region.shape
+    for a in np.arange(0.0, reach + 1.0, 1.0):
+        x, y = np.round(start + a * direction).astype(int)
+        if not (0 <= x < w and 0 <= y < h):
+            return reach
+        if not region[y, x]:
+            return reach if a == 0 else min(reach, float(a) - 0.5)
+    return reach
 
 
 def face_reach(pts: np.ndarray, fixed_xy: np.ndarray) -> float:
@@ -2641,7 +2676,13 @@ def extract_body(
     if len(along_ridge) > len(pts) and len(pts) >= 8:
         ridge_tip_deg = float(np.rad2deg(end_tangents(along_ridge)[1] - end_tangents(pts)[1]))
     trimmed = _extensions(
-        comp, dt, pts, half, fe if reached else None, free_end_bends=settings.free_end == "bends"
+        comp,
+        dt,
+        pts,
+        half,
+        fe if reached else None,
+        free_end_bends=settings.free_end == "bends",
+        region=region,
     )
     # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
     # free end the tip may be outside the photo; along a side the middle was taken from the
