@@ -279,16 +279,18 @@ def encoded_tile(
             cv2.LINE_AA,
         )
     right = cv2.cvtColor(mask_small, cv2.COLOR_GRAY2BGR)
-    cv2.putText(
-        right,
-        f"selected: {settings.describe_color()}"[:60],
-        (8, right.shape[0] - 10),
-        cv2.FONT_HERSHEY_SIMPLEX,
-        0.45,
-        (0, 200, 255),
-        1,
-        cv2.LINE_AA,
-    )
+    labels = (width_label(res, settings), f"selected: {settings.describe_color()}"[:60])
+    for i, label in enumerate(label for label in labels if label):
+        cv2.putText(
+            right,
+            label,
+            (8, right.shape[0] - 10 - 18 * i),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.45,
+            (0, 200, 255),
+            1,
+            cv2.LINE_AA,
+        )
     size = (small.shape[1], small.shape[0])
     rectified = rectified_panel(img, float(f), settings, res, size)
     ends = []
@@ -303,6 +305,32 @@ def encoded_tile(
         band, 0, 0, 0, panels.shape[1] - band.shape[1], cv2.BORDER_CONSTANT, value=(30, 30, 30)
     )
     return np.vstack([band, panels])
+
+
+def width_label(res: AngleResult, settings: MeasureSettings) -> str:
+    """How wide the chosen body or line was read, in mm where ``mm_per_px`` is given: a body read
+    much narrower than it is has lost a side to the backdrop (customer 52's off-white body on
+    light grey paper: 6 mm of its 14 selected, and the reasons pointed at the clamp), one read
+    wider has taken in its shadow.  Empty when no width was read.
+
+    Examples
+    --------
+    >>> from pipeline.measure.core import failed
+    >>> from pipeline.measure.settings import resolve_settings
+    >>> from dataclasses import replace
+    >>> res = replace(failed("tangents", ""), status="ok", line_width_px=64.0)
+    >>> width_label(res, resolve_settings(l0_mm=100.0, target="body", mm_per_px=0.1))
+    'body read 6.4 mm wide (64 px)'
+    >>> width_label(res, resolve_settings(l0_mm=100.0))
+    'line read 64 px wide'
+    """
+    width_px = res.line_width_px
+    if res.status == "failed" or not np.isfinite(width_px) or width_px <= 0:
+        return ""
+    what = "body" if settings.target == "body" else "line"
+    if not settings.mm_per_px:
+        return f"{what} read {width_px:.0f} px wide"
+    return f"{what} read {width_px * settings.mm_per_px:.1f} mm wide ({width_px:.0f} px)"
 
 
 def end_panel(
