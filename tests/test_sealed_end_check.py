@@ -131,6 +131,23 @@ def test_a_straight_end_a_little_longer_than_given_is_noted_and_counted_as_no_ca
     assert not right["reason"].str.contains("longer straight end").any()
 
 
+def test_a_straight_end_on_a_body_hardly_bent_is_no_witness():
+    # customer 55: straight photos of a body with one faint side read a 26 mm straight end for
+    # its 4 (the centre line's wander), and with one bent photo's 12 mm every row was flagged
+    # "measure it again ... (about 26 mm)"; the advice followed left 20 of 20 rows flagged
+    rows = pd.DataFrame({"material": "M", "actuator": "A", "l0_mm": 95.0, "status": "ok",
+                         "psi_deg": [-0.4, -0.2, 3.0, 80.0, 200.0, 193.0], "reason": "",
+                         "sealed_end_mm": 4.0,
+                         "straight_end_mm": [26.8, 26.4, 25.0, np.nan, np.nan, 12.4]})
+    out = check_sealed_ends(rows)
+    assert (out["status"] == "ok").all(), out["reason"].tolist()
+    assert not out["reason"].str.contains("sealed").any()
+    # bent photos showing it are a witness as before
+    bent = check_sealed_ends(rows.assign(psi_deg=[60.0, 90.0, 120.0, 80.0, 200.0, 193.0],
+                                         straight_end_mm=[12.0, 12.5, 12.2, np.nan, np.nan, 12.4]))
+    assert bent["reason"].str.contains("about 12 mm").sum() >= 3
+
+
 def test_straight_ends_that_scatter_are_no_verdict_and_the_long_ones_are_flagged_alone():
     # customer 49's clear body without its empty scene: 3 frames showed 5.9, 13.5 and 22.7 mm
     # for its 6 (two tips not seen whole, reading psi 7-9 deg low); every bent frame was flagged
