@@ -149,6 +149,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
              "l0_mm + this)",
     )
     init.add_argument(
+        "--body-width-mm",
+        type=float,
+        help="body: its width as the camera sees it, mm (with --mm-per-px a photo whose body is "
+             "read 20 %% wider or narrower is flagged: its shadow taken in, a faint side lost; "
+             "leave it out for a body that swells under pressure)",
+    )
+    init.add_argument(
         "--free-end",
         choices=FREE_ENDS,
         default=None,
@@ -385,6 +392,8 @@ def _init(args: argparse.Namespace) -> int:
         settings["fixed_direction_deg"] = args.fixed_direction_deg
     if args.sealed_end_mm is not None:
         settings["sealed_end_mm"] = args.sealed_end_mm
+    if args.body_width_mm is not None:
+        settings["body_width_mm"] = args.body_width_mm
     if args.free_end is not None:
         settings["free_end"] = args.free_end
     if args.exclude:

@@ -308,7 +308,8 @@ def encoded_tile(
 
 
 def width_label(res: AngleResult, settings: MeasureSettings) -> str:
-    """How wide the chosen body or line was read, in mm where ``mm_per_px`` is given: a body read
+    """How wide the chosen body (edge to edge, what ``body_width_mm`` is checked against) or line
+    was read, in mm where ``mm_per_px`` is given: a body read
     much narrower than it is has lost a side to the backdrop (customer 52's off-white body on
     light grey paper: 6 mm of its 14 selected, and the reasons pointed at the clamp), one read
     wider has taken in its shadow.  Empty when no width was read.
@@ -324,7 +325,7 @@ def width_label(res: AngleResult, settings: MeasureSettings) -> str:
     >>> width_label(res, resolve_settings(l0_mm=100.0))
     'line read 64 px wide'
     """
-    width_px = res.line_width_px
+    width_px = res.body_width_px if np.isfinite(res.body_width_px) else res.line_width_px
     if res.status == "failed" or not np.isfinite(width_px) or width_px <= 0:
         return ""
     what = "body" if settings.target == "body" else "line"

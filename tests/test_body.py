@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import re
+
 import cv2
 import numpy as np
 import pytest
 
 from pipeline.measure import measure_image
 from pipeline.measure.quality import NOTE_TIP_FACE, NOTE_TIP_STRIP
-from pipeline.measure.settings import resolve_settings
+from pipeline.measure.settings import SettingsError, resolve_settings
 
 W, H = 1280, 960
 
@@ -418,6 +420,31 @@ def _paint_slot(img, psi, start, end, across, length=600.0, backdrop=(190, 196, 
     side = np.r_[pts + n * across[0] * 46.0, (pts + n * across[1] * 46.0)[::-1]]
     cv2.fillPoly(img, [np.round(np.c_[side[:, 0], -side[:, 1]] + off).astype(np.int32)], backdrop)
     return img
+
+
+@pytest.mark.parametrize("psi", [200.0, 45.0])
+def test_a_body_read_wider_or_narrower_than_body_width_mm_is_flagged(psi):
+    # customer 55: a translucent body with a strong shadow was read 17.5 mm wide for its 13 (its
+    # shadow taken in) and three rows were ok 6-10 deg off; its width given is a witness
+    img, fe, _ = body_photo(psi, seed=7)  # 46 px wide: 13.8 mm at 0.3 mm/px
+    right = measure_image(img, settings_for(fe, mm_per_px=0.3, body_width_mm=13.8))
+    assert right.status == "ok", right.reason
+    wide = measure_image(img, settings_for(fe, mm_per_px=0.3, body_width_mm=10.0))
+    assert wide.status == "flagged"
+    read = re.match(r"body read ([\d.]+) mm wide where body_width_mm is 10: its shad", wide.reason)
+    assert read and float(read.group(1)) == pytest.approx(13.8, abs=0.6), wide.reason
+    narrow = measure_image(img, settings_for(fe, mm_per_px=0.3, body_width_mm=20.0))
+    assert narrow.status == "flagged" and "a side of it is not selected" in narrow.reason
+    # without the scale there is nothing to compare: no flag
+    assert measure_image(img, settings_for(fe, body_width_mm=10.0)).status == "ok"
+
+
+def test_body_width_mm_is_for_a_body_and_a_width():
+    for raw, what in (({"target": "line"}, "drawn line"), ({"target": "body"}, "> 0")):
+        with pytest.raises(SettingsError) as err:
+            resolve_settings(l0_mm=100.0, body_width_mm=-3.0 if "body" in raw.values() else 12.0,
+                             **raw)
+        assert "body_width_mm" in str(err.value) and what in str(err.value)
 
 
 @pytest.mark.parametrize("psi", [200.0, -150.0])

@@ -128,6 +128,9 @@ class AngleResult:
         that does not bend, which :func:`pipeline.sealed_end_check.end_past_l0_mm` tells apart
         over an actuator's photos.  NaN without ``mm_per_px`` (or a calibration), for a line,
         for ``free_end: bends`` and when failed.
+    body_width_px : float
+        A body's width, edge to edge across its centre line (median, original px): what
+        ``body_width_mm`` is checked against; NaN for a line and when failed.
     """
 
     psi_deg: float
@@ -146,6 +149,7 @@ class AngleResult:
     tip_px: tuple[float, float] | None = None
     straight_end_mm: float = float("nan")
     past_l0_mm: float = float("nan")
+    body_width_px: float = float("nan")
 
 
 #: no actuator turns further than this (deg): a psi beyond it is a line that is not its own
@@ -579,6 +583,11 @@ def measure_body(
     except CalibrationMismatch as exc:
         return failed(method, str(exc))
     per_image_px = _work_per_image_px(line, pts)
+    # edge to edge across the centre line (the ridge's distance to the edge reads a px or two
+    # wide: 16 px for a body 12 across)
+    body_width_px = (
+        float(np.nanmedian(body.widths_px)) if np.isfinite(body.widths_px).any() else float("nan")
+    )
     # the body from the fixed end to its tip's face, in the units of pts
     seen_work_px = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
     body_work_px = seen_work_px + body.tip_face_px * per_image_px
@@ -780,6 +789,9 @@ def measure_body(
         else 0.0,
         method=method,
         psi_tip_deg=None if est is tip else float(np.rad2deg(sign * tip.turning_rad)),
+        width_mm=(body_width_px * settings.mm_per_px, settings.body_width_mm)
+        if settings.body_width_mm and settings.mm_per_px and settings.calibration is None
+        else None,
     )
     used = "tangents" if method == "auto" or base is not None else method
     # carried on over a tip the selection fades at, not past an uneven outline (unless along
@@ -799,6 +811,7 @@ def measure_body(
         else base_side_split_deg(line.centreline_px, body.widths_px, TANGENT_WINDOW_FRACTION),
         straight_end_mm=straight_end_mm if measured.status != "failed" else float("nan"),
         past_l0_mm=past_l0_mm if measured.status != "failed" else float("nan"),
+        body_width_px=body_width_px if measured.status != "failed" else float("nan"),
     )
     if est is not tip:
         return measured

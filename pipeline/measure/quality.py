@@ -216,6 +216,43 @@ def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
     return end_short_px > 1.5 * width_px + 4.0
 
 
+#: a body read wider or narrower than ``body_width_mm`` by more than this share of it, and by
+#: more than BODY_WIDTH_MIN_MM, is flagged (:func:`width_off`)
+BODY_WIDTH_SHARE, BODY_WIDTH_MIN_MM = 0.2, 1.0
+
+
+def width_off(read_mm: float, given_mm: float) -> str:
+    """The flag of a body read far wider or narrower (``read_mm``) than ``body_width_mm``
+    (``given_mm``), or "" (:data:`BODY_WIDTH_SHARE`, :data:`BODY_WIDTH_MIN_MM`; NaN: no check).
+
+    The body's own width is a witness like its length: customer 55's 13 mm translucent body with
+    a strong shadow was read 17.5 mm wide (its shadow taken in), `ok` and 6-10 deg off; customer
+    52's off-white body on pale paper 6.4 of its 14 mm (its lit side lost to the backdrop).
+
+    Examples
+    --------
+    >>> width_off(17.5, 13.0)[:58]
+    'body read 17.5 mm wide where body_width_mm is 13: its shad'
+    >>> width_off(6.4, 14.0)[:60]
+    'body read 6.4 mm wide where body_width_mm is 14: a side of i'
+    >>> width_off(14.2, 13.0), width_off(float("nan"), 13.0)
+    ('', '')
+    """
+    if not (np.isfinite(read_mm) and np.isfinite(given_mm)):
+        return ""
+    if abs(read_mm - given_mm) <= max(BODY_WIDTH_SHARE * given_mm, BODY_WIDTH_MIN_MM):
+        return ""
+    why = (
+        "its shadow, or something beside it, is taken in"
+        if read_mm > given_mm
+        else "a side of it is not selected (faint, or lit like the backdrop)"
+    )
+    return (
+        f"body read {read_mm:.1f} mm wide where body_width_mm is {given_mm:g}: {why}; check "
+        "with photoset preview (a body that swells under pressure: leave body_width_mm out)"
+    )
+
+
 def tip_seen_whole(
     end_short_px: float, width_px: float, free_end_width_ratio: float, ridge_tip_deg: float
 ) -> bool:
@@ -367,6 +404,7 @@ def assess_body(
     sealed_end_px: float = 0.0,
     method: str = "tangents",
     psi_tip_deg: float | None = None,
+    width_mm: tuple[float, float] | None = None,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -431,6 +469,8 @@ def assess_body(
             "its end, and a straight sealed end and cap there read |psi| high (2-7 deg at |psi| "
             "100-220 for an 8 mm one): give sealed_end_mm"
         )
+    if width_mm is not None and (off := width_off(*width_mm)):
+        flags.append(off)
     if chambered and base_mismatch_deg is None:
         flags.append(
             "a row of chambers (a PneuNet?): its centre line runs through them as a polygon, so "

@@ -40,6 +40,11 @@ Keys
     (sealed end and any cap, mm, >= 0): psi is then read that far back from the tip's face, not
     where the centre line stops.  Needs ``mm_per_px`` or ``calibration``; ``target: body`` with
     ``free_end: capped`` only.
+``body_width_mm``
+    The body's width as the camera sees it (mm, > 0; a PneuNet's strip and chambers together):
+    with ``mm_per_px`` a photo whose body is read more than 20 % wider or narrower is flagged
+    (its shadow taken in, or a faint side left out; :func:`pipeline.measure.quality.width_off`).
+    ``target: body`` only; leave it out for a body that swells under pressure.
 ``method``
     The estimator for these photos (a key of :data:`pipeline.measure.METHODS`); without it the
     run's method (``--method``, config ``measure.method``) applies.
@@ -93,6 +98,7 @@ FREE_ENDS: tuple[str, ...] = ("capped", "bends")
 KEYS: tuple[str, ...] = (
     "l0_mm", "mm_per_px", "line_color", "fixed_end", "positive_turn", "target", "background", "roi",
     "exclude", "fixed_direction_deg", "free_end", "sealed_end_mm", "method", "calibration",
+    "body_width_mm",
 )
 #: manifest columns that override photoset.yaml per row
 OVERRIDE_COLUMNS: tuple[str, ...] = (
@@ -111,6 +117,7 @@ OVERRIDE_COLUMNS: tuple[str, ...] = (
     "sealed_end_mm",
     "method",
     "calibration",
+    "body_width_mm",
 )
 
 
@@ -175,6 +182,8 @@ class MeasureSettings:
         centre line stops.
     method : str or None
         Estimator for these photos; None: the run's.
+    body_width_mm : float or None
+        The body's width as the camera sees it (mm); None: not checked.
     calibration : Calibration or None
         Board photo(s), square size, inner corners and the computed plane calibration; None:
         measured in the image (scaled by ``mm_per_px``).
@@ -196,6 +205,7 @@ class MeasureSettings:
     sealed_end_mm: float | None = None
     method: str | None = None
     calibration: Calibration | None = None
+    body_width_mm: float | None = None
 
     @property
     def sign(self) -> float:
@@ -570,6 +580,45 @@ def _calibration(
         return None
 
 
+def _body_width(
+    raw: Mapping[str, Any], problems: list[SettingProblem], target: str
+) -> float | None:
+    """``body_width_mm`` as a width > 0 (mm), or None when not given; a problem when it is no such
+    width, or given for a drawn line.
+
+    Examples
+    --------
+    >>> problems = []
+    >>> _body_width({"body_width_mm": "14"}, problems, "body"), problems
+    (14.0, [])
+    >>> _body_width({"body_width_mm": 0}, problems, "body"), problems[0].key
+    (None, 'body_width_mm')
+    """
+    value: Any = raw.get("body_width_mm")
+    if is_missing(value):
+        return None
+    width = user_float(value)
+    if not math.isfinite(width) or width <= 0:
+        problems.append(
+            SettingProblem(
+                "body_width_mm",
+                f"body_width_mm = {value!r} must be a width > 0",
+                "give the body's width in mm as the camera sees it, or leave body_width_mm out",
+            )
+        )
+        return None
+    if target != "body":
+        problems.append(
+            SettingProblem(
+                "body_width_mm",
+                "body_width_mm is given for a drawn line (target: line)",
+                "leave body_width_mm out, or use target: body",
+            )
+        )
+        return None
+    return width
+
+
 def _sealed_end(
     raw: Mapping[str, Any], problems: list[SettingProblem], free_end: str
 ) -> float | None:
@@ -683,6 +732,7 @@ def settings_problems(
         "to its cut end)",
     )
     sealed_end = _sealed_end(raw, problems, free_end)
+    body_width = _body_width(raw, problems, target)
     roi: Polygon | None = None
     if not is_missing(raw.get("roi")):
         try:
@@ -764,6 +814,7 @@ def settings_problems(
         sealed_end_mm=sealed_end,
         method=method,
         calibration=calibration,
+        body_width_mm=body_width,
     ), []
 
 
