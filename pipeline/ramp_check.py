@@ -12,9 +12,7 @@ rest photos: DS20 turns through 300 deg between 0 and 80 kPa, and 70 deg from 80
 - a photo more than :data:`SLACK_DEG` outside that range is ``flagged``, with the reason
   ("breaks its ramp: ..."): a sign flip, a ring read the wrong way round, a piece of halo.
   The worst photo goes first (one already flagged on its own before one that is not) and the
-  leg is checked again without it, so one wrong photo never drags its neighbours down; a photo
-  ``ok`` on its own is judged among those ``ok`` on their own, and not at all where fewer than 3
-  are (a doubtful rest photo read 75 deg off made a right one "break its ramp");
+  leg is checked again without it, so one wrong photo never drags its neighbours down;
 - a photo whose pressure breaks its leg's order is ``flagged`` (a typo in the manifest:
   :func:`pressure_order_breaks`), as its psi would go into the curves at the wrong pressure;
 - a photo whose measured line length is far from the ramp's median is ``flagged`` (a partial
@@ -1067,11 +1065,6 @@ def _check_leg(
         for i in range(len(keep)):
             if i in rank:
                 off, allowed = _allowed_in_leg(psi_trusted, rank[i], same_pressure[keep[i]])
-            elif not doubtful[keep[i]] and len(trusted) < len(keep):
-                # nor, with too few of those, against a doubtful one (customer 55: a rest photo
-                # flagged on its own and read 75 deg off made its leg's right 120 kPa photo
-                # "break its ramp", 4 right rows lost)
-                continue
             else:
                 off, allowed = _allowed_in_leg(psi, i, same_pressure[keep[i]])
             if off > SLACK_DEG:
