@@ -114,10 +114,11 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
     high = 0.5 * psi_abs / out["l0_mm"]  # deg read high per mm of the end missed
     past = pd.to_numeric(out.get("past_l0_mm", pd.Series(np.nan, out.index)), errors="coerce")
     unit = "frames" if "frame" in out.columns and out["frame"].notna().any() else "photos"
+    bent_seen = seen.where(psi_abs >= SEALED_END_MIN_PSI_DEG)
     for _, g in out[out["status"] != "failed"].groupby(["material", "actuator"], sort=False):
-        shown = seen[g.index][psi_abs[g.index] >= SEALED_END_MIN_PSI_DEG].dropna()
+        shown = bent_seen[g.index].dropna()
         bent = int((psi_abs[g.index] >= 90.0).sum())
-        own, witness, scale_mm = seen, "stay straight", 0.0
+        own, witness, scale_mm = bent_seen, "stay straight", 0.0
         if len(shown) < SEALED_END_MIN_PHOTOS or len(shown) <= SEALED_END_MIN_SHARE * bent:
             # no straight end shows (one shorter than about 3/64 of the body, or a cap wider
             # than the body, whose step hides it): with the scale given, the body's length does
@@ -137,7 +138,7 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
             scale_mm = PAST_L0_SCALE_SHARE * float(g["l0_mm"].median() + shown.median())
         spread = float((shown - shown.median()).abs().median())
         if spread > max(SEALED_END_MARGIN_MM, SEALED_END_SPREAD_SHARE * float(shown.median())):
-            if own is seen:
+            if own is bent_seen:
                 _flag_strays(out, g.index, own, given)
             continue
         shown_mm = float(shown.median())
@@ -177,7 +178,7 @@ def check_sealed_ends(angles: pd.DataFrame) -> pd.DataFrame:
                 f"{unit}, so |psi| reads high (about {read_deg:.0f} deg here): measure it again "
                 "from where the chamber ends to the tip, cap included "
                 f"(about {shown_mm:.0f} mm)"
-            ) + ("" if own is seen else ", or check l0_mm and mm_per_px")
+            ) + ("" if own is bent_seen else ", or check l0_mm and mm_per_px")
             # the note that a sealed end left out may read |psi| high says it less exactly
             reason = out.at[i, "reason"]
             before = [
