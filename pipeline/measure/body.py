@@ -949,12 +949,10 @@ CHAMBER_GAPS_MIN, CHAMBER_GAP_DEPTH, CHAMBER_GAP_AREA = 3, 0.5, 0.2
 
 #: ... or, for ribs short and wide apart or slots too narrow for that area (customer 54's ribbed
 #: bodies: notches 3.7 mm wide and 5 mm deep, square where the ribs fan out, or 1.5 mm wide, on
-#: a 12 mm strip; no photo `ok`), where at least CHAMBER_SERIES_MIN of them reaching at least
-#: CHAMBER_SERIES_DEPTH half-widths into the outline closed over them (customer 54's 0.8; the
-#: shallow bays between markers on a body's outline, 14 dots of 6 mm, about half that, took
-#: 9 of 24 clear bodies for PneuNets) have their long sides and areas within
-#: CHAMBER_SERIES_SPREAD of their medians: a row of like slots, not a faint body's patches
-CHAMBER_SERIES_MIN, CHAMBER_SERIES_DEPTH, CHAMBER_SERIES_SPREAD = 5, 0.6, 0.25
+#: a 12 mm strip; no photo `ok`), where at least CHAMBER_SERIES_MIN of them have their long sides
+#: and areas within CHAMBER_SERIES_SPREAD of their medians: a row of like slots, not a faint
+#: body's patches
+CHAMBER_SERIES_MIN, CHAMBER_SERIES_SPREAD = 5, 0.25
 
 
 def _series(deep: list[tuple[int, float, float]]) -> list[int]:
@@ -1017,10 +1015,7 @@ def fill_chamber_gaps(comp: np.ndarray, half: float) -> np.ndarray:
         return comp
     x0, y0 = max(0, x - d), max(0, y - d)
     box = comp[y0 : y + h + d, x0 : x + w + d]
-    closed = cv2.morphologyEx(box, cv2.MORPH_CLOSE, disc)
-    added = (closed > 0) & (box == 0)
-    # how far each added pixel lies inside the closed outline: a slot's depth at its bottom
-    inside = cv2.distanceTransform(closed, cv2.DIST_L2, 5)
+    added = (cv2.morphologyEx(box, cv2.MORPH_CLOSE, disc) > 0) & (box == 0)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(added.astype(np.uint8), connectivity=8)
     slots, deep = [], []  # deep: (label, long side, area) of the slots deep enough
     for i in range(1, n):
@@ -1031,8 +1026,7 @@ def fill_chamber_gaps(comp: np.ndarray, half: float) -> np.ndarray:
         (_, _), (a, b), _ = cv2.minAreaRect(np.c_[xs, ys].astype(np.float32))
         if max(a, b) < CHAMBER_GAP_DEPTH * half:
             continue
-        if float(inside[ys, xs].max()) >= CHAMBER_SERIES_DEPTH * half:
-            deep.append((i, max(a, b), area))
+        deep.append((i, max(a, b), area))
         if area >= CHAMBER_GAP_AREA * half * half and max(a, b) >= 2.0 * min(a, b):
             slots.append(i)
     if len(slots) < CHAMBER_GAPS_MIN:
