@@ -33,7 +33,7 @@ import pandas as pd
 from scipy.sparse.csgraph import dijkstra
 
 from pipeline.measure.colors import color_mask
-from pipeline.measure.estimators import TANGENT_WINDOW_FRACTION, end_tangents, read_point_px
+from pipeline.measure.estimators import TANGENT_WINDOW_FRACTION, end_tangents
 from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
 from pipeline.measure.settings import MeasureSettings, Polygon
 
@@ -133,9 +133,6 @@ class BodyExtraction:
     base_edge : EndFace or None
         A chambered body's direction out of the clamp, from its strip's edge there (original
         px; :func:`base_edge_direction`); None where it is not read.
-    strip_px : ndarray (N, 2) or None
-        A chambered body's strip edge (:func:`strip_edge`, original px), one point per point of
-        the centre line, NaN where not found; None on a body without chambers.
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
         (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
@@ -160,7 +157,6 @@ class BodyExtraction:
     tip_face: EndFace | None = None
     chambered: bool = False
     base_edge: EndFace | None = None
-    strip_px: np.ndarray | None = None
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -1652,63 +1648,6 @@ def base_edge_direction(
     return EndFace(float(-start), (float(edge[0, 0]), float(edge[0, 1])))
 
 
-#: a chambered body's tip is read on its strip's edge where that edge is found without a break
-#: over its last STRIP_TIP_RUN half-widths, ending at most STRIP_TIP_SHORT half-widths before
-#: the centre line's end, and its direction there is within STRIP_TIP_DEG of the centre line's
-STRIP_TIP_RUN, STRIP_TIP_SHORT, STRIP_TIP_DEG = 4.0, 3.0, 20.0
-
-
-def strip_tip_direction(
-    strip_px: np.ndarray, centreline_px: np.ndarray, beyond_px: float, half_px: float
-) -> EndFace | None:
-    """A chambered body's tip direction, on its strip's edge (the layer that does not stretch):
-    its end tangent read ``beyond_px`` (image px) past the centre line's end, as the centre
-    line's own is (negative: back where a sealed end begins), carried over from the centre
-    line to the edge by their lengths near the tip; None where the edge is not found there
-    (:data:`STRIP_TIP_RUN`, :data:`STRIP_TIP_SHORT`, :data:`STRIP_TIP_DEG`).
-
-    The envelope of a row of chambers ends where its last chamber does: a sealed end without
-    chambers, or a last chamber rounded or cut aslant, turned its centre line's end (customer
-    54's ribbed bodies: every bent photo flagged "tip not read on a flat end face").  The strip
-    runs smooth to the tip, and any curve along it turns through psi.
-
-    Examples
-    --------
-    >>> t = np.linspace(0.0, np.deg2rad(120.0), 300)  # a strip bent 120 deg, 6 px outside it
-    >>> mid = np.c_[100 * np.sin(t), 100 * (1 - np.cos(t))]
-    >>> edge = np.c_[106 * np.sin(t), 100 - 106 * np.cos(t)]
-    >>> face = strip_tip_direction(edge, mid, 0.0, 10.0)
-    >>> round(float(np.rad2deg(face.direction_rad)), 1)  # image axes: y down
-    120.0
-    >>> edge[-60:] = np.nan  # not found near the tip
-    >>> strip_tip_direction(edge, mid, 0.0, 10.0) is None
-    True
-    """
-    found = np.isfinite(strip_px[:, 0])
-    if found.sum() < 8 or not found.any():
-        return None
-    last = len(found) - 1 - int(np.argmax(found[::-1]))
-    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(centreline_px, axis=0).T))]
-    if s[-1] - s[last] > STRIP_TIP_SHORT * half_px:
-        return None
-    run_from = s[last] - STRIP_TIP_RUN * half_px
-    near = (s >= run_from) & (np.arange(len(s)) <= last)
-    if run_from < 0 or not found[near].all():
-        return None  # a break in the edge near the tip: a gap, the last chamber's wall
-    edge = strip_px[found][: int(found[: last + 1].sum())]
-    first_near = int(np.argmax(near))
-    ratio = float(np.sum(np.hypot(*np.diff(strip_px[first_near : last + 1], axis=0).T))) / max(
-        float(s[last] - s[first_near]), 1e-9
-    )
-    beyond = (beyond_px + float(s[-1] - s[last])) * ratio
-    end = end_tangents(np.c_[edge[:, 0], -edge[:, 1]], ends_px=(0.0, beyond))[1]
-    own = end_tangents(np.c_[centreline_px[:, 0], -centreline_px[:, 1]])[1]
-    if abs(np.angle(np.exp(1j * (end - own)))) > np.deg2rad(STRIP_TIP_DEG):
-        return None
-    at = read_point_px(edge, beyond)
-    return EndFace(float(-end), at)
-
-
 def _end_face(
     comp: np.ndarray, soft: np.ndarray, pts: np.ndarray, half: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
@@ -2833,10 +2772,6 @@ def extract_body(
         chambered=chambered,
         # a row of chambers leaves the clamp along its strip (its centre line starts on its
         # first chamber)
-        strip_px=strip_edge(comb, _soft_body(comb, selection.strength), pts, half) * scale
-        + (scale - 1) / 2
-        if chambered
-        else None,
         base_edge=_in_original_px(
             base_edge_direction(
                 comb, _soft_body(comb, selection.strength), pts, half, trimmed[0]

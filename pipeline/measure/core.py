@@ -32,7 +32,6 @@ from pipeline.measure.estimators import (
     end_curvature,
     end_tangents,
     hyper,
-    read_point_px,
     straight_end,
     tangents,
     turning,
@@ -563,7 +562,7 @@ def measure_body(
     rarely an arc); any other method may be asked for.  A known ``fixed_direction_deg`` replaces
     the measured base tangent.
     """
-    from pipeline.measure.body import base_side_split_deg, extract_body, strip_tip_direction
+    from pipeline.measure.body import base_side_split_deg, extract_body
 
     background = None
     if settings.background_path is not None and image_bgr is not None:
@@ -691,26 +690,6 @@ def measure_body(
             body.end_short_px, line.width_px, body.free_end_width_ratio, body.ridge_tip_deg
         )
     )
-    # a chambered body whose tip is not read on a face: on its strip's edge, with the base given
-    # (without, it is flagged for its base anyway), where the centre line reaches the tip (the
-    # edge is read beside it: one stopping short of a tip hidden behind the clamp bar read psi
-    # -180 as -165, customer 54). Narrower there is no faint side: its sealed end has no chambers
-    strip_face = (
-        strip_tip_direction(
-            body.strip_px, line.centreline_px, ends[1] / per_image_px, 0.5 * line.width_px
-        )
-        if body.chambered
-        and body.strip_px is not None
-        and base is not None
-        and est is tip
-        and not face_used
-        and tip_seen_whole(body.end_short_px, line.width_px, 1.0, body.ridge_tip_deg)
-        else None
-    )
-    strip_turn = float(np.angle(np.exp(1j * (_face_direction(strip_face, settings) - end))))
-    strip_used = bool(np.isfinite(strip_turn))
-    if strip_used:
-        face_turn, face_used = strip_turn, True
     if face_used:
         # the check of the tip's window is moot with the tip read on its face: the fixed end's
         # alone stays (the change of its direction over a window twice as long)
@@ -782,7 +761,6 @@ def measure_body(
         and settings.free_end == "capped"
         and not face_used,
         tip_face_turn_deg=float(np.rad2deg(sign * face_turn)) if face_used else None,
-        tip_on_strip=strip_used,
         chambered=body.chambered,
         sealed_end_px=(settings.sealed_end_mm or 0.0) / settings.mm_per_px
         if settings.mm_per_px
@@ -816,9 +794,7 @@ def measure_body(
     if est is not tip:
         return measured
     tip_px = (
-        strip_face.middle_px
-        if strip_face is not None and strip_used
-        else body.tip_face.middle_px
+        body.tip_face.middle_px
         if face_used and body.tip_face is not None
         else read_point_px(line.centreline_px, ends[1] / _work_per_image_px(line, pts))
     )
@@ -887,6 +863,28 @@ def _turned(est: CurveEstimate, turn_rad: float, base_shift_rad: float) -> Curve
         kappa_per_px=turning / est.length_px if est.length_px else est.kappa_per_px,
         neighbour_turning_rad=turning + base_shift_rad,
     )
+
+
+def read_point_px(centreline_px: NDArray[np.float64], beyond_px: float) -> tuple[float, float]:
+    """The point ``beyond_px`` past a centre line's last point: back along the line when
+    negative, on along its last direction (over its last 10 px) when positive (image px).
+
+    Examples
+    --------
+    >>> line = np.c_[np.arange(0.0, 101.0), np.zeros(101)]
+    >>> read_point_px(line, -30.0), read_point_px(line, 12.0), read_point_px(line, -500.0)
+    ((70.0, 0.0), (112.0, 0.0), (0.0, 0.0))
+    """
+    pts = np.asarray(centreline_px, float)
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
+    if beyond_px <= 0:
+        at = max(s[-1] + beyond_px, 0.0)
+        return float(np.interp(at, s, pts[:, 0])), float(np.interp(at, s, pts[:, 1]))
+    back = np.array([np.interp(s[-1] - 10.0, s, pts[:, 0]), np.interp(s[-1] - 10.0, s, pts[:, 1])])
+    step = pts[-1] - back
+    unit = step / max(float(np.hypot(*step)), 1e-9)
+    x, y = pts[-1] + beyond_px * unit
+    return float(x), float(y)
 
 
 def carried_on_psi_deg(

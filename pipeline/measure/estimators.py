@@ -762,25 +762,3 @@ METHODS: dict[str, Estimator] = {
     "tangents": tangents,
     "auto": auto,
 }
-
-
-def read_point_px(centreline_px: np.ndarray, beyond_px: float) -> tuple[float, float]:
-    """The point ``beyond_px`` past a centre line's last point: back along the line when
-    negative, on along its last direction (over its last 10 px) when positive (image px).
-
-    Examples
-    --------
-    >>> line = np.c_[np.arange(0.0, 101.0), np.zeros(101)]
-    >>> read_point_px(line, -30.0), read_point_px(line, 12.0), read_point_px(line, -500.0)
-    ((70.0, 0.0), (112.0, 0.0), (0.0, 0.0))
-    """
-    pts = np.asarray(centreline_px, float)
-    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
-    if beyond_px <= 0:
-        at = max(s[-1] + beyond_px, 0.0)
-        return float(np.interp(at, s, pts[:, 0])), float(np.interp(at, s, pts[:, 1]))
-    back = np.array([np.interp(s[-1] - 10.0, s, pts[:, 0]), np.interp(s[-1] - 10.0, s, pts[:, 1])])
-    step = pts[-1] - back
-    unit = step / max(float(np.hypot(*step)), 1e-9)
-    x, y = pts[-1] + beyond_px * unit
-    return float(x), float(y)

@@ -318,9 +318,6 @@ NO_SEALED_END_PSI_DEG = 100.0
 #: least TIP_FACE_NOTE_DEG from where its centre line stops
 NOTE_TIP_FACE = "tip direction read on the flat face that ends the body"
 TIP_FACE_NOTE_DEG = 1.0
-#: a chambered body whose tip direction was read on its strip's edge
-#: (:func:`pipeline.measure.body.strip_tip_direction`)
-NOTE_TIP_STRIP = "tip direction read on the edge of the strip under the chambers"
 #: the sealed-end check's note where an actuator's photos show a straight end a little longer
 #: than the sealed_end_mm given (pipeline.sealed_end_check)
 NOTE_SEALED_END_LONGER = "the photos show a longer straight end"
@@ -400,7 +397,6 @@ def assess_body(
     sealed_end_unknown: bool = False,
     tip_face_turn_deg: float | None = None,
     chambered: bool = False,
-    tip_on_strip: bool = False,
     sealed_end_px: float = 0.0,
     method: str = "tangents",
     psi_tip_deg: float | None = None,
@@ -433,8 +429,8 @@ def assess_body(
     its tip's direction was read on the flat face ending it (``tip_face_turn_deg``: how far that
     turned psi on from the centre line's end, noted from :data:`TIP_FACE_NOTE_DEG`).  A
     ``chambered`` body (a PneuNet's row of chambers, filled) without the base's direction given
-    is flagged (its own is its first chamber's), and so is one whose tip was read neither on its
-    flat end face nor on its strip's edge (``tip_on_strip``, noted).  With
+    is flagged (its own is its first chamber's), and so is one whose tip was not read on its
+    flat end face.  With
     another ``method`` than the tip angle, psi further than :data:`DISAGREE_DEG` from the tip
     angle (``psi_tip_deg``) is flagged: a body is rarely an arc.
     """
@@ -477,7 +473,7 @@ def assess_body(
             "the direction it leaves the clamp in is its first chamber's: give "
             "fixed_direction_deg, the direction of the strip under the chambers at the clamp"
         )
-    if chambered and tip_face_turn_deg is None and not tip_on_strip:
+    if chambered and tip_face_turn_deg is None:
         # its centre line's end is a chamber's side: a rounded or slanted last chamber read
         # 3-16 deg off, ok (the review's rendered PneuNets)
         flags.append(
@@ -485,11 +481,7 @@ def assess_body(
             "the strip under the chambers (rounded, cut aslant, faint, or a sealed_end_mm given): "
             "its centre line's end is a chamber's side; check with photoset preview"
         )
-    if tip_on_strip:
-        notes.append(
-            f"{NOTE_TIP_STRIP} (a row of chambers: its centre line's end is a chamber's side)"
-        )
-    elif tip_face_turn_deg is not None and abs(tip_face_turn_deg) >= TIP_FACE_NOTE_DEG:
+    if tip_face_turn_deg is not None and abs(tip_face_turn_deg) >= TIP_FACE_NOTE_DEG:
         notes.append(
             f"{NOTE_TIP_FACE} ({tip_face_turn_deg:+.1f} deg on from where its centre line stops, "
             "about half a width short of it)"
