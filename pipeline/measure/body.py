@@ -943,37 +943,6 @@ CHAMBER_GAP_HALF_WIDTHS = 1.5
 CHAMBER_GAPS_MIN, CHAMBER_GAP_DEPTH, CHAMBER_GAP_AREA = 3, 0.5, 0.2
 
 
-#: ... or, for ribs short and wide apart or slots too narrow for that area (customer 54's ribbed
-#: bodies: notches 3.7 mm wide and 5 mm deep, square where the ribs fan out, or 1.5 mm wide, on
-#: a 12 mm strip; no photo `ok`), where at least CHAMBER_SERIES_MIN of them have their long sides
-#: and areas within CHAMBER_SERIES_SPREAD of their medians: a row of like slots, not a faint
-#: body's patches
-CHAMBER_SERIES_MIN, CHAMBER_SERIES_SPREAD = 5, 0.25
-
-
-def _series(deep: list[tuple[int, float, float]]) -> list[int]:
-    """The labels of the slots in ``deep`` (label, long side, area) that are alike: long side
-    and area within :data:`CHAMBER_SERIES_SPREAD` of their medians, where at least
-    :data:`CHAMBER_SERIES_MIN` are (else none).
-
-    Examples
-    --------
-    >>> like = [(i, 35.0 + i % 2, 820.0 - 10 * i) for i in range(1, 7)]
-    >>> _series(like + [(7, 60.0, 2000.0)])
-    [1, 2, 3, 4, 5, 6]
-    >>> _series(like[:4])
-    []
-    """
-    if len(deep) < CHAMBER_SERIES_MIN:
-        return []
-    long_side = np.array([d[1] for d in deep])
-    area = np.array([d[2] for d in deep])
-    alike = (np.abs(long_side / np.median(long_side) - 1.0) <= CHAMBER_SERIES_SPREAD) & (
-        np.abs(area / np.median(area) - 1.0) <= CHAMBER_SERIES_SPREAD
-    )
-    return [d[0] for d, a in zip(deep, alike) if a] if alike.sum() >= CHAMBER_SERIES_MIN else []
-
-
 def fill_chamber_gaps(comp: np.ndarray, half: float) -> np.ndarray:
     """``comp`` with the gaps between a row of chambers filled (a PneuNet seen from the side: a
     comb of chambers on the layer that does not stretch), or ``comp`` itself where it shows no
@@ -1013,20 +982,14 @@ def fill_chamber_gaps(comp: np.ndarray, half: float) -> np.ndarray:
     box = comp[y0 : y + h + d, x0 : x + w + d]
     added = (cv2.morphologyEx(box, cv2.MORPH_CLOSE, disc) > 0) & (box == 0)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(added.astype(np.uint8), connectivity=8)
-    slots, deep = [], []  # deep: (label, long side, area) of the slots deep enough
+    slots = []
     for i in range(1, n):
-        area = float(stats[i, cv2.CC_STAT_AREA])
-        if area < 4.0:
+        if stats[i, cv2.CC_STAT_AREA] < max(4.0, CHAMBER_GAP_AREA * half * half):
             continue
         ys, xs = np.nonzero(labels == i)
         (_, _), (a, b), _ = cv2.minAreaRect(np.c_[xs, ys].astype(np.float32))
-        if max(a, b) < CHAMBER_GAP_DEPTH * half:
-            continue
-        deep.append((i, max(a, b), area))
-        if area >= CHAMBER_GAP_AREA * half * half and max(a, b) >= 2.0 * min(a, b):
+        if max(a, b) >= CHAMBER_GAP_DEPTH * half and max(a, b) >= 2.0 * min(a, b):
             slots.append(i)
-    if len(slots) < CHAMBER_GAPS_MIN:
-        slots = _series(deep)
     if len(slots) < CHAMBER_GAPS_MIN:
         return comp
     out = comp.copy()
