@@ -133,6 +133,9 @@ class BodyExtraction:
     base_edge : EndFace or None
         A chambered body's direction out of the clamp, from its strip's edge there (original
         px; :func:`base_edge_direction`); None where it is not read.
+    excluded_start_px : float
+        How much of the stretch the centre line is carried back over to the given fixed end
+        lies under ``exclude`` or outside ``roi`` (original px): a bend there is not seen.
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
         (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
@@ -157,6 +160,7 @@ class BodyExtraction:
     tip_face: EndFace | None = None
     chambered: bool = False
     base_edge: EndFace | None = None
+    excluded_start_px: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -1987,7 +1991,6 @@ def _extensions(
     half: float,
     fixed_xy: tuple[float, float] | None,
     free_end_bends: bool = False,
-    region: np.ndarray | None = None,
 ) -> tuple[float, float]:
     """How far the body bends on beyond each end of the centre line, along the end tangents (px).
 
@@ -1995,11 +1998,9 @@ def _extensions(
     the body bends right from the clamp.  Not into a clamp that is part of the selection, though
     (:func:`_clamp_distance`): the clamp does not bend, and a fixed end clicked inside it (20-40
     px at 1280x960) carried the base's curvature on over the clamp (5-14 deg off on rendered
-    analogues).  Nor out of ``region`` (the pixels looked at, 1, :func:`_region_distance`): a
-    fixed end inside an excluded clamp plate lies in the clamp (10-20 px in, on a body 600 px
-    long, carried the curvature on and read psi 240 as 245-249, ok).  With ``free_end_bends``
-    (a free strip: the end walked from is a cut end too) the given point is reached whatever
-    lies there.
+    analogues).  With ``free_end_bends`` (a free strip: the end walked from is a cut end too)
+    the given point is reached whatever lies there.  Over an excluded part (a clamp plate under
+    ``exclude``) it is carried on too: what lies there is not seen (:func:`_region_distance`).
 
     The free end (``free_end: capped``): 0.  Past the centre line's last point lies the actuator's
     sealed end (a cap), which does not bend, so the tip's direction is the centre line's own at
@@ -2021,7 +2022,6 @@ def _extensions(
             reach = face_reach(pts, np.asarray(fixed_xy, float))
             if not free_end_bends:
                 reach = min(reach, _clamp_distance(comp, dt, p, t, half, reach))
-                reach = min(reach, _region_distance(region, p, t, reach))
             out.append(reach)
             continue
         if end == -1 and not free_end_bends:
@@ -2682,7 +2682,6 @@ def extract_body(
         half,
         fe if reached else None,
         free_end_bends=settings.free_end == "bends",
-        region=region,
     )
     # the body proper (not the tube or a plate joined to it at the clamp) at the border: at its
     # free end the tip may be outside the photo; along a side the middle was taken from the
@@ -2715,9 +2714,15 @@ def extract_body(
         fixed_end_found=reached,
     )
     gap = float(np.hypot(*(pts[0] - np.asarray(fe)))) if fe is not None and reached else 0.0
+    excluded_start = 0.0
+    if fe is not None and reached and len(pts) >= 2 and trimmed[0] > 0:
+        out = pts[0] - pts[min(len(pts) - 1, 5)]
+        out = out / max(float(np.hypot(*out)), 1e-9)
+        excluded_start = trimmed[0] - _region_distance(region, pts[0], out, trimmed[0])
     return BodyExtraction(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
+        excluded_start_px=excluded_start * scale,
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,

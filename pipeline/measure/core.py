@@ -767,6 +767,12 @@ def measure_body(
         else 0.0,
         method=method,
         psi_tip_deg=None if est is tip else float(np.rad2deg(sign * tip.turning_rad)),
+        excluded_start_deg=float(
+            np.rad2deg(abs(end_curvature(pts[::-1])) * body.excluded_start_px * per_image_px)
+        )
+        if base is None and body.excluded_start_px > 0
+        else 0.0,
+        excluded_start_px=body.excluded_start_px,
         width_mm=(body_width_px * settings.mm_per_px, settings.body_width_mm)
         if settings.body_width_mm and settings.mm_per_px and settings.calibration is None
         else None,

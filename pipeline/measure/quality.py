@@ -216,6 +216,9 @@ def tip_out_of_reach(end_short_px: float, width_px: float) -> bool:
     return end_short_px > 1.5 * width_px + 4.0
 
 
+#: a fixed end inside an excluded part: flagged where the base's curvature carried over that
+#: stretch turns psi this much (deg) or more
+EXCLUDED_START_DEG = 2.0
 #: a body read wider or narrower than ``body_width_mm`` by more than this share of it, and by
 #: more than BODY_WIDTH_MIN_MM, is flagged (:func:`width_off`)
 BODY_WIDTH_SHARE, BODY_WIDTH_MIN_MM = 0.2, 1.0
@@ -401,6 +404,8 @@ def assess_body(
     method: str = "tangents",
     psi_tip_deg: float | None = None,
     width_mm: tuple[float, float] | None = None,
+    excluded_start_deg: float = 0.0,
+    excluded_start_px: float = 0.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -467,6 +472,15 @@ def assess_body(
         )
     if width_mm is not None and (off := width_off(*width_mm)):
         flags.append(off)
+    if excluded_start_deg >= EXCLUDED_START_DEG:
+        # the review of stop 60: carried over, a click inside an excluded clamp read psi 240 as
+        # 245-249; stopped at the box, a box drawn onto the body read it as 232-220
+        flags.append(
+            f"fixed_end lies {excluded_start_px:.0f} px inside what exclude / roi leave out, "
+            "and psi takes the body to bend on over that stretch, which is not seen (about "
+            f"{excluded_start_deg:.0f} deg of turn): click fixed_end where the body leaves the "
+            "clamp, draw the box up to there, or give fixed_direction_deg"
+        )
     if chambered and base_mismatch_deg is None:
         flags.append(
             "a row of chambers (a PneuNet?): its centre line runs through them as a polygon, so "
