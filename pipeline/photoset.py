@@ -1213,6 +1213,7 @@ def set_doubts(ps: PhotoSet) -> list[Problem]:
         ([] if ps.is_video else unlisted_problems(ps))
         + repeated_level_problems(ps)
         + sealed_end_problems(ps)
+        + body_width_problems(ps)
     )
 
 
@@ -1249,6 +1250,30 @@ def sealed_end_problems(ps: PhotoSet) -> list[Problem]:
             ),
             "measure the actuator's end that does not bend (from where the chamber ends to the "
             "tip, cap included) and set sealed_end_mm",
+            warning=True,
+        )
+    ]
+
+
+def body_width_problems(ps: PhotoSet) -> list[Problem]:
+    """A warning when rows give ``body_width_mm`` without ``mm_per_px`` (or with a
+    ``calibration``): their width is then not checked (the review of stop 60)."""
+    unchecked = [
+        r
+        for r in ps.rows
+        if r is not None
+        and r.body_width_mm is not None
+        and (not r.mm_per_px or r.calibration is not None)
+    ]
+    if not unchecked:
+        return []
+    return [
+        Problem(
+            str(ps.folder / SETTINGS),
+            None,
+            f"body_width_mm is given for {len(unchecked)} photo(s) without mm_per_px (or with a "
+            "calibration): their body's width read is not checked against it",
+            "give mm_per_px (a ruler in the photo), or leave body_width_mm out",
             warning=True,
         )
     ]

@@ -446,6 +446,24 @@ def test_a_body_read_wider_or_narrower_than_body_width_mm_is_flagged(psi):
     assert measure_image(img, settings_for(fe, body_width_mm=10.0)).status == "ok"
 
 
+def test_body_width_mm_without_a_scale_is_warned_of(tmp_path):
+    from pipeline.photoset import body_width_problems, load_photoset
+
+    img, fe, _ = body_photo(90.0, seed=7)
+    cv2.imwrite(str(tmp_path / "a.jpg"), img)
+    (tmp_path / "manifest.csv").write_text(
+        "image,pressure_kpa,direction,material,actuator,trial\na.jpg,0,up,M,A,1\n"
+    )
+    (tmp_path / "photoset.yaml").write_text(
+        f"l0_mm: 180\ntarget: body\nfixed_end: [{fe[0]:.1f}, {fe[1]:.1f}]\nbody_width_mm: 14\n"
+    )
+    [warning] = body_width_problems(load_photoset(tmp_path))
+    assert warning.warning and "without mm_per_px" in warning.message
+    with open(tmp_path / "photoset.yaml", "a") as f:
+        f.write("mm_per_px: 0.3\n")
+    assert body_width_problems(load_photoset(tmp_path)) == []
+
+
 def test_body_width_mm_is_for_a_body_and_a_width():
     for raw, what in (({"target": "line"}, "drawn line"), ({"target": "body"}, "> 0")):
         with pytest.raises(SettingsError) as err:
