@@ -401,23 +401,35 @@ def bootstrap_k_p(
     return k_p, float(lo), float(hi), len(fits)
 
 
-def rest_angle_deg(hysteresis: pd.DataFrame) -> float:
-    """psi0 of an actuator the model does not know: the mean psi at the lowest pressure of the
-    rising curve (its rest angle), else :data:`~pipeline.constants.PSI0_DEG` (the paper's).
+def rest_angle_deg(hysteresis: pd.DataFrame) -> tuple[float, str]:
+    """psi0 of an actuator the model does not know and where it comes from: the mean psi at the
+    lowest pressure of the rising curve (its rest angle, measured), else
+    :data:`~pipeline.constants.PSI0_DEG` (the paper's: customer 54's one ``ok`` photo, at
+    125 kPa down, gave 210 "measured").
 
     Examples
     --------
     >>> rest_angle_deg(pd.DataFrame({"direction": ["up", "up", "down"],
     ...     "pressure_kpa": [0.0, 20.0, 0.0], "psi_mean_deg": [213.1, 190.0, 208.0]}))
-    213.1
+    (213.1, 'its rest angle, measured')
+    >>> rest_angle_deg(pd.DataFrame({"direction": ["up"], "pressure_kpa": [125.0],
+    ...     "psi_mean_deg": [118.0]}))[1]
+    'its psi at 125 kPa, the lowest measured on its rising curve'
     >>> rest_angle_deg(pd.DataFrame({"direction": ["down"], "pressure_kpa": [0.0],
     ...     "psi_mean_deg": [208.0]}))
-    210.0
+    (210.0, "the paper's: no rising curve measured")
     """
     up = hysteresis[(hysteresis["direction"] == "up") & hysteresis["psi_mean_deg"].notna()]
     if up.empty:
-        return PSI0_DEG
-    return float(up.loc[up["pressure_kpa"].idxmin(), "psi_mean_deg"])
+        return PSI0_DEG, "the paper's: no rising curve measured"
+    lowest = up.loc[up["pressure_kpa"].idxmin()]
+    where = (
+        "its rest angle, measured"
+        if float(lowest["pressure_kpa"]) <= 0.0
+        else f"its psi at {float(lowest['pressure_kpa']):g} kPa, the lowest measured on its "
+        "rising curve"
+    )
+    return float(lowest["psi_mean_deg"]), where
 
 
 def compare_material(
@@ -480,6 +492,7 @@ def compare_material(
     if len(finite):
         out["psi_max_deg"] = float(finite["psi_mean_deg"].max())
         out["psi_min_deg"] = float(finite["psi_mean_deg"].min())
+    if finite["pressure_kpa"].nunique() >= 2:  # one level is no range (customer 54's "0 deg")
         out["range_deg"] = out["psi_max_deg"] - out["psi_min_deg"]
         out["range_kpa"] = float(finite["pressure_kpa"].max() - finite["pressure_kpa"].min())
     out["hysteresis_width_deg"], out["hysteresis_width_at_kpa"] = hysteresis_width(h)
@@ -808,8 +821,8 @@ def compare(
         material_psi0_deg = run_psi0.get(material)
         rest = ""
         if material_psi0_deg is None:  # a material the model does not know: its own rest angle
-            material_psi0_deg = rest_angle_deg(hm)
-            rest = f"psi0 {material_psi0_deg:.1f} deg: its rest angle, measured"
+            material_psi0_deg, source = rest_angle_deg(hm)
+            rest = f"psi0 {material_psi0_deg:.1f} deg: {source}"
         try:
             rec = compare_material(
                 material, hm, rows, model_psi=psi_fn, fit_k_p=fit_fn, psi0_deg=material_psi0_deg,

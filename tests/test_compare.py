@@ -174,6 +174,21 @@ def test_unknown_material_keeps_data_metrics():
     assert out["psi0_deg"] == 200.0 and "psi0 200.0 deg: its rest angle, measured" in out["note"]
 
 
+def test_one_level_measured_gives_no_range_and_no_measured_rest_angle():
+    # customer 54: one ok photo, at 125 kPa down: rms.csv said range 0 deg and "psi0 210.0 deg:
+    # its rest angle, measured" (the paper's 210, nothing measured at rest)
+    h = _hyst().assign(material="PN110")
+    one = h[(h["direction"] == "down") & (h["pressure_kpa"] == 10)]
+    out = compare(one, model_psi=None, fit_k_p=None).iloc[0]
+    assert math.isnan(out["range_deg"]) and math.isnan(out["range_kpa"])
+    assert "psi0 210.0 deg: the paper's: no rising curve measured" in out["note"]
+    rising = h[(h["direction"] == "up") & (h["pressure_kpa"] > 0)]
+    out = compare(rising, model_psi=None, fit_k_p=None).iloc[0]
+    assert "psi0 100.0 deg: its psi at 10 kPa, the lowest measured on its rising curve" in (
+        out["note"]
+    )
+
+
 def test_bad_hysteresis_table():
     with pytest.raises(UserInputError, match="missing column"):
         compare(_hyst().drop(columns="psi_mean_deg"), model_psi=None, fit_k_p=None)
