@@ -378,6 +378,17 @@ def test_two_doubtful_photos_read_wrong_alike_do_not_outvote_a_right_one_between
     assert (out.loc[[3, 4], "status"] == "flagged").all()
 
 
+def test_a_sign_flipped_photo_among_doubtful_ones_still_breaks_its_ramp():
+    # the review of stop 60: an exemption for ok photos in legs with fewer than 3 photos ok on
+    # their own (a3f9d7e, reverted) left -120 for +120 ok and flagged its right neighbours
+    df = _ramp([0.0, 40.0, 80.0, -120.0, 160.0, 200.0])
+    df.loc[[0, 1, 2, 4], ["status", "reason"]] = ["flagged", "uneven outline (width 36-91 px)"]
+    out = check_ramps(df)
+    assert out.loc[3, "status"] == "flagged" and out.loc[3, "reason"].startswith(
+        "breaks its ramp"
+    )
+
+
 def test_a_video_frame_off_its_neighbours_by_a_few_degrees_breaks_its_ramp():
     # customer 20: two frames of a 15 fps ramp read 6.6 and 6.8 deg off, ok, where neighbouring
     # frames differ by 0.7 deg of noise; a photo ramp's 12 deg slack let them through. A video's
