@@ -309,10 +309,10 @@ def encoded_tile(
 
 def width_label(res: AngleResult, settings: MeasureSettings) -> str:
     """How wide the chosen body (edge to edge, what ``body_width_mm`` is checked against) or line
-    was read, in mm where ``mm_per_px`` is given: a body read
-    much narrower than it is has lost a side to the backdrop (customer 52's off-white body on
-    light grey paper: 6 mm of its 14 selected, and the reasons pointed at the clamp), one read
-    wider has taken in its shadow.  Empty when no width was read.
+    was read, in mm where ``mm_per_px`` is given: a body read much narrower than it is has lost
+    a side to the backdrop (customer 52's off-white body on light grey paper: about 6.5 mm of its
+    14 selected, and the reasons pointed at the clamp), one read wider has taken in its shadow.
+    Empty when no width was read.
 
     Examples
     --------

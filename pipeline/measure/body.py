@@ -1043,9 +1043,10 @@ def fill_inner_holes(comp: np.ndarray, half: float) -> np.ndarray:
     thick = cv2.distanceTransform(filled, cv2.DIST_L2, 5)
     inner = []
     for c in holes:
-        one = np.zeros_like(comp)
-        cv2.drawContours(one, [c], -1, 1, cv2.FILLED)
-        if float(thick[one > 0].max()) <= INNER_HOLE_HALF_WIDTHS * half:
+        x, y, w, h = cv2.boundingRect(c)  # the hole's own box, not the whole photo per hole
+        one = np.zeros((h, w), np.uint8)
+        cv2.drawContours(one, [c], -1, 1, cv2.FILLED, offset=(-x, -y))
+        if float(thick[y : y + h, x : x + w][one > 0].max()) <= INNER_HOLE_HALF_WIDTHS * half:
             inner.append(c)
     if not inner:
         return comp

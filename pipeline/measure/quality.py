@@ -230,7 +230,7 @@ def width_off(read_mm: float, given_mm: float) -> str:
 
     The body's own width is a witness like its length: customer 55's 13 mm translucent body with
     a strong shadow was read 17.5 mm wide (its shadow taken in), `ok` and 6-10 deg off; customer
-    52's off-white body on pale paper 6.4 of its 14 mm (its lit side lost to the backdrop).
+    52's off-white body on pale paper about 6.5 of its 14 mm (its lit side lost to the backdrop).
 
     Examples
     --------
