@@ -22,10 +22,16 @@ FIXED_END = (W / 2, 60.0)
 PSI = (0.0, 20.0, 45.0, 75.0, 110.0, 150.0, 190.0, 150.0, 100.0, 40.0, 0.0)
 
 
-def faint_photo(psi_deg: float | None, *, seed: int, length: float = 380.0, width: float = 56.0):
+def faint_photo(
+    psi_deg: float | None, *, seed: int, length: float = 380.0, width: float = 56.0,
+    shaded_half: float | None = None,
+):
     """The scene (``psi_deg`` None: the empty scene): a body of constant curvature leaving the
     clamp straight down, its lit side 60 grey levels above the backdrop and its shaded side 5, its
-    soft shadow beside it, and the clamp's shadow darkening the backdrop below the clamp."""
+    soft shadow beside it, and the clamp's shadow darkening the backdrop below the clamp.
+
+    ``shaded_half`` (grey levels): the body's lit half is 60 levels above the backdrop and its
+    shaded half this many, instead of the one fading into the other across the body."""
     rng = np.random.default_rng(seed)
     img = np.full((H, W), BACKDROP)
     fe = np.array(FIXED_END)
@@ -53,7 +59,9 @@ def faint_photo(psi_deg: float | None, *, seed: int, length: float = 380.0, widt
                     px(c[i : i + 2][::-1] - n[i : i + 2][::-1] * b * width),
                 ]
                 pts = [np.round(quad * 8).astype(np.int32)]
-                cv2.fillPoly(img, pts, BACKDROP + 60 * (1 - u) + 5 * u, cv2.LINE_AA, 3)
+                level = 60 * (1 - u) + 5 * u if shaded_half is None else (
+                    60.0 if u < 0.5 else shaded_half)
+                cv2.fillPoly(img, pts, BACKDROP + level, cv2.LINE_AA, 3)
                 m = np.zeros((H, W), np.uint8)
                 cv2.fillPoly(m, pts, 1, cv2.LINE_8, 3)
                 body |= m > 0
@@ -96,3 +104,34 @@ def test_with_the_clamps_direction_given_they_are_measured_from_it(faint_sets):
     assert not angles["reason"].str.contains("psi may be").any(), angles["reason"].iloc[0]
     assert (angles["status"] == "ok").sum() >= 9
     assert angles["error_deg"].median() < 3.0
+
+
+@pytest.mark.parametrize("shaded_half", [6.0, 10.0, 14.0])
+def test_a_side_fainter_than_the_weak_threshold_is_selected_whole_or_left_out_whole(shaded_half):
+    # customer 55: a translucent body lit from one side, its shaded half 9-10 grey levels above
+    # the empty scene (5-6 in the colour distance, under the weak threshold's floor of 6), was
+    # selected as speckle: the centre line wobbled and half the rows were flagged.  Against the
+    # empty scene the faint half counts, median-filtered, when clearly above that filter's own
+    # threshold (10, 14 levels: the whole 56 px); a side at that threshold (6) is left out whole
+    # (its lit half, 28 px, measures psi as well), never selected in part
+    from pipeline.measure.body import body_mask
+    from pipeline.measure.settings import resolve_settings
+
+    photo = faint_photo(0.0, seed=1, shaded_half=shaded_half)
+    mask = body_mask(photo, resolve_settings(l0_mm=100.0, target="body"),
+                     background_bgr=faint_photo(None, seed=99)).mask
+    widths = [int(mask[row].sum()) for row in (150, 250, 350)]
+    whole = 56 if shaded_half > 8 else 28
+    assert all(abs(w - whole) <= 3 for w in widths), widths
+
+
+def test_a_ramp_of_a_body_with_a_faint_half_is_measured_ok(tmp_path, ramp_set_writer):
+    # the same body over a ramp, its shaded half 10 grey levels above the empty scene: 4 of 11
+    # rows were flagged (the selection took the faint half in part), now all are ok and right
+    photos = [faint_photo(psi, seed=i, shaded_half=10.0) for i, psi in enumerate(PSI)]
+    settings = ["l0_mm: 100", "target: body", f"fixed_end: [{FIXED_END[0]}, {FIXED_END[1]}]",
+                "fixed_direction_deg: -90"]
+    angles = _measured(ramp_set_writer(tmp_path / "half", photos, settings,
+                                       faint_photo(None, seed=99)))
+    assert (angles["status"] == "ok").all(), angles["reason"].tolist()
+    assert angles["error_deg"].max() < 3.0, angles["error_deg"].round(2).tolist()
