@@ -1571,6 +1571,30 @@ def test_a_faint_tips_fix_names_the_empty_scene_only_where_none_was_given(given)
     assert ("or give the empty scene (background)" in quality.reason) is not given
 
 
+@pytest.mark.parametrize(("share", "candidates", "said"), [
+    (0.83, 3, True), (0.2, 3, False), (0.83, 1, False),
+])
+def test_a_faint_bodys_selection_flags_say_first_that_it_is_faint(share, candidates, said):
+    # customer 55: a translucent body one grey level fainter than customer 53's was flagged as a
+    # PneuNet, a ring, rival bodies or an uneven outline, its mask speckled on its shaded half;
+    # the reason now says first that the body is faint, and only on a flag about its selection
+    from pipeline.measure.extract import LineExtraction
+    from pipeline.measure.quality import assess_body
+
+    pts = np.c_[np.zeros(200), np.arange(200.0)]
+    line = LineExtraction(pts, 20.0, False, candidates, 100.0, 200.0, 0.0, False, True,
+                          (0.0, 0.0))
+    quality = assess_body(
+        line, psi_deg=10.0, psi_check_deg=10.0, widths_px=np.full(200, 20.0),
+        expected_length_px=None, length_px=200.0, base_mismatch_deg=None,
+        selected_fraction=0.05, background_given=True, faint_share=share,
+    )
+    assert quality.status == ("flagged" if candidates > 1 else "ok"), quality.reason
+    assert quality.reason.startswith(
+        "the body differs only faintly from the empty scene over 83% of it"
+    ) is said, quality.reason
+
+
 def test_a_selection_shorter_than_the_sealed_end_is_a_failed_row_not_a_negative_length():
     # customer 33's clear body: only bright edges were selected, shorter than the 7 mm sealed
     # end, and the rows read lengths of -8 px, "-3% of l0 visible" and psi -222 deg

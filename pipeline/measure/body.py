@@ -35,6 +35,7 @@ from scipy.sparse.csgraph import dijkstra
 from pipeline.measure.colors import color_mask
 from pipeline.measure.estimators import TANGENT_WINDOW_FRACTION, end_tangents
 from pipeline.measure.extract import LineExtraction, NoLineFound, _pixel_graph, region_mask
+from pipeline.measure.quality import FAINT_BODY_SHARE
 from pipeline.measure.settings import MeasureSettings, Polygon
 
 #: the body must differ from the backdrop by at least this many noise sigmas (robust, Lab units)
@@ -143,6 +144,9 @@ class BodyExtraction:
     excluded_start_px : float
         How much of the stretch the centre line is carried back over to the given fixed end
         lies under ``exclude`` or outside ``roi`` (original px): a bend there is not seen.
+    faint_share : float
+        The share of the body's pixels that differ from the background by less than the clear
+        threshold (0 for a colour-only selection): a translucent body's.
     hollow_outline : bool
         The selection outlines a long region whose inside does not differ from the background
         (:attr:`BodySelection.hollow_width_px`), at least :data:`HOLLOW_WIDTHS` times as wide as
@@ -168,6 +172,7 @@ class BodyExtraction:
     chambered: bool = False
     base_edge: EndFace | None = None
     excluded_start_px: float = 0.0
+    faint_share: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -2678,9 +2683,13 @@ def extract_body(
         half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
+        faint = np.isfinite(selection.contrast) and float(
+            np.mean(selection.strength[comp > 0] < 1.0)) >= FAINT_BODY_SHARE
         raise NoLineFound(
             f"no body found: the selection ({what}) is a blob, not an elongated actuator "
             f"({length:.0f} px long, {2 * half:.0f} px wide)"
+            + ("; it differs only faintly: the body may be selected in pieces (light its shaded "
+               "side too, or use a backdrop it stands out against)" if faint else "")
         )
     ridge = path  # the whole ridge, end to end: what the centre line should cover
     path, _ = _trim_by_thickness(path, dt, half)
@@ -2782,6 +2791,9 @@ def extract_body(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         excluded_start_px=excluded_start * scale,
+        faint_share=float(np.mean(selection.strength[comp > 0] < 1.0))
+        if np.isfinite(selection.contrast) and comp.any()
+        else 0.0,
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,

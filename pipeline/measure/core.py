@@ -773,6 +773,7 @@ def measure_body(
         if base is None and body.excluded_start_px > 0
         else 0.0,
         excluded_start_px=body.excluded_start_px,
+        faint_share=body.faint_share,
         width_mm=(body_width_px * settings.mm_per_px, settings.body_width_mm)
         if settings.body_width_mm and settings.mm_per_px and settings.calibration is None
         else None,

@@ -182,6 +182,15 @@ END_HOOK_DEG = 10.0
 SMOOTH_DISAGREE_DEG = 8.0
 #: body: width along the centre line (90th / 10th percentile) above this -> uneven outline
 WIDTH_RATIO = 2.2
+#: body: a body this share of which differs from the background by less than the clear
+#: threshold is faint, and a flag on its selection's shape (these words) says so first:
+#: customer 55's translucent body one grey level fainter was flagged as a PneuNet, a ring,
+#: rival bodies or an uneven outline, its mask speckled on its shaded half
+FAINT_BODY_SHARE = 0.5
+SELECTION_SHAPE_FLAGS = (
+    "a row of chambers", "candidate bodies", "uneven outline", "body closes on itself",
+    "the end tangents and a smooth fit", "end direction unstable",
+)
 #: body: the free end's direction may change this much (deg) when the centre line is carried on
 #: along the selection's ridge over the part of the tip it did not reach; more is flagged, and
 #: psi is then the carried-on line's (:func:`pipeline.measure.core.carried_on_psi_deg`)
@@ -406,6 +415,7 @@ def assess_body(
     width_mm: tuple[float, float] | None = None,
     excluded_start_deg: float = 0.0,
     excluded_start_px: float = 0.0,
+    faint_share: float = 0.0,
 ) -> Quality:
     """``ok`` / ``flagged`` for a body's centre line (``target: body``), every reason listed.
 
@@ -676,4 +686,25 @@ def assess_body(
         notes.append(f"{NOTE_SELECTION_COVERS} {100 * selected_fraction:.0f}% of the photo")
     if background_estimated:
         notes.append(NOTE_RAMP_BACKGROUND)
+    if faint_share >= FAINT_BODY_SHARE and any(
+        word in flag for flag in flags for word in SELECTION_SHAPE_FLAGS
+    ):
+        flags.insert(0, faint_body(faint_share, background_given))
     return Quality("flagged" if flags else "ok", "; ".join(flags + notes))
+
+
+def faint_body(share: float, background_given: bool) -> str:
+    """Why a faint body's selection is flagged, said first (:data:`FAINT_BODY_SHARE`).
+
+    Examples
+    --------
+    >>> faint_body(0.83, True)[:67]
+    'the body differs only faintly from the empty scene over 83% of it: '
+    """
+    return (
+        "the body differs only faintly from the "
+        + ("empty scene" if background_given else "backdrop")
+        + f" over {100 * share:.0f}% of it: its selection may be speckled or in pieces "
+        "(photoset preview shows it), which the reasons after this one may stem from; light "
+        "its shaded side too (a second lamp, a reflector) or use a backdrop it stands out against"
+    )
