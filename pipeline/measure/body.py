@@ -46,13 +46,20 @@ MIN_DIFFERENCE = 12.0
 #: within this fraction of the photo's size of it
 WEAK_SIGMAS = 3.0
 GROW_FRACTION = 0.012
-#: against an empty-scene photo, where the shadows are told apart, a faint side counts too: a
-#: difference whose median over FAINT_MEDIAN_PX px is at least FAINT_SIGMAS of that median's
-#: own noise and FAINT_DIFFERENCE, within FAINT_REACH times the weak reach of a clear one,
+#: where the shadows are told apart (or, without an empty scene, lighter than the backdrop), a
+#: faint side counts too: a difference whose median over FAINT_MEDIAN_PX px is at least
+#: FAINT_SIGMAS of that median's own noise and FAINT_DIFFERENCE, within FAINT_REACH times the
+#: weak reach of a clear one,
 #: when what it adds lies at FAINT_CLEAR times that threshold or more (median): customer 55's
 #: translucent body lit from one side differed by 5-6 on its shaded half, under the weak
 #: threshold's floor of 6, and half its rows were lost one grey level below customer 53's scene
 FAINT_MEDIAN_PX, FAINT_SIGMAS, FAINT_DIFFERENCE, FAINT_REACH, FAINT_CLEAR = 5, 6.0, 3.0, 3, 1.5
+#: ... each connected region of it on its own (the review of stop 61: light bounced onto the
+#: backdrop beside the lit side, alone under FAINT_CLEAR, came in on a faint half's median and
+#: gave rows ok 5.6-10.5 deg off); a share of what it adds this close to the threshold
+#: (FAINT_MARGINAL times it or less) is at the edge of the selection (:attr:`BodySelection.
+#: faint_marginal`)
+FAINT_MARGINAL = 1.25
 #: lightness counts this much in the colour distance (shadows change lightness most)
 LIGHTNESS_WEIGHT = 0.6
 #: holes larger than this fraction of the body's area stay open (the inside of a ring)
@@ -144,6 +151,8 @@ class BodyExtraction:
     excluded_start_px : float
         How much of the stretch the centre line is carried back over to the given fixed end
         lies under ``exclude`` or outside ``roi`` (original px): a bend there is not seen.
+    faint_taken, faint_marginal : bool, float
+        :attr:`BodySelection.faint_taken`, :attr:`BodySelection.faint_marginal`.
     faint_share : float
         The share of the body's pixels that differ from the background by less than the clear
         threshold (0 for a colour-only selection): a translucent body's.
@@ -173,6 +182,8 @@ class BodyExtraction:
     base_edge: EndFace | None = None
     excluded_start_px: float = 0.0
     faint_share: float = 0.0
+    faint_taken: bool = False
+    faint_marginal: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -699,15 +710,41 @@ def faint_differences(diff: np.ndarray) -> np.ndarray:
     return np.asarray(filtered / max(FAINT_SIGMAS * sigma, FAINT_DIFFERENCE), np.float32)
 
 
+def clear_regions(added: np.ndarray, faint: np.ndarray) -> np.ndarray:
+    """Where ``added`` (bool) lies in a connected region (8-connected) of it whose median of
+    ``faint`` is at least :data:`FAINT_CLEAR` (bool).
+
+    Examples
+    --------
+    >>> added = np.array([[1, 1, 0, 1, 1]], bool)
+    >>> clear_regions(added, np.float32([[2.0, 1.8, 0, 1.1, 1.2]])).tolist()
+    [[True, True, False, False, False]]
+    """
+    n, labels = cv2.connectedComponents(added.astype(np.uint8), connectivity=8)
+    if n <= 1:
+        return np.zeros(added.shape, bool)
+    region, value = labels[added], faint[added]
+    order = np.lexsort((value, region))
+    counts = np.bincount(region, minlength=n)
+    middle = np.cumsum(counts) - counts + (counts - 1) // 2  # each region's median, sorted
+    clear = np.zeros(n, bool)
+    present = counts > 0
+    clear[present] = value[order][middle[present]] >= FAINT_CLEAR
+    clear[0] = False
+    return clear[labels] & added
+
+
 def _hysteresis(
-    diff: np.ndarray, high: float, low: float, faint: np.ndarray | None = None
+    diff: np.ndarray, high: float, low: float, faint: np.ndarray | None = None,
+    faint_gain: float = 1.0,
 ) -> np.ndarray:
     """0/1 mask of the pixels above ``low`` connected to a pixel above ``high`` (as Canny's edges).
 
-    ``faint`` (:func:`faint_differences`) adds the pixels over 1 in it within
-    :data:`FAINT_REACH` times the reach of a clear pixel, when their median is at least
-    :data:`FAINT_CLEAR`: where it is lower, they are speckle of a side at the threshold, which
-    made the centre line wobble where leaving the side out altogether measured the body right.
+    ``faint`` (:func:`faint_differences`) adds the pixels over ``faint_gain`` in it within
+    :data:`FAINT_REACH` times the reach of a clear pixel, each connected region of them where
+    its median is at least :data:`FAINT_CLEAR`: where it is lower, they are speckle of a side at
+    the threshold (which made the centre line wobble where leaving the side out altogether
+    measured the body right), or light bounced onto the backdrop.
 
     Examples
     --------
@@ -727,13 +764,11 @@ def _hysteresis(
     near = cv2.dilate(strong, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2))
     above = (diff > low) & (near > 0)
     if faint is not None:
-        far = cv2.dilate(
-            strong,
-            cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * FAINT_REACH * reach + 1,) * 2),
-        )
-        added = (faint > 1.0) & (far > 0) & ~above
-        if added.any() and float(np.median(faint[added])) >= FAINT_CLEAR:
-            above |= added
+        # as far from a clear pixel as FAINT_REACH reaches (a distance: a dilation that wide
+        # doubled the selection's time at 2000 px)
+        far = cv2.distanceTransform(1 - strong, cv2.DIST_L2, 3) <= FAINT_REACH * reach
+        added = (faint > faint_gain) & far & ~above
+        above |= added & clear_regions(added, faint)
     weak = above.astype(np.uint8)
     n, labels = cv2.connectedComponents(weak, connectivity=8)
     seeded = np.zeros(n, bool)
@@ -757,12 +792,19 @@ class BodySelection:
         The width (work px) of a long region the selection outlines, larger than its walls, whose
         inside does not differ from the background (:func:`fill_outlined`; 0 for none): a clear
         body seen by its rims only, when far wider than what is measured.
+    faint_taken : bool
+        A faint side was taken into the selection (:func:`faint_differences`).
+    faint_marginal : float
+        The share of what it took in that lies within :data:`FAINT_MARGINAL` times its
+        threshold: at the edge of being selected.
     """
 
     mask: np.ndarray
     strength: np.ndarray
     contrast: float
     hollow_width_px: float = 0.0
+    faint_taken: bool = False
+    faint_marginal: float = 0.0
 
 
 def body_mask(
@@ -771,6 +813,7 @@ def body_mask(
     *,
     scale: float = 1.0,
     background_bgr: np.ndarray | None = None,
+    faint_gain: float = 1.0,
 ) -> BodySelection:
     """The pixels of the actuator body (before choosing one component).
 
@@ -784,6 +827,9 @@ def body_mask(
         Original px per px of ``image_bgr``.
     background_bgr : ndarray, optional
         The empty-scene photo at the same size.
+    faint_gain : float
+        A faint side is taken in from this many times its threshold (the check of a faint
+        side's reading raises it: :func:`pipeline.measure.core.faint_side_steady`).
 
     Returns
     -------
@@ -794,7 +840,7 @@ def body_mask(
     allowed = np.ones((h, w), np.uint8) if region is None else region
     strength: np.ndarray = np.zeros((h, w), np.float32)
     contrast = float("inf")
-    hollow = 0.0
+    hollow, marginal, taken_any = 0.0, 0.0, False
     if not allowed.any():  # roi / exclude leave nothing to look at (the backdrop model crashed)
         return BodySelection(allowed.copy(), strength, contrast)
     mask = allowed.copy()
@@ -838,13 +884,25 @@ def body_mask(
             lit = _hysteresis(np.where(shade, 0.0, diff), thr, low)
             if lit.sum() >= keep * differs.sum():
                 differs, unlit = lit, shade
-        if unlit is not None and background_bgr is not None and not settings.background_estimated:
-            # against an empty scene photographed, the shadows told apart: a faint side counts
-            # too (where the body is not told from its shadow, a faint margin is its shadow's, and
-            # customer 55's strong shadow gave more rows ok 5-14 deg off; against the empty scene
-            # estimated from a ramp, 8 of a bench set's 42 second looks were lost)
-            faint = np.where(unlit, 0.0, faint_differences(diff))
-            differs = _hysteresis(np.where(unlit, 0.0, diff), thr, low, faint)
+        if (unlit is not None or shade is None) and not settings.background_estimated:
+            # a faint side counts too, where the shadows are told apart or none is looked for
+            # (a neutral body without an empty scene): where the body is not told from its
+            # shadow, a faint margin is its shadow's (customer 55's strong shadow gave more rows
+            # ok 5-14 deg off); against the empty scene estimated from a ramp, 8 of a bench set's
+            # 42 second looks were lost
+            out = np.zeros(diff.shape, bool) if unlit is None else unlit
+            faint = np.where(out, 0.0, faint_differences(diff))
+            if background_bgr is None:
+                # against the backdrop's colour, only where lighter than it: a neutral body's
+                # shadow is not told apart there (taken in, 4 of customer 55's ramps without
+                # their empty scene had rows ok 5-18 deg off)
+                faint = np.where(_lab(seen)[:, :, 0] > backdrop[0][:, :, 0], faint, 0.0)
+            plain = differs
+            differs = _hysteresis(np.where(out, 0.0, diff), thr, low, faint, faint_gain)
+            taken = (differs > 0) & (plain == 0)
+            taken_any = bool(taken.any())
+            if taken_any:
+                marginal = float(np.mean(faint[taken] <= FAINT_MARGINAL * faint_gain))
         if background_bgr is None or not settings.background_estimated:
             differs, hollow = fill_outlined(differs, diff, allowed, OUTLINE_FILL_SIGMAS * sigma)
         mask &= differs
@@ -856,7 +914,7 @@ def body_mask(
             strength[unlit & (mask == 0)] = 0.0
         sel = diff[mask > 0]
         contrast = float(np.median(sel) / sigma) if sel.size else 0.0
-    return BodySelection(mask, strength, contrast, hollow)
+    return BodySelection(mask, strength, contrast, hollow, taken_any, marginal)
 
 
 def _texture_disc(shape: tuple[int, ...]) -> np.ndarray:
@@ -2593,6 +2651,7 @@ def extract_body(
     *,
     scale: float = 1.0,
     background_bgr: np.ndarray | None = None,
+    faint_gain: float = 1.0,
 ) -> BodyExtraction:
     """Segment the actuator body and return its centre line (see the module docstring).
 
@@ -2606,6 +2665,8 @@ def extract_body(
         Original px per px of ``image_bgr``.
     background_bgr : ndarray, optional
         Empty-scene photo at the size of ``image_bgr``.
+    faint_gain : float
+        See :func:`body_mask`.
 
     Returns
     -------
@@ -2619,7 +2680,9 @@ def extract_body(
     if image_bgr is None or image_bgr.ndim != 3:
         raise NoLineFound("unreadable image (not a colour image)")
     h, w = image_bgr.shape[:2]
-    selection = body_mask(image_bgr, settings, scale=scale, background_bgr=background_bgr)
+    selection = body_mask(
+        image_bgr, settings, scale=scale, background_bgr=background_bgr, faint_gain=faint_gain
+    )
     raw = selection.mask
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
     allowed_px = float(h * w if region is None else region.sum())
@@ -2791,6 +2854,8 @@ def extract_body(
         line=line, mask=comp, widths_px=widths * scale, selected_fraction=selected,
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         excluded_start_px=excluded_start * scale,
+        faint_taken=selection.faint_taken,
+        faint_marginal=selection.faint_marginal,
         faint_share=float(np.mean(selection.strength[comp > 0] < 1.0))
         if np.isfinite(selection.contrast) and comp.any()
         else 0.0,
