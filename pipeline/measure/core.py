@@ -847,8 +847,8 @@ def faint_side_steady(
     threshold: :attr:`pipeline.measure.body.BodySelection.faint_marginal`) where it is ``ok``
     and psi moves at most :data:`FAINT_STEADY_DEG` when measured again with that threshold
     :data:`FAINT_STEADY_GAIN` times higher (or too little lies near it to move); else the
-    reading with the faint side left out, where that is ``ok`` (what was read before faint
-    sides were taken in).
+    reading with the faint side left out (what was read before faint sides were taken in),
+    unless that fails where ``res`` was read.
 
     Where a faint side fades along the body it is taken in where it is a little brighter only,
     and the tip's direction depends on where that is; psi is the same on any curve along the
@@ -863,7 +863,7 @@ def faint_side_steady(
         if again.status != "failed" and abs(again.psi_deg - res.psi_deg) <= FAINT_STEADY_DEG:
             return res
     plain = measure_body(image_bgr, settings, scale=scale, method=method, faint_gain=np.inf)
-    return plain if plain.status == "ok" or res.status == "ok" else res
+    return res if plain.status == "failed" and res.status != "ok" else plain
 
 
 #: a flat end face's normal is taken for the tip's direction when it turns the centre line's
