@@ -56,10 +56,13 @@ GROW_FRACTION = 0.012
 FAINT_MEDIAN_PX, FAINT_SIGMAS, FAINT_DIFFERENCE, FAINT_REACH, FAINT_CLEAR = 5, 6.0, 3.0, 3, 1.5
 #: ... each connected region of it on its own (the review of stop 61: light bounced onto the
 #: backdrop beside the lit side, alone under FAINT_CLEAR, came in on a faint half's median and
-#: gave rows ok 5.6-10.5 deg off); a share of what it adds this close to the threshold
-#: (FAINT_MARGINAL times it or less) is at the edge of the selection (:attr:`BodySelection.
-#: faint_marginal`)
-FAINT_MARGINAL = 1.25
+#: gave rows ok 5.6-10.5 deg off); and not at all where FAINT_MARGINAL_SHARE or more of what it
+#: adds lies within FAINT_MARGINAL times the threshold: a side at the edge of being selected (the
+#: review's shaded side fading from 14 to 6 grey levels along the body, taken in part at the tip,
+#: read rows 5-18 deg off, ok; a bench set's translucent body without its empty scene, 8-9 deg
+#: off on a tip's speckled rim; 0.05-0.87 of theirs lay there, 0.00-0.01 of customer 55's and
+#: 56's faint halves)
+FAINT_MARGINAL, FAINT_MARGINAL_SHARE = 1.25, 0.03
 #: lightness counts this much in the colour distance (shadows change lightness most)
 LIGHTNESS_WEIGHT = 0.6
 #: holes larger than this fraction of the body's area stay open (the inside of a ring)
@@ -151,8 +154,8 @@ class BodyExtraction:
     excluded_start_px : float
         How much of the stretch the centre line is carried back over to the given fixed end
         lies under ``exclude`` or outside ``roi`` (original px): a bend there is not seen.
-    faint_taken, faint_marginal : bool, float
-        :attr:`BodySelection.faint_taken`, :attr:`BodySelection.faint_marginal`.
+    faint_taken : bool
+        :attr:`BodySelection.faint_taken`.
     faint_share : float
         The share of the body's pixels that differ from the background by less than the clear
         threshold (0 for a colour-only selection): a translucent body's.
@@ -183,7 +186,6 @@ class BodyExtraction:
     excluded_start_px: float = 0.0
     faint_share: float = 0.0
     faint_taken: bool = False
-    faint_marginal: float = 0.0
 
 
 def _lab(image_bgr: np.ndarray) -> np.ndarray:
@@ -735,12 +737,11 @@ def clear_regions(added: np.ndarray, faint: np.ndarray) -> np.ndarray:
 
 
 def _hysteresis(
-    diff: np.ndarray, high: float, low: float, faint: np.ndarray | None = None,
-    faint_gain: float = 1.0,
+    diff: np.ndarray, high: float, low: float, faint: np.ndarray | None = None
 ) -> np.ndarray:
     """0/1 mask of the pixels above ``low`` connected to a pixel above ``high`` (as Canny's edges).
 
-    ``faint`` (:func:`faint_differences`) adds the pixels over ``faint_gain`` in it within
+    ``faint`` (:func:`faint_differences`) adds the pixels over 1 in it within
     :data:`FAINT_REACH` times the reach of a clear pixel, each connected region of them where
     its median is at least :data:`FAINT_CLEAR`: where it is lower, they are speckle of a side at
     the threshold (which made the centre line wobble where leaving the side out altogether
@@ -767,7 +768,7 @@ def _hysteresis(
         # as far from a clear pixel as FAINT_REACH reaches (a distance: a dilation that wide
         # doubled the selection's time at 2000 px)
         far = cv2.distanceTransform(1 - strong, cv2.DIST_L2, 3) <= FAINT_REACH * reach
-        added = (faint > faint_gain) & far & ~above
+        added = (faint > 1.0) & far & ~above
         above |= added & clear_regions(added, faint)
     weak = above.astype(np.uint8)
     n, labels = cv2.connectedComponents(weak, connectivity=8)
@@ -794,9 +795,6 @@ class BodySelection:
         body seen by its rims only, when far wider than what is measured.
     faint_taken : bool
         A faint side was taken into the selection (:func:`faint_differences`).
-    faint_marginal : float
-        The share of what it took in that lies within :data:`FAINT_MARGINAL` times its
-        threshold: at the edge of being selected.
     """
 
     mask: np.ndarray
@@ -804,7 +802,6 @@ class BodySelection:
     contrast: float
     hollow_width_px: float = 0.0
     faint_taken: bool = False
-    faint_marginal: float = 0.0
 
 
 def body_mask(
@@ -813,7 +810,7 @@ def body_mask(
     *,
     scale: float = 1.0,
     background_bgr: np.ndarray | None = None,
-    faint_gain: float = 1.0,
+    faint_sides: bool = True,
 ) -> BodySelection:
     """The pixels of the actuator body (before choosing one component).
 
@@ -827,9 +824,9 @@ def body_mask(
         Original px per px of ``image_bgr``.
     background_bgr : ndarray, optional
         The empty-scene photo at the same size.
-    faint_gain : float
-        A faint side is taken in from this many times its threshold (the check of a faint
-        side's reading raises it: :func:`pipeline.measure.core.faint_side_steady`).
+    faint_sides : bool
+        Take a faint side in (:func:`faint_differences`); False: what was selected before faint
+        sides were (a reading with one that is not ``ok`` is read again so).
 
     Returns
     -------
@@ -840,7 +837,7 @@ def body_mask(
     allowed = np.ones((h, w), np.uint8) if region is None else region
     strength: np.ndarray = np.zeros((h, w), np.float32)
     contrast = float("inf")
-    hollow, marginal, taken_any = 0.0, 0.0, False
+    hollow, taken_any = 0.0, False
     if not allowed.any():  # roi / exclude leave nothing to look at (the backdrop model crashed)
         return BodySelection(allowed.copy(), strength, contrast)
     mask = allowed.copy()
@@ -884,7 +881,11 @@ def body_mask(
             lit = _hysteresis(np.where(shade, 0.0, diff), thr, low)
             if lit.sum() >= keep * differs.sum():
                 differs, unlit = lit, shade
-        if (unlit is not None or shade is None) and not settings.background_estimated:
+        if (
+            faint_sides
+            and (unlit is not None or shade is None)
+            and not settings.background_estimated
+        ):
             # a faint side counts too, where the shadows are told apart or none is looked for
             # (a neutral body without an empty scene): where the body is not told from its
             # shadow, a faint margin is its shadow's (customer 55's strong shadow gave more rows
@@ -897,12 +898,10 @@ def body_mask(
                 # shadow is not told apart there (taken in, 4 of customer 55's ramps without
                 # their empty scene had rows ok 5-18 deg off)
                 faint = np.where(_lab(seen)[:, :, 0] > backdrop[0][:, :, 0], faint, 0.0)
-            plain = differs
-            differs = _hysteresis(np.where(out, 0.0, diff), thr, low, faint, faint_gain)
-            taken = (differs > 0) & (plain == 0)
-            taken_any = bool(taken.any())
-            if taken_any:
-                marginal = float(np.mean(faint[taken] <= FAINT_MARGINAL * faint_gain))
+            taking = _hysteresis(np.where(out, 0.0, diff), thr, low, faint)
+            taken = (taking > 0) & (differs == 0)
+            if taken.any() and np.mean(faint[taken] <= FAINT_MARGINAL) < FAINT_MARGINAL_SHARE:
+                differs, taken_any = taking, True
         if background_bgr is None or not settings.background_estimated:
             differs, hollow = fill_outlined(differs, diff, allowed, OUTLINE_FILL_SIGMAS * sigma)
         mask &= differs
@@ -914,7 +913,7 @@ def body_mask(
             strength[unlit & (mask == 0)] = 0.0
         sel = diff[mask > 0]
         contrast = float(np.median(sel) / sigma) if sel.size else 0.0
-    return BodySelection(mask, strength, contrast, hollow, taken_any, marginal)
+    return BodySelection(mask, strength, contrast, hollow, taken_any)
 
 
 def _texture_disc(shape: tuple[int, ...]) -> np.ndarray:
@@ -2651,7 +2650,7 @@ def extract_body(
     *,
     scale: float = 1.0,
     background_bgr: np.ndarray | None = None,
-    faint_gain: float = 1.0,
+    faint_sides: bool = True,
 ) -> BodyExtraction:
     """Segment the actuator body and return its centre line (see the module docstring).
 
@@ -2665,7 +2664,7 @@ def extract_body(
         Original px per px of ``image_bgr``.
     background_bgr : ndarray, optional
         Empty-scene photo at the size of ``image_bgr``.
-    faint_gain : float
+    faint_sides : bool
         See :func:`body_mask`.
 
     Returns
@@ -2681,7 +2680,7 @@ def extract_body(
         raise NoLineFound("unreadable image (not a colour image)")
     h, w = image_bgr.shape[:2]
     selection = body_mask(
-        image_bgr, settings, scale=scale, background_bgr=background_bgr, faint_gain=faint_gain
+        image_bgr, settings, scale=scale, background_bgr=background_bgr, faint_sides=faint_sides
     )
     raw = selection.mask
     region = region_mask(image_bgr.shape, settings.roi, settings.exclude, scale)
@@ -2855,7 +2854,6 @@ def extract_body(
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         excluded_start_px=excluded_start * scale,
         faint_taken=selection.faint_taken,
-        faint_marginal=selection.faint_marginal,
         faint_share=float(np.mean(selection.strength[comp > 0] < 1.0))
         if np.isfinite(selection.contrast) and comp.any()
         else 0.0,

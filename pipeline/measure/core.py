@@ -559,15 +559,16 @@ def measure_body(
     *,
     scale: float,
     method: str = DEFAULT_METHOD,
-    faint_gain: float = 1.0,
+    faint_sides: bool = True,
 ) -> AngleResult:
     """psi of the actuator's body (``target: body``): its centre line's total turning.
 
     ``auto`` is :func:`~pipeline.measure.estimators.tangents` here (the tip angle: a body is
     rarely an arc); any other method may be asked for.  A known ``fixed_direction_deg`` replaces
-    the measured base tangent.  ``faint_gain``: see :func:`pipeline.measure.body.body_mask`; at
-    1 a reading that took in a faint side near its threshold is checked
-    (:func:`faint_side_steady`).
+    the measured base tangent.  ``faint_sides``: see :func:`pipeline.measure.body.body_mask`; a
+    reading that took a faint side in and is not ``ok`` gives way to the one without it, unless
+    that fails (what was read before faint sides were taken in: a small patch of a faint side
+    taken in at the tip alone made a hook, and customer 56 lost 2 rows right before).
     """
     from pipeline.measure.body import base_side_split_deg, extract_body
 
@@ -579,7 +580,7 @@ def measure_body(
         background = loaded
     try:
         body = extract_body(
-            image_bgr, settings, scale=scale, background_bgr=background, faint_gain=faint_gain
+            image_bgr, settings, scale=scale, background_bgr=background, faint_sides=faint_sides
         )
     except NoLineFound as exc:
         return failed(method, str(exc))
@@ -818,52 +819,10 @@ def measure_body(
         measured = replace(
             measured, base_direction_deg=own_base_deg if seen else float("nan"), tip_px=tip_px
         )
-    if faint_gain != 1.0 or not body.faint_taken:
+    if measured.status == "ok" or not body.faint_taken:
         return measured
-    return faint_side_steady(
-        image_bgr, settings, measured, body.faint_marginal, scale=scale, method=method
-    )
-
-
-#: an ok reading that took in a faint side this share of which lay near its threshold is
-#: measured again with that threshold FAINT_STEADY_GAIN times higher; where psi moves more than
-#: FAINT_STEADY_DEG, or the reading is not ok, the faint side is left out: the review of stop
-#: 61's shaded side fading from 14 to 6 grey levels along the body was taken in near the clamp
-#: and in part at the tip, and rows read 5-18 deg off, ok (left out, the lit half read them
-#: within 2 deg)
-FAINT_MARGINAL_SHARE, FAINT_STEADY_GAIN, FAINT_STEADY_DEG = 0.03, 1.25, 2.0
-
-
-def faint_side_steady(
-    image_bgr: np.ndarray,
-    settings: MeasureSettings,
-    res: AngleResult,
-    marginal: float,
-    *,
-    scale: float,
-    method: str = DEFAULT_METHOD,
-) -> AngleResult:
-    """``res`` (a body whose selection took in a faint side, ``marginal`` of it near its
-    threshold: :attr:`pipeline.measure.body.BodySelection.faint_marginal`) where it is ``ok``
-    and psi moves at most :data:`FAINT_STEADY_DEG` when measured again with that threshold
-    :data:`FAINT_STEADY_GAIN` times higher (or too little lies near it to move); else the
-    reading with the faint side left out (what was read before faint sides were taken in),
-    unless that fails where ``res`` was read.
-
-    Where a faint side fades along the body it is taken in where it is a little brighter only,
-    and the tip's direction depends on where that is; psi is the same on any curve along the
-    body, so its lit part alone reads it.
-    """
-    if res.status == "ok":
-        if marginal < FAINT_MARGINAL_SHARE:
-            return res
-        again = measure_body(
-            image_bgr, settings, scale=scale, method=method, faint_gain=FAINT_STEADY_GAIN
-        )
-        if again.status != "failed" and abs(again.psi_deg - res.psi_deg) <= FAINT_STEADY_DEG:
-            return res
-    plain = measure_body(image_bgr, settings, scale=scale, method=method, faint_gain=np.inf)
-    return res if plain.status == "failed" and res.status != "ok" else plain
+    plain = measure_body(image_bgr, settings, scale=scale, method=method, faint_sides=False)
+    return measured if plain.status == "failed" else plain
 
 
 #: a flat end face's normal is taken for the tip's direction when it turns the centre line's
