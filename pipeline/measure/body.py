@@ -804,6 +804,14 @@ class BodySelection:
     faint_taken: bool = False
 
 
+def faint_share(selection: BodySelection, comp: np.ndarray) -> float:
+    """The share of the body ``comp`` (0/1) that differs from the background by less than the
+    clear threshold (:attr:`BodyExtraction.faint_share`; 0 for a colour-only selection)."""
+    if not np.isfinite(selection.contrast) or not comp.any():
+        return 0.0
+    return float(np.mean(selection.strength[comp > 0] < 1.0))
+
+
 def body_mask(
     image_bgr: np.ndarray,
     settings: MeasureSettings,
@@ -2745,8 +2753,7 @@ def extract_body(
         half = float(np.median(dt[yi, xi])) if len(path) else 0.0
     length = float(np.sum(np.hypot(*np.diff(path, axis=0).T))) if len(path) > 1 else 0.0
     if length < max(4.0 * half, 10.0):
-        faint = np.isfinite(selection.contrast) and float(
-            np.mean(selection.strength[comp > 0] < 1.0)) >= FAINT_BODY_SHARE
+        faint = faint_share(selection, comp) >= FAINT_BODY_SHARE
         raise NoLineFound(
             f"no body found: the selection ({what}) is a blob, not an elongated actuator "
             f"({length:.0f} px long, {2 * half:.0f} px wide)"
@@ -2854,9 +2861,7 @@ def extract_body(
         continues=_continues(mask & (1 - comp), pts, half), start_gap_px=gap * scale,
         excluded_start_px=excluded_start * scale,
         faint_taken=selection.faint_taken,
-        faint_share=float(np.mean(selection.strength[comp > 0] < 1.0))
-        if np.isfinite(selection.contrast) and comp.any()
-        else 0.0,
+        faint_share=faint_share(selection, comp),
         end_short_px=_uncovered(ridge, pts[-1]) * scale, ridge_tip_deg=ridge_tip_deg,
         free_end_width_ratio=end_med[1] / max(body_width, 1e-6), side_on_border=side_on_border,
         tip_at_region_edge=tip_at_region_edge,
